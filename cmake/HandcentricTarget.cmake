@@ -1,0 +1,37 @@
+# handcentric_library(<module> SOURCES ... DEPS ...)
+# One CMake library per folder, aliased and exported as handcentric::<module>.
+# Warnings are errors on project code only (PRIVATE), never pushed onto downstream users.
+function(handcentric_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Werror)
+endfunction()
+
+function(handcentric_library module)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  set(target handcentric_${module})
+  add_library(${target} ${ARG_SOURCES})
+  add_library(handcentric::${module} ALIAS ${target})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${module} OUTPUT_NAME handcentric_${module})
+  target_include_directories(${target} PUBLIC
+    $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
+    $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  target_link_libraries(${target} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  handcentric_warnings(${target})
+  install(TARGETS ${target} EXPORT handcentricTargets
+          ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endfunction()
+
+# handcentric_test(<name> SOURCES ... DEPS ... LABELS ...): one Catch2 executable per folder.
+# Every TEST_CASE carries exactly one tag among LABELS ([unit], [property], [proofs],
+# [experiment]); each tag becomes the ctest label of its cases, so `ctest -L property` works.
+function(handcentric_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} Catch2::Catch2 rapidcheck_catch)
+  handcentric_warnings(${name})
+  foreach(label IN LISTS ARG_LABELS)
+    catch_discover_tests(${name} TEST_SPEC "[${label}]" PROPERTIES LABELS ${label})
+  endforeach()
+endfunction()

@@ -1,0 +1,39 @@
+#pragma once
+// Typed errors thrown at every boundary that takes outside data. Each message names the
+// offending value and says how to fix it; `handcentric` prints it on one line and exits 1.
+#include <stdexcept>
+#include <string>
+
+namespace handcentric {
+
+/// Base of every error handcentric throws on bad input.
+class Error : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A matrix or quaternion that is not a rotation: non-finite, not orthonormal, det = -1, zero.
+class InvalidRotation : public Error {
+ public:
+  using Error::Error;
+};
+
+/// A rigid transform with a non-finite translation or a bad homogeneous row.
+class InvalidTransform : public Error {
+ public:
+  using Error::Error;
+};
+
+/// A scene that a representation cannot read: empty history or chunk, non-finite points.
+class InvalidScene : public Error {
+ public:
+  using Error::Error;
+};
+
+/// Any other bad argument: a wrong vector length, an unknown name, an out-of-range number.
+class InvalidArgument : public Error {
+ public:
+  using Error::Error;
+};
+
+}  // namespace handcentric

@@ -1,0 +1,15 @@
+#pragma once
+// Compact, round-trippable text for numbers, vectors and matrices, used in error messages and
+// witnesses (17 significant digits, so a printed value reproduces the double exactly).
+#include <Eigen/Core>
+#include <string>
+
+namespace handcentric {
+
+/// A double with 17 significant digits ("nan", "inf" spelled out).
+std::string format_number(double value);
+
+/// A matrix as [[a, b, c], [d, e, f], ...]; a column vector as [a, b, c].
+std::string format_matrix(const Eigen::Ref<const Eigen::MatrixXd>& matrix);
+
+}  // namespace handcentric

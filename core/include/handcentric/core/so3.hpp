@@ -1,0 +1,31 @@
+#pragma once
+// SO(3) exponential and logarithm on raw 3x3 matrices (the unchecked math behind Rotation).
+//
+// The rotation vector of Sec. 2.1 / App. A.3 is r(R) = phi v with angle phi in [0, pi] and unit
+// axis v. log() is accurate over the whole range:
+//   - near phi = 0 it uses the series phi / sin(phi) = 1 + phi^2/6 + 7 phi^4/360;
+//   - near phi = pi it takes no acos and divides by no sin(phi): the axis comes from the column
+//     of the symmetric part (R + R^T)/2 - cos(phi) I = (1 - cos(phi)) v v^T with the largest
+//     diagonal, and its sign from the skew part (R - R^T)/2 = sin(phi) [v]x;
+//   - the angle is always atan2(sin(phi), cos(phi)), never acos.
+//
+// Canonical sign at exactly pi: r and -r are the same rotation there. When the skew part is
+// exactly zero (so it carries no sign), log() returns the axis whose largest-magnitude component
+// is positive (the first such component when two tie). Tested in tests/core.
+#include <Eigen/Core>
+
+namespace handcentric::so3 {
+
+/// [w]x, the skew matrix with [w]x u = w x u.
+Eigen::Matrix3d hat(const Eigen::Vector3d& w);
+
+/// exp([r]x) by Rodrigues' formula, series below an angle of 1e-4. No validation: r must be finite.
+Eigen::Matrix3d exp(const Eigen::Vector3d& rotation_vector);
+
+/// The rotation vector r(R), angle in [0, pi]. No validation: R must be a rotation matrix.
+Eigen::Vector3d log(const Eigen::Matrix3d& R);
+
+/// The rotation angle of R in [0, pi], via atan2. No validation.
+double angle(const Eigen::Matrix3d& R);
+
+}  // namespace handcentric::so3

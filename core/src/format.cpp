@@ -1,0 +1,41 @@
+#include "handcentric/core/format.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+namespace handcentric {
+
+std::string format_number(double value) {
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.17g", value);
+  return buffer;
+}
+
+std::string format_matrix(const Eigen::Ref<const Eigen::MatrixXd>& matrix) {
+  auto row_text = [&](Eigen::Index r) {
+    std::string text = "[";
+    for (Eigen::Index c = 0; c < matrix.cols(); ++c) {
+      if (c > 0) text += ", ";
+      text += format_number(matrix(r, c));
+    }
+    return text + "]";
+  };
+  if (matrix.cols() == 1) {  // a column vector prints as one flat list
+    std::string text = "[";
+    for (Eigen::Index r = 0; r < matrix.rows(); ++r) {
+      if (r > 0) text += ", ";
+      text += format_number(matrix(r, 0));
+    }
+    return text + "]";
+  }
+  std::string text = "[";
+  for (Eigen::Index r = 0; r < matrix.rows(); ++r) {
+    if (r > 0) text += ", ";
+    text += row_text(r);
+  }
+  return text + "]";
+}
+
+}  // namespace handcentric

@@ -1,0 +1,94 @@
+#include "handcentric/core/so3.hpp"
+
+#include <cmath>
+
+namespace handcentric::so3 {
+namespace {
+
+// Below this angle exp() uses Taylor series: the first omitted term is phi^6 ~ 1e-24, far
+// below double rounding, while the closed forms lose digits to cancellation in 1 - cos(phi).
+constexpr double kExpSeriesAngle = 1e-4;
+// Below this |sin(phi)| log() uses the series of phi / sin(phi).
+constexpr double kLogSeriesSine = 1e-4;
+// cos(phi) below this (phi > ~2.5 rad) switches log() to the symmetric-part axis: there
+// sin(phi) < 0.6 and dividing the skew part by it would amplify its rounding error.
+constexpr double kNearPiCosine = -0.8;
+
+// The skew part of R: (R - R^T)/2 = sin(phi) [v]x, returned as sin(phi) v.
+Eigen::Vector3d skew_vector(const Eigen::Matrix3d& R) {
+  return 0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
+}
+
+}  // namespace
+
+Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
+  Eigen::Matrix3d W;
+  W << 0.0, -w.z(), w.y(),  //
+      w.z(), 0.0, -w.x(),   //
+      -w.y(), w.x(), 0.0;
+  return W;
+}
+
+Eigen::Matrix3d exp(const Eigen::Vector3d& r) {
+  const double phi2 = r.squaredNorm();
+  const double phi = std::sqrt(phi2);
+  double a;  // sin(phi) / phi
+  double b;  // (1 - cos(phi)) / phi^2
+  if (phi < kExpSeriesAngle) {
+    a = 1.0 - phi2 / 6.0 * (1.0 - phi2 / 20.0);
+    b = 0.5 - phi2 / 24.0 * (1.0 - phi2 / 30.0);
+  } else {
+    a = std::sin(phi) / phi;
+    const double half_sin = std::sin(0.5 * phi) / phi;  // 1 - cos = 2 sin^2(phi/2): no cancellation
+    b = 2.0 * half_sin * half_sin;
+  }
+  // R = I + a [r]x + b [r]x^2, with [r]x^2 = r r^T - phi^2 I, written out.
+  Eigen::Matrix3d R;
+  const double x = r.x(), y = r.y(), z = r.z();
+  const double bxy = b * x * y, bxz = b * x * z, byz = b * y * z;
+  R(0, 0) = 1.0 - b * (y * y + z * z);
+  R(1, 1) = 1.0 - b * (x * x + z * z);
+  R(2, 2) = 1.0 - b * (x * x + y * y);
+  R(0, 1) = bxy - a * z;
+  R(1, 0) = bxy + a * z;
+  R(0, 2) = bxz + a * y;
+  R(2, 0) = bxz - a * y;
+  R(1, 2) = byz - a * x;
+  R(2, 1) = byz + a * x;
+  return R;
+}
+
+double angle(const Eigen::Matrix3d& R) {
+  const double cosine = 0.5 * (R.trace() - 1.0);
+  return std::atan2(skew_vector(R).norm(), cosine);
+}
+
+Eigen::Vector3d log(const Eigen::Matrix3d& R) {
+  const Eigen::Vector3d sin_axis = skew_vector(R);  // sin(phi) v
+  const double sine = sin_axis.norm();
+  const double cosine = 0.5 * (R.trace() - 1.0);
+  const double phi = std::atan2(sine, cosine);
+
+  if (cosine > kNearPiCosine) {
+    // r = phi / sin(phi) * sin(phi) v; series where sin(phi) ~ phi is tiny.
+    const double scale = sine < kLogSeriesSine ? 1.0 + phi * phi / 6.0 * (1.0 + 7.0 / 60.0 * phi * phi)
+                                               : phi / sine;
+    return scale * sin_axis;
+  }
+
+  // Near pi: (R + R^T)/2 - cos(phi) I = (1 - cos(phi)) v v^T. Take the column with the largest
+  // diagonal entry (the largest |v_i|), so the division below is by at least 1/sqrt(3).
+  const double one_minus_cos = 1.0 - cosine;  // in [1.8, 2]: no cancellation
+  Eigen::Matrix3d B = 0.5 * (R + R.transpose());
+  B.diagonal().array() -= cosine;
+  Eigen::Index i = 0;
+  B.diagonal().maxCoeff(&i);
+  Eigen::Vector3d axis = B.col(i) / std::sqrt(B(i, i) * one_minus_cos);  // v, with v_i > 0
+  axis.normalize();
+  // The skew part carries the sign; when it is exactly zero (phi = pi) the v_i > 0 choice above
+  // is the documented canonical sign: the largest-magnitude component is positive.
+  if (axis.dot(sin_axis) < 0.0) axis = -axis;
+  return phi * axis;
+}
+
+}  // namespace handcentric::so3

@@ -1,0 +1,48 @@
+#pragma once
+// RapidCheck generators for rotations, rigid transforms and scenes.
+//
+// Rotations are Haar-uniform (Shoemake's method from three uniform numbers), mixed with the
+// edge cases where SO(3) code breaks: the identity, angles of 1e-12, angles within 1e-9 of pi
+// and exactly pi. Every generator shrinks toward simpler values (smaller numbers, fewer poses).
+#include <rapidcheck.h>
+
+#include "handcentric/core/rigid_transform.hpp"
+#include "handcentric/core/rotation.hpp"
+#include "handcentric/core/scene.hpp"
+#include "handcentric/props/group.hpp"
+
+namespace handcentric::props {
+
+/// A Haar-uniform rotation (no edge cases).
+rc::Gen<Rotation> haar_rotation();
+
+/// Haar-uniform rotations mixed with edge cases (identity, 1e-12, pi - 1e-9, pi): 1 in 5 is an edge case.
+rc::Gen<Rotation> rotation();
+
+/// A rotation whose angle is within 1e-10 of pi (about a Haar-random axis).
+rc::Gen<Rotation> rotation_near_pi();
+
+/// A rotation whose angle is at most 1e-10.
+rc::Gen<Rotation> rotation_near_identity();
+
+/// A translation with each coordinate in [-max_abs, max_abs].
+rc::Gen<Eigen::Vector3d> translation(double max_abs);
+
+/// An element of `group`, including that group's edge cases (identity, tiny angles, angles near
+/// pi where the group has them, translations of 1e3 where it has translations). Translations
+/// are otherwise up to 10 (m) per coordinate.
+rc::Gen<RigidTransform> group_element(Group group);
+
+/// Scene sizes.
+struct SceneShape {
+  int min_history = 0, max_history = 4;  ///< H
+  int min_chunk = 1, max_chunk = 32;     ///< K
+  int max_world_points = 3;
+  int max_hand_points = 3;
+};
+
+/// A scene: a random start pose, a smooth but rotating chunk (constant twist per step with a
+/// random twist), a history the same way backwards, eye-in-hand and world points.
+rc::Gen<Scene> scene(SceneShape shape = {});
+
+}  // namespace handcentric::props

@@ -1,0 +1,25 @@
+#pragma once
+// The transform families a representation is checked against (DESIGN.md "Group").
+//
+//   translation : p~ in R^3, R~ = I
+//   rotation    : R~ in SO(3) about the world origin, p~ = 0
+//   se2         : rotation about world z plus an x-y translation (planar SE(2))
+//   se3         : any rigid transform
+//   c8          : the 8 rotations about world z by multiples of 45 deg, through the origin
+#include <string>
+#include <vector>
+
+namespace handcentric::props {
+
+enum class Group { translation, rotation, se2, se3, c8 };
+
+/// All five, in the order above.
+const std::vector<Group>& all_groups();
+
+/// "translation", "rotation", "se2", "se3", "c8".
+std::string to_string(Group group);
+
+/// Parses a group name; throws handcentric::InvalidArgument naming the value and the valid names.
+Group parse_group(const std::string& name);
+
+}  // namespace handcentric::props

@@ -1,0 +1,167 @@
+#include "handcentric/props/generators.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "handcentric/core/sampling.hpp"
+
+namespace handcentric::props {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr int kResolution = 1 << 30;  // uniform numbers are k / 2^30, k an integer (shrinks to 0)
+
+// A uniform number in [0, 1).
+rc::Gen<double> unit_interval() {
+  return rc::gen::map(rc::gen::inRange(0, kResolution),
+                      [](int k) { return static_cast<double>(k) / kResolution; });
+}
+
+// A uniform number in [-max_abs, max_abs].
+rc::Gen<double> symmetric(double max_abs) {
+  return rc::gen::map(rc::gen::inRange(-kResolution, kResolution + 1), [max_abs](int k) {
+    return max_abs * static_cast<double>(k) / kResolution;
+  });
+}
+
+// A Haar-uniform unit axis (the axis of a Haar rotation is uniform on the sphere).
+rc::Gen<Eigen::Vector3d> unit_axis() {
+  return rc::gen::map(rc::gen::tuple(unit_interval(), unit_interval()), [](const auto& uv) {
+    return sphere_point(std::get<0>(uv), std::get<1>(uv));
+  });
+}
+
+// A rotation by `angle` (drawn by angle_gen) about a uniform axis.
+rc::Gen<Rotation> axis_angle(rc::Gen<double> angle_gen) {
+  return rc::gen::map(rc::gen::tuple(unit_axis(), angle_gen), [](const auto& axis_angle) {
+    return Rotation::exp(std::get<1>(axis_angle) * std::get<0>(axis_angle));
+  });
+}
+
+rc::Gen<Rotation> rotation_about_z() {
+  return rc::gen::map(symmetric(kPi), [](double angle) { return Rotation::about_z(angle); });
+}
+
+rc::Gen<Rotation> z_rotation_edge_cases() {
+  return rc::gen::element(Rotation::identity(), Rotation::about_z(1e-12),
+                          Rotation::about_z(kPi - 1e-9), Rotation::about_z(kPi));
+}
+
+rc::Gen<Rotation> c8_rotation() {
+  return rc::gen::map(rc::gen::inRange(0, 8),
+                      [](int i) { return Rotation::about_z(i * kPi / 4.0); });
+}
+
+rc::Gen<Eigen::Vector3d> translation_with_edges(double max_abs, bool planar) {
+  auto gen = rc::gen::weightedOneOf<Eigen::Vector3d>({
+      {8, translation(max_abs)},
+      {1, rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero())},
+      {1, rc::gen::map(unit_axis(), [](const Eigen::Vector3d& axis) -> Eigen::Vector3d {
+         return 1e3 * axis;
+       })},
+  });
+  if (!planar) return gen;
+  return rc::gen::map(gen, [](Eigen::Vector3d p) {
+    p.z() = 0.0;
+    return p;
+  });
+}
+
+rc::Gen<RigidTransform> combine(rc::Gen<Rotation> rotations, rc::Gen<Eigen::Vector3d> translations) {
+  return rc::gen::map(rc::gen::tuple(rotations, translations), [](const auto& rp) {
+    return RigidTransform(std::get<0>(rp), std::get<1>(rp));
+  });
+}
+
+// A twist for one control step: translations up to `step`, rotation angles up to `turn`.
+rc::Gen<Twist> step_twist(double step, double turn) {
+  return rc::gen::map(rc::gen::tuple(translation(step), translation(turn)), [](const auto& vw) {
+    Twist twist;
+    twist << std::get<0>(vw), std::get<1>(vw);
+    return twist;
+  });
+}
+
+}  // namespace
+
+rc::Gen<Rotation> haar_rotation() {
+  return rc::gen::map(rc::gen::tuple(unit_interval(), unit_interval(), unit_interval()),
+                      [](const auto& u) { return shoemake_rotation(std::get<0>(u), std::get<1>(u), std::get<2>(u)); });
+}
+
+rc::Gen<Rotation> rotation_near_pi() {
+  return axis_angle(rc::gen::map(unit_interval(), [](double u) { return kPi - 1e-10 * u; }));
+}
+
+rc::Gen<Rotation> rotation_near_identity() {
+  return axis_angle(rc::gen::map(unit_interval(), [](double u) { return 1e-10 * u; }));
+}
+
+rc::Gen<Rotation> rotation() {
+  return rc::gen::weightedOneOf<Rotation>({
+      {16, haar_rotation()},
+      {1, rc::gen::just(Rotation::identity())},
+      {1, axis_angle(rc::gen::just(1e-12))},
+      {1, axis_angle(rc::gen::just(kPi - 1e-9))},
+      {1, axis_angle(rc::gen::just(kPi))},
+  });
+}
+
+rc::Gen<Eigen::Vector3d> translation(double max_abs) {
+  return rc::gen::map(rc::gen::tuple(symmetric(max_abs), symmetric(max_abs), symmetric(max_abs)),
+                      [](const auto& xyz) {
+                        return Eigen::Vector3d(std::get<0>(xyz), std::get<1>(xyz), std::get<2>(xyz));
+                      });
+}
+
+rc::Gen<RigidTransform> group_element(Group group) {
+  constexpr double kMaxTranslation = 10.0;
+  switch (group) {
+    case Group::translation:
+      return combine(rc::gen::just(Rotation::identity()),
+                     translation_with_edges(kMaxTranslation, false));
+    case Group::rotation:
+      return combine(rotation(), rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
+    case Group::se2:
+      return combine(rc::gen::weightedOneOf<Rotation>({{4, rotation_about_z()}, {1, z_rotation_edge_cases()}}),
+                     translation_with_edges(kMaxTranslation, true));
+    case Group::se3:
+      return combine(rotation(), translation_with_edges(kMaxTranslation, false));
+    case Group::c8:
+      return combine(c8_rotation(), rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
+  }
+  return rc::gen::just(RigidTransform::identity());
+}
+
+rc::Gen<Scene> scene(SceneShape shape) {
+  return rc::gen::apply(
+      [](const RigidTransform& world_T_hand0, const Twist& forward, const Twist& backward,
+         int history, int chunk, const std::vector<Eigen::Vector3d>& hand_points,
+         const std::vector<Eigen::Vector3d>& world_points) {
+        Scene s;
+        // Smooth, rotating motion: a constant body twist per control step, each way from T_0.
+        const RigidTransform step_forward = RigidTransform::exp(forward);
+        const RigidTransform step_backward = RigidTransform::exp(backward);
+        s.world_T_hand_history.push_back(world_T_hand0);
+        for (int h = 1; h <= history; ++h) {
+          s.world_T_hand_history.push_back(s.world_T_hand_history.back() * step_backward);
+        }
+        RigidTransform world_T_handk = world_T_hand0;
+        for (int k = 1; k <= chunk; ++k) {
+          world_T_handk = world_T_handk * step_forward;
+          s.world_T_hand_chunk.push_back(world_T_handk);
+        }
+        s.hand_points = hand_points;
+        s.world_points = world_points;
+        return s;
+      },
+      combine(rotation(), translation(10.0)), step_twist(0.1, 0.3), step_twist(0.1, 0.3),
+      rc::gen::inRange(shape.min_history, shape.max_history + 1),
+      rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
+      rc::gen::resize(shape.max_hand_points,
+                      rc::gen::container<std::vector<Eigen::Vector3d>>(translation(1.0))),
+      rc::gen::resize(shape.max_world_points,
+                      rc::gen::container<std::vector<Eigen::Vector3d>>(translation(10.0))));
+}
+
+}  // namespace handcentric::props
