@@ -36,7 +36,7 @@ Eigen::VectorXd observation_buffer(const Scene& scene) {
 
 // World-frame proprioception o_{-h} = T_{-h} (Sec. 2.1), used by absolute, relative, relative_diff.
 Eigen::VectorXd world_observation(const Scene& scene) {
-  scene.validate();
+  scene.validate_observation();
   Eigen::VectorXd out = observation_buffer(scene);
   Eigen::Index slot = 0;
   for (const RigidTransform& world_T_hand : scene.world_T_hand_history) {
@@ -170,7 +170,7 @@ Eigen::VectorXd HandCentricRepresentation::encode_actions(const Scene& scene) co
 }
 
 Eigen::VectorXd HandCentricRepresentation::encode_observation(const Scene& scene) const {
-  scene.validate();
+  scene.validate_observation();
   const RigidTransform& world_T_hand0 = scene.world_T_hand0();
   Eigen::VectorXd out = observation_buffer(scene);
   Eigen::Index slot = 0;

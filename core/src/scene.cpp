@@ -19,15 +19,19 @@ void require_finite_points(const std::vector<Eigen::Vector3d>& points, const cha
 
 }  // namespace
 
-void Scene::validate() const {
+void Scene::validate_observation() const {
   if (world_T_hand_history.empty()) {
     throw InvalidScene("scene has no hand pose: the history needs at least T_0 (H >= 0)");
   }
+  require_finite_points(world_points, "world");
+  require_finite_points(hand_points, "eye-in-hand");
+}
+
+void Scene::validate() const {
+  validate_observation();
   if (world_T_hand_chunk.empty()) {
     throw InvalidScene("scene has an empty action chunk: K must be at least 1");
   }
-  require_finite_points(world_points, "world");
-  require_finite_points(hand_points, "eye-in-hand");
 }
 
 Scene operator*(const RigidTransform& g, const Scene& scene) {

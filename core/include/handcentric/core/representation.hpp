@@ -27,6 +27,7 @@ class Representation {
   virtual Eigen::VectorXd encode_actions(const Scene& scene) const = 0;
 
   /// The observation (proprioception history, eye-in-hand points, world points) as a vector.
+  /// Reads no action: the chunk may be empty. Throws InvalidScene for an invalid observation.
   virtual Eigen::VectorXd encode_observation(const Scene& scene) const = 0;
 
   /// Whether decode_actions() is available (a plug-in representation may only encode).

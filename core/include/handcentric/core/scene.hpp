@@ -33,6 +33,10 @@ struct Scene {
 
   /// Throws InvalidScene naming the problem: empty history, empty chunk, non-finite point.
   void validate() const;
+
+  /// What a policy may read (history and points; the chunk is not looked at): throws
+  /// InvalidScene for an empty history or a non-finite point.
+  void validate_observation() const;
 };
 
 /// g * scene (Sec. 2.2's "T~ o"): poses and world points move, eye-in-hand points do not.
