@@ -1,5 +1,6 @@
 #include "handcentric/core/so3.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace handcentric::so3 {
@@ -13,6 +14,19 @@ constexpr double kLogSeriesSine = 1e-4;
 // cos(phi) below this (phi > ~2.5 rad) switches log() to the symmetric-part axis: there
 // sin(phi) < 0.6 and dividing the skew part by it would amplify its rounding error.
 constexpr double kNearPiCosine = -0.8;
+constexpr double kPi = 3.141592653589793238462643383279502884;
+
+// phi in [0, pi] from sin(phi) >= 0 and cos(phi), each through a well-conditioned function:
+// asin where |cos| >= 0.8 (d asin / ds = 1 / |cos| <= 1.25), acos in between (d acos / dc =
+// 1 / sin <= 1.67). Both are about twice as fast as atan2 in glibc, and neither is ever used
+// near its singular end (acos near +-1, asin near 1), which is what makes acos-based logs
+// inaccurate near 0 and pi.
+double angle_from(double sine, double cosine) {
+  sine = std::min(sine, 1.0);  // rounding of a unit-norm skew part may exceed 1
+  if (cosine >= 0.8) return std::asin(sine);
+  if (cosine > -0.8) return std::acos(cosine);
+  return kPi - std::asin(sine);
+}
 
 // The skew part of R: (R - R^T)/2 = sin(phi) [v]x, returned as sin(phi) v.
 Eigen::Vector3d skew_vector(const Eigen::Matrix3d& R) {
@@ -31,16 +45,21 @@ Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
 
 Eigen::Matrix3d exp(const Eigen::Vector3d& r) {
   const double phi2 = r.squaredNorm();
-  const double phi = std::sqrt(phi2);
   double a;  // sin(phi) / phi
   double b;  // (1 - cos(phi)) / phi^2
-  if (phi < kExpSeriesAngle) {
-    a = 1.0 - phi2 / 6.0 * (1.0 - phi2 / 20.0);
-    b = 0.5 - phi2 / 24.0 * (1.0 - phi2 / 30.0);
+  if (phi2 < kExpSeriesAngle * kExpSeriesAngle) {
+    a = 1.0 - phi2 * (1.0 / 6.0) * (1.0 - phi2 * (1.0 / 20.0));
+    b = 0.5 - phi2 * (1.0 / 24.0) * (1.0 - phi2 * (1.0 / 30.0));
   } else {
-    a = std::sin(phi) / phi;
-    const double half_sin = std::sin(0.5 * phi) / phi;  // 1 - cos = 2 sin^2(phi/2): no cancellation
-    b = 2.0 * half_sin * half_sin;
+    // One sin/cos pair of the half angle (compiled to a single sincos call):
+    // sin(phi) = 2 s c and 1 - cos(phi) = 2 s^2, which has no cancellation near phi = 0.
+    const double phi = std::sqrt(phi2);
+    const double inv_phi = 1.0 / phi;  // before the call, so the division overlaps it
+    const double half = 0.5 * phi;
+    double s, c;
+    ::sincos(half, &s, &c);  // glibc: both in one call
+    a = 2.0 * s * c * inv_phi;
+    b = 2.0 * (s * inv_phi) * (s * inv_phi);
   }
   // R = I + a [r]x + b [r]x^2, with [r]x^2 = r r^T - phi^2 I, written out.
   Eigen::Matrix3d R;
@@ -60,19 +79,21 @@ Eigen::Matrix3d exp(const Eigen::Vector3d& r) {
 
 double angle(const Eigen::Matrix3d& R) {
   const double cosine = 0.5 * (R.trace() - 1.0);
-  return std::atan2(skew_vector(R).norm(), cosine);
+  return angle_from(skew_vector(R).norm(), cosine);
 }
 
 Eigen::Vector3d log(const Eigen::Matrix3d& R) {
   const Eigen::Vector3d sin_axis = skew_vector(R);  // sin(phi) v
   const double sine = sin_axis.norm();
   const double cosine = 0.5 * (R.trace() - 1.0);
-  const double phi = std::atan2(sine, cosine);
+  const double inv_sine = 1.0 / sine;  // before the call, so the division overlaps it (inf at 0: unused)
+  const double phi = angle_from(sine, cosine);
 
   if (cosine > kNearPiCosine) {
     // r = phi / sin(phi) * sin(phi) v; series where sin(phi) ~ phi is tiny.
-    const double scale = sine < kLogSeriesSine ? 1.0 + phi * phi / 6.0 * (1.0 + 7.0 / 60.0 * phi * phi)
-                                               : phi / sine;
+    const double scale = sine < kLogSeriesSine
+                             ? 1.0 + phi * phi * (1.0 / 6.0) * (1.0 + (7.0 / 60.0) * phi * phi)
+                             : phi * inv_sine;
     return scale * sin_axis;
   }
 

@@ -59,7 +59,11 @@ class RigidTransform {
   /// a * b: first b, then a (a_T_c = a_T_b * b_T_c).
   RigidTransform operator*(const RigidTransform& other) const {
     const Eigen::Matrix3d& R = rotation_.matrix();
-    return unchecked(R * other.rotation_.matrix(), R * other.translation_ + translation_);
+    RigidTransform out;
+    out.rotation_ = Rotation::from_matrix_unchecked(R * other.rotation_.matrix());
+    out.translation_.noalias() = R * other.translation_;
+    out.translation_ += translation_;
+    return out;
   }
 
   /// Acts on a point: R x + p.

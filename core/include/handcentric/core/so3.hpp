@@ -7,7 +7,8 @@
 //   - near phi = pi it takes no acos and divides by no sin(phi): the axis comes from the column
 //     of the symmetric part (R + R^T)/2 - cos(phi) I = (1 - cos(phi)) v v^T with the largest
 //     diagonal, and its sign from the skew part (R - R^T)/2 = sin(phi) [v]x;
-//   - the angle is always atan2(sin(phi), cos(phi)), never acos.
+//   - the angle is asin(sin phi) where |cos phi| >= 0.8 and acos(cos phi) in between: each only
+//     where it is well conditioned (never acos near 0 or pi).
 //
 // Canonical sign at exactly pi: r and -r are the same rotation there. When the skew part is
 // exactly zero (so it carries no sign), log() returns the axis whose largest-magnitude component
@@ -25,7 +26,7 @@ Eigen::Matrix3d exp(const Eigen::Vector3d& rotation_vector);
 /// The rotation vector r(R), angle in [0, pi]. No validation: R must be a rotation matrix.
 Eigen::Vector3d log(const Eigen::Matrix3d& R);
 
-/// The rotation angle of R in [0, pi], via atan2. No validation.
+/// The rotation angle of R in [0, pi] (see above). No validation.
 double angle(const Eigen::Matrix3d& R);
 
 }  // namespace handcentric::so3
