@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs the Debian bookworm packages handcentric needs, only when some are missing.
+# Runs as root (CI) or through sudo. Every dependency is a Debian package: nothing is
+# downloaded at build time and nothing is vendored.
+set -euo pipefail
+
+packages=(
+  ca-certificates cmake g++ make pkg-config python3
+  libeigen3-dev catch2 librapidcheck-dev libbox2d-dev libopencv-dev libginac-dev
+  libcli11-dev nlohmann-json3-dev libbenchmark-dev
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}" >&2
+as_root=()
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then
+    as_root=(sudo)
+  else
+    echo "install-deps: missing packages (${missing[*]}) and not root; install them or run as root" >&2
+    exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${as_root[@]}" apt-get update -qq
+# --no-install-recommends keeps OpenCV to its -dev packages (we link core, imgproc, imgcodecs).
+"${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
