@@ -2,7 +2,7 @@
 // define them (the full classifier over all groups is in tests/props).
 #include <catch2/catch.hpp>
 
-#include "throws.hpp"
+#include "throws.hpp"  // tests/support
 #include <numbers>
 
 #include "handcentric/core/errors.hpp"

@@ -1,7 +1,7 @@
 // SE(3): composition, inverse, inverse-compose, exp/log, planar SE(2), validation.
 #include <catch2/catch.hpp>
 
-#include "throws.hpp"
+#include "throws.hpp"  // tests/support
 #include <numbers>
 
 #include "handcentric/core/errors.hpp"

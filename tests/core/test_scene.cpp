@@ -1,7 +1,7 @@
 // Scene: how a global transform acts on it (Sec. 2.2), and validation.
 #include <catch2/catch.hpp>
 
-#include "throws.hpp"
+#include "throws.hpp"  // tests/support
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/scene.hpp"

@@ -1,7 +1,7 @@
 // SO(3): exp/log accuracy over the whole angle range, the canonical sign at pi, validation.
 #include <catch2/catch.hpp>
 
-#include "throws.hpp"
+#include "throws.hpp"  // tests/support
 #include <cmath>
 #include <numbers>
 #include <random>
