@@ -1,0 +1,100 @@
+// `handcentric render`: PNG drawings of the 2D insertion task (sim/draw.hpp): one scene, a demo
+// file, or one closed-loop rollout.
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "handcentric/core/errors.hpp"
+#include "handcentric/sim/collision.hpp"
+#include "handcentric/sim/demos.hpp"
+#include "handcentric/sim/draw.hpp"
+#include "handcentric/sim/policies.hpp"
+#include "handcentric/sim/rollout.hpp"
+#include "handcentric/sim/scenes.hpp"
+
+#if __has_include("handcentric/policy/model_file.hpp")
+#include "handcentric/policy/model_file.hpp"
+#define HANDCENTRIC_RENDER_HAS_MODELS 1
+#endif
+
+namespace handcentric::apps {
+namespace {
+
+struct RenderOptions {
+  bool scene = false;
+  std::string demos;
+  bool rollout = false;
+  std::string policy = "expert";
+  std::string model;
+  std::string dist = "train";
+  std::uint64_t seed = 1;
+  std::uint64_t index = 0;
+  int max_demos = 20;
+  int size = 800;
+  std::string out;
+};
+
+std::unique_ptr<ChunkPolicy> rollout_policy(const RenderOptions& options) {
+  if (options.model.empty()) return sim::make_scripted_policy(options.policy);
+#ifdef HANDCENTRIC_RENDER_HAS_MODELS
+  return std::make_unique<policy::LearnedPolicy>(policy::load_model(options.model));
+#else
+  throw InvalidArgument("--model '" + options.model + "': this build has no policy module to load models");
+#endif
+}
+
+int run_render(const RenderOptions& options) {
+  const sim::CollisionChecker checker;
+  sim::Image image;
+  std::string what;
+  if (!options.demos.empty()) {
+    if (options.max_demos < 1) throw InvalidArgument("--max must be at least 1, got " + std::to_string(options.max_demos));
+    auto demos = sim::load_demos(options.demos);
+    if (demos.size() > static_cast<std::size_t>(options.max_demos)) demos.resize(static_cast<std::size_t>(options.max_demos));
+    image = sim::draw_demos(demos, checker.geometry(), options.size);
+    what = std::to_string(demos.size()) + " demos";
+  } else {
+    const sim::TaskScene scene = sim::sample_scene(sim::SceneDistribution::parse(options.dist), options.seed, options.index);
+    if (options.scene) {
+      image = sim::draw_scene(scene, checker.geometry(), options.size);
+      what = "scene";
+    } else {
+      const auto policy = rollout_policy(options);
+      const sim::Rollout rollout = sim::rollout(*policy, scene, checker, sim::stream_seed(options.seed, options.index));
+      image = sim::draw_rollout(scene, rollout, checker.geometry(), options.size);
+      what = "rollout (" + sim::outcome_name(rollout.outcome) + " after " + std::to_string(rollout.steps) + " steps)";
+    }
+  }
+  sim::write_png(options.out, image);
+  std::cout << "wrote " << what << " to " << options.out << "\n";
+  return 0;
+}
+
+void add_render_command(CLI::App& app, int& exit_code) {
+  auto options = std::make_shared<RenderOptions>();
+  CLI::App* cmd = app.add_subcommand("render", "PNG of a scene, a demo file or a rollout of the 2D task");
+  auto* scene = cmd->add_flag("--scene", options->scene, "draw scene --index of --dist / --seed");
+  auto* demos = cmd->add_option("--demos", options->demos, "draw the demos of this file (in the hole frame)");
+  auto* rollout = cmd->add_flag("--rollout", options->rollout, "draw a rollout of --policy on scene --index");
+  scene->excludes(demos)->excludes(rollout);
+  demos->excludes(rollout);
+  auto* policy = cmd->add_option("--policy", options->policy, "policy of --rollout")
+                     ->check(CLI::IsMember(sim::scripted_policy_names()))->capture_default_str();
+  cmd->add_option("--model", options->model, "a trained model for --rollout (instead of --policy)")->excludes(policy);
+  cmd->add_option("--dist", options->dist, "train, ood or a hole-angle range A:B in degrees")->capture_default_str();
+  cmd->add_option("--seed", options->seed, "seed of the scene stream (as in `handcentric eval`)")->capture_default_str();
+  cmd->add_option("--index", options->index, "which scene of the stream")->capture_default_str();
+  cmd->add_option("--max", options->max_demos, "at most this many demos (--demos)")->capture_default_str();
+  cmd->add_option("--size", options->size, "image width and height in pixels")->capture_default_str();
+  cmd->add_option("--out", options->out, "output PNG (written atomically)")->required();
+  cmd->callback([options, &exit_code] {
+    if (!options->scene && options->demos.empty() && !options->rollout) throw CLI::RequiredError("--scene, --demos or --rollout");
+    exit_code = run_render(*options);
+  });
+}
+
+const CommandRegistration render_command("render", add_render_command);
+
+}  // namespace
+}  // namespace handcentric::apps

@@ -1,0 +1,54 @@
+#pragma once
+// Demonstrations: expert trajectories of the 2D insertion task, their file format, and the
+// training scenes a behavior-cloning policy learns from (Sec. 4.2).
+//
+// File format (docs/SIM.md): JSON Lines. Line 1 is a header
+//   {"format": "handcentric-demos", "version": 1, "count": N, "clearance": c}
+// then one line per demo (record 1..N):
+//   {"world_T_hole": P, "world_T_hand": [P, P, ...]}
+// where each pose P is a 3x4 matrix [[r00, r01, r02, x], [r10, r11, r12, y], [r20, r21, r22, z]]
+// (row-major, shortest round-trip decimal, so a load gives back the same bits).
+#include <string>
+#include <vector>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/rigid_transform.hpp"
+#include "handcentric/core/scene.hpp"
+#include "handcentric/sim/geometry.hpp"
+
+namespace handcentric::sim {
+
+/// A demo file that cannot be read: missing, not JSON Lines, wrong shapes, NaN, a non-rigid or
+/// non-planar pose, a truncated file. The message names the file, the record and the value.
+class InvalidDemoFile : public Error {
+ public:
+  using Error::Error;
+};
+
+struct Demo {
+  RigidTransform world_T_hole;               ///< the hole (planar)
+  std::vector<RigidTransform> world_T_hand;  ///< the hand at each control step; [0] = start
+};
+
+/// Reads and validates a demo file (format above). Throws InvalidDemoFile naming the record.
+std::vector<Demo> load_demos(const std::string& path);
+
+/// Writes `demos` atomically (a temporary file beside `path`, then rename). Throws
+/// InvalidArgument for an empty or non-planar demo, Error when the file cannot be written.
+void save_demos(const std::string& path, const std::vector<Demo>& demos,
+                const PegHoleGeometry& geometry = PegHoleGeometry());
+
+/// The eye-in-hand observation of Sec. 4.2: the two corners of the hole's opening
+/// (left, then right) in the frame of the hand at world_T_hand.
+std::vector<Eigen::Vector3d> eye_in_hand_points(const RigidTransform& world_T_hole,
+                                                const RigidTransform& world_T_hand,
+                                                const PegHoleGeometry& geometry = PegHoleGeometry());
+
+/// One Scene per control step t = 0..T-1 of `demo`: history T_t, T_{t-1}, ..., T_{t-H} (the
+/// first pose repeated before the start), chunk T_{t+1}..T_{t+K} (the last pose repeated after
+/// the end), hand_points = eye_in_hand_points at T_t, no world points.
+/// Throws InvalidArgument for H < 0, K < 1 or an empty demo.
+std::vector<Scene> training_scenes(const Demo& demo, int H, int K,
+                                   const PegHoleGeometry& geometry = PegHoleGeometry());
+
+}  // namespace handcentric::sim
