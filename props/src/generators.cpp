@@ -133,6 +133,20 @@ rc::Gen<RigidTransform> group_element(Group group) {
   return rc::gen::just(RigidTransform::identity());
 }
 
+namespace {
+
+// Between min_count and max_count points; with min_count = 0, RapidCheck's sized container.
+rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, double max_abs) {
+  if (min_count <= 0) {
+    return rc::gen::resize(max_count, rc::gen::container<std::vector<Eigen::Vector3d>>(translation(max_abs)));
+  }
+  return rc::gen::mapcat(rc::gen::inRange(min_count, std::max(min_count, max_count) + 1), [max_abs](int count) {
+    return rc::gen::container<std::vector<Eigen::Vector3d>>(static_cast<std::size_t>(count), translation(max_abs));
+  });
+}
+
+}  // namespace
+
 rc::Gen<Scene> scene(SceneShape shape) {
   return rc::gen::apply(
       [](const RigidTransform& world_T_hand0, const Twist& forward, const Twist& backward,
@@ -158,10 +172,8 @@ rc::Gen<Scene> scene(SceneShape shape) {
       combine(rotation(), translation(10.0)), step_twist(0.1, 0.3), step_twist(0.1, 0.3),
       rc::gen::inRange(shape.min_history, shape.max_history + 1),
       rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
-      rc::gen::resize(shape.max_hand_points,
-                      rc::gen::container<std::vector<Eigen::Vector3d>>(translation(1.0))),
-      rc::gen::resize(shape.max_world_points,
-                      rc::gen::container<std::vector<Eigen::Vector3d>>(translation(10.0))));
+      points(shape.min_hand_points, shape.max_hand_points, 1.0),
+      points(shape.min_world_points, shape.max_world_points, 10.0));
 }
 
 }  // namespace handcentric::props

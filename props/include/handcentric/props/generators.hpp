@@ -39,6 +39,8 @@ struct SceneShape {
   int min_chunk = 1, max_chunk = 32;     ///< K
   int max_world_points = 3;
   int max_hand_points = 3;
+  int min_world_points = 0;  ///< above 0, the count is drawn in [min, max] (a fixed count: min = max)
+  int min_hand_points = 0;
 };
 
 /// A scene: a random start pose, a smooth but rotating chunk (constant twist per step with a

@@ -1,0 +1,73 @@
+#pragma once
+// Pointwise checks: invariance of any function of a scene (a representation's actions or
+// observation, a flow target's input or regression target at fixed eps and t), and equivariance
+// of an outer policy (eq. 4). Each runs RapidCheck on generated (scene, g) pairs, g from a
+// group (generators.hpp, edge cases included), and returns a Verdict (verdict.hpp) with a
+// shrunk witness when the check fails. Tolerances and the near-identity rule: tolerance.hpp.
+//
+// Errors thrown by the function under test (a handcentric::Error, e.g. a plug-in that stops
+// answering) are not counterexamples: the check stops and rethrows them.
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "handcentric/core/chunk_policy.hpp"
+#include "handcentric/core/flow_target.hpp"
+#include "handcentric/core/representation.hpp"
+#include "handcentric/props/generators.hpp"
+#include "handcentric/props/run.hpp"
+#include "handcentric/props/tolerance.hpp"
+#include "handcentric/props/verdict.hpp"
+
+namespace handcentric::props {
+
+struct CheckOptions {
+  int cases = kDefaultCases;          ///< RapidCheck cases per check (near-identity ones included)
+  std::uint64_t seed = kDefaultSeed;  ///< RapidCheck seed: same seed, same cases, same witness
+  SceneShape shape = {};              ///< scene sizes
+  std::uint64_t noise_seed = 1;       ///< the fixed eps of pointwise flow checks
+  double flow_time = 0.5;             ///< the fixed t of flow checks
+  /// The pointwise tolerance is relative_tolerance * (1 + L) (tolerance.hpp). 1e-9 suits double
+  /// arithmetic; a policy computed in float needs ~1e-4.
+  double relative_tolerance = kRelativeTolerance;
+};
+
+/// Eye-in-hand scenes (no world points): Theorem 1's assumption, the audit's default.
+SceneShape eye_in_hand_shape();
+
+/// CheckOptions with eye_in_hand_shape().
+CheckOptions eye_in_hand_options();
+
+/// A vector-valued function of a scene, the thing whose invariance is checked.
+using SceneFunction = std::function<Eigen::VectorXd(const Scene&)>;
+
+SceneFunction actions_of(std::shared_ptr<const Representation> representation);
+SceneFunction observation_of(std::shared_ptr<const Representation> representation);
+
+/// The flow target's network input (or regression target) at time t and a fixed eps: the
+/// first noise_dimension(scene) standard normals of mt19937_64(noise_seed). The same eps is
+/// used for s and g * s, so this is the pointwise question of App. A (eqs. 11, 16, 23, 29).
+SceneFunction flow_input_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed, double t);
+SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed, double t);
+
+/// The first `n` standard normals of mt19937_64(seed) (core/sampling.hpp).
+Eigen::VectorXd fixed_noise(Eigen::Index n, std::uint64_t seed);
+
+/// f(g * s) = f(s) within pointwise_tolerance for g in `group`. `component` only labels the verdict.
+Verdict check_invariance(const SceneFunction& f, Component component, Group group,
+                         const CheckOptions& options = {});
+
+/// |f(g * s) - f(s)|_inf recomputed from a witness (a test re-derives the counterexample).
+double recompute_error(const SceneFunction& f, const Witness& witness);
+
+/// eq. (4): policy.act(g * o, s) = g * policy.act(o, s) within pointwise_tolerance, for the
+/// observations generated with options.shape and the noise seed options.noise_seed. The
+/// witness's before/after are g * a(o) and a(g * o), each pose flattened to [p, r(R)].
+Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOptions& options = {});
+
+/// max_k distance(a(g * o)_k, (g * a(o))_k) recomputed from a witness.
+double recompute_equivariance_error(const ChunkPolicy& policy, const Witness& witness,
+                                    std::uint64_t noise_seed);
+
+}  // namespace handcentric::props

@@ -1,0 +1,66 @@
+#include "handcentric/props/verdict.hpp"
+
+#include <sstream>
+
+#include "handcentric/core/format.hpp"
+
+namespace handcentric::props {
+namespace {
+
+// "r = [..], p = [..]" of a pose: the rotation vector and the translation.
+std::string pose_text(const RigidTransform& T) {
+  return "r = " + format_matrix(T.rotation().log()) + ", p = " + format_matrix(T.translation());
+}
+
+// A long vector shows its first 12 entries and how many it has.
+std::string vector_text(const Eigen::VectorXd& v) {
+  if (v.size() <= 12) return format_matrix(v);
+  std::string text("(");
+  text += std::to_string(v.size());
+  text += " numbers) ";
+  text += format_matrix(v.head(12));
+  text += " ...";
+  return text;
+}
+
+}  // namespace
+
+std::string to_string(Component component) {
+  switch (component) {
+    case Component::actions: return "actions";
+    case Component::observation: return "observation";
+    case Component::flow_input: return "flow_input";
+    case Component::flow_target: return "flow_target";
+    case Component::policy: return "policy";
+  }
+  return "?";
+}
+
+std::string to_string(Mode mode) { return mode == Mode::pointwise ? "pointwise" : "distribution"; }
+
+std::string format_witness(const Witness& witness) {
+  std::ostringstream out;
+  const Scene& s = witness.scene;
+  out << "g: " << pose_text(witness.g) << "\n"
+      << "scene: H = " << s.history_length() << ", K = " << s.chunk_length() << ", "
+      << s.hand_points.size() << " eye-in-hand and " << s.world_points.size() << " world points\n";
+  for (std::size_t h = 0; h < s.world_T_hand_history.size(); ++h) {
+    out << "  T_" << (h == 0 ? "" : "-") << h << ": " << pose_text(s.world_T_hand_history[h]) << "\n";
+  }
+  for (std::size_t k = 0; k < s.world_T_hand_chunk.size(); ++k) {
+    out << "  T_" << k + 1 << ": " << pose_text(s.world_T_hand_chunk[k]) << "\n";
+  }
+  for (const auto& x : s.hand_points) out << "  eye-in-hand point: " << format_matrix(x) << "\n";
+  for (const auto& x : s.world_points) out << "  world point: " << format_matrix(x) << "\n";
+  out << "before: " << vector_text(witness.before) << "\n"
+      << "after:  " << vector_text(witness.after) << "\n"
+      << "error " << format_number(witness.error);
+  if (witness.p_value < 1.0) {
+    out << " (energy distance), p = " << format_number(witness.p_value);
+  } else {
+    out << " > tolerance " << format_number(witness.tolerance);
+  }
+  return out.str();
+}
+
+}  // namespace handcentric::props
