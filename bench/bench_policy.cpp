@@ -1,0 +1,95 @@
+// Policy speed (issue 5): training throughput of the flow head on the anchor network of
+// bench/vs_pytorch.sh, 57 inputs (24 noisy action + 1 time + 32 observation) -> 256 -> 256 -> 256
+// -> 24, SiLU, Adam, batch 256; and sampling latency at batch 1 (10 Euler steps). Numbers are
+// recorded in docs/BENCHMARKS.md ("## Policy") with the commands that produced them.
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "handcentric/core/representations.hpp"
+#include "handcentric/core/sampling.hpp"
+#include "handcentric/policy/head.hpp"
+#include "handcentric/policy/trainer.hpp"
+
+using namespace handcentric;
+using namespace handcentric::policy;
+
+namespace {
+
+PolicyConfig anchor_config(HeadKind head) {
+  PolicyConfig config;
+  config.head = head;
+  config.representation = head == HeadKind::c8flow ? "absolute" : "hand_centric";
+  config.action_dimension = 24;
+  config.observation_dimension = 32;
+  config.time_embedding = 0;  // t itself: the 57-input anchor network
+  config.hidden_width = 256;
+  config.hidden_layers = 3;
+  config.batch_size = 256;
+  config.euler_steps = 10;
+  config.chunk_length = 4;
+  config.history_length = 2;
+  if (head == HeadKind::c8flow) {  // an absolute layout needs 6 (H + 1) + 3 (points): 18 + 6 + 9
+    config.hand_points = 2;
+    config.world_points = 3;
+    config.observation_dimension = 33;
+  }
+  return config;
+}
+
+Eigen::MatrixXd random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937_64& rng) {
+  Eigen::MatrixXd m(rows, cols);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m(i) = standard_normal(rng);
+  return m;
+}
+
+void BM_flow_train_step_batch256(benchmark::State& state) {
+  const PolicyConfig config = anchor_config(HeadKind::flow);
+  std::mt19937_64 rng(1);
+  const Eigen::MatrixXd actions = random_matrix(24, 4096, rng), observations = random_matrix(32, 4096, rng);
+  auto head = make_head(config);
+  head->prepare(actions, observations, rng);
+  const Eigen::MatrixXf batch_a = actions.leftCols(256).cast<float>();
+  const Eigen::MatrixXf batch_o = observations.leftCols(256).cast<float>();
+  for (auto _ : state) benchmark::DoNotOptimize(head->train_step(batch_a, batch_o, rng));
+  state.SetItemsProcessed(state.iterations() * 256);  // items/s = training samples/s
+}
+BENCHMARK(BM_flow_train_step_batch256)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void sample_batch1(benchmark::State& state, HeadKind kind) {
+  const PolicyConfig config = anchor_config(kind);
+  std::mt19937_64 rng(2);
+  const Eigen::MatrixXd actions = random_matrix(24, 512, rng);
+  const Eigen::MatrixXd observations = random_matrix(config.observation_dimension, 512, rng);
+  auto head = make_head(config);
+  head->prepare(actions, observations, rng);
+  const Eigen::MatrixXf o = observations.col(0).cast<float>();
+  for (auto _ : state) benchmark::DoNotOptimize(head->sample(o, rng));
+}
+void BM_flow_sample_10_euler_steps_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::flow); }
+void BM_ddpm_sample_10_ddim_steps_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::ddpm); }
+void BM_cvae_sample_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::cvae); }
+void BM_c8flow_sample_10_euler_steps_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::c8flow); }
+BENCHMARK(BM_flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ddpm_sample_10_ddim_steps_batch1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_cvae_sample_batch1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_c8flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond);
+
+// The whole outer policy at the paper's defaults (K = 16, H = 2, two eye-in-hand points):
+// encode, 10 Euler steps, decode. The network is 64 + 16 inputs wide here (96 action +
+// 16 time features + 22 observation), as `handcentric train` builds it.
+void BM_hand_centric_flow_act_K16(benchmark::State& state) {
+  std::mt19937_64 rng(3);
+  std::vector<Scene> scenes;
+  for (int i = 0; i < 64; ++i) scenes.push_back(random_scene(rng, 2, 16, 2, 0, 1.0));
+  PolicyConfig config;
+  config.steps = 1;
+  const LearnedPolicy policy = train_policy(config, scenes, 4);
+  std::uint64_t seed = 0;
+  for (auto _ : state) benchmark::DoNotOptimize(policy.act(scenes[0], ++seed));
+}
+BENCHMARK(BM_hand_centric_flow_act_K16)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,57 @@
+#pragma once
+// PolicyConfig: everything that defines a learned policy besides its weights; stored in model
+// files as "key=value" lines (to_text / from_text).
+#include <cstdint>
+#include <string>
+
+namespace handcentric::policy {
+
+/// The generative head (Sec. 2.3 and App. B): rectified flow, DDPM, CVAE, or the
+/// C8-symmetrized flow (the analogue of Equivariant Diffusion Policy [7]).
+enum class HeadKind { flow, ddpm, cvae, c8flow };
+
+enum class Activation { silu, relu };
+
+/// "flow", "ddpm", "cvae", "c8flow".
+std::string to_string(HeadKind kind);
+/// Throws InvalidArgument naming the value and the valid names.
+HeadKind parse_head(const std::string& name);
+std::string to_string(Activation activation);
+Activation parse_activation(const std::string& name);
+
+struct PolicyConfig {
+  HeadKind head = HeadKind::flow;
+  std::string representation = "hand_centric";
+  int chunk_length = 16;   ///< K
+  int history_length = 2;  ///< H
+  // Set from the training data by the trainer (the observation layout, see representation.hpp).
+  int hand_points = 0;
+  int world_points = 0;
+  int action_dimension = 0;
+  int observation_dimension = 0;
+  // Network: hidden_layers layers of hidden_width, then a linear output.
+  int hidden_width = 256;
+  int hidden_layers = 3;
+  Activation activation = Activation::silu;
+  int time_embedding = 16;  ///< sinusoidal features of t (even, >= 2), or 0 for t itself
+  // Training.
+  int steps = 5000;
+  int batch_size = 256;
+  double learning_rate = 1e-3;
+  double weight_decay = 0.0;  ///< decoupled (AdamW)
+  double gradient_clip = 1.0;  ///< global L2 norm; 0 disables
+  // Sampling and heads.
+  int euler_steps = 10;          ///< rectified flow, eq. (5)
+  int ddpm_train_steps = 100;    ///< DDPM diffusion steps
+  int ddim_steps = 10;           ///< DDIM sampling steps
+  int cvae_latent = 16;
+  double cvae_kl_weight = 1e-2;
+
+  /// Throws InvalidArgument naming the first out-of-range field and its valid range.
+  void validate() const;
+  std::string to_text() const;
+  /// Parses to_text() output; throws InvalidArgument for an unknown key or a bad value.
+  static PolicyConfig from_text(const std::string& text);
+};
+
+}  // namespace handcentric::policy

@@ -1,0 +1,14 @@
+#pragma once
+// Errors of the policy module, on top of core/errors.hpp.
+#include "handcentric/core/errors.hpp"
+
+namespace handcentric {
+
+/// A model file that cannot be read: missing, truncated, corrupted (checksum), a wrong version
+/// or not a handcentric model at all. The message names the file and what to do.
+class InvalidModelFile : public Error {
+ public:
+  using Error::Error;
+};
+
+}  // namespace handcentric

@@ -1,0 +1,49 @@
+#pragma once
+// Head: the generative model that maps an observation vector to an action vector, trained on
+// (action, observation) pairs that a Representation produced. Every head takes RAW vectors
+// (one per column) and owns its normalization, so the outer policy is the same for all:
+//
+//   flow   : rectified flow matching, eq. (5), Euler sampler            (Sec. 2.3)
+//   ddpm   : epsilon-prediction diffusion, DDIM sampler                  (App. B ablation)
+//   cvae   : conditional VAE                                             (App. B ablation)
+//   c8flow : rectified flow whose sampler averages the velocity over the 8 rotations about world
+//            z through the origin, f(x) = 1/8 sum_g g_* f(g^-1 x), on ABSOLUTE actions: the
+//            analogue of Equivariant Diffusion Policy [7] (not [7] itself; see c8_action.hpp)
+#include <Eigen/Core>
+#include <memory>
+#include <random>
+
+#include "handcentric/policy/binary_io.hpp"
+#include "handcentric/policy/config.hpp"
+
+namespace handcentric::policy {
+
+class Head {
+ public:
+  virtual ~Head() = default;
+  virtual HeadKind kind() const = 0;
+
+  /// Fits the normalization statistics from the whole training set (actions: action_dimension
+  /// x N, observations: observation_dimension x N) and initializes the weights from `rng`.
+  virtual void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+                       std::mt19937_64& rng) = 0;
+
+  /// One optimizer step on a minibatch of raw columns; returns the minibatch loss before it.
+  virtual double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
+                            std::mt19937_64& rng) = 0;
+
+  /// One raw action vector per raw observation column; all noise from `rng`.
+  virtual Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const = 0;
+
+  /// Normalization statistics and weights (the config is stored by the model file).
+  virtual void write(ByteWriter& out) const = 0;
+  /// Reads what write() wrote, checking every length against the config.
+  virtual void read(ByteReader& in) = 0;
+};
+
+/// The head `config.head` for the dimensions in `config` (action_dimension and
+/// observation_dimension must be set). Throws InvalidArgument for a bad config, and for c8flow
+/// with a representation other than "absolute".
+std::unique_ptr<Head> make_head(const PolicyConfig& config);
+
+}  // namespace handcentric::policy

@@ -1,0 +1,51 @@
+#pragma once
+// LearnedPolicy: the outer policy of Sec. 3, steps 1-3, for any representation and any head:
+//
+//   world observation --representation.encode_observation--> vector
+//                     --head.sample (noise from noise_seed)--> action vector
+//                     --representation.decode_actions(., T_0)--> world chunk T_1..T_K
+//
+// With the hand_centric representation, the observation vector and the head's output do not
+// change under a global g (Theorem 1), and decode maps them through g T_0: the chunk moves with
+// g, eq. (4), whatever the network learned.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "handcentric/core/chunk_policy.hpp"
+#include "handcentric/core/representation.hpp"
+#include "handcentric/policy/config.hpp"
+#include "handcentric/policy/head.hpp"
+
+namespace handcentric::policy {
+
+class LearnedPolicy final : public ChunkPolicy {
+ public:
+  /// Throws InvalidArgument for a null representation or head, or one whose name / kind does
+  /// not match `config`.
+  LearnedPolicy(PolicyConfig config, std::shared_ptr<const Representation> representation,
+                std::shared_ptr<const Head> head);
+
+  /// "<head>/<representation>", e.g. "flow/hand_centric".
+  std::string name() const override;
+
+  /// Throws InvalidScene for an invalid observation, one whose H or point counts differ from
+  /// training, or a non-finite output (an observation far outside the training data).
+  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+
+  /// The head's raw action vector for `observation` (before decoding).
+  Eigen::VectorXd action_vector(const Scene& observation, std::uint64_t noise_seed) const;
+
+  const PolicyConfig& config() const { return config_; }
+  const Representation& representation() const { return *representation_; }
+  const Head& head() const { return *head_; }
+  std::shared_ptr<const Head> shared_head() const { return head_; }
+  std::shared_ptr<const Representation> shared_representation() const { return representation_; }
+
+ private:
+  PolicyConfig config_;
+  std::shared_ptr<const Representation> representation_;
+  std::shared_ptr<const Head> head_;
+};
+
+}  // namespace handcentric::policy

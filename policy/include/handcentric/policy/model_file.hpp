@@ -1,0 +1,34 @@
+#pragma once
+// Model files: one trained LearnedPolicy, versioned and checksummed.
+//
+//   magic        8 bytes "HCPOLICY"        (anything else: not a handcentric model)
+//   version      u32 = kModelFormatVersion
+//   payload size u64
+//   payload      config (PolicyConfig::to_text), representation name, head kind,
+//                the head's normalization statistics and weights (Head::write)
+//   checksum     u64 FNV-1a 64 of every byte before it
+//
+// Little-endian; written to "<path>.tmp.<pid>" and renamed over `path` (atomic on POSIX).
+#include <cstdint>
+#include <string>
+
+#include "handcentric/policy/learned_policy.hpp"
+
+namespace handcentric::policy {
+
+constexpr std::uint32_t kModelFormatVersion = 1;
+
+/// The file's bytes (for tests that damage them).
+std::string serialize_model(const LearnedPolicy& policy);
+
+/// Throws InvalidModelFile naming `source` for any damage: truncated, wrong magic, wrong version,
+/// bad checksum, a config or lengths that do not fit, trailing bytes.
+LearnedPolicy deserialize_model(const std::string& bytes, const std::string& source);
+
+/// Writes atomically. Throws InvalidArgument naming the path when it cannot be written.
+void save_model(const LearnedPolicy& policy, const std::string& path);
+
+/// Throws InvalidModelFile naming the path (missing, unreadable or damaged).
+LearnedPolicy load_model(const std::string& path);
+
+}  // namespace handcentric::policy

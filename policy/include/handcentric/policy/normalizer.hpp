@@ -1,0 +1,44 @@
+#pragma once
+// Per-dimension normalization from training statistics: x_n = (x - mean) / scale.
+//
+// It is a CONSTANT affine map, fixed once from the training set. Applied to an invariant vector
+// (a hand-centric action or observation) it gives an invariant vector, so it cannot break the
+// invariance that Theorem 1 rests on; only a map that looked at the world pose could.
+// (tests/policy: normalized_hand_centric_vectors_stay_se3_invariant.)
+#include <Eigen/Core>
+
+namespace handcentric::policy {
+
+class Normalizer {
+ public:
+  /// The identity map for `dimension` numbers.
+  explicit Normalizer(Eigen::Index dimension = 0);
+  /// Validating: throws InvalidArgument for different lengths, a non-finite mean, a scale that
+  /// is not finite and positive, or an `active` entry other than 0 or 1 (empty: all 1).
+  Normalizer(Eigen::VectorXd mean, Eigen::VectorXd scale, Eigen::VectorXd active = {});
+
+  /// Mean and standard deviation of each row of `data` (one sample per column). A row whose
+  /// standard deviation is below 1e-8 * (1 + |mean|) (a constant, e.g. z in a planar task) gets
+  /// scale 1, so it is only shifted, and active 0. Throws InvalidArgument for no columns or a
+  /// non-finite entry.
+  static Normalizer fit(const Eigen::MatrixXd& data);
+
+  Eigen::Index dimension() const { return mean_.size(); }
+  const Eigen::VectorXd& mean() const { return mean_; }
+  const Eigen::VectorXd& scale() const { return scale_; }
+  /// 1 for a dimension that varies in the training data, 0 for a constant one. The heads put no
+  /// noise and no velocity there (a planar task's z and tilt stay exactly at their constant).
+  const Eigen::VectorXd& active() const { return active_; }
+  const Eigen::VectorXf& active_float() const { return active_f_; }
+
+  /// In place, column by column: x <- (x - mean) / scale.
+  void normalize(Eigen::Ref<Eigen::MatrixXf> columns) const;
+  /// In place: x <- mean + scale * x.
+  void denormalize(Eigen::Ref<Eigen::MatrixXf> columns) const;
+
+ private:
+  Eigen::VectorXd mean_, scale_, active_;
+  Eigen::VectorXf mean_f_, inv_scale_f_, scale_f_, active_f_;
+};
+
+}  // namespace handcentric::policy

@@ -1,0 +1,38 @@
+#pragma once
+// Training a LearnedPolicy from scenes: encode with the representation, fit normalization, then
+// config.steps Adam steps on minibatches drawn with replacement. Deterministic: the same
+// config, scenes and seed give the same weights, bit for bit (on one thread).
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "handcentric/core/scene.hpp"
+#include "handcentric/policy/config.hpp"
+#include "handcentric/policy/dataset.hpp"
+#include "handcentric/policy/learned_policy.hpp"
+
+namespace handcentric::policy {
+
+struct TrainingProgress {
+  int step = 0;   ///< steps done
+  int steps = 0;  ///< steps in total
+  double loss = 0.0;                ///< mean minibatch loss since the previous report
+  double samples_per_second = 0.0;  ///< since the start
+  double eta_seconds = 0.0;
+};
+
+using ProgressCallback = std::function<void(const TrainingProgress&)>;
+
+/// Trains `config.head` on `scenes` with `config.representation`. Dimensions and point counts
+/// in the returned policy's config come from the data. `progress` (optional) is called about
+/// every `report_every` steps and after the last step. Throws InvalidArgument for a bad config
+/// or a non-finite loss (diverged training), InvalidScene for bad scenes (dataset.hpp).
+LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes, std::uint64_t seed,
+                           const ProgressCallback& progress = {}, int report_every = 100);
+
+/// The same on already encoded data (benchmarks; `config.representation` must still name the
+/// representation that encoded it).
+LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64_t seed,
+                           const ProgressCallback& progress = {}, int report_every = 100);
+
+}  // namespace handcentric::policy

@@ -1,0 +1,161 @@
+#include "handcentric/policy/config.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <functional>
+#include <sstream>
+#include <vector>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
+
+namespace handcentric::policy {
+
+std::string to_string(HeadKind kind) {
+  switch (kind) {
+    case HeadKind::flow: return "flow";
+    case HeadKind::ddpm: return "ddpm";
+    case HeadKind::cvae: return "cvae";
+    case HeadKind::c8flow: return "c8flow";
+  }
+  return "?";
+}
+
+HeadKind parse_head(const std::string& name) {
+  for (HeadKind kind : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow}) {
+    if (to_string(kind) == name) return kind;
+  }
+  throw InvalidArgument("unknown head '" + name + "': use one of flow, ddpm, cvae, c8flow");
+}
+
+std::string to_string(Activation activation) {
+  return activation == Activation::silu ? "silu" : "relu";
+}
+
+Activation parse_activation(const std::string& name) {
+  if (name == "silu") return Activation::silu;
+  if (name == "relu") return Activation::relu;
+  throw InvalidArgument("unknown activation '" + name + "': use silu or relu");
+}
+
+namespace {
+
+void require(bool ok, const std::string& field, const std::string& value, const std::string& range) {
+  if (!ok) throw InvalidArgument("policy config: " + field + " = " + value + " is out of range: use " + range);
+}
+
+// One entry per stored field: how to print it and how to parse it.
+struct Field {
+  std::string key;
+  std::function<std::string(const PolicyConfig&)> get;
+  std::function<void(PolicyConfig&, const std::string&)> set;
+};
+
+int parse_int(const std::string& key, const std::string& text) {
+  int value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size()) {
+    throw InvalidArgument("policy config: " + key + " = '" + text + "' is not an integer");
+  }
+  return value;
+}
+
+double parse_double(const std::string& key, const std::string& text) {
+  std::istringstream in(text);
+  double value = 0.0;
+  in >> value;
+  if (!in || !in.eof() || !std::isfinite(value)) {
+    throw InvalidArgument("policy config: " + key + " = '" + text + "' is not a finite number");
+  }
+  return value;
+}
+
+#define HC_INT_FIELD(name)                                                   \
+  Field {                                                                    \
+    #name, [](const PolicyConfig& c) { return std::to_string(c.name); },     \
+        [](PolicyConfig& c, const std::string& v) { c.name = parse_int(#name, v); } \
+  }
+#define HC_DOUBLE_FIELD(name)                                                   \
+  Field {                                                                       \
+    #name, [](const PolicyConfig& c) { return format_number(c.name); },         \
+        [](PolicyConfig& c, const std::string& v) { c.name = parse_double(#name, v); } \
+  }
+
+const std::vector<Field>& fields() {
+  static const std::vector<Field> all = {
+      Field{"head", [](const PolicyConfig& c) { return to_string(c.head); },
+            [](PolicyConfig& c, const std::string& v) { c.head = parse_head(v); }},
+      Field{"representation", [](const PolicyConfig& c) { return c.representation; },
+            [](PolicyConfig& c, const std::string& v) { c.representation = v; }},
+      HC_INT_FIELD(chunk_length), HC_INT_FIELD(history_length), HC_INT_FIELD(hand_points),
+      HC_INT_FIELD(world_points), HC_INT_FIELD(action_dimension), HC_INT_FIELD(observation_dimension),
+      HC_INT_FIELD(hidden_width), HC_INT_FIELD(hidden_layers),
+      Field{"activation", [](const PolicyConfig& c) { return to_string(c.activation); },
+            [](PolicyConfig& c, const std::string& v) { c.activation = parse_activation(v); }},
+      HC_INT_FIELD(time_embedding), HC_INT_FIELD(steps), HC_INT_FIELD(batch_size),
+      HC_DOUBLE_FIELD(learning_rate), HC_DOUBLE_FIELD(weight_decay), HC_DOUBLE_FIELD(gradient_clip),
+      HC_INT_FIELD(euler_steps), HC_INT_FIELD(ddpm_train_steps), HC_INT_FIELD(ddim_steps),
+      HC_INT_FIELD(cvae_latent), HC_DOUBLE_FIELD(cvae_kl_weight),
+  };
+  return all;
+}
+
+#undef HC_INT_FIELD
+#undef HC_DOUBLE_FIELD
+
+}  // namespace
+
+void PolicyConfig::validate() const {
+  const auto s = [](auto v) { return std::to_string(v); };
+  require(chunk_length >= 1 && chunk_length <= 1024, "chunk_length", s(chunk_length), "1..1024");
+  require(history_length >= 0 && history_length <= 1024, "history_length", s(history_length), "0..1024");
+  require(hand_points >= 0, "hand_points", s(hand_points), ">= 0");
+  require(world_points >= 0, "world_points", s(world_points), ">= 0");
+  require(action_dimension >= 0, "action_dimension", s(action_dimension), ">= 0");
+  require(observation_dimension >= 0, "observation_dimension", s(observation_dimension), ">= 0");
+  require(hidden_width >= 1 && hidden_width <= 65536, "hidden_width", s(hidden_width), "1..65536");
+  require(hidden_layers >= 1 && hidden_layers <= 64, "hidden_layers", s(hidden_layers), "1..64");
+  require(time_embedding == 0 || (time_embedding >= 2 && time_embedding % 2 == 0 && time_embedding <= 1024),
+          "time_embedding", s(time_embedding), "0 (raw t) or an even number 2..1024");
+  require(steps >= 0, "steps", s(steps), ">= 0");
+  require(batch_size >= 1 && batch_size <= 1 << 20, "batch_size", s(batch_size), "1..1048576");
+  require(learning_rate > 0.0 && learning_rate < 10.0, "learning_rate", format_number(learning_rate), "(0, 10)");
+  require(weight_decay >= 0.0 && weight_decay < 1.0, "weight_decay", format_number(weight_decay), "[0, 1)");
+  require(gradient_clip >= 0.0, "gradient_clip", format_number(gradient_clip), ">= 0 (0 disables)");
+  require(euler_steps >= 1 && euler_steps <= 10000, "euler_steps", s(euler_steps), "1..10000");
+  require(ddpm_train_steps >= 2 && ddpm_train_steps <= 10000, "ddpm_train_steps", s(ddpm_train_steps), "2..10000");
+  require(ddim_steps >= 1 && ddim_steps <= ddpm_train_steps, "ddim_steps", s(ddim_steps),
+          "1..ddpm_train_steps (" + s(ddpm_train_steps) + ")");
+  require(cvae_latent >= 1 && cvae_latent <= 4096, "cvae_latent", s(cvae_latent), "1..4096");
+  require(cvae_kl_weight >= 0.0, "cvae_kl_weight", format_number(cvae_kl_weight), ">= 0");
+}
+
+std::string PolicyConfig::to_text() const {
+  std::string text;
+  for (const Field& field : fields()) text += field.key + "=" + field.get(*this) + "\n";
+  return text;
+}
+
+PolicyConfig PolicyConfig::from_text(const std::string& text) {
+  PolicyConfig config;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    const auto eq = line.find('=');
+    if (eq == std::string::npos) throw InvalidArgument("policy config: line '" + line + "' is not key=value");
+    const std::string key = line.substr(0, eq);
+    bool known = false;
+    for (const Field& field : fields()) {
+      if (field.key == key) {
+        field.set(config, line.substr(eq + 1));
+        known = true;
+      }
+    }
+    if (!known) throw InvalidArgument("policy config: unknown key '" + key + "'");
+  }
+  config.validate();
+  return config;
+}
+
+}  // namespace handcentric::policy

@@ -1,0 +1,119 @@
+// Conditional VAE (Sohn et al. 2015), for the App. B ablation, in normalized coordinates. The
+// objective and its gradients: cvae_loss.hpp. Sampling: z ~ N(0, I), a = D([z; o]).
+#include <cmath>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/policy/adam.hpp"
+#include "handcentric/policy/gaussian.hpp"
+#include "handcentric/policy/head.hpp"
+#include "handcentric/policy/cvae_loss.hpp"
+#include "handcentric/policy/mlp.hpp"
+#include "handcentric/policy/normalizer.hpp"
+
+namespace handcentric::policy {
+namespace {
+
+std::vector<int> widths(const PolicyConfig& config, int input, int output) {
+  std::vector<int> w{input};
+  for (int l = 0; l < config.hidden_layers; ++l) w.push_back(config.hidden_width);
+  w.push_back(output);
+  return w;
+}
+
+class CvaeHead final : public Head {
+ public:
+  explicit CvaeHead(const PolicyConfig& config)
+      : config_(config),
+        action_normalizer_(config.action_dimension),
+        observation_normalizer_(config.observation_dimension),
+        encoder_(widths(config, config.action_dimension + config.observation_dimension, 2 * config.cvae_latent),
+                 config.activation),
+        decoder_(widths(config, config.cvae_latent + config.observation_dimension, config.action_dimension),
+                 config.activation),
+        encoder_adam_(encoder_.parameter_count(), options(config)),
+        decoder_adam_(decoder_.parameter_count(), options(config)) {}
+
+  HeadKind kind() const override { return HeadKind::cvae; }
+
+  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override {
+    action_normalizer_ = Normalizer::fit(actions);
+    observation_normalizer_ = Normalizer::fit(observations);
+    encoder_.initialize(rng);
+    decoder_.initialize(rng);
+  }
+
+  double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
+                    std::mt19937_64& rng) override {
+    a_ = actions;
+    o_ = observations;
+    action_normalizer_.normalize(a_);
+    observation_normalizer_.normalize(o_);
+    noise_.resize(config_.cvae_latent, actions.cols());
+    fill_standard_normal(rng, noise_);
+    const double loss = cvae_loss_and_gradients<float>(encoder_, decoder_, a_, o_, noise_, config_.cvae_kl_weight, buffers_);
+    step(decoder_, decoder_adam_);
+    step(encoder_, encoder_adam_);
+    return loss;
+  }
+
+  Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
+    const Eigen::Index batch = observations.cols(), dobs = observations.rows(), Z = config_.cvae_latent;
+    Eigen::MatrixXf input(Z + dobs, batch), output, scratch[2];
+    fill_standard_normal(rng, input.topRows(Z));
+    input.bottomRows(dobs) = observations;
+    observation_normalizer_.normalize(input.bottomRows(dobs));
+    decoder_.infer(input, output, scratch);
+    action_normalizer_.denormalize(output);
+    return output;
+  }
+
+  void write(ByteWriter& out) const override {
+    out.doubles(action_normalizer_.mean());
+    out.doubles(action_normalizer_.scale());
+    out.doubles(action_normalizer_.active());
+    out.doubles(observation_normalizer_.mean());
+    out.doubles(observation_normalizer_.scale());
+    out.floats(encoder_.parameters());
+    out.floats(decoder_.parameters());
+  }
+
+  void read(ByteReader& in) override {
+    try {
+      Eigen::VectorXd mean = in.doubles(config_.action_dimension);
+      Eigen::VectorXd scale = in.doubles(config_.action_dimension);
+      Eigen::VectorXd active = in.doubles(config_.action_dimension);
+      action_normalizer_ = Normalizer(mean, scale, active);
+      mean = in.doubles(config_.observation_dimension);
+      scale = in.doubles(config_.observation_dimension);
+      observation_normalizer_ = Normalizer(mean, scale);
+    } catch (const InvalidArgument& error) {
+      in.fail(std::string("bad normalization statistics: ") + error.what());
+    }
+    encoder_.parameters() = in.floats(encoder_.parameter_count());
+    decoder_.parameters() = in.floats(decoder_.parameter_count());
+  }
+
+ private:
+  static AdamOptions options(const PolicyConfig& config) {
+    return AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay};
+  }
+  void step(Mlp& network, Adam& adam) {
+    gradient_ = network.gradient();
+    clip_gradient_norm(gradient_, config_.gradient_clip);
+    adam.step(network.parameters(), gradient_);
+  }
+
+  PolicyConfig config_;
+  Normalizer action_normalizer_, observation_normalizer_;
+  Mlp encoder_, decoder_;
+  Adam encoder_adam_, decoder_adam_;
+  Eigen::MatrixXf a_, o_, noise_;
+  CvaeBuffers<float> buffers_;
+  Eigen::VectorXf gradient_;
+};
+
+}  // namespace
+
+std::unique_ptr<Head> make_cvae_head(const PolicyConfig& config) { return std::make_unique<CvaeHead>(config); }
+
+}  // namespace handcentric::policy

@@ -1,0 +1,124 @@
+// DDPM (Ho et al. 2020) with epsilon prediction, for the App. B ablation; DDIM sampling (Song et
+// al. 2021, eta = 0) in config.ddim_steps steps. In normalized coordinates, like the flow head.
+//
+//   schedule  cosine (Nichol & Dhariwal 2021): abar(s) = cos^2(((s / T) + 0.008) / 1.008 * pi / 2)
+//             normalized by abar(0), beta_k = min(1 - abar_k / abar_{k-1}, 0.999), abar_k = prod(1 - beta)
+//   training  k uniform in 0..T-1, x = sqrt(abar_k) a + sqrt(1 - abar_k) eps, target eps,
+//             network input [x, time features of (k + 1) / T, o]
+//   sampling  tau_i = T - 1 - i * (T / S), i = 0..S-1; x0_hat = (x - sqrt(1 - abar) eps_hat) / sqrt(abar),
+//             clipped to the range of the normalized training actions (at least +-1), as
+//             Diffusion Policy clips to its data range; x <- sqrt(abar_prev) x0_hat + sqrt(1 - abar_prev) eps_hat.
+//             Without the clip, the first step (abar_{T-1} ~ 2e-7) multiplies any error in
+//             eps_hat by ~2000 and the later steps start far outside the training distribution.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <numbers>
+#include <vector>
+
+#include "handcentric/policy/gaussian.hpp"
+#include "handcentric/policy/time_embedding.hpp"
+#include "network_head.hpp"
+
+namespace handcentric::policy {
+namespace {
+
+std::vector<double> cosine_alpha_bar(int T) {
+  const auto f = [T](double s) {
+    const double c = std::cos((s / T + 0.008) / 1.008 * std::numbers::pi / 2.0);
+    return c * c;
+  };
+  std::vector<double> alpha_bar(T);
+  double product = 1.0;
+  for (int k = 0; k < T; ++k) {
+    const double beta = std::min(1.0 - f(k + 1) / f(k), 0.999);
+    product *= 1.0 - beta;
+    alpha_bar[k] = product;
+  }
+  return alpha_bar;
+}
+
+class DdpmHead final : public NetworkHead {
+ public:
+  explicit DdpmHead(const PolicyConfig& config)
+      : NetworkHead(config), alpha_bar_(cosine_alpha_bar(config.ddpm_train_steps)) {}
+  HeadKind kind() const override { return HeadKind::ddpm; }
+
+  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override {
+    NetworkHead::prepare(actions, observations, rng);
+    Eigen::MatrixXf normalized = actions.cast<float>();
+    action_normalizer_.normalize(normalized);
+    clip_ = std::max(1.0f, normalized.cwiseAbs().maxCoeff());
+  }
+
+  void write(ByteWriter& out) const override {
+    NetworkHead::write(out);
+    out.f64(clip_);
+  }
+
+  void read(ByteReader& in) override {
+    NetworkHead::read(in);
+    const double clip = in.f64();
+    if (!(clip >= 1.0 && clip < 1e6)) in.fail("a DDPM clip range of " + std::to_string(clip));
+    clip_ = static_cast<float>(clip);
+  }
+
+  double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
+                    std::mt19937_64& rng) override {
+    a_ = actions;
+    o_ = observations;
+    action_normalizer_.normalize(a_);
+    observation_normalizer_.normalize(o_);
+    const Eigen::Index batch = a_.cols();
+    const int T = config_.ddpm_train_steps;
+    noise_.resize(a_.rows(), batch);
+    fill_standard_normal(rng, noise_);
+    noise_.array().colwise() *= action_normalizer_.active_float().array();  // constant dims: no noise
+    t_.resize(batch);
+    x_.resize(a_.rows(), batch);
+    for (Eigen::Index j = 0; j < batch; ++j) {
+      const int k = static_cast<int>(rng() % static_cast<std::uint64_t>(T));
+      t_[j] = static_cast<double>(k + 1) / T;
+      x_.col(j) = static_cast<float>(std::sqrt(alpha_bar_[k])) * a_.col(j) +
+                  static_cast<float>(std::sqrt(1.0 - alpha_bar_[k])) * noise_.col(j);
+    }
+    assemble(x_, t_, o_, input_);
+    return regress(network_.forward(input_), noise_);
+  }
+
+  Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
+    Eigen::MatrixXf o = observations;
+    observation_normalizer_.normalize(o);
+    const Eigen::Index batch = o.cols();
+    const int T = config_.ddpm_train_steps, S = config_.ddim_steps;
+    Eigen::MatrixXf x(config_.action_dimension, batch);
+    fill_standard_normal(rng, x);
+    const Eigen::VectorXf& active = action_normalizer_.active_float();
+    x.array().colwise() *= active.array();
+    Eigen::MatrixXf input, eps_hat, scratch[2];
+    for (int i = 0; i < S; ++i) {
+      const int k = T - 1 - i * (T / S);
+      const int k_prev = i + 1 < S ? T - 1 - (i + 1) * (T / S) : -1;
+      const double abar = alpha_bar_[k], abar_prev = k_prev >= 0 ? alpha_bar_[k_prev] : 1.0;
+      assemble(x, Eigen::VectorXd::Constant(batch, static_cast<double>(k + 1) / T), o, input);
+      network_.infer(input, eps_hat, scratch);
+      eps_hat.array().colwise() *= active.array();
+      Eigen::MatrixXf x0 = (x - static_cast<float>(std::sqrt(1.0 - abar)) * eps_hat) /
+                           static_cast<float>(std::sqrt(abar));
+      x0 = x0.cwiseMax(-clip_).cwiseMin(clip_);
+      x = static_cast<float>(std::sqrt(abar_prev)) * x0 + static_cast<float>(std::sqrt(1.0 - abar_prev)) * eps_hat;
+    }
+    action_normalizer_.denormalize(x);
+    return x;
+  }
+
+ private:
+  std::vector<double> alpha_bar_;
+  float clip_ = 1.0f;  ///< max |normalized training action|, at least 1
+};
+
+}  // namespace
+
+std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config) { return std::make_unique<DdpmHead>(config); }
+
+}  // namespace handcentric::policy

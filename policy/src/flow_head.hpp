@@ -1,0 +1,24 @@
+#pragma once
+// Private: the rectified-flow head (eq. (5)), also the base of the C8-symmetrized flow.
+#include "network_head.hpp"
+
+namespace handcentric::policy {
+
+class FlowHead : public NetworkHead {
+ public:
+  using NetworkHead::NetworkHead;
+  HeadKind kind() const override { return HeadKind::flow; }
+  double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
+                    std::mt19937_64& rng) override;
+  Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override;
+
+  /// The learned velocity in NORMALIZED coordinates, f_theta(x_t, t, o) of eq. (5), for
+  /// normalized x (columns) and normalized o.
+  Eigen::MatrixXf normalized_velocity(const Eigen::MatrixXf& x, double t, const Eigen::MatrixXf& o) const;
+
+ protected:
+  /// One step on already normalized actions a_ and observations o_ (the buffers).
+  double train_normalized(std::mt19937_64& rng);
+};
+
+}  // namespace handcentric::policy

@@ -1,0 +1,103 @@
+#include "handcentric/policy/head.hpp"
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/policy/losses.hpp"
+#include "handcentric/policy/time_embedding.hpp"
+#include "network_head.hpp"
+
+namespace handcentric::policy {
+
+std::unique_ptr<Head> make_flow_head(const PolicyConfig& config);
+std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config);
+std::unique_ptr<Head> make_cvae_head(const PolicyConfig& config);
+std::unique_ptr<Head> make_c8_flow_head(const PolicyConfig& config);
+
+std::unique_ptr<Head> make_head(const PolicyConfig& config) {
+  config.validate();
+  if (config.action_dimension < 1 || config.observation_dimension < 1) {
+    throw InvalidArgument("make_head: action_dimension " + std::to_string(config.action_dimension) +
+                          " and observation_dimension " + std::to_string(config.observation_dimension) +
+                          " must be set (>= 1) from the training data first");
+  }
+  switch (config.head) {
+    case HeadKind::flow: return make_flow_head(config);
+    case HeadKind::ddpm: return make_ddpm_head(config);
+    case HeadKind::cvae: return make_cvae_head(config);
+    case HeadKind::c8flow: return make_c8_flow_head(config);
+  }
+  throw InvalidArgument("make_head: unknown head");
+}
+
+namespace {
+std::vector<int> network_widths(const PolicyConfig& config, int output) {
+  std::vector<int> widths{config.action_dimension + time_feature_count(config.time_embedding) +
+                          config.observation_dimension};
+  for (int l = 0; l < config.hidden_layers; ++l) widths.push_back(config.hidden_width);
+  widths.push_back(output);
+  return widths;
+}
+}  // namespace
+
+NetworkHead::NetworkHead(const PolicyConfig& config)
+    : config_(config),
+      action_normalizer_(config.action_dimension),
+      observation_normalizer_(config.observation_dimension),
+      network_(network_widths(config, config.action_dimension), config.activation),
+      adam_(network_.parameter_count(), AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}) {}
+
+void NetworkHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+                          std::mt19937_64& rng) {
+  action_normalizer_ = Normalizer::fit(actions);
+  observation_normalizer_ = Normalizer::fit(observations);
+  network_.initialize(rng);
+}
+
+int NetworkHead::time_rows() const { return time_feature_count(config_.time_embedding); }
+
+void NetworkHead::assemble(const Eigen::MatrixXf& x, const Eigen::VectorXd& t, const Eigen::MatrixXf& o,
+                           Eigen::MatrixXf& input) const {
+  const Eigen::Index da = x.rows(), dt = time_rows(), batch = x.cols();
+  input.resize(da + dt + o.rows(), batch);
+  input.topRows(da) = x;
+  input.bottomRows(o.rows()) = o;
+  Eigen::VectorXf features(dt);
+  for (Eigen::Index j = 0; j < batch; ++j) {
+    time_features(t[j], config_.time_embedding, features);
+    input.block(da, j, dt, 1) = features;
+  }
+}
+
+double NetworkHead::regress(const Eigen::MatrixXf& output, const Eigen::MatrixXf& target) {
+  const double loss = mse_loss<float>(output, target, d_output_);  // eq. (5), averaged
+  network_.backward(d_output_);
+  gradient_ = network_.gradient();
+  clip_gradient_norm(gradient_, config_.gradient_clip);
+  adam_.step(network_.parameters(), gradient_);
+  return loss;
+}
+
+void NetworkHead::write(ByteWriter& out) const {
+  out.doubles(action_normalizer_.mean());
+  out.doubles(action_normalizer_.scale());
+  out.doubles(action_normalizer_.active());
+  out.doubles(observation_normalizer_.mean());
+  out.doubles(observation_normalizer_.scale());
+  out.floats(network_.parameters());
+}
+
+void NetworkHead::read(ByteReader& in) {
+  try {
+    Eigen::VectorXd mean = in.doubles(config_.action_dimension);
+    Eigen::VectorXd scale = in.doubles(config_.action_dimension);
+    Eigen::VectorXd active = in.doubles(config_.action_dimension);
+    action_normalizer_ = Normalizer(mean, scale, active);
+    mean = in.doubles(config_.observation_dimension);
+    scale = in.doubles(config_.observation_dimension);
+    observation_normalizer_ = Normalizer(mean, scale);
+  } catch (const InvalidArgument& error) {
+    in.fail(std::string("bad normalization statistics: ") + error.what());
+  }
+  network_.parameters() = in.floats(network_.parameter_count());
+}
+
+}  // namespace handcentric::policy

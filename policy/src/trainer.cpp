@@ -1,0 +1,77 @@
+#include "handcentric/policy/trainer.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <random>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/representations.hpp"
+
+namespace handcentric::policy {
+
+LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes, std::uint64_t seed,
+                           const ProgressCallback& progress, int report_every) {
+  config.validate();
+  const auto representation = make_representation(config.representation);
+  return train_policy(config, encode_scenes(*representation, scenes, config.history_length, config.chunk_length),
+                      seed, progress, report_every);
+}
+
+LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64_t seed,
+                           const ProgressCallback& progress, int report_every) {
+  config.validate();
+  std::shared_ptr<const Representation> representation = make_representation(config.representation);
+  if (data.size() == 0) throw InvalidScene("no training samples: give at least one demonstration step");
+  config.action_dimension = static_cast<int>(data.actions.rows());
+  config.observation_dimension = static_cast<int>(data.observations.rows());
+  config.hand_points = data.hand_points;
+  config.world_points = data.world_points;
+  std::shared_ptr<Head> head = make_head(config);
+
+  std::mt19937_64 rng(seed);
+  head->prepare(data.actions, data.observations, rng);
+  const Eigen::MatrixXf actions = data.actions.cast<float>();
+  const Eigen::MatrixXf observations = data.observations.cast<float>();
+  if (!actions.allFinite() || !observations.allFinite()) {
+    throw InvalidScene("the training data has a value beyond the float32 range (|x| > 3.4e38): express poses and "
+                       "points in metres and radians");
+  }
+  Eigen::MatrixXf batch_actions(actions.rows(), config.batch_size);
+  Eigen::MatrixXf batch_observations(observations.rows(), config.batch_size);
+
+  const auto start = std::chrono::steady_clock::now();
+  double loss_sum = 0.0;
+  int loss_count = 0;
+  const auto n = static_cast<std::uint64_t>(data.size());
+  for (int step = 1; step <= config.steps; ++step) {
+    for (int j = 0; j < config.batch_size; ++j) {
+      const auto i = static_cast<Eigen::Index>(rng() % n);
+      batch_actions.col(j) = actions.col(i);
+      batch_observations.col(j) = observations.col(i);
+    }
+    const double loss = head->train_step(batch_actions, batch_observations, rng);
+    if (!std::isfinite(loss)) {
+      throw InvalidArgument("training diverged at step " + std::to_string(step) + " (loss " + std::to_string(loss) +
+                            ", learning rate " + std::to_string(config.learning_rate) +
+                            "): lower the learning rate or keep gradient clipping on");
+    }
+    loss_sum += loss;
+    ++loss_count;
+    if (progress && (step % std::max(report_every, 1) == 0 || step == config.steps)) {
+      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      TrainingProgress report;
+      report.step = step;
+      report.steps = config.steps;
+      report.loss = loss_sum / loss_count;
+      report.samples_per_second = seconds > 0.0 ? static_cast<double>(step) * config.batch_size / seconds : 0.0;
+      report.eta_seconds = seconds / step * (config.steps - step);
+      progress(report);
+      loss_sum = 0.0;
+      loss_count = 0;
+    }
+  }
+  return LearnedPolicy(config, representation, head);
+}
+
+}  // namespace handcentric::policy
