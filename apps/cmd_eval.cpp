@@ -9,6 +9,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/expert.hpp"
@@ -16,10 +17,6 @@
 #include "handcentric/sim/rollout.hpp"
 #include "handcentric/sim/scenes.hpp"
 
-#if __has_include("handcentric/policy/model_file.hpp")
-#include "handcentric/policy/model_file.hpp"
-#define HANDCENTRIC_EVAL_HAS_MODELS 1
-#endif
 
 namespace handcentric::apps {
 namespace {
@@ -35,23 +32,11 @@ struct EvalOptions {
   bool json = false;
 };
 
-std::unique_ptr<ChunkPolicy> load_policy(const EvalOptions& options) {
-  if (!options.model.empty()) {
-#ifdef HANDCENTRIC_EVAL_HAS_MODELS
-    return std::make_unique<policy::LearnedPolicy>(policy::load_model(options.model));
-#else
-    throw InvalidArgument("--model '" + options.model +
-                          "': this build has no policy module to load models; use --policy expert, straight or hold");
-#endif
-  }
-  return sim::make_scripted_policy(options.policy.empty() ? "expert" : options.policy);
-}
-
 int run_eval(const EvalOptions& options) {
   if (options.trials < 1) throw InvalidArgument("--trials must be at least 1, got " + std::to_string(options.trials));
   const sim::SceneDistribution distribution =
       sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist);
-  const auto policy = load_policy(options);
+  const auto policy = load_chunk_policy(options.model, options.policy.empty() ? "expert" : options.policy);
   auto scenes = sim::sample_scenes(distribution, options.trials, options.seed);
   if (!options.transform.empty()) scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
   const sim::CollisionChecker checker;

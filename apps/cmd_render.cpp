@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
@@ -13,10 +14,6 @@
 #include "handcentric/sim/rollout.hpp"
 #include "handcentric/sim/scenes.hpp"
 
-#if __has_include("handcentric/policy/model_file.hpp")
-#include "handcentric/policy/model_file.hpp"
-#define HANDCENTRIC_RENDER_HAS_MODELS 1
-#endif
 
 namespace handcentric::apps {
 namespace {
@@ -35,15 +32,6 @@ struct RenderOptions {
   std::string out;
 };
 
-std::unique_ptr<ChunkPolicy> rollout_policy(const RenderOptions& options) {
-  if (options.model.empty()) return sim::make_scripted_policy(options.policy);
-#ifdef HANDCENTRIC_RENDER_HAS_MODELS
-  return std::make_unique<policy::LearnedPolicy>(policy::load_model(options.model));
-#else
-  throw InvalidArgument("--model '" + options.model + "': this build has no policy module to load models");
-#endif
-}
-
 int run_render(const RenderOptions& options) {
   const sim::CollisionChecker checker;
   sim::Image image;
@@ -60,7 +48,7 @@ int run_render(const RenderOptions& options) {
       image = sim::draw_scene(scene, checker.geometry(), options.size);
       what = "scene";
     } else {
-      const auto policy = rollout_policy(options);
+      const auto policy = load_chunk_policy(options.model, options.policy);
       const sim::Rollout rollout = sim::rollout(*policy, scene, checker, sim::stream_seed(options.seed, options.index));
       image = sim::draw_rollout(scene, rollout, checker.geometry(), options.size);
       what = "rollout (" + sim::outcome_name(rollout.outcome) + " after " + std::to_string(rollout.steps) + " steps)";
