@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "handcentric/core/atomic_file.hpp"
 #include "handcentric/proofs/claims.hpp"
 #include "handcentric/proofs/report.hpp"
 
@@ -21,7 +22,7 @@ struct ProveOptions {
 int run_prove(const ProveOptions& options) {
   const std::vector<proofs::ClaimOutcome> outcomes = proofs::certify_all(proofs::paper_claims());
   if (!options.markdown_path.empty()) {
-    proofs::write_file_atomically(options.markdown_path, proofs::report_markdown(outcomes));
+    write_file_atomically(options.markdown_path, proofs::report_markdown(outcomes));
   }
   std::cout << (options.json ? proofs::report_json(outcomes) : proofs::report_text(outcomes));
   if (!options.json && !options.markdown_path.empty()) {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/policy/binary_io.hpp"
 #include "handcentric/policy/errors.hpp"
@@ -82,23 +83,7 @@ LearnedPolicy deserialize_model(const std::string& bytes, const std::string& sou
 }
 
 void save_model(const LearnedPolicy& policy, const std::string& path) {
-  const std::string bytes = serialize_model(policy);
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      std::remove(temporary.c_str());
-      throw InvalidArgument("cannot write the model to '" + path + "': check that the directory exists and is writable");
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    throw InvalidArgument("cannot move the model into '" + path + "': " + error.message());
-  }
+  write_file_atomically(path, serialize_model(policy));
 }
 
 LearnedPolicy load_model(const std::string& path) {

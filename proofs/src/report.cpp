@@ -109,29 +109,4 @@ std::string report_markdown(const std::vector<ClaimOutcome>& outcomes) {
   return out.str();
 }
 
-void write_file_atomically(const std::string& path, const std::string& contents) {
-  if (path.empty()) throw ReportFileError("report path is empty; give a file name, e.g. docs/CLAIMS.md");
-  const std::string temporary = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file) {
-      throw ReportFileError("cannot write '" + path + "' (" + std::strerror(errno) +
-                            "); check that its directory exists and is writable");
-    }
-    file << contents;
-    file.flush();
-    if (!file) {
-      std::remove(temporary.c_str());
-      throw ReportFileError("cannot write '" + path + "' (write failed); check the free space");
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::remove(temporary.c_str());
-    throw ReportFileError("cannot write '" + path + "' (" + error.message() +
-                          "); check that it is not a directory and that its folder is writable");
-  }
-}
-
 }  // namespace handcentric::proofs

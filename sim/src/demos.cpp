@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "handcentric/core/format.hpp"
-#include "handcentric/sim/atomic_file.hpp"
+#include "handcentric/core/atomic_file.hpp"
 
 namespace handcentric::sim {
 namespace {

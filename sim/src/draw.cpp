@@ -9,7 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "handcentric/core/errors.hpp"
-#include "handcentric/sim/atomic_file.hpp"
+#include "handcentric/core/atomic_file.hpp"
 
 namespace handcentric::sim {
 namespace {

@@ -86,6 +86,6 @@ TEST_CASE("damaged_model_files_are_typed_errors", "[unit]") {
 
 TEST_CASE("missing_or_unwritable_model_paths_are_typed_errors", "[unit]") {
   HC_CHECK_THROWS(load_model("/nonexistent/dir/x.model"), InvalidModelFile, Catch::Contains("no such model file"));
-  HC_CHECK_THROWS(save_model(small_policy(), "/nonexistent/dir/x.model"), InvalidArgument,
+  HC_CHECK_THROWS(save_model(small_policy(), "/nonexistent/dir/x.model"), FileError,
                   Catch::Contains("/nonexistent/dir/x.model"));
 }

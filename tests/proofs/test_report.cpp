@@ -73,21 +73,3 @@ TEST_CASE("committed_claims_report_is_up_to_date", "[proofs]") {
   CHECK(read_file(committed) != report_markdown(with_first_failed()));
 }
 
-TEST_CASE("report_files_are_written_atomically_and_bad_paths_are_typed_errors", "[proofs]") {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / "handcentric_test_proofs_report";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  const std::string path = (dir / "CLAIMS.md").string();
-  write_file_atomically(path, "old\n");
-  write_file_atomically(path, "new\n");
-  CHECK(read_file(path) == "new\n");
-  CHECK(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()) ==
-        1);
-  CHECK_THROWS_AS(write_file_atomically((dir / "missing" / "x.md").string(), "x"), ReportFileError);
-  CHECK_THROWS_WITH(write_file_atomically((dir / "missing" / "x.md").string(), "x"),
-                    Catch::Contains("missing/x.md") && Catch::Contains("directory"));
-  CHECK_THROWS_AS(write_file_atomically(dir.string(), "x"), ReportFileError);  // a directory
-  CHECK_THROWS_AS(write_file_atomically("", "x"), ReportFileError);
-  std::filesystem::remove_all(dir);
-}

@@ -30,6 +30,12 @@ class InvalidScene : public Error {
   using Error::Error;
 };
 
+/// A file that cannot be read or written: names the path, the reason and the fix.
+class FileError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// Any other bad argument: a wrong vector length, an unknown name, an out-of-range number.
 class InvalidArgument : public Error {
  public:

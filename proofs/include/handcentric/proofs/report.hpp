@@ -14,12 +14,6 @@
 
 namespace handcentric::proofs {
 
-/// A report file that cannot be written: names the path and the reason.
-class ReportFileError : public Error {
- public:
-  using Error::Error;
-};
-
 /// "N/N certificates verified" and one line per claim.
 std::string summary_text(const std::vector<ClaimOutcome>& outcomes);
 
@@ -31,9 +25,5 @@ std::string report_json(const std::vector<ClaimOutcome>& outcomes);
 
 /// The markdown claims report (docs/CLAIMS.md).
 std::string report_markdown(const std::vector<ClaimOutcome>& outcomes);
-
-/// Writes `contents` to `path` atomically (a temporary file beside it, then rename). Throws
-/// ReportFileError naming the path when it cannot be written.
-void write_file_atomically(const std::string& path, const std::string& contents);
 
 }  // namespace handcentric::proofs

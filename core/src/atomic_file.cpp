@@ -1,37 +1,41 @@
-#include "handcentric/sim/atomic_file.hpp"
+#include "handcentric/core/atomic_file.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <system_error>
-#include <unistd.h>
 
 #include "handcentric/core/errors.hpp"
 
-namespace handcentric::sim {
+namespace handcentric {
 
 void write_file_atomically(const std::string& path, const std::string& bytes) {
-  if (path.empty()) throw InvalidArgument("output path is empty; pass a file name such as out.jsonl");
+  if (path.empty()) throw FileError("output path is empty; give a file name, e.g. out.jsonl");
   const std::string temporary = path + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
     if (!out) {
-      throw Error("cannot write '" + path + "': cannot create '" + temporary +
-                  "' (does the directory exist and is it writable?)");
+      throw FileError("cannot write '" + path + "' (" + std::strerror(errno) +
+                      "); check that its directory exists and is writable");
     }
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     out.flush();
     if (!out) {
       std::remove(temporary.c_str());
-      throw Error("cannot write '" + path + "': writing '" + temporary + "' failed (disk full?)");
+      throw FileError("cannot write '" + path + "' (write failed); check the free space");
     }
   }
   std::error_code error;
   std::filesystem::rename(temporary, path, error);
   if (error) {
     std::remove(temporary.c_str());
-    throw Error("cannot write '" + path + "': rename from '" + temporary + "' failed: " + error.message());
+    throw FileError("cannot write '" + path + "' (" + error.message() +
+                    "); check that it is not a directory and that its folder is writable");
   }
 }
 
-}  // namespace handcentric::sim
+}  // namespace handcentric

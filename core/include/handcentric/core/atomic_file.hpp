@@ -1,0 +1,13 @@
+#pragma once
+// Atomic file writes: the bytes go to a temporary file beside the target, which is then renamed
+// over it, so a reader never sees a half-written demo file, model, report or image.
+#include <string>
+
+namespace handcentric {
+
+/// Writes `bytes` to `path` atomically. Throws FileError naming the path, the reason (missing
+/// directory, no permission, a directory in the way, disk full) and the fix when it cannot; the
+/// target is then left as it was and no temporary file remains.
+void write_file_atomically(const std::string& path, const std::string& bytes);
+
+}  // namespace handcentric
