@@ -9,6 +9,7 @@
 #include "handcentric/policy/cvae_loss.hpp"
 #include "handcentric/policy/mlp.hpp"
 #include "handcentric/policy/normalizer.hpp"
+#include "normalizer_io.hpp"
 
 namespace handcentric::policy {
 namespace {
@@ -68,27 +69,13 @@ class CvaeHead final : public Head {
   }
 
   void write(ByteWriter& out) const override {
-    out.doubles(action_normalizer_.mean());
-    out.doubles(action_normalizer_.scale());
-    out.doubles(action_normalizer_.active());
-    out.doubles(observation_normalizer_.mean());
-    out.doubles(observation_normalizer_.scale());
+    write_normalizers(out, action_normalizer_, observation_normalizer_);
     out.floats(encoder_.parameters());
     out.floats(decoder_.parameters());
   }
 
   void read(ByteReader& in) override {
-    try {
-      Eigen::VectorXd mean = in.doubles(config_.action_dimension);
-      Eigen::VectorXd scale = in.doubles(config_.action_dimension);
-      Eigen::VectorXd active = in.doubles(config_.action_dimension);
-      action_normalizer_ = Normalizer(mean, scale, active);
-      mean = in.doubles(config_.observation_dimension);
-      scale = in.doubles(config_.observation_dimension);
-      observation_normalizer_ = Normalizer(mean, scale);
-    } catch (const InvalidArgument& error) {
-      in.fail(std::string("bad normalization statistics: ") + error.what());
-    }
+    read_normalizers(in, config_, action_normalizer_, observation_normalizer_);
     encoder_.parameters() = in.floats(encoder_.parameter_count());
     decoder_.parameters() = in.floats(decoder_.parameter_count());
   }

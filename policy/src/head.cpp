@@ -4,6 +4,7 @@
 #include "handcentric/policy/losses.hpp"
 #include "handcentric/policy/time_embedding.hpp"
 #include "network_head.hpp"
+#include "normalizer_io.hpp"
 
 namespace handcentric::policy {
 
@@ -77,26 +78,12 @@ double NetworkHead::regress(const Eigen::MatrixXf& output, const Eigen::MatrixXf
 }
 
 void NetworkHead::write(ByteWriter& out) const {
-  out.doubles(action_normalizer_.mean());
-  out.doubles(action_normalizer_.scale());
-  out.doubles(action_normalizer_.active());
-  out.doubles(observation_normalizer_.mean());
-  out.doubles(observation_normalizer_.scale());
+  write_normalizers(out, action_normalizer_, observation_normalizer_);
   out.floats(network_.parameters());
 }
 
 void NetworkHead::read(ByteReader& in) {
-  try {
-    Eigen::VectorXd mean = in.doubles(config_.action_dimension);
-    Eigen::VectorXd scale = in.doubles(config_.action_dimension);
-    Eigen::VectorXd active = in.doubles(config_.action_dimension);
-    action_normalizer_ = Normalizer(mean, scale, active);
-    mean = in.doubles(config_.observation_dimension);
-    scale = in.doubles(config_.observation_dimension);
-    observation_normalizer_ = Normalizer(mean, scale);
-  } catch (const InvalidArgument& error) {
-    in.fail(std::string("bad normalization statistics: ") + error.what());
-  }
+  read_normalizers(in, config_, action_normalizer_, observation_normalizer_);
   network_.parameters() = in.floats(network_.parameter_count());
 }
 
