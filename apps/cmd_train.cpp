@@ -52,6 +52,10 @@ int run_train(const TrainOptions& options) {
   config.head = policy::parse_head(options.head);
   config.representation = options.representation;
   make_representation(options.representation);  // an unknown name fails before the demos load
+  if (options.steps < 1) {
+    throw InvalidArgument("--steps must be at least 1, got " + std::to_string(options.steps) +
+                          " (an untrained model has no final loss to report)");
+  }
   config.steps = options.steps;
   config.chunk_length = options.chunk;
   config.history_length = options.history;

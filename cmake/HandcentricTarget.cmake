@@ -38,3 +38,14 @@ function(handcentric_test name)
     catch_discover_tests(${name} TEST_SPEC "[${label}]" PROPERTIES LABELS ${label})
   endforeach()
 endfunction()
+
+# handcentric_cli_test(<name> <exit code> <regex> <args separated by |>): runs the `handcentric`
+# command and checks its exit code and that stdout + stderr match the regex
+# (tests/support/expect_exit.cmake). Labelled `unit`.
+function(handcentric_cli_test name code regex args)
+  add_test(NAME ${name}
+           COMMAND ${CMAKE_COMMAND} "-DCOMMAND=$<TARGET_FILE:handcentric>" "-DARGS=${args}"
+                   "-DEXPECT_CODE=${code}" "-DEXPECT_REGEX=${regex}"
+                   -P "${PROJECT_SOURCE_DIR}/tests/support/expect_exit.cmake")
+  set_tests_properties(${name} PROPERTIES LABELS unit)
+endfunction()
