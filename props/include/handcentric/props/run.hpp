@@ -6,6 +6,7 @@
 // Seeds: RC_PARAMS="seed=S" sets S; without it, properties run with kDefaultSeed, so a test run
 // is deterministic. A failure message always names its seed and how to replay it.
 #include <rapidcheck.h>
+#include <rapidcheck/detail/TestListenerAdapter.h>
 
 #include <cstdint>
 #include <sstream>
@@ -29,14 +30,23 @@ struct PropertyOutcome {
 /// kDefaultCases unless RC_PARAMS names them.
 rc::detail::TestParams test_params();
 
+/// Whether a failure is news (print RapidCheck's "to reproduce" line at exit) or the expected
+/// result of a planted fault (stay quiet: the outcome carries the counterexample).
+enum class Expect { pass, failure };
+
 /// Runs `testable` (a callable whose arguments RapidCheck generates) under `params`.
 template <typename Testable>
 PropertyOutcome run_property(const std::string& description, Testable&& testable,
-                             const rc::detail::TestParams& params = test_params()) {
+                             const rc::detail::TestParams& params = test_params(),
+                             Expect expect = Expect::pass) {
   rc::detail::TestMetadata metadata;
   metadata.id = description;
   metadata.description = description;
-  const auto result = rc::detail::checkTestable(std::forward<Testable>(testable), metadata, params);
+  rc::detail::TestListenerAdapter quiet;
+  const auto result =
+      expect == Expect::pass
+          ? rc::detail::checkTestable(std::forward<Testable>(testable), metadata, params)
+          : rc::detail::checkTestable(std::forward<Testable>(testable), metadata, params, quiet);
   PropertyOutcome outcome;
   outcome.seed = params.seed;
   std::ostringstream message;
