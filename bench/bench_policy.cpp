@@ -9,6 +9,7 @@
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/policy/head.hpp"
+#include "handcentric/policy/mlp.hpp"
 #include "handcentric/policy/trainer.hpp"
 
 using namespace handcentric;
@@ -74,6 +75,20 @@ BENCHMARK(BM_flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ddpm_sample_10_ddim_steps_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_cvae_sample_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_c8flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond);
+
+// One network evaluation at batch 1 (the inner loop of sampling): 57 -> 256 -> 256 -> 256 -> 24.
+void BM_mlp_infer_batch1(benchmark::State& state) {
+  Mlp mlp({57, 256, 256, 256, 24}, Activation::silu);
+  std::mt19937_64 rng(5);
+  mlp.initialize(rng);
+  Eigen::MatrixXf input = Eigen::MatrixXf::Random(57, 1), output, scratch[2];
+  for (auto _ : state) {
+    mlp.infer(input, output, scratch);
+    input(0, 0) = output(0, 0) * 1e-3f;  // a dependency, as between Euler steps
+  }
+  state.SetBytesProcessed(state.iterations() * mlp.parameter_count() * 4);  // bytes/s = weight bytes read
+}
+BENCHMARK(BM_mlp_infer_batch1)->Unit(benchmark::kMicrosecond);
 
 // The whole outer policy at the paper's defaults (K = 16, H = 2, two eye-in-hand points):
 // encode, 10 Euler steps, decode. The network is 64 + 16 inputs wide here (96 action +

@@ -5,6 +5,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
+#include "kernels/kernel_set.hpp"
 
 namespace handcentric::policy {
 
@@ -37,16 +38,23 @@ void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient) {
   const float step_size = static_cast<float>(options_.learning_rate / bias1);
   const float inv_sqrt_bias2 = static_cast<float>(1.0 / std::sqrt(bias2));
   const float eps = static_cast<float>(options_.epsilon);
-  m_.array() = b1 * m_.array() + (1.0f - b1) * gradient.array();
-  v_.array() = b2 * v_.array() + (1.0f - b2) * gradient.array().square();
-  if (options_.weight_decay > 0.0) {
-    parameters *= static_cast<float>(1.0 - options_.learning_rate * options_.weight_decay);
-  }
-  parameters.array() -= step_size * m_.array() / (v_.array().sqrt() * inv_sqrt_bias2 + eps);
+  kernels::AdamUpdate update;
+  update.n = parameters.size();
+  update.parameters = parameters.data();
+  update.gradient = gradient.data();
+  update.m = m_.data();
+  update.v = v_.data();
+  update.beta1 = b1;
+  update.beta2 = b2;
+  update.step_size = step_size;
+  update.inv_sqrt_bias2 = inv_sqrt_bias2;
+  update.epsilon = eps;
+  update.decay = static_cast<float>(1.0 - options_.learning_rate * options_.weight_decay);  // AdamW
+  kernels::active().adam(update);
 }
 
 double clip_gradient_norm(Eigen::VectorXf& gradient, double max_norm) {
-  const double norm = std::sqrt(gradient.template cast<double>().squaredNorm());
+  const double norm = std::sqrt(kernels::active().squared_norm(gradient.size(), gradient.data()));
   if (max_norm > 0.0 && norm > max_norm) gradient *= static_cast<float>(max_norm / norm);
   return norm;
 }

@@ -70,7 +70,7 @@ void NetworkHead::assemble(const Eigen::MatrixXf& x, const Eigen::VectorXd& t, c
 
 double NetworkHead::regress(const Eigen::MatrixXf& output, const Eigen::MatrixXf& target) {
   const double loss = mse_loss<float>(output, target, d_output_);  // eq. (5), averaged
-  network_.backward(d_output_);
+  network_.backward_parameters(d_output_);
   gradient_ = network_.gradient();
   clip_gradient_norm(gradient_, config_.gradient_clip);
   adam_.step(network_.parameters(), gradient_);

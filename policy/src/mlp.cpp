@@ -2,9 +2,11 @@
 
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "kernels/kernel_set.hpp"
 
 namespace handcentric::policy {
 
@@ -59,6 +61,12 @@ template <typename Matrix>
 void activate(Activation activation, const Matrix& z, Matrix& a) {
   using Scalar = typename Matrix::Scalar;
   if (activation == Activation::silu) {
+    if constexpr (std::is_same_v<Scalar, float>) {
+      if (&z == &a) {
+        kernels::active().silu(a.size(), a.data());
+        return;
+      }
+    }
     a.array() = z.array() / (Scalar(1) + (-z.array()).exp());
   } else {
     a.array() = z.array().max(Scalar(0));
@@ -77,6 +85,51 @@ void multiply_by_derivative(Activation activation, const Matrix& z, Matrix& delt
   }
 }
 
+// The three products of a layer, on column-major storage. float runs on the dispatched kernels
+// (kernels.hpp); double (the gradient checks) on Eigen.
+using kernels::Op;
+
+// out (rows x batch) = W in + b 1^T.
+template <typename Scalar, typename W, typename B, typename In, typename Out>
+void affine(const W& weights, const B& bias, const In& in, Out& out) {
+  out.resize(weights.rows(), in.cols());
+  if constexpr (std::is_same_v<Scalar, float>) {
+    kernels::active().gemm({Op::none, Op::none, static_cast<int>(weights.rows()), static_cast<int>(in.cols()),
+                                 static_cast<int>(weights.cols()), weights.data(), static_cast<int>(weights.rows()),
+                                 in.data(), static_cast<int>(in.outerStride()), bias.data(), out.data(),
+                                 static_cast<int>(out.rows())});
+  } else {
+    out.noalias() = weights * in;
+    out.colwise() += bias;
+  }
+}
+
+// dW (out x in) = delta a^T.
+template <typename Scalar, typename Delta, typename A, typename DW>
+void outer(const Delta& delta, const A& a, DW& dW) {
+  if constexpr (std::is_same_v<Scalar, float>) {
+    kernels::active().gemm({Op::none, Op::transpose, static_cast<int>(delta.rows()), static_cast<int>(a.rows()),
+                                 static_cast<int>(delta.cols()), delta.data(), static_cast<int>(delta.rows()),
+                                 a.data(), static_cast<int>(a.rows()), nullptr, dW.data(), static_cast<int>(dW.rows())});
+  } else {
+    dW.noalias() = delta * a.transpose();
+  }
+}
+
+// out (in x batch) = W^T delta.
+template <typename Scalar, typename W, typename Delta, typename Out>
+void transposed(const W& weights, const Delta& delta, Out& out) {
+  out.resize(weights.cols(), delta.cols());
+  if constexpr (std::is_same_v<Scalar, float>) {
+    kernels::active().gemm({Op::transpose, Op::none, static_cast<int>(weights.cols()),
+                                 static_cast<int>(delta.cols()), static_cast<int>(weights.rows()), weights.data(),
+                                 static_cast<int>(weights.rows()), delta.data(), static_cast<int>(delta.rows()),
+                                 nullptr, out.data(), static_cast<int>(out.rows())});
+  } else {
+    out.noalias() = weights.transpose() * delta;
+  }
+}
+
 }  // namespace
 
 template <typename Scalar>
@@ -87,14 +140,18 @@ const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::forward(const Eigen::Ref<cons
   }
   a_[0] = input;
   for (int l = 0; l < layers(); ++l) {
-    z_[l].noalias() = W(l) * a_[l];
-    z_[l].colwise() += b(l);
+    affine<Scalar>(W(l), b(l), a_[l], z_[l]);
     if (l + 1 < layers()) {
       if (activation_ == Activation::silu) {
         // Keep sigmoid(z) for backward(): one exp per unit instead of two.
         sigmoid_[l].resize(z_[l].rows(), z_[l].cols());
-        sigmoid_[l].array() = Scalar(1) / (Scalar(1) + (-z_[l].array()).exp());
-        a_[l + 1].array() = z_[l].array() * sigmoid_[l].array();
+        a_[l + 1].resize(z_[l].rows(), z_[l].cols());
+        if constexpr (std::is_same_v<Scalar, float>) {
+          kernels::active().silu_forward(z_[l].size(), z_[l].data(), sigmoid_[l].data(), a_[l + 1].data());
+        } else {
+          sigmoid_[l].array() = Scalar(1) / (Scalar(1) + (-z_[l].array()).exp());
+          a_[l + 1].array() = z_[l].array() * sigmoid_[l].array();
+        }
       } else {
         a_[l + 1].resize(z_[l].rows(), z_[l].cols());
         activate(activation_, z_[l], a_[l + 1]);
@@ -106,6 +163,16 @@ const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::forward(const Eigen::Ref<cons
 
 template <typename Scalar>
 const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::backward(const Eigen::Ref<const Matrix>& d_output) {
+  return delta_[propagate(d_output, true)];
+}
+
+template <typename Scalar>
+void MlpT<Scalar>::backward_parameters(const Eigen::Ref<const Matrix>& d_output) {
+  propagate(d_output, false);
+}
+
+template <typename Scalar>
+int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input_gradient) {
   const Eigen::Index batch = a_[0].cols();
   if (d_output.rows() != output_size() || d_output.cols() != batch) {
     throw InvalidArgument("Mlp::backward: d_output is " + std::to_string(d_output.rows()) + "x" +
@@ -119,8 +186,12 @@ const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::backward(const Eigen::Ref<con
     if (l + 1 < layers()) {
       if (activation_ == Activation::silu) {
         // SiLU'(z) = s (1 + z (1 - s)), s = sigmoid(z) from forward().
-        const auto s = sigmoid_[l].array();
-        delta.array() *= s * (Scalar(1) + z_[l].array() * (Scalar(1) - s));
+        if constexpr (std::is_same_v<Scalar, float>) {
+          kernels::active().silu_backward(delta.size(), z_[l].data(), sigmoid_[l].data(), delta.data());
+        } else {
+          const auto s = sigmoid_[l].array();
+          delta.array() *= s * (Scalar(1) + z_[l].array() * (Scalar(1) - s));
+        }
       } else {
         multiply_by_derivative(activation_, z_[l], delta);
       }
@@ -128,12 +199,13 @@ const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::backward(const Eigen::Ref<con
     const Eigen::Index n = static_cast<Eigen::Index>(widths_[l + 1]) * widths_[l];
     Eigen::Map<Matrix> dW(gradient_.data() + offsets_[l], widths_[l + 1], widths_[l]);
     Eigen::Map<Vector> db(gradient_.data() + offsets_[l] + n, widths_[l + 1]);
-    dW.noalias() = delta * a_[l].transpose();
+    outer<Scalar>(delta, a_[l], dW);
     db.noalias() = delta.rowwise().sum();
-    delta_[1 - current].noalias() = W(l).transpose() * delta;
+    if (l == 0 && !input_gradient) break;
+    transposed<Scalar>(W(l), delta, delta_[1 - current]);
     current = 1 - current;
   }
-  return delta_[current];
+  return current;
 }
 
 template <typename Scalar>
@@ -143,18 +215,15 @@ void MlpT<Scalar>::infer(const Eigen::Ref<const Matrix>& input, Matrix& output, 
                           std::to_string(input_size()));
   }
   if (layers() == 1) {
-    output.noalias() = W(0) * input;
-    output.colwise() += b(0);
+    affine<Scalar>(W(0), b(0), input, output);
     return;
   }
-  scratch[0].noalias() = W(0) * input;
-  scratch[0].colwise() += b(0);
+  affine<Scalar>(W(0), b(0), input, scratch[0]);
   int current = 0;
   for (int l = 1; l < layers(); ++l) {
     activate(activation_, scratch[current], scratch[current]);
     Matrix& next = l + 1 < layers() ? scratch[1 - current] : output;
-    next.noalias() = W(l) * scratch[current];
-    next.colwise() += b(l);
+    affine<Scalar>(W(l), b(l), scratch[current], next);
     current = 1 - current;
   }
 }

@@ -6,13 +6,15 @@
 // Column-major batches: an input is (input_size x B), one sample per column, so every layer
 // is one GEMM over the whole minibatch. All parameters live in ONE flat vector (W_1, b_1,
 // W_2, b_2, ...; each W column-major) so that Adam, clipping and model files see one array.
-// Scalar = float for training and sampling; double for the finite-difference gradient checks.
+// Scalar = float for training and sampling, on the run-time dispatched kernels of kernels.hpp;
+// double (Eigen) for the finite-difference gradient checks.
 #include <Eigen/Core>
 #include <cstdint>
 #include <random>
 #include <vector>
 
 #include "handcentric/policy/config.hpp"
+#include "handcentric/policy/kernels.hpp"
 
 namespace handcentric::policy {
 
@@ -47,6 +49,8 @@ class MlpT {
   /// Backward pass from d loss / d output (output x B) of the last forward(): sets gradient()
   /// and returns d loss / d input (input x B).
   const Matrix& backward(const Eigen::Ref<const Matrix>& d_output);
+  /// backward() without d loss / d input: sets gradient() only (one product less).
+  void backward_parameters(const Eigen::Ref<const Matrix>& d_output);
 
   /// Inference into `output` without touching the training caches; `scratch` holds two
   /// buffers that are reused (no allocation once they have the right size).
@@ -56,6 +60,8 @@ class MlpT {
   int layers() const { return static_cast<int>(widths_.size()) - 1; }
   Eigen::Map<const Matrix> W(int layer) const;
   Eigen::Map<const Vector> b(int layer) const;
+  /// The backward pass; returns the index into delta_ of d loss / d input when input_gradient.
+  int propagate(const Eigen::Ref<const Matrix>& d_output, bool input_gradient);
 
   std::vector<int> widths_;
   Activation activation_ = Activation::silu;

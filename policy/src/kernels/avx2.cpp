@@ -1,0 +1,213 @@
+// AVX2 + FMA kernels (see gemm_avx512.cpp for why every vector function carries the target
+// attribute and the translation unit does not). avx2_kernels() is only used after
+// kernel_isa_supported(KernelIsa::avx2) said yes.
+#include <immintrin.h>
+
+#include <cmath>
+#include <cstddef>
+#include <utility>
+
+#include "kernel_set.hpp"
+#include "pack.hpp"
+
+#define HC_AVX2 __attribute__((target("avx2,fma")))
+
+namespace handcentric::policy::kernels {
+namespace {
+
+// C tile of 16 x 6 = 12 ymm accumulators; per k: 2 loads of A, 6 broadcasts of B, 12 FMAs.
+struct Avx2Kernel {
+  static constexpr int MR = 16, NR = 6;
+
+  template <BLayout layout>
+  HC_AVX2 static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc, bool accumulate,
+                           const float* bias) {
+    __m256 acc[NR][2];
+    #pragma GCC unroll 32
+    for (int j = 0; j < NR; ++j) acc[j][0] = acc[j][1] = _mm256_setzero_ps();
+    for (int p = 0; p < kc; ++p) {
+      const __m256 a0 = _mm256_load_ps(a), a1 = _mm256_load_ps(a + 8);
+      #pragma GCC unroll 32
+      for (int j = 0; j < NR; ++j) {
+        const __m256 bj = _mm256_broadcast_ss(layout == BLayout::columns ? b + j * static_cast<long>(ldb) : b + j);
+        acc[j][0] = _mm256_fmadd_ps(a0, bj, acc[j][0]);
+        acc[j][1] = _mm256_fmadd_ps(a1, bj, acc[j][1]);
+      }
+      a += MR;
+      b += layout == BLayout::packed ? NR : layout == BLayout::rows ? ldb : 1;
+    }
+    __m256 add0 = _mm256_setzero_ps(), add1 = _mm256_setzero_ps();
+    if (!accumulate && bias != nullptr) {
+      add0 = _mm256_loadu_ps(bias);
+      add1 = _mm256_loadu_ps(bias + 8);
+    }
+    #pragma GCC unroll 32
+    for (int j = 0; j < NR; ++j) {
+      float* cj = c + static_cast<long>(j) * ldc;
+      if (accumulate) {
+        add0 = _mm256_loadu_ps(cj);
+        add1 = _mm256_loadu_ps(cj + 8);
+      }
+      _mm256_storeu_ps(cj, _mm256_add_ps(acc[j][0], add0));
+      _mm256_storeu_ps(cj + 8, _mm256_add_ps(acc[j][1], add1));
+    }
+  }
+};
+
+// y(rows) = A(rows x k) x (+ bias), rows <= 8 V; the last of the V ymm accumulators is masked.
+template <int V>
+HC_AVX2 void gemv_block(int rows, int k, const float* a, long lda, const float* x, const float* bias, float* y) {
+  const int tail = rows - 8 * (V - 1);  // 1..8 rows in the last vector
+  alignas(32) int lanes[8];
+  for (int i = 0; i < 8; ++i) lanes[i] = i < tail ? -1 : 0;
+  const __m256i last = _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes));
+  __m256 acc[V];
+  #pragma GCC unroll 32
+  for (int v = 0; v + 1 < V; ++v) acc[v] = bias != nullptr ? _mm256_loadu_ps(bias + 8 * v) : _mm256_setzero_ps();
+  acc[V - 1] = bias != nullptr ? _mm256_maskload_ps(bias + 8 * (V - 1), last) : _mm256_setzero_ps();
+  for (int p = 0; p < k; ++p) {
+    const float* column = a + p * lda;
+    const __m256 xp = _mm256_broadcast_ss(x + p);
+    #pragma GCC unroll 32
+    for (int v = 0; v < V; v += 8) _mm_prefetch(reinterpret_cast<const char*>(column + 4 * lda + 8 * v), _MM_HINT_T0);
+    #pragma GCC unroll 32
+    for (int v = 0; v + 1 < V; ++v) acc[v] = _mm256_fmadd_ps(_mm256_loadu_ps(column + 8 * v), xp, acc[v]);
+    acc[V - 1] = _mm256_fmadd_ps(_mm256_maskload_ps(column + 8 * (V - 1), last), xp, acc[V - 1]);
+  }
+  #pragma GCC unroll 32
+  for (int v = 0; v + 1 < V; ++v) _mm256_storeu_ps(y + 8 * v, acc[v]);
+  _mm256_maskstore_ps(y + 8 * (V - 1), last, acc[V - 1]);
+}
+
+template <int... V>
+HC_AVX2 void gemv_rows(int vectors, int rows, int k, const float* a, long lda, const float* x, const float* bias,
+                       float* y, std::integer_sequence<int, V...>) {
+  ((vectors == V + 1 ? gemv_block<V + 1>(rows, k, a, lda, x, bias, y) : void()), ...);
+}
+
+HC_AVX2 void gemv(const Gemm& g) {
+  constexpr int kBlockRows = 96;  // 12 accumulators of the 16 ymm registers
+  for (int i0 = 0; i0 < g.m; i0 += kBlockRows) {
+    const int rows = std::min(kBlockRows, g.m - i0);
+    gemv_rows((rows + 7) / 8, rows, g.k, g.a + i0, g.lda, g.b, g.row_bias ? g.row_bias + i0 : nullptr, g.c + i0,
+              std::make_integer_sequence<int, 12>{});
+  }
+}
+
+HC_AVX2 void gemm(const Gemm& g) {
+  if (trivial_gemm(g)) return;
+  if (g.n == 1 && g.op_a == Op::none && (g.op_b == Op::none || g.ldb == 1)) {
+    gemv(g);
+  } else {
+    blocked_gemm<Avx2Kernel>(g);
+  }
+}
+
+// exp(x) by ExpPolynomial (kernel_set.hpp), 2^n built in the exponent bits; x is
+// clamped to [-87.3, 88.7] so that n + 127 stays a normal exponent.
+HC_AVX2 __m256 exp_ps(__m256 x) {
+  x = _mm256_min_ps(_mm256_max_ps(x, _mm256_set1_ps(-87.3f)), _mm256_set1_ps(88.7f));
+  const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(ExpPolynomial::kLog2e)),
+                                   _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  __m256 r = _mm256_fnmadd_ps(n, _mm256_set1_ps(ExpPolynomial::kLn2High), x);
+  r = _mm256_fnmadd_ps(n, _mm256_set1_ps(ExpPolynomial::kLn2Low), r);
+  __m256 p = _mm256_set1_ps(ExpPolynomial::kC[0]);
+#pragma GCC unroll 5
+  for (int i = 1; i < 6; ++i) p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(ExpPolynomial::kC[i]));
+  p = _mm256_fmadd_ps(p, _mm256_mul_ps(r, r), _mm256_add_ps(r, _mm256_set1_ps(1.0f)));
+  const __m256i exponent = _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
+  return _mm256_mul_ps(p, _mm256_castsi256_ps(exponent));
+}
+
+HC_AVX2 __m256 sigmoid_ps(__m256 z) {
+  const __m256 one = _mm256_set1_ps(1.0f);
+  return _mm256_div_ps(one, _mm256_add_ps(one, exp_ps(_mm256_sub_ps(_mm256_setzero_ps(), z))));
+}
+
+// The tails (n mod 8 values) go through a zero-padded 8-float buffer.
+template <typename Body>
+HC_AVX2 void for_blocks(std::ptrdiff_t n, Body&& body) {
+  std::ptrdiff_t i = 0;
+  for (; i + 8 <= n; i += 8) body(i, 8);
+  if (i < n) body(i, static_cast<int>(n - i));
+}
+
+HC_AVX2 __m256 load(const float* p, int count) {
+  if (count == 8) return _mm256_loadu_ps(p);
+  alignas(32) float buffer[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  for (int i = 0; i < count; ++i) buffer[i] = p[i];
+  return _mm256_load_ps(buffer);
+}
+
+HC_AVX2 void store(float* p, __m256 x, int count) {
+  if (count == 8) {
+    _mm256_storeu_ps(p, x);
+    return;
+  }
+  alignas(32) float buffer[8];
+  _mm256_store_ps(buffer, x);
+  for (int i = 0; i < count; ++i) p[i] = buffer[i];
+}
+
+HC_AVX2 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a) {
+  for_blocks(n, [&](std::ptrdiff_t i, int count) HC_AVX2 {
+    const __m256 zi = load(z + i, count), si = sigmoid_ps(zi);
+    store(s + i, si, count);
+    store(a + i, _mm256_mul_ps(zi, si), count);
+  });
+}
+
+HC_AVX2 void silu_backward(std::ptrdiff_t n, const float* z, const float* s, float* delta) {
+  for_blocks(n, [&](std::ptrdiff_t i, int count) HC_AVX2 {
+    const __m256 one = _mm256_set1_ps(1.0f);
+    const __m256 zi = load(z + i, count), si = load(s + i, count);
+    const __m256 derivative = _mm256_mul_ps(si, _mm256_fmadd_ps(zi, _mm256_sub_ps(one, si), one));
+    store(delta + i, _mm256_mul_ps(load(delta + i, count), derivative), count);
+  });
+}
+
+HC_AVX2 void silu(std::ptrdiff_t n, float* x) {
+  for_blocks(n, [&](std::ptrdiff_t i, int count) HC_AVX2 {
+    const __m256 xi = load(x + i, count);
+    store(x + i, _mm256_mul_ps(xi, sigmoid_ps(xi)), count);
+  });
+}
+
+HC_AVX2 double squared_norm(std::ptrdiff_t n, const float* g) {
+  __m256d sum0 = _mm256_setzero_pd(), sum1 = _mm256_setzero_pd();
+  for_blocks(n, [&](std::ptrdiff_t i, int count) HC_AVX2 {
+    const __m256 gi = load(g + i, count);
+    const __m256d lo = _mm256_cvtps_pd(_mm256_castps256_ps128(gi)), hi = _mm256_cvtps_pd(_mm256_extractf128_ps(gi, 1));
+    sum0 = _mm256_fmadd_pd(lo, lo, sum0);
+    sum1 = _mm256_fmadd_pd(hi, hi, sum1);
+  });
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, _mm256_add_pd(sum0, sum1));
+  return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
+}
+
+HC_AVX2 void adam(const AdamUpdate& u) {
+  for_blocks(u.n, [&](std::ptrdiff_t i, int count) HC_AVX2 {
+    const __m256 g = load(u.gradient + i, count);
+    const __m256 m = _mm256_fmadd_ps(_mm256_set1_ps(u.beta1), load(u.m + i, count),
+                                     _mm256_mul_ps(_mm256_set1_ps(1.0f - u.beta1), g));
+    const __m256 v = _mm256_fmadd_ps(_mm256_set1_ps(u.beta2), load(u.v + i, count),
+                                     _mm256_mul_ps(_mm256_set1_ps(1.0f - u.beta2), _mm256_mul_ps(g, g)));
+    __m256 p = load(u.parameters + i, count);
+    if (u.decay != 1.0f) p = _mm256_mul_ps(p, _mm256_set1_ps(u.decay));
+    const __m256 denominator = _mm256_fmadd_ps(_mm256_sqrt_ps(v), _mm256_set1_ps(u.inv_sqrt_bias2), _mm256_set1_ps(u.epsilon));
+    p = _mm256_sub_ps(p, _mm256_div_ps(_mm256_mul_ps(_mm256_set1_ps(u.step_size), m), denominator));
+    store(u.m + i, m, count);
+    store(u.v + i, v, count);
+    store(u.parameters + i, p, count);
+  });
+}
+
+}  // namespace
+
+const KernelSet& avx2_kernels() {
+  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam};
+  return set;
+}
+
+}  // namespace handcentric::policy::kernels

@@ -1,0 +1,222 @@
+// AVX-512 F kernels. Every function that uses AVX-512 carries the target attribute, and the
+// translation unit is compiled for the baseline target: no template or inline function of
+// another header is compiled for AVX-512 here, so nothing AVX-512 can leak into the rest of the
+// program through the linker's choice of one copy of an inline function. avx512_kernels() is only
+// used after kernel_isa_supported(KernelIsa::avx512) said yes.
+#include <immintrin.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+
+#include "kernel_set.hpp"
+#include "pack.hpp"
+
+#define HC_AVX512 __attribute__((target("avx512f,fma")))
+
+namespace handcentric::policy::kernels {
+namespace {
+
+// C tile of 32 x 12 = 24 zmm accumulators; per k: 2 loads of A, 12 broadcasts of B, 24 FMAs.
+struct Avx512Kernel {
+  static constexpr int MR = 32, NR = 12;
+
+  template <BLayout layout>
+  HC_AVX512 static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc, bool accumulate,
+                             const float* bias) {
+    __m512 acc[NR][2];
+    #pragma GCC unroll 32
+    for (int j = 0; j < NR; ++j) acc[j][0] = acc[j][1] = _mm512_setzero_ps();
+    for (int p = 0; p < kc; ++p) {
+      const __m512 a0 = _mm512_load_ps(a), a1 = _mm512_load_ps(a + 16);
+      _mm_prefetch(reinterpret_cast<const char*>(a + 8 * MR), _MM_HINT_T0);
+      #pragma GCC unroll 32
+      for (int j = 0; j < NR; ++j) {
+        const __m512 bj = _mm512_set1_ps(layout == BLayout::columns ? b[j * static_cast<long>(ldb)] : b[j]);
+        acc[j][0] = _mm512_fmadd_ps(a0, bj, acc[j][0]);
+        acc[j][1] = _mm512_fmadd_ps(a1, bj, acc[j][1]);
+      }
+      a += MR;
+      b += layout == BLayout::packed ? NR : layout == BLayout::rows ? ldb : 1;
+    }
+    if (accumulate) {
+      #pragma GCC unroll 32
+      for (int j = 0; j < NR; ++j) {
+        float* cj = c + static_cast<long>(j) * ldc;
+        _mm512_storeu_ps(cj, _mm512_add_ps(acc[j][0], _mm512_loadu_ps(cj)));
+        _mm512_storeu_ps(cj + 16, _mm512_add_ps(acc[j][1], _mm512_loadu_ps(cj + 16)));
+      }
+    } else {
+      __m512 bias0 = _mm512_setzero_ps(), bias1 = _mm512_setzero_ps();
+      if (bias != nullptr) {
+        bias0 = _mm512_loadu_ps(bias);
+        bias1 = _mm512_loadu_ps(bias + 16);
+      }
+      #pragma GCC unroll 32
+      for (int j = 0; j < NR; ++j) {
+        float* cj = c + static_cast<long>(j) * ldc;
+        _mm512_storeu_ps(cj, _mm512_add_ps(acc[j][0], bias0));
+        _mm512_storeu_ps(cj + 16, _mm512_add_ps(acc[j][1], bias1));
+      }
+    }
+  }
+};
+
+// y(rows) = A(rows x k) x (+ bias) with V zmm accumulators held over the whole k loop. A's
+// columns are read in order (one stream, prefetched 4 columns ahead). When every column starts
+// `shift` floats past a 64-byte boundary (Eigen aligns its heap to 16 bytes only), the vectors
+// start `shift` lanes early so that each load is one cache line: the first vector masks off its
+// first `shift` lanes and the last one the lanes past the end (masked lanes are neither read
+// nor written). Needs shift + rows <= 16 V.
+template <int V>
+HC_AVX512 void gemv_block(int shift, int rows, int k, const float* a, long lda, const float* x, const float* bias,
+                          float* y) {
+  const int lanes = shift + rows;  // in 16 (V - 1) + 1 .. 16 V
+  __mmask16 head = static_cast<__mmask16>(0xFFFFu << shift);
+  const int tail_lanes = lanes - 16 * (V - 1);
+  __mmask16 tail = static_cast<__mmask16>(tail_lanes >= 16 ? 0xFFFFu : (1u << tail_lanes) - 1u);
+  if constexpr (V == 1) head = tail = static_cast<__mmask16>(head & tail);
+  a -= shift;
+  y -= shift;
+  if (bias != nullptr) bias -= shift;
+  __m512 acc[V];
+  #pragma GCC unroll 32
+  for (int v = 0; v < V; ++v) {
+    const __mmask16 mask = v == 0 ? head : v + 1 == V ? tail : static_cast<__mmask16>(0xFFFF);
+    acc[v] = bias != nullptr ? _mm512_maskz_loadu_ps(mask, bias + 16 * v) : _mm512_setzero_ps();
+  }
+  for (int p = 0; p < k; ++p) {
+    const float* column = a + p * lda;
+    const __m512 xp = _mm512_set1_ps(x[p]);
+    // (no software prefetch: the hardware streamer does better here)
+    acc[0] = _mm512_fmadd_ps(_mm512_maskz_loadu_ps(head, column), xp, acc[0]);
+    #pragma GCC unroll 32
+    for (int v = 1; v + 1 < V; ++v) acc[v] = _mm512_fmadd_ps(_mm512_loadu_ps(column + 16 * v), xp, acc[v]);
+    if constexpr (V > 1) acc[V - 1] = _mm512_fmadd_ps(_mm512_maskz_loadu_ps(tail, column + 16 * (V - 1)), xp, acc[V - 1]);
+  }
+  _mm512_mask_storeu_ps(y, head, acc[0]);
+  #pragma GCC unroll 32
+  for (int v = 1; v + 1 < V; ++v) _mm512_storeu_ps(y + 16 * v, acc[v]);
+  if constexpr (V > 1) _mm512_mask_storeu_ps(y + 16 * (V - 1), tail, acc[V - 1]);
+}
+
+template <int... V>
+HC_AVX512 void gemv_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* x,
+                         const float* bias, float* y, std::integer_sequence<int, V...>) {
+  ((vectors == V + 1 ? gemv_block<V + 1>(shift, rows, k, a, lda, x, bias, y) : void()), ...);
+}
+
+HC_AVX512 void gemv(const Gemm& g) {
+  constexpr int kMaxVectors = 24;  // accumulators, of the 32 zmm registers
+  // Columns share their offset from a cache line when lda is a multiple of 16 floats.
+  const auto address = reinterpret_cast<std::uintptr_t>(g.a);
+  const int shift = (g.lda % 16 == 0 && address % 4 == 0) ? static_cast<int>(address % 64 / 4) : 0;
+  const int block_rows = 16 * kMaxVectors - shift;
+  for (int i0 = 0; i0 < g.m; i0 += block_rows) {
+    const int rows = std::min(block_rows, g.m - i0);
+    const int block_shift = i0 == 0 ? shift : 0;  // later blocks start on a line
+    gemv_rows((block_shift + rows + 15) / 16, block_shift, rows, g.k, g.a + i0, g.lda, g.b,
+              g.row_bias ? g.row_bias + i0 : nullptr, g.c + i0, std::make_integer_sequence<int, kMaxVectors>{});
+  }
+}
+
+HC_AVX512 void gemm(const Gemm& g) {
+  if (trivial_gemm(g)) return;
+  if (g.n == 1 && g.op_a == Op::none && (g.op_b == Op::none || g.ldb == 1)) {
+    gemv(g);
+  } else {
+    blocked_gemm<Avx512Kernel>(g);
+  }
+}
+
+// exp(x) by ExpPolynomial (kernel_set.hpp), times 2^n by scalef, which also gives 0 and +inf
+// past the ends; x is clamped to +-88.7 first.
+HC_AVX512 __m512 exp_ps(__m512 x) {
+  x = _mm512_min_ps(_mm512_max_ps(x, _mm512_set1_ps(-88.7f)), _mm512_set1_ps(88.7f));
+  const __m512 n = _mm512_roundscale_ps(_mm512_mul_ps(x, _mm512_set1_ps(ExpPolynomial::kLog2e)),
+                                        _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  __m512 r = _mm512_fnmadd_ps(n, _mm512_set1_ps(ExpPolynomial::kLn2High), x);
+  r = _mm512_fnmadd_ps(n, _mm512_set1_ps(ExpPolynomial::kLn2Low), r);
+  __m512 p = _mm512_set1_ps(ExpPolynomial::kC[0]);
+#pragma GCC unroll 5
+  for (int i = 1; i < 6; ++i) p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(ExpPolynomial::kC[i]));
+  p = _mm512_fmadd_ps(p, _mm512_mul_ps(r, r), _mm512_add_ps(r, _mm512_set1_ps(1.0f)));
+  return _mm512_scalef_ps(p, n);
+}
+
+HC_AVX512 __m512 sigmoid_ps(__m512 z) {
+  const __m512 one = _mm512_set1_ps(1.0f);
+  return _mm512_div_ps(one, _mm512_add_ps(one, exp_ps(_mm512_sub_ps(_mm512_setzero_ps(), z))));
+}
+
+HC_AVX512 __mmask16 tail_mask(std::ptrdiff_t remaining) {
+  return remaining >= 16 ? static_cast<__mmask16>(0xFFFF) : static_cast<__mmask16>((1u << remaining) - 1u);
+}
+
+HC_AVX512 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a) {
+  for (std::ptrdiff_t i = 0; i < n; i += 16) {
+    const __mmask16 mask = tail_mask(n - i);
+    const __m512 zi = _mm512_maskz_loadu_ps(mask, z + i);
+    const __m512 si = sigmoid_ps(zi);
+    _mm512_mask_storeu_ps(s + i, mask, si);
+    _mm512_mask_storeu_ps(a + i, mask, _mm512_mul_ps(zi, si));
+  }
+}
+
+HC_AVX512 void silu_backward(std::ptrdiff_t n, const float* z, const float* s, float* delta) {
+  const __m512 one = _mm512_set1_ps(1.0f);
+  for (std::ptrdiff_t i = 0; i < n; i += 16) {
+    const __mmask16 mask = tail_mask(n - i);
+    const __m512 zi = _mm512_maskz_loadu_ps(mask, z + i), si = _mm512_maskz_loadu_ps(mask, s + i);
+    const __m512 derivative = _mm512_mul_ps(si, _mm512_fmadd_ps(zi, _mm512_sub_ps(one, si), one));
+    _mm512_mask_storeu_ps(delta + i, mask, _mm512_mul_ps(_mm512_maskz_loadu_ps(mask, delta + i), derivative));
+  }
+}
+
+HC_AVX512 void silu(std::ptrdiff_t n, float* x) {
+  for (std::ptrdiff_t i = 0; i < n; i += 16) {
+    const __mmask16 mask = tail_mask(n - i);
+    const __m512 xi = _mm512_maskz_loadu_ps(mask, x + i);
+    _mm512_mask_storeu_ps(x + i, mask, _mm512_mul_ps(xi, sigmoid_ps(xi)));
+  }
+}
+
+HC_AVX512 double squared_norm(std::ptrdiff_t n, const float* g) {
+  __m512d sum0 = _mm512_setzero_pd(), sum1 = _mm512_setzero_pd();
+  for (std::ptrdiff_t i = 0; i < n; i += 16) {
+    const __m512 gi = _mm512_maskz_loadu_ps(tail_mask(n - i), g + i);
+    const __m512d lo = _mm512_cvtps_pd(_mm512_castps512_ps256(gi));
+    const __m512d hi = _mm512_cvtps_pd(_mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(gi), 1)));
+    sum0 = _mm512_fmadd_pd(lo, lo, sum0);
+    sum1 = _mm512_fmadd_pd(hi, hi, sum1);
+  }
+  return _mm512_reduce_add_pd(_mm512_add_pd(sum0, sum1));
+}
+
+HC_AVX512 void adam(const AdamUpdate& u) {
+  const __m512 b1 = _mm512_set1_ps(u.beta1), c1 = _mm512_set1_ps(1.0f - u.beta1);
+  const __m512 b2 = _mm512_set1_ps(u.beta2), c2 = _mm512_set1_ps(1.0f - u.beta2);
+  const __m512 step = _mm512_set1_ps(u.step_size), scale = _mm512_set1_ps(u.inv_sqrt_bias2);
+  const __m512 eps = _mm512_set1_ps(u.epsilon), decay = _mm512_set1_ps(u.decay);
+  for (std::ptrdiff_t i = 0; i < u.n; i += 16) {
+    const __mmask16 mask = tail_mask(u.n - i);
+    const __m512 g = _mm512_maskz_loadu_ps(mask, u.gradient + i);
+    const __m512 m = _mm512_fmadd_ps(b1, _mm512_maskz_loadu_ps(mask, u.m + i), _mm512_mul_ps(c1, g));
+    const __m512 v = _mm512_fmadd_ps(b2, _mm512_maskz_loadu_ps(mask, u.v + i), _mm512_mul_ps(c2, _mm512_mul_ps(g, g)));
+    __m512 p = _mm512_maskz_loadu_ps(mask, u.parameters + i);
+    if (u.decay != 1.0f) p = _mm512_mul_ps(p, decay);
+    p = _mm512_sub_ps(p, _mm512_div_ps(_mm512_mul_ps(step, m), _mm512_fmadd_ps(_mm512_sqrt_ps(v), scale, eps)));
+    _mm512_mask_storeu_ps(u.m + i, mask, m);
+    _mm512_mask_storeu_ps(u.v + i, mask, v);
+    _mm512_mask_storeu_ps(u.parameters + i, mask, p);
+  }
+}
+
+}  // namespace
+
+const KernelSet& avx512_kernels() {
+  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam};
+  return set;
+}
+
+}  // namespace handcentric::policy::kernels

@@ -1,0 +1,111 @@
+// Kernel selection (kernels.hpp).
+#include <atomic>
+#include <cstdlib>
+#include <mutex>
+
+#include "kernel_set.hpp"
+#include "handcentric/core/errors.hpp"
+
+namespace handcentric::policy {
+
+std::string to_string(KernelIsa isa) {
+  switch (isa) {
+    case KernelIsa::generic: return "generic";
+    case KernelIsa::avx2: return "avx2";
+    case KernelIsa::avx512: return "avx512";
+  }
+  return "unknown";
+}
+
+KernelIsa parse_kernel_isa(const std::string& name) {
+  for (KernelIsa isa : {KernelIsa::generic, KernelIsa::avx2, KernelIsa::avx512}) {
+    if (name == to_string(isa)) return isa;
+  }
+  throw InvalidArgument("unknown kernel set '" + name + "': use generic, avx2 or avx512");
+}
+
+bool kernel_isa_supported(KernelIsa isa) {
+  switch (isa) {
+    case KernelIsa::generic: return true;
+#if defined(HANDCENTRIC_X86_KERNELS)
+    // __builtin_cpu_supports also checks that the OS saves the ymm / zmm state (XGETBV).
+    case KernelIsa::avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case KernelIsa::avx512: return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("fma");
+#else
+    case KernelIsa::avx2:
+    case KernelIsa::avx512: return false;
+#endif
+  }
+  return false;
+}
+
+KernelIsa best_kernel_isa() {
+  if (kernel_isa_supported(KernelIsa::avx512)) return KernelIsa::avx512;
+  if (kernel_isa_supported(KernelIsa::avx2)) return KernelIsa::avx2;
+  return KernelIsa::generic;
+}
+
+namespace {
+
+std::atomic<int> g_isa{-1};  // -1: not chosen yet
+std::mutex g_isa_mutex;
+
+void require_supported(KernelIsa isa, const std::string& origin) {
+  if (!kernel_isa_supported(isa)) {
+    throw InvalidArgument(origin + " asks for the " + to_string(isa) + " kernels, which this CPU (or this build) " +
+                          "cannot run: use " + to_string(best_kernel_isa()) + " or generic");
+  }
+}
+
+}  // namespace
+
+KernelIsa kernel_isa() {
+  const int chosen = g_isa.load(std::memory_order_acquire);
+  if (chosen >= 0) return static_cast<KernelIsa>(chosen);
+  std::lock_guard<std::mutex> lock(g_isa_mutex);
+  if (g_isa.load() < 0) {
+    KernelIsa isa = best_kernel_isa();
+    if (const char* env = std::getenv("HANDCENTRIC_KERNELS"); env != nullptr && *env != '\0') {
+      try {
+        isa = parse_kernel_isa(env);
+      } catch (const InvalidArgument& error) {
+        throw InvalidArgument(std::string("HANDCENTRIC_KERNELS: ") + error.what());
+      }
+      require_supported(isa, "HANDCENTRIC_KERNELS=" + std::string(env));
+    }
+    g_isa.store(static_cast<int>(isa), std::memory_order_release);
+  }
+  return static_cast<KernelIsa>(g_isa.load());
+}
+
+void set_kernel_isa(KernelIsa isa) {
+  require_supported(isa, "set_kernel_isa");
+  std::lock_guard<std::mutex> lock(g_isa_mutex);
+  g_isa.store(static_cast<int>(isa), std::memory_order_release);
+}
+
+namespace kernels {
+
+bool trivial_gemm(const Gemm& g) {
+  if (g.m <= 0 || g.n <= 0) return true;
+  if (g.k > 0) return false;
+  for (int j = 0; j < g.n; ++j) {  // the empty product: C = bias 1^T
+    for (int i = 0; i < g.m; ++i) g.c[i + static_cast<long>(j) * g.ldc] = g.row_bias ? g.row_bias[i] : 0.0f;
+  }
+  return true;
+}
+
+const KernelSet& kernels_for(KernelIsa isa) {
+  switch (isa) {
+#if defined(HANDCENTRIC_X86_KERNELS)
+    case KernelIsa::avx512: return avx512_kernels();
+    case KernelIsa::avx2: return avx2_kernels();
+#endif
+    default: return generic_kernels();
+  }
+}
+
+const KernelSet& active() { return kernels_for(kernel_isa()); }
+
+}  // namespace kernels
+}  // namespace handcentric::policy

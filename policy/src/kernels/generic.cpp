@@ -1,0 +1,71 @@
+// The portable kernel set: Eigen, compiled for the build's target (SSE2 on plain x86-64).
+// It is also the reference the vector sets are tested against (tests/policy/test_kernels.cpp).
+#include <Eigen/Core>
+#include <cmath>
+
+#include "kernel_set.hpp"
+
+namespace handcentric::policy::kernels {
+namespace {
+
+using ArrayMap = Eigen::Map<Eigen::ArrayXf>;
+using ConstArrayMap = Eigen::Map<const Eigen::ArrayXf>;
+
+void gemm(const Gemm& g) {
+  if (trivial_gemm(g)) return;
+  using Map = Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>;
+  const int a_rows = g.op_a == Op::none ? g.m : g.k, a_cols = g.op_a == Op::none ? g.k : g.m;
+  const int b_rows = g.op_b == Op::none ? g.k : g.n, b_cols = g.op_b == Op::none ? g.n : g.k;
+  const Map a(g.a, a_rows, a_cols, Eigen::OuterStride<>(g.lda));
+  const Map b(g.b, b_rows, b_cols, Eigen::OuterStride<>(g.ldb));
+  Eigen::Map<Eigen::MatrixXf, 0, Eigen::OuterStride<>> c(g.c, g.m, g.n, Eigen::OuterStride<>(g.ldc));
+  if (g.op_a == Op::none && g.op_b == Op::none) {
+    c.noalias() = a * b;
+  } else if (g.op_a == Op::none) {
+    c.noalias() = a * b.transpose();
+  } else if (g.op_b == Op::none) {
+    c.noalias() = a.transpose() * b;
+  } else {
+    c.noalias() = a.transpose() * b.transpose();
+  }
+  if (g.row_bias != nullptr) c.colwise() += Eigen::Map<const Eigen::VectorXf>(g.row_bias, g.m);
+}
+
+void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a) {
+  const ConstArrayMap zz(z, n);
+  ArrayMap ss(s, n);
+  ss = 1.0f / (1.0f + (-zz).exp());
+  ArrayMap(a, n) = zz * ss;
+}
+
+void silu_backward(std::ptrdiff_t n, const float* z, const float* s, float* delta) {
+  const ConstArrayMap zz(z, n), ss(s, n);
+  ArrayMap(delta, n) *= ss * (1.0f + zz * (1.0f - ss));
+}
+
+void silu(std::ptrdiff_t n, float* x) {
+  ArrayMap xx(x, n);
+  xx = xx / (1.0f + (-xx).exp());
+}
+
+double squared_norm(std::ptrdiff_t n, const float* g) {
+  return Eigen::Map<const Eigen::VectorXf>(g, n).cast<double>().squaredNorm();
+}
+
+void adam(const AdamUpdate& u) {
+  ArrayMap p(u.parameters, u.n), m(u.m, u.n), v(u.v, u.n);
+  const ConstArrayMap g(u.gradient, u.n);
+  m = u.beta1 * m + (1.0f - u.beta1) * g;
+  v = u.beta2 * v + (1.0f - u.beta2) * g.square();
+  if (u.decay != 1.0f) p *= u.decay;
+  p -= u.step_size * m / (v.sqrt() * u.inv_sqrt_bias2 + u.epsilon);
+}
+
+}  // namespace
+
+const KernelSet& generic_kernels() {
+  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam};
+  return set;
+}
+
+}  // namespace handcentric::policy::kernels

@@ -1,0 +1,78 @@
+#pragma once
+// Private: the float32 kernels behind Mlp and Adam, one implementation per instruction set
+// (generic.cpp: Eigen for the build's target; avx2.cpp; avx512.cpp), chosen at run time by
+// the functions at the bottom (dispatch.cpp, kernels.hpp).
+//
+// Storage is column-major throughout, as in Eigen: element (i, j) of an r x c matrix with
+// leading dimension ld is data[i + j * ld]. op(X) is X or X^T as stored.
+#include <cstddef>
+
+#include "handcentric/policy/kernels.hpp"
+
+namespace handcentric::policy::kernels {
+
+enum class Op { none, transpose };
+
+/// C (m x n, ldc) = op(A) op(B) + bias 1^T, with op(A) m x k and op(B) k x n; `row_bias` (m
+/// floats) may be null. C must not alias A, B or the bias. k = 0 gives C = bias 1^T (or 0).
+/// n = 1 with op(A) = A is a matrix-vector product (batch-1 sampling) and has its own kernel.
+struct Gemm {
+  Op op_a = Op::none, op_b = Op::none;
+  int m = 0, n = 0, k = 0;
+  const float* a = nullptr;
+  int lda = 0;
+  const float* b = nullptr;
+  int ldb = 0;
+  const float* row_bias = nullptr;
+  float* c = nullptr;
+  int ldc = 0;
+};
+
+/// Handles the degenerate shapes (m, n or k <= 0; k = 0 writes C = bias 1^T) and returns
+/// true; false for a real product. Every set's gemm starts with it.
+bool trivial_gemm(const Gemm& problem);
+
+/// Adam's update of n parameters (adam.hpp): m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g^2,
+/// p = decay p - step_size m / (sqrt(v) inv_sqrt_bias2 + eps).
+struct AdamUpdate {
+  std::ptrdiff_t n = 0;
+  float* parameters = nullptr;
+  const float* gradient = nullptr;
+  float* m = nullptr;
+  float* v = nullptr;
+  float beta1 = 0, beta2 = 0, step_size = 0, inv_sqrt_bias2 = 0, epsilon = 0, decay = 1;
+};
+
+/// exp(x) in the vector sets (Cephes' expf): x = n ln2 + r with n = round(x log2 e) and
+/// ln2 = kLn2High + kLn2Low (r exact to float rounding), then
+/// exp(r) = 1 + r + r^2 (c0 r^5 + c1 r^4 + ... + c5), relative error ~1e-7, times 2^n.
+struct ExpPolynomial {
+  static constexpr float kLog2e = 1.44269504088896341f;
+  static constexpr float kLn2High = 0.693359375f, kLn2Low = -2.12194440e-4f;
+  static constexpr float kC[6] = {1.9875691500e-4f, 1.3981999507e-3f, 8.3334519073e-3f,
+                                  4.1665795894e-2f, 1.6666665459e-1f, 5.0000001201e-1f};
+};
+
+/// One instruction set's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
+struct KernelSet {
+  void (*gemm)(const Gemm& problem);
+  /// s = sigmoid(z), a = z s over n values (training: s is kept for the backward pass).
+  void (*silu_forward)(std::ptrdiff_t n, const float* z, float* s, float* a);
+  /// delta *= SiLU'(z) = s (1 + z (1 - s)) over n values.
+  void (*silu_backward)(std::ptrdiff_t n, const float* z, const float* s, float* delta);
+  /// x = SiLU(x) in place (inference).
+  void (*silu)(std::ptrdiff_t n, float* x);
+  /// sum of g_i^2, in double.
+  double (*squared_norm)(std::ptrdiff_t n, const float* g);
+  void (*adam)(const AdamUpdate& update);
+};
+
+const KernelSet& generic_kernels();
+const KernelSet& avx2_kernels();    ///< only where HANDCENTRIC_X86_KERNELS is defined
+const KernelSet& avx512_kernels();  ///< only where HANDCENTRIC_X86_KERNELS is defined
+
+/// The set for `isa` (which must be supported), and the one in use (kernel_isa()).
+const KernelSet& kernels_for(KernelIsa isa);
+const KernelSet& active();
+
+}  // namespace handcentric::policy::kernels

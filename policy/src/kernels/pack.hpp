@@ -1,0 +1,177 @@
+#pragma once
+// Private: packing and the blocked loop nest of the GEMM in avx2.cpp and avx512.cpp (the BLIS
+// scheme). A block of op(A) is copied into panels of MR rows, each panel k-major
+// (panel[k * MR + i]); a block of op(B) into panels of NR columns (panel[k * NR + j]). Rows and
+// columns past the matrix are zero, so the micro-kernel always runs on full MR x NR tiles.
+// Compiled for the build's baseline target (no target attributes): packing is O(mk + kn)
+// against the O(mnk) products, so it does not need vector code.
+#include <algorithm>
+#include <cstddef>
+#include <memory>
+#include <new>
+
+#include "kernel_set.hpp"
+
+namespace handcentric::policy::kernels {
+
+/// op(A)(i, p) for A stored column-major with leading dimension lda.
+inline float element(Op op, const float* a, int lda, int i, int p) {
+  return op == Op::none ? a[i + static_cast<long>(p) * lda] : a[p + static_cast<long>(i) * lda];
+}
+
+/// Panels of MR rows of op(A)(i0 : i0 + mc, p0 : p0 + kc) into `out` (ceil(mc / MR) * kc * MR floats).
+template <int MR>
+void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out) {
+  for (int panel = 0; panel < mc; panel += MR) {
+    const int rows = std::min(MR, mc - panel);
+    if (op == Op::none) {
+      for (int p = 0; p < kc; ++p) {
+        const float* column = a + (i0 + panel) + static_cast<long>(p0 + p) * lda;
+        float* dst = out + p * MR;
+        for (int i = 0; i < rows; ++i) dst[i] = column[i];
+        for (int i = rows; i < MR; ++i) dst[i] = 0.0f;
+      }
+    } else {
+      for (int i = 0; i < MR; ++i) {
+        if (i < rows) {
+          const float* row = a + p0 + static_cast<long>(i0 + panel + i) * lda;  // contiguous in p
+          for (int p = 0; p < kc; ++p) out[p * MR + i] = row[p];
+        } else {
+          for (int p = 0; p < kc; ++p) out[p * MR + i] = 0.0f;
+        }
+      }
+    }
+    out += static_cast<long>(kc) * MR;
+  }
+}
+
+/// Panels of NR columns of op(B)(p0 : p0 + kc, j0 : j0 + nc) into `out` (ceil(nc / NR) * kc * NR floats).
+template <int NR>
+void pack_b(Op op, const float* b, int ldb, int p0, int kc, int j0, int nc, float* out) {
+  for (int panel = 0; panel < nc; panel += NR) {
+    const int cols = std::min(NR, nc - panel);
+    if (op == Op::none) {
+      for (int j = 0; j < NR; ++j) {
+        if (j < cols) {
+          const float* column = b + p0 + static_cast<long>(j0 + panel + j) * ldb;  // contiguous in p
+          for (int p = 0; p < kc; ++p) out[p * NR + j] = column[p];
+        } else {
+          for (int p = 0; p < kc; ++p) out[p * NR + j] = 0.0f;
+        }
+      }
+    } else {
+      for (int p = 0; p < kc; ++p) {
+        const float* row = b + (j0 + panel) + static_cast<long>(p0 + p) * ldb;  // op(B)(p, .) is contiguous
+        float* dst = out + p * NR;
+        for (int j = 0; j < cols; ++j) dst[j] = row[j];
+        for (int j = cols; j < NR; ++j) dst[j] = 0.0f;
+      }
+    }
+    out += static_cast<long>(kc) * NR;
+  }
+}
+
+/// A float buffer on a 64-byte boundary (a cache line; the micro-kernels load it aligned).
+class AlignedBuffer {
+ public:
+  float* data() { return data_.get(); }
+  /// Grows (contents lost) to at least `count` floats.
+  void resize(std::size_t count) {
+    if (count <= size_) return;
+    const std::size_t bytes = (count * sizeof(float) + 63) / 64 * 64;
+    data_.reset(static_cast<float*>(::operator new[](bytes, std::align_val_t{64})));
+    size_ = count;
+  }
+
+ private:
+  struct Free {
+    void operator()(float* p) const { ::operator delete[](p, std::align_val_t{64}); }
+  };
+  std::unique_ptr<float[], Free> data_;
+  std::size_t size_ = 0;
+};
+
+/// Buffers reused across calls on one thread (no allocation once they are large enough).
+struct PackBuffers {
+  AlignedBuffer a, b;
+  static PackBuffers& local() {
+    thread_local PackBuffers buffers;
+    return buffers;
+  }
+};
+
+/// How a micro-kernel reads its k x NR block of op(B): `packed` (panel[p * NR + j], from
+/// pack_b), or in place, `rows` (op(B) = B^T: b[p * ldb + j]) or `columns` (op(B) = B:
+/// b[p + j * ldb]).
+enum class BLayout { packed, rows, columns };
+
+/// The blocked loop nest shared by the instruction sets (the BLIS order: columns of C, then k,
+/// then rows). A block of MC x KC of op(A) is packed (it stays in L2 and streams through the
+/// micro-kernel); op(B) is read in place, NR columns at a time (a k x NR block is reused from
+/// L1 by every row panel), except a last partial panel, which is packed with zero padding.
+/// Kernel::tile<BLayout>(kc, a_panel, b, ldb, c, ldc, accumulate, bias) writes a full MR x NR
+/// tile of C: C = A B (+ bias, an MR-float pointer or null) or, when accumulate, C += A B.
+/// The first k block writes C (plus the bias), later ones add to it.
+template <typename Kernel>
+void blocked_gemm(const Gemm& g) {
+  constexpr int MR = Kernel::MR, NR = Kernel::NR;
+  constexpr int KC = 256, MC = 256, NC = 384;
+  PackBuffers& buffers = PackBuffers::local();
+  buffers.a.resize(static_cast<std::size_t>((MC + MR - 1) / MR * MR) * KC);
+  buffers.b.resize(static_cast<std::size_t>(NR) * KC);
+  alignas(64) float tile[MR * NR];
+  alignas(64) float bias_tile[MR];
+  for (int j0 = 0; j0 < g.n; j0 += NC) {
+    const int nc = std::min(NC, g.n - j0);
+    const int full = nc / NR * NR;  // columns in full panels, read in place
+    for (int p0 = 0; p0 < g.k; p0 += KC) {
+      const int kc = std::min(KC, g.k - p0);
+      const bool accumulate = p0 > 0;
+      if (full < nc) pack_b<NR>(g.op_b, g.b, g.ldb, p0, kc, j0 + full, nc - full, buffers.b.data());
+      for (int i0 = 0; i0 < g.m; i0 += MC) {
+        const int mc = std::min(MC, g.m - i0);
+        pack_a<MR>(g.op_a, g.a, g.lda, i0, mc, p0, kc, buffers.a.data());
+        for (int jr = 0; jr < nc; jr += NR) {
+          const int cols = std::min(NR, nc - jr);
+          const long j = j0 + jr;
+          const float* b_in_place = g.op_b == Op::none ? g.b + p0 + j * g.ldb : g.b + j + static_cast<long>(p0) * g.ldb;
+          for (int ir = 0; ir < mc; ir += MR) {
+            const int rows = std::min(MR, mc - ir);
+            const float* a_panel = buffers.a.data() + static_cast<long>(ir / MR) * kc * MR;
+            const float* bias = nullptr;
+            if (!accumulate && g.row_bias != nullptr) {
+              bias = g.row_bias + i0 + ir;
+              if (rows < MR) {
+                std::fill(bias_tile, bias_tile + MR, 0.0f);
+                std::copy(bias, bias + rows, bias_tile);
+                bias = bias_tile;
+              }
+            }
+            float* c = g.c + (i0 + ir) + j * g.ldc;
+            float* target = c;
+            int ld_target = g.ldc;
+            if (rows < MR || cols < NR) {  // an edge tile: computed in `tile`, the valid part copied
+              target = tile;
+              ld_target = MR;
+              if (accumulate) {
+                for (int jj = 0; jj < cols; ++jj) std::copy(c + jj * g.ldc, c + jj * g.ldc + rows, tile + jj * MR);
+              }
+            }
+            if (cols < NR) {
+              Kernel::template tile<BLayout::packed>(kc, a_panel, buffers.b.data(), NR, target, ld_target, accumulate, bias);
+            } else if (g.op_b == Op::none) {
+              Kernel::template tile<BLayout::columns>(kc, a_panel, b_in_place, g.ldb, target, ld_target, accumulate, bias);
+            } else {
+              Kernel::template tile<BLayout::rows>(kc, a_panel, b_in_place, g.ldb, target, ld_target, accumulate, bias);
+            }
+            if (target == tile) {
+              for (int jj = 0; jj < cols; ++jj) std::copy(tile + jj * MR, tile + jj * MR + rows, c + jj * g.ldc);
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace handcentric::policy::kernels

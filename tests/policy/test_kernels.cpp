@@ -1,0 +1,297 @@
+// The float32 kernels of every instruction set this CPU runs (generic, avx2, avx512; see
+// policy/include/handcentric/policy/kernels.hpp) against a double-precision reference: GEMM in
+// the three orientations Mlp uses and the fourth, with biases, every edge of the blocking
+// (partial tiles, k beyond one k block, n beyond one column block, strides, k = 0), GEMV with
+// unaligned columns, the SiLU kernels, the squared norm and Adam. Then the whole Mlp per
+// kernel set against MlpT<double>. The checks are seen failing on planted faults.
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/sampling.hpp"
+#include "handcentric/policy/adam.hpp"
+#include "handcentric/policy/kernels.hpp"
+#include "handcentric/policy/mlp.hpp"
+#include "kernels/kernel_set.hpp"
+#include "throws.hpp"
+
+using namespace handcentric;
+using namespace handcentric::policy;
+using kernels::Op;
+
+namespace {
+
+std::vector<KernelIsa> supported_sets() {
+  std::vector<KernelIsa> sets;
+  for (KernelIsa isa : {KernelIsa::generic, KernelIsa::avx2, KernelIsa::avx512}) {
+    if (kernel_isa_supported(isa)) sets.push_back(isa);
+  }
+  return sets;
+}
+
+// Restores the process-wide kernel set when a test leaves.
+struct KernelSetGuard {
+  KernelIsa saved = kernel_isa();
+  ~KernelSetGuard() { set_kernel_isa(saved); }
+};
+
+std::vector<float> random_floats(std::size_t n, std::mt19937_64& rng) {
+  std::vector<float> v(n);
+  for (float& x : v) x = static_cast<float>(2.0 * uniform01(rng) - 1.0);
+  return v;
+}
+
+// A GEMM problem with its own storage: op(A) m x k, op(B) k x n, leading dimensions padded
+// by `pad` so strides differ from the sizes; C is prefilled with garbage (it must be overwritten).
+struct Problem {
+  Op op_a, op_b;
+  int m, n, k, pad;
+  bool bias;
+  std::vector<float> a, b, row_bias, c;
+  int lda, ldb, ldc;
+
+  Problem(Op op_a_, Op op_b_, int m_, int n_, int k_, int pad_, bool bias_, std::mt19937_64& rng)
+      : op_a(op_a_), op_b(op_b_), m(m_), n(n_), k(k_), pad(pad_), bias(bias_) {
+    const int a_rows = op_a == Op::none ? m : k, a_cols = op_a == Op::none ? k : m;
+    const int b_rows = op_b == Op::none ? k : n, b_cols = op_b == Op::none ? n : k;
+    lda = a_rows + pad;
+    ldb = b_rows + pad;
+    ldc = m + pad;
+    a = random_floats(static_cast<std::size_t>(lda) * std::max(a_cols, 1), rng);
+    b = random_floats(static_cast<std::size_t>(ldb) * std::max(b_cols, 1), rng);
+    row_bias = random_floats(static_cast<std::size_t>(m), rng);
+    c.assign(static_cast<std::size_t>(ldc) * std::max(n, 1), 1e30f);
+  }
+  float A(int i, int p) const { return op_a == Op::none ? a[i + p * lda] : a[p + i * lda]; }
+  float B(int p, int j) const { return op_b == Op::none ? b[p + j * ldb] : b[j + p * ldb]; }
+  kernels::Gemm gemm() {
+    return {op_a, op_b, m, n, k, a.data(), lda, b.data(), ldb, bias ? row_bias.data() : nullptr, c.data(), ldc};
+  }
+};
+
+// The worst |C - C_ref| / bound over C, with C_ref in double and the bound the float rounding
+// of a k-term sum, 4 k eps (sum_p |a_ip b_pj| + |bias_i|) + 1e-30. `skip_last_term` plants a
+// fault in the reference (the last product left out), which the check must catch.
+double gemm_error(const Problem& problem, bool skip_last_term = false) {
+  double worst = 0.0;
+  for (int j = 0; j < problem.n; ++j) {
+    for (int i = 0; i < problem.m; ++i) {
+      double sum = problem.bias ? problem.row_bias[i] : 0.0;
+      double magnitude = std::abs(sum);
+      const int terms = skip_last_term ? problem.k - 1 : problem.k;
+      for (int p = 0; p < terms; ++p) {
+        const double term = static_cast<double>(problem.A(i, p)) * problem.B(p, j);
+        sum += term;
+        magnitude += std::abs(term);
+      }
+      const double bound = 4.0 * std::max(problem.k, 1) * 6e-8 * magnitude + 1e-30;
+      worst = std::max(worst, std::abs(problem.c[i + j * problem.ldc] - sum) / bound);
+    }
+  }
+  return worst;
+}
+
+struct Shape {
+  int m, n, k;
+};
+
+// Edges of the blocking of both vector sets (MR 32 / 16, NR 12 / 6, KC 256, NC 384) and the
+// network's own shapes (57 -> 256 -> 256 -> 24 at batch 256 and 1).
+const std::vector<Shape> kShapes = {
+    {1, 1, 1},    {3, 2, 5},     {16, 6, 7},    {17, 7, 9},    {32, 12, 16},  {33, 13, 31},
+    {31, 11, 257}, {24, 256, 256}, {256, 256, 57}, {256, 57, 256}, {57, 256, 256}, {40, 400, 20},
+    {256, 1, 256}, {24, 1, 256},  {300, 1, 57},  {7, 1, 3},     {400, 1, 5},   {5, 3, 0}};
+
+}  // namespace
+
+TEST_CASE("every_kernel_set_multiplies_like_the_double_reference", "[unit]") {
+  std::mt19937_64 rng(11);
+  for (KernelIsa isa : supported_sets()) {
+    INFO("kernel set " << to_string(isa));
+    for (const Shape& shape : kShapes) {
+      for (Op op_a : {Op::none, Op::transpose}) {
+        for (Op op_b : {Op::none, Op::transpose}) {
+          for (int pad : {0, 3}) {
+            const bool bias = (shape.m + shape.k + pad) % 2 == 0;
+            Problem problem(op_a, op_b, shape.m, shape.n, shape.k, pad, bias, rng);
+            kernels::kernels_for(isa).gemm(problem.gemm());
+            INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a) << " op_b "
+                      << int(op_b) << " pad " << pad << " bias " << bias);
+            CHECK(gemm_error(problem) <= 1.0);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
+  // Planted fault: compare the kernel against a reference that leaves out the last k term
+  // (what an off-by-one in the k loop of a kernel would do).
+  std::mt19937_64 rng(12);
+  for (KernelIsa isa : supported_sets()) {
+    for (const Shape& shape : {Shape{33, 13, 31}, Shape{256, 1, 256}}) {
+      Problem problem(Op::none, Op::none, shape.m, shape.n, shape.k, 0, false, rng);
+      kernels::kernels_for(isa).gemm(problem.gemm());
+      CHECK(gemm_error(problem) <= 1.0);
+      CHECK(gemm_error(problem, /*skip_last_term=*/true) > 1.0);
+    }
+  }
+}
+
+TEST_CASE("gemv_reads_columns_at_every_offset_from_a_cache_line", "[unit]") {
+  // Batch-1 sampling reads the weights where Eigen put them (16-byte aligned); the AVX-512
+  // GEMV shifts its vectors to the cache line. Every start offset 0..15 floats, lda % 16 == 0.
+  std::mt19937_64 rng(13);
+  const int m = 264, k = 40, lda = 272;
+  std::vector<float> storage = random_floats(static_cast<std::size_t>(lda) * k + 16, rng);
+  const std::vector<float> x = random_floats(k, rng), bias = random_floats(m, rng);
+  for (KernelIsa isa : supported_sets()) {
+    for (int offset = 0; offset < 16; ++offset) {
+      std::vector<float> y(m + 32, 7.0f);
+      const float* a = storage.data() + offset;
+      kernels::kernels_for(isa).gemm({Op::none, Op::none, m, 1, k, a, lda, x.data(), k, bias.data(), y.data() + 16, m});
+      double worst = 0.0;
+      for (int i = 0; i < m; ++i) {
+        double sum = bias[i], magnitude = std::abs(sum);
+        for (int p = 0; p < k; ++p) {
+          sum += static_cast<double>(a[i + p * lda]) * x[p];
+          magnitude += std::abs(static_cast<double>(a[i + p * lda]) * x[p]);
+        }
+        worst = std::max(worst, std::abs(y[16 + i] - sum) / (4.0 * k * 6e-8 * magnitude));
+      }
+      INFO(to_string(isa) << " offset " << offset);
+      CHECK(worst <= 1.0);
+      // Nothing written outside y: the masked lanes stay untouched.
+      for (int i = 0; i < 16; ++i) CHECK(y[i] == 7.0f);
+      for (int i = 16 + m; i < m + 32; ++i) CHECK(y[i] == 7.0f);
+    }
+  }
+}
+
+TEST_CASE("every_kernel_set_computes_silu_norm_and_adam_like_the_reference", "[unit]") {
+  std::mt19937_64 rng(14);
+  for (KernelIsa isa : supported_sets()) {
+    INFO("kernel set " << to_string(isa));
+    const kernels::KernelSet& set = kernels::kernels_for(isa);
+    for (int n : {1, 7, 8, 15, 16, 17, 100, 1000}) {
+      std::vector<float> z = random_floats(n, rng);
+      for (float& v : z) v *= 20.0f;  // both tails of the sigmoid
+      if (n > 3) {
+        z[0] = 95.0f;  // past the exp clamp: sigmoid 1, SiLU z
+        z[1] = -95.0f;  // sigmoid ~0, SiLU ~0, never NaN
+        z[2] = 0.0f;
+      }
+      std::vector<float> s(n), a(n), inplace = z, delta = random_floats(n, rng), delta0 = delta;
+      set.silu_forward(n, z.data(), s.data(), a.data());
+      set.silu(n, inplace.data());
+      set.silu_backward(n, z.data(), s.data(), delta.data());
+      for (int i = 0; i < n; ++i) {
+        const double zd = z[i], sd = 1.0 / (1.0 + std::exp(-zd));
+        const double derivative = sd * (1.0 + zd * (1.0 - sd));
+        INFO("n " << n << " z " << zd);
+        CHECK(std::abs(s[i] - sd) <= 1e-6 * sd + 1e-30);
+        CHECK(std::abs(a[i] - zd * sd) <= 1e-6 * std::abs(zd * sd) + 1e-30);
+        CHECK(std::abs(inplace[i] - zd * sd) <= 1e-6 * std::abs(zd * sd) + 1e-30);
+        CHECK(std::abs(delta[i] - delta0[i] * derivative) <= 1e-5 * std::abs(delta0[i] * derivative) + 1e-30);
+      }
+      double norm = 0.0;
+      for (float v : delta0) norm += static_cast<double>(v) * v;
+      CHECK(std::abs(set.squared_norm(n, delta0.data()) - norm) <= 1e-12 * norm);
+
+      std::vector<float> p = random_floats(n, rng), g = random_floats(n, rng), m = random_floats(n, rng),
+                         v = random_floats(n, rng);
+      for (float& x : v) x = std::abs(x);
+      const std::vector<float> p0 = p, m0 = m, v0 = v;
+      kernels::AdamUpdate update{n, p.data(), g.data(), m.data(), v.data(), 0.9f, 0.999f, 1e-3f, 1.2f, 1e-8f, 0.99f};
+      set.adam(update);
+      for (int i = 0; i < n; ++i) {
+        const double m1 = 0.9 * m0[i] + 0.1 * g[i], v1 = 0.999 * v0[i] + 0.001 * double(g[i]) * g[i];
+        const double p1 = 0.99 * p0[i] - 1e-3 * m1 / (std::sqrt(v1) * 1.2 + 1e-8);
+        CHECK(std::abs(m[i] - m1) <= 1e-6);
+        CHECK(std::abs(v[i] - v1) <= 1e-6);
+        CHECK(std::abs(p[i] - p1) <= 1e-6);
+      }
+    }
+  }
+}
+
+TEST_CASE("mlp_on_every_kernel_set_matches_the_double_network", "[unit]") {
+  // Forward, backward (parameter and input gradients) and batch-1 inference of one network
+  // with the same parameters in float on each kernel set and in double (Eigen).
+  KernelSetGuard guard;
+  std::mt19937_64 rng(15);
+  for (const std::vector<int>& widths : {std::vector<int>{57, 256, 256, 24}, std::vector<int>{5, 33, 17, 3}}) {
+    MlpT<double> reference(widths, Activation::silu);
+    reference.initialize(rng);
+    Eigen::MatrixXd input(widths.front(), 37), d_output(widths.back(), 37);
+    for (Eigen::Index i = 0; i < input.size(); ++i) input(i) = 2.0 * uniform01(rng) - 1.0;
+    for (Eigen::Index i = 0; i < d_output.size(); ++i) d_output(i) = 2.0 * uniform01(rng) - 1.0;
+    const Eigen::MatrixXd output = reference.forward(input);
+    const Eigen::MatrixXd d_input = reference.backward(d_output);
+    for (KernelIsa isa : supported_sets()) {
+      INFO("kernel set " << to_string(isa) << ", input width " << widths.front());
+      set_kernel_isa(isa);
+      Mlp net(widths, Activation::silu);
+      net.parameters() = reference.parameters().cast<float>();
+      const Eigen::MatrixXf out = net.forward(input.cast<float>());
+      const Eigen::MatrixXf din = net.backward(d_output.cast<float>());
+      const auto relative = [](const auto& x, const Eigen::MatrixXd& y) {
+        return (x.template cast<double>() - y).cwiseAbs().maxCoeff() / (1.0 + y.cwiseAbs().maxCoeff());
+      };
+      CHECK(relative(out, output) < 1e-5);
+      CHECK(relative(din, d_input) < 1e-5);
+      CHECK(relative(net.gradient(), reference.gradient()) < 1e-5);
+      Eigen::MatrixXf single, scratch[2];
+      net.infer(input.col(3).cast<float>(), single, scratch);
+      CHECK(relative(single, output.col(3)) < 1e-5);
+    }
+  }
+}
+
+TEST_CASE("kernel_sets_are_named_chosen_and_refused_with_typed_errors", "[unit]") {
+  KernelSetGuard guard;
+  for (KernelIsa isa : {KernelIsa::generic, KernelIsa::avx2, KernelIsa::avx512}) {
+    CHECK(parse_kernel_isa(to_string(isa)) == isa);
+  }
+  HC_CHECK_THROWS(parse_kernel_isa("sse9"), InvalidArgument, Catch::Contains("'sse9'") && Catch::Contains("avx512"));
+  CHECK(kernel_isa_supported(KernelIsa::generic));
+  CHECK(kernel_isa_supported(best_kernel_isa()));
+  set_kernel_isa(KernelIsa::generic);
+  CHECK(kernel_isa() == KernelIsa::generic);
+  for (KernelIsa isa : {KernelIsa::avx2, KernelIsa::avx512}) {
+    if (!kernel_isa_supported(isa)) {
+      HC_CHECK_THROWS(set_kernel_isa(isa), InvalidArgument, Catch::Contains(to_string(isa)));
+    }
+  }
+}
+
+TEST_CASE("training_is_bit_for_bit_repeatable_on_each_kernel_set", "[unit]") {
+  // Same seed, same kernel set: the same bits. (Different sets differ in the last bits.)
+  KernelSetGuard guard;
+  for (KernelIsa isa : supported_sets()) {
+    set_kernel_isa(isa);
+    const auto train = [] {
+      std::mt19937_64 rng(16);
+      Mlp net({9, 40, 40, 4}, Activation::silu);
+      net.initialize(rng);
+      Adam adam(net.parameter_count(), AdamOptions{1e-3, 0.9, 0.999, 1e-8, 0.0});
+      Eigen::MatrixXf input(9, 50), d_output(4, 50);
+      for (int step = 0; step < 5; ++step) {
+        for (Eigen::Index i = 0; i < input.size(); ++i) input(i) = static_cast<float>(uniform01(rng));
+        d_output = net.forward(input) * 0.1f;
+        net.backward_parameters(d_output);
+        adam.step(net.parameters(), net.gradient());
+      }
+      return Eigen::VectorXf(net.parameters());
+    };
+    const Eigen::VectorXf first = train(), second = train();
+    INFO(to_string(isa));
+    CHECK(first.cwiseEqual(second).all());
+  }
+}
