@@ -23,7 +23,7 @@ Adam::Adam(Eigen::Index parameter_count, AdamOptions options) : options_(options
   v_ = Eigen::VectorXf::Zero(parameter_count);
 }
 
-void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient) {
+void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient, float gradient_scale) {
   if (parameters.size() != m_.size() || gradient.size() != m_.size()) {
     throw InvalidArgument("Adam::step: " + std::to_string(parameters.size()) + " parameters and " +
                           std::to_string(gradient.size()) + " gradients, expected " +
@@ -42,6 +42,7 @@ void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient) {
   update.n = parameters.size();
   update.parameters = parameters.data();
   update.gradient = gradient.data();
+  update.gradient_scale = gradient_scale;
   update.m = m_.data();
   update.v = v_.data();
   update.beta1 = b1;
@@ -53,9 +54,16 @@ void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient) {
   kernels::active().adam(update);
 }
 
+float gradient_clip_scale(const Eigen::VectorXf& gradient, double max_norm, double* norm) {
+  const double length = std::sqrt(kernels::active().squared_norm(gradient.size(), gradient.data()));
+  if (norm != nullptr) *norm = length;
+  return max_norm > 0.0 && length > max_norm ? static_cast<float>(max_norm / length) : 1.0f;
+}
+
 double clip_gradient_norm(Eigen::VectorXf& gradient, double max_norm) {
-  const double norm = std::sqrt(kernels::active().squared_norm(gradient.size(), gradient.data()));
-  if (max_norm > 0.0 && norm > max_norm) gradient *= static_cast<float>(max_norm / norm);
+  double norm = 0.0;
+  const float scale = gradient_clip_scale(gradient, max_norm, &norm);
+  if (scale != 1.0f) gradient *= scale;
   return norm;
 }
 

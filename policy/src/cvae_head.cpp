@@ -85,9 +85,7 @@ class CvaeHead final : public Head {
     return AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay};
   }
   void step(Mlp& network, Adam& adam) {
-    gradient_ = network.gradient();
-    clip_gradient_norm(gradient_, config_.gradient_clip);
-    adam.step(network.parameters(), gradient_);
+    adam.step(network.parameters(), network.gradient(), gradient_clip_scale(network.gradient(), config_.gradient_clip));
   }
 
   PolicyConfig config_;
@@ -96,7 +94,6 @@ class CvaeHead final : public Head {
   Adam encoder_adam_, decoder_adam_;
   Eigen::MatrixXf a_, o_, noise_;
   CvaeBuffers<float> buffers_;
-  Eigen::VectorXf gradient_;
 };
 
 }  // namespace

@@ -9,7 +9,7 @@ namespace handcentric::policy {
 
 void fill_standard_normal(std::mt19937_64& rng, Eigen::Ref<Eigen::MatrixXf> out) {
   // Ref<MatrixXf> has an inner stride of 1 but may have an outer stride: walk column by column.
-  double spare = 0.0;
+  float spare = 0.0f;
   bool have_spare = false;
   for (Eigen::Index j = 0; j < out.cols(); ++j) {
     for (Eigen::Index i = 0; i < out.rows(); ++i) {
@@ -18,11 +18,13 @@ void fill_standard_normal(std::mt19937_64& rng, Eigen::Ref<Eigen::MatrixXf> out)
         have_spare = false;
         continue;
       }
-      const double u1 = 1.0 - uniform01(rng);  // in (0, 1]: log is finite
-      const double u2 = uniform01(rng);
-      const double radius = std::sqrt(-2.0 * std::log(u1));
-      const double angle = 2.0 * std::numbers::pi * u2;
-      out(i, j) = static_cast<float>(radius * std::cos(angle));
+      // Box-Muller in float: the noise is float anyway, and float log / sin / cos cost a
+      // third of the double ones (this loop was 8% of a training step).
+      const float u1 = static_cast<float>(1.0 - uniform01(rng));  // in (0, 1]: log is finite
+      const float u2 = static_cast<float>(uniform01(rng));
+      const float radius = std::sqrt(-2.0f * std::log(u1));
+      const float angle = 2.0f * std::numbers::pi_v<float> * u2;
+      out(i, j) = radius * std::cos(angle);
       spare = radius * std::sin(angle);
       have_spare = true;
     }

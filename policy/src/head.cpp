@@ -71,9 +71,9 @@ void NetworkHead::assemble(const Eigen::MatrixXf& x, const Eigen::VectorXd& t, c
 double NetworkHead::regress(const Eigen::MatrixXf& output, const Eigen::MatrixXf& target) {
   const double loss = mse_loss<float>(output, target, d_output_);  // eq. (5), averaged
   network_.backward_parameters(d_output_);
-  gradient_ = network_.gradient();
-  clip_gradient_norm(gradient_, config_.gradient_clip);
-  adam_.step(network_.parameters(), gradient_);
+  // Clipping folded into Adam's step: the gradient is read once more, not copied and rewritten.
+  const float clip = gradient_clip_scale(network_.gradient(), config_.gradient_clip);
+  adam_.step(network_.parameters(), network_.gradient(), clip);
   return loss;
 }
 

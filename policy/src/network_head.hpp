@@ -39,7 +39,6 @@ class NetworkHead : public Head {
   // Minibatch buffers.
   Eigen::MatrixXf a_, o_, noise_, x_, target_, input_, d_output_;
   Eigen::VectorXd t_;
-  Eigen::VectorXf gradient_;
 };
 
 }  // namespace handcentric::policy

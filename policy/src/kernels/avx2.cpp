@@ -18,6 +18,7 @@ namespace {
 // C tile of 16 x 6 = 12 ymm accumulators; per k: 2 loads of A, 6 broadcasts of B, 12 FMAs.
 struct Avx2Kernel {
   static constexpr int MR = 16, NR = 6;
+  static constexpr auto pack_a = kernels::pack_a<MR>;
 
   template <BLayout layout>
   HC_AVX2 static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc, bool accumulate,
@@ -188,7 +189,7 @@ HC_AVX2 double squared_norm(std::ptrdiff_t n, const float* g) {
 
 HC_AVX2 void adam(const AdamUpdate& u) {
   for_blocks(u.n, [&](std::ptrdiff_t i, int count) HC_AVX2 {
-    const __m256 g = load(u.gradient + i, count);
+    const __m256 g = _mm256_mul_ps(load(u.gradient + i, count), _mm256_set1_ps(u.gradient_scale));
     const __m256 m = _mm256_fmadd_ps(_mm256_set1_ps(u.beta1), load(u.m + i, count),
                                      _mm256_mul_ps(_mm256_set1_ps(1.0f - u.beta1), g));
     const __m256 v = _mm256_fmadd_ps(_mm256_set1_ps(u.beta2), load(u.v + i, count),

@@ -21,6 +21,38 @@ namespace {
 struct Avx512Kernel {
   static constexpr int MR = 32, NR = 12;
 
+  // pack_a<MR> with vector moves: op(A) = A copies two (masked) vectors per k; op(A) = A^T
+  // gathers each row panel's k-th column (16 rows at stride lda) from rows that stay in L1.
+  HC_AVX512 static void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out) {
+    if (op == Op::transpose && static_cast<long>(lda) * 16 >= (1L << 29)) {  // offsets beyond int32 bytes
+      kernels::pack_a<MR>(op, a, lda, i0, mc, p0, kc, out);
+      return;
+    }
+    const __m512i rows_apart = _mm512_mullo_epi32(_mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15),
+                                                  _mm512_set1_epi32(lda));
+    for (int panel = 0; panel < mc; panel += MR) {
+      const int rows = std::min(MR, mc - panel);
+      const __mmask16 mask0 = static_cast<__mmask16>(rows >= 16 ? 0xFFFFu : (1u << rows) - 1u);
+      const __mmask16 mask1 = static_cast<__mmask16>(rows >= 32 ? 0xFFFFu : rows <= 16 ? 0u : (1u << (rows - 16)) - 1u);
+      if (op == Op::none) {
+        const float* column = a + (i0 + panel) + static_cast<long>(p0) * lda;
+        for (int p = 0; p < kc; ++p, column += lda) {
+          _mm512_store_ps(out + p * MR, _mm512_maskz_loadu_ps(mask0, column));
+          _mm512_store_ps(out + p * MR + 16, _mm512_maskz_loadu_ps(mask1, column + 16));
+        }
+      } else {
+        const float* row0 = a + p0 + static_cast<long>(i0 + panel) * lda;  // op(A)(i, p) = a[p + i lda]
+        const float* row16 = rows > 16 ? row0 + 16L * lda : row0;  // unused (mask 0) when rows <= 16
+        for (int p = 0; p < kc; ++p) {
+          _mm512_store_ps(out + p * MR, _mm512_mask_i32gather_ps(_mm512_setzero_ps(), mask0, rows_apart, row0 + p, 4));
+          _mm512_store_ps(out + p * MR + 16,
+                          _mm512_mask_i32gather_ps(_mm512_setzero_ps(), mask1, rows_apart, row16 + p, 4));
+        }
+      }
+      out += static_cast<long>(kc) * MR;
+    }
+  }
+
   template <BLayout layout>
   HC_AVX512 static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc, bool accumulate,
                              const float* bias) {
@@ -144,9 +176,16 @@ HC_AVX512 __m512 exp_ps(__m512 x) {
   return _mm512_scalef_ps(p, n);
 }
 
+// 1 / d for a positive normal d: rcp14 and one Newton step (relative error ~1e-8; a division
+// costs several times more). Past 2^126 the result flushes to 0, as 1 / d is subnormal there.
+HC_AVX512 __m512 reciprocal_ps(__m512 d) {
+  const __m512 r = _mm512_rcp14_ps(d);
+  return _mm512_mul_ps(r, _mm512_fnmadd_ps(d, r, _mm512_set1_ps(2.0f)));
+}
+
 HC_AVX512 __m512 sigmoid_ps(__m512 z) {
   const __m512 one = _mm512_set1_ps(1.0f);
-  return _mm512_div_ps(one, _mm512_add_ps(one, exp_ps(_mm512_sub_ps(_mm512_setzero_ps(), z))));
+  return reciprocal_ps(_mm512_add_ps(one, exp_ps(_mm512_sub_ps(_mm512_setzero_ps(), z))));
 }
 
 HC_AVX512 __mmask16 tail_mask(std::ptrdiff_t remaining) {
@@ -198,14 +237,15 @@ HC_AVX512 void adam(const AdamUpdate& u) {
   const __m512 b2 = _mm512_set1_ps(u.beta2), c2 = _mm512_set1_ps(1.0f - u.beta2);
   const __m512 step = _mm512_set1_ps(u.step_size), scale = _mm512_set1_ps(u.inv_sqrt_bias2);
   const __m512 eps = _mm512_set1_ps(u.epsilon), decay = _mm512_set1_ps(u.decay);
+  const __m512 gradient_scale = _mm512_set1_ps(u.gradient_scale);
   for (std::ptrdiff_t i = 0; i < u.n; i += 16) {
     const __mmask16 mask = tail_mask(u.n - i);
-    const __m512 g = _mm512_maskz_loadu_ps(mask, u.gradient + i);
+    const __m512 g = _mm512_mul_ps(_mm512_maskz_loadu_ps(mask, u.gradient + i), gradient_scale);
     const __m512 m = _mm512_fmadd_ps(b1, _mm512_maskz_loadu_ps(mask, u.m + i), _mm512_mul_ps(c1, g));
     const __m512 v = _mm512_fmadd_ps(b2, _mm512_maskz_loadu_ps(mask, u.v + i), _mm512_mul_ps(c2, _mm512_mul_ps(g, g)));
     __m512 p = _mm512_maskz_loadu_ps(mask, u.parameters + i);
     if (u.decay != 1.0f) p = _mm512_mul_ps(p, decay);
-    p = _mm512_sub_ps(p, _mm512_div_ps(_mm512_mul_ps(step, m), _mm512_fmadd_ps(_mm512_sqrt_ps(v), scale, eps)));
+    p = _mm512_fnmadd_ps(_mm512_mul_ps(step, m), reciprocal_ps(_mm512_fmadd_ps(_mm512_sqrt_ps(v), scale, eps)), p);
     _mm512_mask_storeu_ps(u.m + i, mask, m);
     _mm512_mask_storeu_ps(u.v + i, mask, v);
     _mm512_mask_storeu_ps(u.parameters + i, mask, p);

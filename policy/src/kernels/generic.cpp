@@ -54,7 +54,8 @@ double squared_norm(std::ptrdiff_t n, const float* g) {
 
 void adam(const AdamUpdate& u) {
   ArrayMap p(u.parameters, u.n), m(u.m, u.n), v(u.v, u.n);
-  const ConstArrayMap g(u.gradient, u.n);
+  const ConstArrayMap gradient(u.gradient, u.n);
+  const auto g = gradient * u.gradient_scale;
   m = u.beta1 * m + (1.0f - u.beta1) * g;
   v = u.beta2 * v + (1.0f - u.beta2) * g.square();
   if (u.decay != 1.0f) p *= u.decay;

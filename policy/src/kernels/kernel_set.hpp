@@ -32,12 +32,13 @@ struct Gemm {
 /// true; false for a real product. Every set's gemm starts with it.
 bool trivial_gemm(const Gemm& problem);
 
-/// Adam's update of n parameters (adam.hpp): m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g^2,
-/// p = decay p - step_size m / (sqrt(v) inv_sqrt_bias2 + eps).
+/// Adam's update of n parameters (adam.hpp) from g = gradient_scale gradient:
+/// m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g^2, p = decay p - step_size m / (sqrt(v) inv_sqrt_bias2 + eps).
 struct AdamUpdate {
   std::ptrdiff_t n = 0;
   float* parameters = nullptr;
   const float* gradient = nullptr;
+  float gradient_scale = 1;
   float* m = nullptr;
   float* v = nullptr;
   float beta1 = 0, beta2 = 0, step_size = 0, inv_sqrt_bias2 = 0, epsilon = 0, decay = 1;

@@ -109,6 +109,7 @@ enum class BLayout { packed, rows, columns };
 /// then rows). A block of MC x KC of op(A) is packed (it stays in L2 and streams through the
 /// micro-kernel); op(B) is read in place, NR columns at a time (a k x NR block is reused from
 /// L1 by every row panel), except a last partial panel, which is packed with zero padding.
+/// Kernel::pack_a has pack_a<MR>'s contract (it may be a faster vector version).
 /// Kernel::tile<BLayout>(kc, a_panel, b, ldb, c, ldc, accumulate, bias) writes a full MR x NR
 /// tile of C: C = A B (+ bias, an MR-float pointer or null) or, when accumulate, C += A B.
 /// The first k block writes C (plus the bias), later ones add to it.
@@ -130,7 +131,7 @@ void blocked_gemm(const Gemm& g) {
       if (full < nc) pack_b<NR>(g.op_b, g.b, g.ldb, p0, kc, j0 + full, nc - full, buffers.b.data());
       for (int i0 = 0; i0 < g.m; i0 += MC) {
         const int mc = std::min(MC, g.m - i0);
-        pack_a<MR>(g.op_a, g.a, g.lda, i0, mc, p0, kc, buffers.a.data());
+        Kernel::pack_a(g.op_a, g.a, g.lda, i0, mc, p0, kc, buffers.a.data());
         for (int jr = 0; jr < nc; jr += NR) {
           const int cols = std::min(NR, nc - jr);
           const long j = j0 + jr;

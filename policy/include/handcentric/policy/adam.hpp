@@ -19,8 +19,10 @@ class Adam {
   /// epsilon or weight decay.
   Adam(Eigen::Index parameter_count, AdamOptions options);
 
-  /// One update of `parameters` from `gradient` (same length as the constructor's count).
-  void step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient);
+  /// One update of `parameters` from gradient_scale * `gradient` (same length as the
+  /// constructor's count); the scale is where clipping goes (gradient_clip_scale), so the
+  /// gradient is not rewritten first.
+  void step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient, float gradient_scale = 1.0f);
 
   long long steps_taken() const { return t_; }
 
@@ -29,6 +31,10 @@ class Adam {
   Eigen::VectorXf m_, v_;
   long long t_ = 0;
 };
+
+/// The factor that brings `gradient`'s L2 norm down to `max_norm`: max_norm / |g| when |g| >
+/// max_norm, else 1 (and 1 when max_norm is 0: no clipping). `norm`, when given, gets |g|.
+float gradient_clip_scale(const Eigen::VectorXf& gradient, double max_norm, double* norm = nullptr);
 
 /// Scales `gradient` so that its L2 norm is at most `max_norm` (0 disables); returns the norm
 /// before clipping.
