@@ -61,12 +61,6 @@ template <typename Matrix>
 void activate(Activation activation, const Matrix& z, Matrix& a) {
   using Scalar = typename Matrix::Scalar;
   if (activation == Activation::silu) {
-    if constexpr (std::is_same_v<Scalar, float>) {
-      if (&z == &a) {
-        kernels::active().silu(a.size(), a.data());
-        return;
-      }
-    }
     a.array() = z.array() / (Scalar(1) + (-z.array()).exp());
   } else {
     a.array() = z.array().max(Scalar(0));
@@ -89,15 +83,22 @@ void multiply_by_derivative(Activation activation, const Matrix& z, Matrix& delt
 // (kernels.hpp); double (the gradient checks) on Eigen.
 using kernels::Op;
 
-// out (rows x batch) = W in + b 1^T.
+// out (rows x batch) = W in + b 1^T (float: then SiLU in place when `silu`, with sigmoid(z)
+// into `sigmoid` when it is not null).
 template <typename Scalar, typename W, typename B, typename In, typename Out>
-void affine(const W& weights, const B& bias, const In& in, Out& out) {
+void affine(const W& weights, const B& bias, const In& in, Out& out, bool silu = false, Scalar* sigmoid = nullptr) {
   out.resize(weights.rows(), in.cols());
   if constexpr (std::is_same_v<Scalar, float>) {
-    kernels::active().gemm({Op::none, Op::none, static_cast<int>(weights.rows()), static_cast<int>(in.cols()),
-                                 static_cast<int>(weights.cols()), weights.data(), static_cast<int>(weights.rows()),
-                                 in.data(), static_cast<int>(in.outerStride()), bias.data(), out.data(),
-                                 static_cast<int>(out.rows())});
+    kernels::Gemm problem{Op::none, Op::none, static_cast<int>(weights.rows()), static_cast<int>(in.cols()),
+                          static_cast<int>(weights.cols()), weights.data(), static_cast<int>(weights.rows()),
+                          in.data(), static_cast<int>(in.outerStride()), bias.data(), out.data(),
+                          static_cast<int>(out.rows())};
+    if (silu) {
+      problem.epilogue = kernels::Epilogue::silu;
+      problem.sigmoid = sigmoid;
+      problem.lds = static_cast<int>(out.rows());
+    }
+    kernels::active().gemm(problem);
   } else {
     out.noalias() = weights * in;
     out.colwise() += bias;
@@ -140,18 +141,24 @@ const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::forward(const Eigen::Ref<cons
   }
   a_[0] = input;
   for (int l = 0; l < layers(); ++l) {
+    const bool hidden = l + 1 < layers();
+    if constexpr (std::is_same_v<Scalar, float>) {
+      if (hidden && activation_ == Activation::silu) {
+        // SiLU fused into the product; sigmoid(z) kept for backward() (one exp per unit, not
+        // two), and z itself is not kept: SiLU' = s + a (1 - s).
+        sigmoid_[l].resize(widths_[l + 1], input.cols());
+        affine<Scalar>(W(l), b(l), a_[l], a_[l + 1], true, sigmoid_[l].data());
+        continue;
+      }
+    }
     affine<Scalar>(W(l), b(l), a_[l], z_[l]);
-    if (l + 1 < layers()) {
+    if (hidden) {
       if (activation_ == Activation::silu) {
-        // Keep sigmoid(z) for backward(): one exp per unit instead of two.
+        // double (the gradient checks): z kept, sigmoid(z) for backward().
         sigmoid_[l].resize(z_[l].rows(), z_[l].cols());
         a_[l + 1].resize(z_[l].rows(), z_[l].cols());
-        if constexpr (std::is_same_v<Scalar, float>) {
-          kernels::active().silu_forward(z_[l].size(), z_[l].data(), sigmoid_[l].data(), a_[l + 1].data());
-        } else {
-          sigmoid_[l].array() = Scalar(1) / (Scalar(1) + (-z_[l].array()).exp());
-          a_[l + 1].array() = z_[l].array() * sigmoid_[l].array();
-        }
+        sigmoid_[l].array() = Scalar(1) / (Scalar(1) + (-z_[l].array()).exp());
+        a_[l + 1].array() = z_[l].array() * sigmoid_[l].array();
       } else {
         a_[l + 1].resize(z_[l].rows(), z_[l].cols());
         activate(activation_, z_[l], a_[l + 1]);
@@ -187,7 +194,7 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
       if (activation_ == Activation::silu) {
         // SiLU'(z) = s (1 + z (1 - s)), s = sigmoid(z) from forward().
         if constexpr (std::is_same_v<Scalar, float>) {
-          kernels::active().silu_backward(delta.size(), z_[l].data(), sigmoid_[l].data(), delta.data());
+          kernels::active().silu_backward(delta.size(), a_[l + 1].data(), sigmoid_[l].data(), delta.data());
         } else {
           const auto s = sigmoid_[l].array();
           delta.array() *= s * (Scalar(1) + z_[l].array() * (Scalar(1) - s));
@@ -200,7 +207,15 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
     Eigen::Map<Matrix> dW(gradient_.data() + offsets_[l], widths_[l + 1], widths_[l]);
     Eigen::Map<Vector> db(gradient_.data() + offsets_[l] + n, widths_[l + 1]);
     outer<Scalar>(delta, a_[l], dW);
-    db.noalias() = delta.rowwise().sum();
+    if constexpr (std::is_same_v<Scalar, float>) {
+      // db = delta 1: the batch-1 kernel (GEMV) against a vector of ones.
+      if (ones_.size() != delta.cols()) ones_ = Vector::Ones(delta.cols());
+      kernels::active().gemm({Op::none, Op::none, static_cast<int>(delta.rows()), 1, static_cast<int>(delta.cols()),
+                              delta.data(), static_cast<int>(delta.rows()), ones_.data(), static_cast<int>(delta.cols()),
+                              nullptr, db.data(), static_cast<int>(delta.rows())});
+    } else {
+      db.noalias() = delta.rowwise().sum();
+    }
     if (l == 0 && !input_gradient) break;
     transposed<Scalar>(W(l), delta, delta_[1 - current]);
     current = 1 - current;
@@ -218,12 +233,14 @@ void MlpT<Scalar>::infer(const Eigen::Ref<const Matrix>& input, Matrix& output, 
     affine<Scalar>(W(0), b(0), input, output);
     return;
   }
-  affine<Scalar>(W(0), b(0), input, scratch[0]);
+  const bool fused = std::is_same_v<Scalar, float> && activation_ == Activation::silu;
+  affine<Scalar>(W(0), b(0), input, scratch[0], fused);
   int current = 0;
   for (int l = 1; l < layers(); ++l) {
-    activate(activation_, scratch[current], scratch[current]);
-    Matrix& next = l + 1 < layers() ? scratch[1 - current] : output;
-    affine<Scalar>(W(l), b(l), scratch[current], next);
+    if (!fused) activate(activation_, scratch[current], scratch[current]);
+    const bool hidden = l + 1 < layers();
+    Matrix& next = hidden ? scratch[1 - current] : output;
+    affine<Scalar>(W(l), b(l), scratch[current], next, fused && hidden);
     current = 1 - current;
   }
 }

@@ -190,7 +190,7 @@ TEST_CASE("every_kernel_set_computes_silu_norm_and_adam_like_the_reference", "[u
       std::vector<float> s(n), a(n), inplace = z, delta = random_floats(n, rng), delta0 = delta;
       set.silu_forward(n, z.data(), s.data(), a.data());
       set.silu(n, inplace.data());
-      set.silu_backward(n, z.data(), s.data(), delta.data());
+      set.silu_backward(n, a.data(), s.data(), delta.data());
       for (int i = 0; i < n; ++i) {
         const double zd = z[i], sd = 1.0 / (1.0 + std::exp(-zd));
         const double derivative = sd * (1.0 + zd * (1.0 - sd));

@@ -15,9 +15,14 @@
 namespace handcentric::policy::kernels {
 namespace {
 
+HC_AVX2 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
+HC_AVX2 void silu(std::ptrdiff_t n, float* x);
+
 // C tile of 16 x 6 = 12 ymm accumulators; per k: 2 loads of A, 6 broadcasts of B, 12 FMAs.
 struct Avx2Kernel {
   static constexpr int MR = 16, NR = 6;
+  static constexpr auto epilogue_silu_forward = silu_forward;
+  static constexpr auto epilogue_silu = silu;
   static constexpr auto pack_a = kernels::pack_a<MR>;
 
   template <BLayout layout>
@@ -96,9 +101,11 @@ HC_AVX2 void gemv(const Gemm& g) {
 }
 
 HC_AVX2 void gemm(const Gemm& g) {
-  if (trivial_gemm(g)) return;
-  if (g.n == 1 && g.op_a == Op::none && (g.op_b == Op::none || g.ldb == 1)) {
+  if (trivial_gemm(g)) {
+    apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
+  } else if (g.n == 1 && g.op_a == Op::none && (g.op_b == Op::none || g.ldb == 1)) {
     gemv(g);
+    apply_epilogue(g, 0, g.m, 0, 1, silu_forward, silu);
   } else {
     blocked_gemm<Avx2Kernel>(g);
   }
@@ -158,11 +165,11 @@ HC_AVX2 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a) 
   });
 }
 
-HC_AVX2 void silu_backward(std::ptrdiff_t n, const float* z, const float* s, float* delta) {
+HC_AVX2 void silu_backward(std::ptrdiff_t n, const float* a, const float* s, float* delta) {
   for_blocks(n, [&](std::ptrdiff_t i, int count) HC_AVX2 {
     const __m256 one = _mm256_set1_ps(1.0f);
-    const __m256 zi = load(z + i, count), si = load(s + i, count);
-    const __m256 derivative = _mm256_mul_ps(si, _mm256_fmadd_ps(zi, _mm256_sub_ps(one, si), one));
+    const __m256 ai = load(a + i, count), si = load(s + i, count);
+    const __m256 derivative = _mm256_fmadd_ps(ai, _mm256_sub_ps(one, si), si);  // s + a (1 - s)
     store(delta + i, _mm256_mul_ps(load(delta + i, count), derivative), count);
   });
 }

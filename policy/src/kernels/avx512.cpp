@@ -17,9 +17,14 @@
 namespace handcentric::policy::kernels {
 namespace {
 
+HC_AVX512 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
+HC_AVX512 void silu(std::ptrdiff_t n, float* x);
+
 // C tile of 32 x 12 = 24 zmm accumulators; per k: 2 loads of A, 12 broadcasts of B, 24 FMAs.
 struct Avx512Kernel {
   static constexpr int MR = 32, NR = 12;
+  static constexpr auto epilogue_silu_forward = silu_forward;
+  static constexpr auto epilogue_silu = silu;
 
   // pack_a<MR> with vector moves: op(A) = A copies two (masked) vectors per k; op(A) = A^T
   // gathers each row panel's k-th column (16 rows at stride lda) from rows that stay in L1.
@@ -153,9 +158,11 @@ HC_AVX512 void gemv(const Gemm& g) {
 }
 
 HC_AVX512 void gemm(const Gemm& g) {
-  if (trivial_gemm(g)) return;
-  if (g.n == 1 && g.op_a == Op::none && (g.op_b == Op::none || g.ldb == 1)) {
+  if (trivial_gemm(g)) {
+    apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
+  } else if (g.n == 1 && g.op_a == Op::none && (g.op_b == Op::none || g.ldb == 1)) {
     gemv(g);
+    apply_epilogue(g, 0, g.m, 0, 1, silu_forward, silu);
   } else {
     blocked_gemm<Avx512Kernel>(g);
   }
@@ -202,12 +209,12 @@ HC_AVX512 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a
   }
 }
 
-HC_AVX512 void silu_backward(std::ptrdiff_t n, const float* z, const float* s, float* delta) {
+HC_AVX512 void silu_backward(std::ptrdiff_t n, const float* a, const float* s, float* delta) {
   const __m512 one = _mm512_set1_ps(1.0f);
   for (std::ptrdiff_t i = 0; i < n; i += 16) {
     const __mmask16 mask = tail_mask(n - i);
-    const __m512 zi = _mm512_maskz_loadu_ps(mask, z + i), si = _mm512_maskz_loadu_ps(mask, s + i);
-    const __m512 derivative = _mm512_mul_ps(si, _mm512_fmadd_ps(zi, _mm512_sub_ps(one, si), one));
+    const __m512 ai = _mm512_maskz_loadu_ps(mask, a + i), si = _mm512_maskz_loadu_ps(mask, s + i);
+    const __m512 derivative = _mm512_fmadd_ps(ai, _mm512_sub_ps(one, si), si);  // s + a (1 - s)
     _mm512_mask_storeu_ps(delta + i, mask, _mm512_mul_ps(_mm512_maskz_loadu_ps(mask, delta + i), derivative));
   }
 }

@@ -95,6 +95,20 @@ bool trivial_gemm(const Gemm& g) {
   return true;
 }
 
+void apply_epilogue(const Gemm& g, int i0, int rows, int j0, int cols,
+                    void (*silu_forward)(std::ptrdiff_t, const float*, float*, float*),
+                    void (*silu)(std::ptrdiff_t, float*)) {
+  if (g.epilogue == Epilogue::none) return;
+  for (int j = j0; j < j0 + cols; ++j) {
+    float* c = g.c + i0 + static_cast<long>(j) * g.ldc;
+    if (g.sigmoid != nullptr) {
+      silu_forward(rows, c, g.sigmoid + i0 + static_cast<long>(j) * g.lds, c);
+    } else {
+      silu(rows, c);
+    }
+  }
+}
+
 const KernelSet& kernels_for(KernelIsa isa) {
   switch (isa) {
 #if defined(HANDCENTRIC_X86_KERNELS)

@@ -11,7 +11,17 @@ namespace {
 using ArrayMap = Eigen::Map<Eigen::ArrayXf>;
 using ConstArrayMap = Eigen::Map<const Eigen::ArrayXf>;
 
+void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
+void silu(std::ptrdiff_t n, float* x);
+
+void product(const Gemm& g);
+
 void gemm(const Gemm& g) {
+  product(g);
+  apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
+}
+
+void product(const Gemm& g) {
   if (trivial_gemm(g)) return;
   using Map = Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>;
   const int a_rows = g.op_a == Op::none ? g.m : g.k, a_cols = g.op_a == Op::none ? g.k : g.m;
@@ -32,15 +42,14 @@ void gemm(const Gemm& g) {
 }
 
 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a) {
-  const ConstArrayMap zz(z, n);
   ArrayMap ss(s, n);
-  ss = 1.0f / (1.0f + (-zz).exp());
-  ArrayMap(a, n) = zz * ss;
+  ss = 1.0f / (1.0f + (-ConstArrayMap(z, n)).exp());
+  ArrayMap(a, n) = ConstArrayMap(z, n) * ss;  // a may be z: s is computed first
 }
 
-void silu_backward(std::ptrdiff_t n, const float* z, const float* s, float* delta) {
-  const ConstArrayMap zz(z, n), ss(s, n);
-  ArrayMap(delta, n) *= ss * (1.0f + zz * (1.0f - ss));
+void silu_backward(std::ptrdiff_t n, const float* a, const float* s, float* delta) {
+  const ConstArrayMap aa(a, n), ss(s, n);
+  ArrayMap(delta, n) *= ss + aa * (1.0f - ss);
 }
 
 void silu(std::ptrdiff_t n, float* x) {

@@ -13,9 +13,15 @@ namespace handcentric::policy::kernels {
 
 enum class Op { none, transpose };
 
+/// What happens to C once its sum is complete: nothing, or SiLU in place (a hidden layer's
+/// activation, applied while the block of C is still in L1).
+enum class Epilogue { none, silu };
+
 /// C (m x n, ldc) = op(A) op(B) + bias 1^T, with op(A) m x k and op(B) k x n; `row_bias` (m
 /// floats) may be null. C must not alias A, B or the bias. k = 0 gives C = bias 1^T (or 0).
 /// n = 1 with op(A) = A is a matrix-vector product (batch-1 sampling) and has its own kernel.
+/// With Epilogue::silu, C = SiLU(Z) for that Z, and `sigmoid` (m x n, lds), when not null,
+/// gets sigmoid(Z) (kept for the backward pass).
 struct Gemm {
   Op op_a = Op::none, op_b = Op::none;
   int m = 0, n = 0, k = 0;
@@ -26,11 +32,20 @@ struct Gemm {
   const float* row_bias = nullptr;
   float* c = nullptr;
   int ldc = 0;
+  Epilogue epilogue = Epilogue::none;
+  float* sigmoid = nullptr;
+  int lds = 0;
 };
 
 /// Handles the degenerate shapes (m, n or k <= 0; k = 0 writes C = bias 1^T) and returns
 /// true; false for a real product. Every set's gemm starts with it.
 bool trivial_gemm(const Gemm& problem);
+
+/// Applies problem.epilogue to rows [i0, i0 + rows) of columns [j0, j0 + cols) of C with one
+/// set's SiLU functions (KernelSet::silu_forward when problem.sigmoid is set, else silu).
+void apply_epilogue(const Gemm& problem, int i0, int rows, int j0, int cols,
+                    void (*silu_forward)(std::ptrdiff_t, const float*, float*, float*),
+                    void (*silu)(std::ptrdiff_t, float*));
 
 /// Adam's update of n parameters (adam.hpp) from g = gradient_scale gradient:
 /// m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g^2, p = decay p - step_size m / (sqrt(v) inv_sqrt_bias2 + eps).
@@ -57,10 +72,11 @@ struct ExpPolynomial {
 /// One instruction set's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
 struct KernelSet {
   void (*gemm)(const Gemm& problem);
-  /// s = sigmoid(z), a = z s over n values (training: s is kept for the backward pass).
+  /// s = sigmoid(z), a = z s over n values (training: s is kept for the backward pass); a may be z.
   void (*silu_forward)(std::ptrdiff_t n, const float* z, float* s, float* a);
-  /// delta *= SiLU'(z) = s (1 + z (1 - s)) over n values.
-  void (*silu_backward)(std::ptrdiff_t n, const float* z, const float* s, float* delta);
+  /// delta *= SiLU'(z) over n values, from s = sigmoid(z) and a = SiLU(z) = z s:
+  /// SiLU'(z) = s (1 + z (1 - s)) = s + a (1 - s), so z itself need not be kept.
+  void (*silu_backward)(std::ptrdiff_t n, const float* a, const float* s, float* delta);
   /// x = SiLU(x) in place (inference).
   void (*silu)(std::ptrdiff_t n, float* x);
   /// sum of g_i^2, in double.

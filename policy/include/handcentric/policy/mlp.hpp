@@ -72,6 +72,7 @@ class MlpT {
   std::vector<Matrix> sigmoid_;  ///< SiLU only: sigmoid(z_[l]) of the last forward()
   std::vector<Matrix> a_;  ///< a_[0] = input, a_[l] = act(z_[l-1])
   Matrix delta_[2];
+  Vector ones_;  ///< float: batch ones, for db = delta 1
 };
 
 using Mlp = MlpT<float>;
