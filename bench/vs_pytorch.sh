@@ -8,7 +8,7 @@
 #
 # Debian's torch imports only under Debian's own /usr/bin/python3, not under another python3
 # earlier on PATH, so the script calls /usr/bin/python3 explicitly; it installs python3-torch
-# with apt-get when the import fails (root, or sudo).
+# and OpenBLAS with apt-get when they are missing (root, or sudo).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 build="${1:-$here/../build}"
@@ -19,13 +19,22 @@ if [[ ! -x "$bench" ]]; then
   echo "vs_pytorch.sh: $bench not found: build first (cmake --build $build --target bench_policy)" >&2
   exit 1
 fi
-if ! "$python" -c "import torch" 2>/dev/null; then
-  echo "vs_pytorch.sh: installing python3-torch (Debian package) ..." >&2
+# Debian's torch does its CPU matrix products through whatever libblas.so.3 the alternatives
+# system points to; with only the reference BLAS (libblas3) it trains ~6x slower (4.2k
+# samples/s measured here), which would flatter us. So PyTorch gets OpenBLAS.
+missing=()
+"$python" -c "import torch" 2>/dev/null || missing+=(python3-torch)
+dpkg -s libopenblas0-pthread >/dev/null 2>&1 || dpkg -s libopenblas0-openmp >/dev/null 2>&1 ||
+  dpkg -s libopenblas0-serial >/dev/null 2>&1 || missing+=(libopenblas0-pthread)
+if ((${#missing[@]})); then
+  echo "vs_pytorch.sh: installing ${missing[*]} (Debian packages) ..." >&2
   sudo_cmd=""
   if [[ "$(id -u)" -ne 0 ]]; then sudo_cmd="sudo"; fi
   $sudo_cmd apt-get update
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y python3-torch
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y "${missing[@]}"
 fi
+echo "pytorch's BLAS: $(readlink -f /usr/lib/x86_64-linux-gnu/libblas.so.3 2>/dev/null || echo unknown)"
+echo "handcentric's kernels: ${HANDCENTRIC_KERNELS:-best for this CPU}"
 
 ours_json="$("$bench" --benchmark_filter='BM_flow_train_step_batch256|BM_flow_sample_10_euler_steps_batch1' \
   --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"

@@ -1,9 +1,9 @@
 // The float32 kernels of every instruction set this CPU runs (generic, avx2, avx512; see
 // policy/include/handcentric/policy/kernels.hpp) against a double-precision reference: GEMM in
 // the three orientations Mlp uses and the fourth, with biases, every edge of the blocking
-// (partial tiles, k beyond one k block, n beyond one column block, strides, k = 0), GEMV with
-// unaligned columns, the SiLU kernels, the squared norm and Adam. Then the whole Mlp per
-// kernel set against MlpT<double>. The checks are seen failing on planted faults.
+// (partial tiles, k beyond one k block, n beyond one column block, strides, k = 0), the narrow
+// products of sampling (n <= 16) with unaligned columns, the SiLU kernels, the squared norm
+// and Adam. Then the whole Mlp per kernel set against MlpT<double>. The checks are seen failing on planted faults.
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -105,7 +105,9 @@ struct Shape {
 const std::vector<Shape> kShapes = {
     {1, 1, 1},    {3, 2, 5},     {16, 6, 7},    {17, 7, 9},    {32, 12, 16},  {33, 13, 31},
     {31, 11, 257}, {24, 256, 256}, {256, 256, 57}, {256, 57, 256}, {57, 256, 256}, {40, 400, 20},
-    {256, 1, 256}, {24, 1, 256},  {300, 1, 57},  {7, 1, 3},     {400, 1, 5},   {5, 3, 0}};
+    {256, 1, 256}, {24, 1, 256},  {300, 1, 57},  {7, 1, 3},     {400, 1, 5},   {5, 3, 0},
+    // the narrow kernel (n <= 16: groups of up to 8 columns, 24 / N vectors of rows)
+    {50, 3, 20},   {100, 4, 33},  {70, 5, 9},    {260, 8, 40},  {33, 9, 17},   {400, 16, 5},  {17, 15, 64}};
 
 }  // namespace
 
@@ -144,32 +146,38 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
   }
 }
 
-TEST_CASE("gemv_reads_columns_at_every_offset_from_a_cache_line", "[unit]") {
+TEST_CASE("narrow_products_read_columns_at_every_offset_from_a_cache_line", "[unit]") {
   // Batch-1 sampling reads the weights where Eigen put them (16-byte aligned); the AVX-512
-  // GEMV shifts its vectors to the cache line. Every start offset 0..15 floats, lda % 16 == 0.
+  // narrow kernel shifts its vectors to the cache line. Every start offset 0..15 floats,
+  // lda % 16 == 0, for 1, 3 and 8 columns.
   std::mt19937_64 rng(13);
   const int m = 264, k = 40, lda = 272;
   std::vector<float> storage = random_floats(static_cast<std::size_t>(lda) * k + 16, rng);
-  const std::vector<float> x = random_floats(k, rng), bias = random_floats(m, rng);
+  const std::vector<float> x = random_floats(8 * k, rng), bias = random_floats(m, rng);
   for (KernelIsa isa : supported_sets()) {
-    for (int offset = 0; offset < 16; ++offset) {
-      std::vector<float> y(m + 32, 7.0f);
-      const float* a = storage.data() + offset;
-      kernels::kernels_for(isa).gemm({Op::none, Op::none, m, 1, k, a, lda, x.data(), k, bias.data(), y.data() + 16, m});
-      double worst = 0.0;
-      for (int i = 0; i < m; ++i) {
-        double sum = bias[i], magnitude = std::abs(sum);
-        for (int p = 0; p < k; ++p) {
-          sum += static_cast<double>(a[i + p * lda]) * x[p];
-          magnitude += std::abs(static_cast<double>(a[i + p * lda]) * x[p]);
+    for (int n : {1, 3, 8}) {
+      for (int offset = 0; offset < 16; ++offset) {
+        const int ldc = m + 32;
+        std::vector<float> y(static_cast<std::size_t>(ldc) * n, 7.0f);
+        const float* a = storage.data() + offset;
+        kernels::kernels_for(isa).gemm({Op::none, Op::none, m, n, k, a, lda, x.data(), k, bias.data(), y.data() + 16, ldc});
+        double worst = 0.0;
+        for (int j = 0; j < n; ++j) {
+          for (int i = 0; i < m; ++i) {
+            double sum = bias[i], magnitude = std::abs(sum);
+            for (int p = 0; p < k; ++p) {
+              sum += static_cast<double>(a[i + p * lda]) * x[p + j * k];
+              magnitude += std::abs(static_cast<double>(a[i + p * lda]) * x[p + j * k]);
+            }
+            worst = std::max(worst, std::abs(y[16 + i + j * ldc] - sum) / (4.0 * k * 6e-8 * magnitude));
+          }
+          // Nothing written outside C: the masked lanes stay untouched.
+          for (int i = 0; i < 16; ++i) CHECK(y[i + j * ldc] == 7.0f);
+          for (int i = 16 + m; i < ldc; ++i) CHECK(y[i + j * ldc] == 7.0f);
         }
-        worst = std::max(worst, std::abs(y[16 + i] - sum) / (4.0 * k * 6e-8 * magnitude));
+        INFO(to_string(isa) << " n " << n << " offset " << offset);
+        CHECK(worst <= 1.0);
       }
-      INFO(to_string(isa) << " offset " << offset);
-      CHECK(worst <= 1.0);
-      // Nothing written outside y: the masked lanes stay untouched.
-      for (int i = 0; i < 16; ++i) CHECK(y[i] == 7.0f);
-      for (int i = 16 + m; i < m + 32; ++i) CHECK(y[i] == 7.0f);
     }
   }
 }
