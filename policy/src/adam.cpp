@@ -45,6 +45,13 @@ void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient) {
   parameters.array() -= step_size * m_.array() / (v_.array().sqrt() * inv_sqrt_bias2 + eps);
 }
 
+void Adam::set_learning_rate(double learning_rate) {
+  if (!(learning_rate > 0.0) || !std::isfinite(learning_rate)) {
+    throw InvalidArgument("Adam: learning rate " + format_number(learning_rate) + ": use a finite lr > 0");
+  }
+  options_.learning_rate = learning_rate;
+}
+
 double clip_gradient_norm(Eigen::VectorXf& gradient, double max_norm) {
   const double norm = std::sqrt(gradient.template cast<double>().squaredNorm());
   if (max_norm > 0.0 && norm > max_norm) gradient *= static_cast<float>(max_norm / norm);
