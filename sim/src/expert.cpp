@@ -17,6 +17,8 @@ namespace {
 /// (about half the peg's length: the distance its tip moves per radian, halved).
 constexpr double kAngleScale = 4.0;
 constexpr double kViaWeight = 0.05;
+/// Weight of the arrival term: the approach's last segment along the insertion direction.
+constexpr double kArrivalWeight = 10.0;
 constexpr double kCollisionWeight = 5.0;
 constexpr double kStepSize = 0.5;
 /// The penalty starts this far (cm) from the walls; the pre-insertion pose is ~1 cm away.
@@ -172,6 +174,13 @@ ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19
   e.row(free - 1) += pre.transpose();
   Eigen::MatrixXd A = K.transpose() * K;
   Eigen::MatrixX3d b = -K.transpose() * e;
+  // Arrival: the insertion continues the path, q_{N+1} = pre - s e_y with s = |start - pre| / N
+  // the mean segment length, so the acceleration at q_N = pre is q_{N-1} - (pre + s e_y); it is
+  // weighted kArrivalWeight: the approach arrives moving along the hole axis, without the jump in
+  // lateral and angular velocity at pre-insertion that a policy would have to reproduce exactly.
+  const Vec3 above_pre = pre + Vec3(0.0, 0.0, (start - pre).norm() / N);
+  A(free - 1, free - 1) += kArrivalWeight;
+  b.row(free - 1) += kArrivalWeight * above_pre.transpose();
   if (options.random_via) {
     const int m = free / 2;
     const double fraction = uniform(rng, kViaMinFraction, kViaMaxFraction);

@@ -11,6 +11,9 @@
 //        cost = sum_i |q_{i+1} - 2 q_i + q_{i-1}|^2          (smoothness: squared accelerations,
 //                                                              theta scaled by kAngleScale cm/rad)
 //             + w_via |q_m - via|^2                          (a random via point: diverse demos)
+//             + w_arr |q_{N-1} - (q_N + s e_y)|^2              (arrival along the hole axis: the
+//                                                              acceleration at q_N, continuing
+//                                                              into the insertion, s = |q_0 - q_N|/N)
 //             + w_col sum_i penalty(q_i)                     (hinge on a smooth clearance proxy)
 //      with preconditioned gradient steps q <- q - eta A^{-1} grad, A the quadratic part;
 //   2. insertion: straight down the hole axis to the tip kInsertionDepth deep;
