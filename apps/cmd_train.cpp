@@ -32,12 +32,12 @@ struct TrainOptions {
   std::uint64_t seed = 1;
   int max_demos = 0;
   int chunk = 16;
-  int history = 2;
+  int history = 0;  // H = 2 lets the policy copy the demo's velocity past pre-insertion (docs/SIM.md)
   int batch = 256;
   int width = 256;
   int layers = 3;
   double learning_rate = 1e-3;
-  std::string lr_schedule = "constant";
+  std::string lr_schedule = "cosine";
   int euler_steps = 10;
   int time_embedding = 16;
   bool quiet = false;

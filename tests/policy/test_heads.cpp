@@ -190,8 +190,10 @@ TEST_CASE("bad_training_input_is_a_typed_error", "[unit]") {
 TEST_CASE("cosine_learning_rate_decays_from_the_peak_towards_zero", "[unit]") {
   PolicyConfig config = test::small_config(HeadKind::flow, "hand_centric", 1000);
   config.learning_rate = 2e-3;
+  CHECK(PolicyConfig().lr_schedule == LearningRateSchedule::cosine);  // the default
+  config.lr_schedule = LearningRateSchedule::constant;
   CHECK(learning_rate_at(config, 1) == 2e-3);
-  CHECK(learning_rate_at(config, 1000) == 2e-3);  // constant: the default
+  CHECK(learning_rate_at(config, 1000) == 2e-3);
   config.lr_schedule = LearningRateSchedule::cosine;
   CHECK(learning_rate_at(config, 1) == 2e-3);
   CHECK(learning_rate_at(config, 501) == Approx(1e-3).epsilon(1e-12));  // half way: half the peak
@@ -213,6 +215,7 @@ TEST_CASE("the_trainer_applies_the_learning_rate_schedule_to_every_head", "[unit
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow}) {
     INFO(to_string(head));
     PolicyConfig config = test::small_config(head, head == HeadKind::c8flow ? "absolute" : "hand_centric", 30);
+    config.lr_schedule = LearningRateSchedule::constant;
     // the sampled actions, not the model files (those also store the schedule's name)
     const Eigen::VectorXd constant = train_policy(config, scenes, 8).action_vector(scenes[0], 1);
     config.lr_schedule = LearningRateSchedule::cosine;
