@@ -36,11 +36,12 @@ int run_eval(const EvalOptions& options) {
   if (options.trials < 1) throw InvalidArgument("--trials must be at least 1, got " + std::to_string(options.trials));
   const sim::SceneDistribution distribution =
       sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist);
-  const auto policy = load_chunk_policy(options.model, options.policy.empty() ? "expert" : options.policy);
+  const LoadedPolicy loaded = load_chunk_policy(options.model, options.policy.empty() ? "expert" : options.policy);
+  const auto& policy = loaded.policy;
   auto scenes = sim::sample_scenes(distribution, options.trials, options.seed);
   if (!options.transform.empty()) scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
   const sim::CollisionChecker checker;
-  const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed);
+  const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed, loaded.rollout_options);
   const double n = summary.trials;
   if (options.json) {
     const nlohmann::json out = {{"trials", summary.trials},     {"success", summary.success / n},

@@ -48,8 +48,9 @@ int run_render(const RenderOptions& options) {
       image = sim::draw_scene(scene, checker.geometry(), options.size);
       what = "scene";
     } else {
-      const auto policy = load_chunk_policy(options.model, options.policy);
-      const sim::Rollout rollout = sim::rollout(*policy, scene, checker, sim::stream_seed(options.seed, options.index));
+      const LoadedPolicy loaded = load_chunk_policy(options.model, options.policy);
+      const sim::Rollout rollout = sim::rollout(*loaded.policy, scene, checker,
+                                                sim::stream_seed(options.seed, options.index), loaded.rollout_options);
       image = sim::draw_rollout(scene, rollout, checker.geometry(), options.size);
       what = "rollout (" + sim::outcome_name(rollout.outcome) + " after " + std::to_string(rollout.steps) + " steps)";
     }

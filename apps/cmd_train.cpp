@@ -32,11 +32,14 @@ struct TrainOptions {
   std::uint64_t seed = 1;
   int max_demos = 0;
   int chunk = 16;
-  int history = 2;
+  int history = 0;  // H = 2 lets the policy copy the demo's velocity past pre-insertion (docs/SIM.md)
   int batch = 256;
   int width = 256;
   int layers = 3;
   double learning_rate = 1e-3;
+  std::string lr_schedule = "cosine";
+  int euler_steps = 10;
+  int time_embedding = 16;
   bool quiet = false;
 };
 
@@ -63,6 +66,9 @@ int run_train(const TrainOptions& options) {
   config.hidden_width = options.width;
   config.hidden_layers = options.layers;
   config.learning_rate = options.learning_rate;
+  config.lr_schedule = policy::parse_schedule(options.lr_schedule);
+  config.euler_steps = options.euler_steps;
+  config.time_embedding = options.time_embedding;
   config.validate();
   if (options.max_demos < 0) {
     throw InvalidArgument("--max-demos must be >= 0 (0 = all), got " + std::to_string(options.max_demos));
@@ -126,6 +132,11 @@ void add_train_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--width", options->width, "hidden layer width")->capture_default_str();
   cmd->add_option("--layers", options->layers, "hidden layers")->capture_default_str();
   cmd->add_option("--lr", options->learning_rate, "Adam learning rate")->capture_default_str();
+  cmd->add_option("--lr-schedule", options->lr_schedule, "constant|cosine (from --lr down to ~0 at the last step)")
+      ->capture_default_str();
+  cmd->add_option("--euler-steps", options->euler_steps, "Euler steps of the flow sampler")->capture_default_str();
+  cmd->add_option("--time-embedding", options->time_embedding, "sinusoidal features of t (even), 0 for t itself")
+      ->capture_default_str();
   cmd->add_flag("--quiet", options->quiet, "no progress display");
   cmd->callback([options, &exit_code] { exit_code = run_train(*options); });
 }

@@ -6,10 +6,16 @@
 
 namespace handcentric::apps {
 
-std::unique_ptr<ChunkPolicy> load_chunk_policy(const std::string& model_path,
-                                               const std::string& scripted_name) {
-  if (!model_path.empty()) return std::make_unique<policy::LearnedPolicy>(policy::load_model(model_path));
-  return sim::make_scripted_policy(scripted_name);
+LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string& scripted_name) {
+  LoadedPolicy loaded;
+  if (model_path.empty()) {
+    loaded.policy = sim::make_scripted_policy(scripted_name);
+    return loaded;
+  }
+  auto model = std::make_unique<policy::LearnedPolicy>(policy::load_model(model_path));
+  loaded.rollout_options.history = model->config().history_length;
+  loaded.policy = std::move(model);
+  return loaded;
 }
 
 }  // namespace handcentric::apps

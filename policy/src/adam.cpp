@@ -60,6 +60,13 @@ float gradient_clip_scale(const Eigen::VectorXf& gradient, double max_norm, doub
   return max_norm > 0.0 && length > max_norm ? static_cast<float>(max_norm / length) : 1.0f;
 }
 
+void Adam::set_learning_rate(double learning_rate) {
+  if (!(learning_rate > 0.0) || !std::isfinite(learning_rate)) {
+    throw InvalidArgument("Adam: learning rate " + format_number(learning_rate) + ": use a finite lr > 0");
+  }
+  options_.learning_rate = learning_rate;
+}
+
 double clip_gradient_norm(Eigen::VectorXf& gradient, double max_norm) {
   double norm = 0.0;
   const float scale = gradient_clip_scale(gradient, max_norm, &norm);

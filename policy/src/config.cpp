@@ -38,6 +38,16 @@ Activation parse_activation(const std::string& name) {
   throw InvalidArgument("unknown activation '" + name + "': use silu or relu");
 }
 
+std::string to_string(LearningRateSchedule schedule) {
+  return schedule == LearningRateSchedule::cosine ? "cosine" : "constant";
+}
+
+LearningRateSchedule parse_schedule(const std::string& name) {
+  if (name == "constant") return LearningRateSchedule::constant;
+  if (name == "cosine") return LearningRateSchedule::cosine;
+  throw InvalidArgument("unknown learning-rate schedule '" + name + "': use constant or cosine");
+}
+
 namespace {
 
 void require(bool ok, const std::string& field, const std::string& value, const std::string& range) {
@@ -93,7 +103,10 @@ const std::vector<Field>& fields() {
       Field{"activation", [](const PolicyConfig& c) { return to_string(c.activation); },
             [](PolicyConfig& c, const std::string& v) { c.activation = parse_activation(v); }},
       HC_INT_FIELD(time_embedding), HC_INT_FIELD(steps), HC_INT_FIELD(batch_size),
-      HC_DOUBLE_FIELD(learning_rate), HC_DOUBLE_FIELD(weight_decay), HC_DOUBLE_FIELD(gradient_clip),
+      HC_DOUBLE_FIELD(learning_rate),
+      Field{"lr_schedule", [](const PolicyConfig& c) { return to_string(c.lr_schedule); },
+            [](PolicyConfig& c, const std::string& v) { c.lr_schedule = parse_schedule(v); }},
+      HC_DOUBLE_FIELD(weight_decay), HC_DOUBLE_FIELD(gradient_clip),
       HC_INT_FIELD(euler_steps), HC_INT_FIELD(ddpm_train_steps), HC_INT_FIELD(ddim_steps),
       HC_INT_FIELD(cvae_latent), HC_DOUBLE_FIELD(cvae_kl_weight),
   };

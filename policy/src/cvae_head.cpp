@@ -57,6 +57,11 @@ class CvaeHead final : public Head {
     return loss;
   }
 
+  void set_learning_rate(double learning_rate) override {
+    encoder_adam_.set_learning_rate(learning_rate);
+    decoder_adam_.set_learning_rate(learning_rate);
+  }
+
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
     const Eigen::Index batch = observations.cols(), dobs = observations.rows(), Z = config_.cvae_latent;
     Eigen::MatrixXf input(Z + dobs, batch), output, scratch[2];

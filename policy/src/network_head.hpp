@@ -17,6 +17,7 @@ class NetworkHead : public Head {
   void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override;
   void write(ByteWriter& out) const override;
   void read(ByteReader& in) override;
+  void set_learning_rate(double learning_rate) override { adam_.set_learning_rate(learning_rate); }
 
   const Mlp& network() const { return network_; }
   const Normalizer& action_normalizer() const { return action_normalizer_; }

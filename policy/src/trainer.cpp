@@ -3,12 +3,28 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <numbers>
 #include <random>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 
 namespace handcentric::policy {
+
+double learning_rate_at(const PolicyConfig& config, int step) {
+  if (step < 1 || step > config.steps) {
+    throw InvalidArgument("learning_rate_at: step " + std::to_string(step) + " is outside 1.." +
+                          std::to_string(config.steps));
+  }
+  switch (config.lr_schedule) {
+    case LearningRateSchedule::constant: return config.learning_rate;
+    case LearningRateSchedule::cosine: {
+      const double progress = static_cast<double>(step - 1) / config.steps;  // [0, 1)
+      return config.learning_rate * 0.5 * (1.0 + std::cos(std::numbers::pi * progress));
+    }
+  }
+  return config.learning_rate;
+}
 
 LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes, std::uint64_t seed,
                            const ProgressCallback& progress, int report_every) {
@@ -50,10 +66,12 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
       batch_actions.col(j) = actions.col(i);
       batch_observations.col(j) = observations.col(i);
     }
+    const double learning_rate = learning_rate_at(config, step);
+    head->set_learning_rate(learning_rate);
     const double loss = head->train_step(batch_actions, batch_observations, rng);
     if (!std::isfinite(loss)) {
       throw InvalidArgument("training diverged at step " + std::to_string(step) + " (loss " + std::to_string(loss) +
-                            ", learning rate " + std::to_string(config.learning_rate) +
+                            ", learning rate " + std::to_string(learning_rate) +
                             "): lower the learning rate or keep gradient clipping on");
     }
     loss_sum += loss;

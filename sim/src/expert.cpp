@@ -151,6 +151,9 @@ std::vector<RigidTransform> resample_at_control_step(const std::vector<RigidTran
 ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19937_64& rng,
                               const CollisionChecker& checker, const ExpertOptions& options) {
   if (!is_planar(hole_T_hand_start)) throw InvalidArgument("expert: the start pose is not planar");
+  if (!(options.arrival_weight >= 0.0) || !std::isfinite(options.arrival_weight)) {
+    throw InvalidArgument("expert: arrival weight must be finite and >= 0, got " + std::to_string(options.arrival_weight));
+  }
   if (options.waypoints < 3 || options.iterations < 0) {
     throw InvalidArgument("expert: need at least 3 waypoints and >= 0 iterations, got " +
                           std::to_string(options.waypoints) + " and " + std::to_string(options.iterations));
@@ -172,6 +175,13 @@ ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19
   e.row(free - 1) += pre.transpose();
   Eigen::MatrixXd A = K.transpose() * K;
   Eigen::MatrixX3d b = -K.transpose() * e;
+  // Arrival: the insertion continues the path, q_{N+1} = pre - s e_y with s = |start - pre| / N
+  // the mean segment length, so the acceleration at q_N = pre is q_{N-1} - (pre + s e_y); it is
+  // weighted options.arrival_weight: the approach arrives moving along the hole axis, without the jump in
+  // lateral and angular velocity at pre-insertion that a policy would have to reproduce exactly.
+  const Vec3 above_pre = pre + Vec3(0.0, 0.0, (start - pre).norm() / N);
+  A(free - 1, free - 1) += options.arrival_weight;
+  b.row(free - 1) += options.arrival_weight * above_pre.transpose();
   if (options.random_via) {
     const int m = free / 2;
     const double fraction = uniform(rng, kViaMinFraction, kViaMaxFraction);

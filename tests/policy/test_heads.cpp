@@ -76,12 +76,14 @@ namespace {
 // Trains on two scenes (one chunk per observation) and returns (final loss, max distance of a
 // sampled chunk to its demo). Two, not one: with one scene every dimension is constant and the
 // heads reproduce it exactly without learning anything (normalizer.hpp, active = 0).
-std::pair<double, double> overfit_one_chunk(HeadKind head, int steps) {
+std::pair<double, double> overfit_one_chunk(HeadKind head, int steps,
+                                            LearningRateSchedule schedule = LearningRateSchedule::constant) {
   const std::vector<Scene> scenes = test::small_scenes(2, 17);
   double last_loss = 0.0;
   PolicyConfig config = test::small_config(head, "hand_centric", steps);
   config.hidden_width = 64;
   config.learning_rate = 1e-2;
+  config.lr_schedule = schedule;
   const LearnedPolicy policy = train_policy(
       config, scenes, 3,
       [&](const TrainingProgress& p) { last_loss = p.loss; }, 100);
@@ -183,4 +185,48 @@ TEST_CASE("bad_training_input_is_a_typed_error", "[unit]") {
   huge.actions(0, 3) = 1e39;  // finite in double, inf in float32
   HC_CHECK_THROWS(train_policy(test::small_config(HeadKind::flow, "absolute", 1), huge, 1), InvalidScene,
                   Catch::Contains("float32 range"));
+}
+
+TEST_CASE("cosine_learning_rate_decays_from_the_peak_towards_zero", "[unit]") {
+  PolicyConfig config = test::small_config(HeadKind::flow, "hand_centric", 1000);
+  config.learning_rate = 2e-3;
+  CHECK(PolicyConfig().lr_schedule == LearningRateSchedule::cosine);  // the default
+  config.lr_schedule = LearningRateSchedule::constant;
+  CHECK(learning_rate_at(config, 1) == 2e-3);
+  CHECK(learning_rate_at(config, 1000) == 2e-3);
+  config.lr_schedule = LearningRateSchedule::cosine;
+  CHECK(learning_rate_at(config, 1) == 2e-3);
+  CHECK(learning_rate_at(config, 501) == Approx(1e-3).epsilon(1e-12));  // half way: half the peak
+  CHECK(learning_rate_at(config, 1000) > 0.0);
+  CHECK(learning_rate_at(config, 1000) < 2e-3 * 1e-5);  // ~ lr pi^2 / (4 steps^2)
+  for (int step = 2; step <= 1000; ++step) CHECK(learning_rate_at(config, step) < learning_rate_at(config, step - 1));
+  HC_CHECK_THROWS(learning_rate_at(config, 0), InvalidArgument, Catch::Contains("outside 1..1000"));
+  HC_CHECK_THROWS(learning_rate_at(config, 1001), InvalidArgument, Catch::Contains("outside 1..1000"));
+  HC_CHECK_THROWS(parse_schedule("linear"), InvalidArgument, Catch::Contains("constant or cosine"));
+  // stored in model files
+  CHECK(PolicyConfig::from_text(config.to_text()).lr_schedule == LearningRateSchedule::cosine);
+  HC_CHECK_THROWS(PolicyConfig::from_text("lr_schedule=step\n"), InvalidArgument, Catch::Contains("'step'"));
+}
+
+TEST_CASE("the_trainer_applies_the_learning_rate_schedule_to_every_head", "[unit]") {
+  // A trainer that ignored config.lr_schedule would give the constant schedule's weights bit
+  // for bit (the same actions); and decaying the rate must let the one-chunk fit settle lower than a constant rate.
+  const std::vector<Scene> scenes = test::small_scenes(20, 4);
+  for (HeadKind head : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow}) {
+    INFO(to_string(head));
+    PolicyConfig config = test::small_config(head, head == HeadKind::c8flow ? "absolute" : "hand_centric", 30);
+    config.lr_schedule = LearningRateSchedule::constant;
+    // the sampled actions, not the model files (those also store the schedule's name)
+    const Eigen::VectorXd constant = train_policy(config, scenes, 8).action_vector(scenes[0], 1);
+    config.lr_schedule = LearningRateSchedule::cosine;
+    CHECK((train_policy(config, scenes, 8).action_vector(scenes[0], 1) - constant).norm() > 1e-6);
+  }
+  const auto [constant_loss, constant_distance] = overfit_one_chunk(HeadKind::flow, 2000);
+  const auto [cosine_loss, cosine_distance] =
+      overfit_one_chunk(HeadKind::flow, 2000, LearningRateSchedule::cosine);
+  INFO("flow, one chunk, 2000 steps: constant loss " << constant_loss << ", distance " << constant_distance
+                                                       << "; cosine loss " << cosine_loss << ", distance "
+                                                       << cosine_distance);
+  CHECK(cosine_loss < constant_loss);
+  CHECK(cosine_distance < constant_distance);
 }

@@ -1,5 +1,6 @@
 // The trajectory-optimization expert: solves the scenes, valid demos, equivariant by construction,
 // deterministic.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <numbers>
@@ -147,4 +148,52 @@ TEST_CASE("without_the_collision_term_invalid_solutions_are_discarded_and_counte
                                             demo.world_T_hole.inverse_compose(demo.world_T_hand[t + 1])));
     }
   }
+}
+
+namespace {
+
+// The median, over the demos, of the lateral (cm) and angular (deg) change in the last step
+// before the hand first stands on the hole axis upright (the start of the straight insertion).
+std::pair<double, double> arrival_jump(const ExpertOptions& options) {
+  const CollisionChecker checker;
+  const ExpertRun run = expert_demos(sample_scenes(SceneDistribution::train(), 60, 21), 21, checker, options);
+  std::vector<double> lateral, angular;
+  for (const Demo& demo : run.demos) {
+    for (std::size_t t = 1; t < demo.world_T_hand.size(); ++t) {
+      const Eigen::Vector3d q = planar_coordinates(demo.world_T_hole.inverse_compose(demo.world_T_hand[t]));
+      if (std::abs(q(0)) > 1e-9 || std::abs(q(1)) > 1e-9) continue;
+      const Eigen::Vector3d before = planar_coordinates(demo.world_T_hole.inverse_compose(demo.world_T_hand[t - 1]));
+      lateral.push_back(std::abs(before(1)));
+      angular.push_back(std::abs(before(0)) * 180.0 / std::numbers::pi);
+      break;
+    }
+  }
+  REQUIRE(lateral.size() == run.demos.size());
+  std::sort(lateral.begin(), lateral.end());
+  std::sort(angular.begin(), angular.end());
+  return {lateral[lateral.size() / 2], angular[angular.size() / 2]};
+}
+
+}  // namespace
+
+TEST_CASE("the_approach_arrives_at_pre_insertion_along_the_hole_axis", "[unit]") {
+  // A policy has to reproduce the demos' turn into the hole within the 0.05 cm clearance: the
+  // approach must not reach pre-insertion moving sideways and turn down in one step.
+  const auto [lateral_cm, angle_deg] = arrival_jump(ExpertOptions());
+  INFO("median last approach step: " << lateral_cm << " cm sideways, " << angle_deg << " deg");
+  CHECK(lateral_cm < 0.02);
+  CHECK(angle_deg < 0.1);
+}
+
+TEST_CASE("mutant_approach_without_the_arrival_term_turns_down_in_one_step", "[unit]") {
+  ExpertOptions no_arrival_term;
+  no_arrival_term.arrival_weight = 0.0;
+  const auto [lateral_cm, angle_deg] = arrival_jump(no_arrival_term);
+  INFO("median last approach step: " << lateral_cm << " cm sideways, " << angle_deg << " deg");
+  CHECK_FALSE((lateral_cm < 0.02 && angle_deg < 0.1));
+  ExpertOptions negative;
+  negative.arrival_weight = -1.0;
+  std::mt19937_64 rng(1);
+  CHECK_THROWS_AS(plan_in_hole_frame(RigidTransform::planar(0.0, 0.0, 15.0), rng, CollisionChecker(), negative),
+                  InvalidArgument);
 }

@@ -26,6 +26,11 @@ class Adam {
 
   long long steps_taken() const { return t_; }
 
+  /// The learning rate of the next steps (a schedule, trainer.hpp). Throws InvalidArgument for a
+  /// non-positive or non-finite value.
+  void set_learning_rate(double learning_rate);
+  double learning_rate() const { return options_.learning_rate; }
+
  private:
   AdamOptions options_;
   Eigen::VectorXf m_, v_;

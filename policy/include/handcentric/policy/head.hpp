@@ -32,6 +32,9 @@ class Head {
   virtual double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
                             std::mt19937_64& rng) = 0;
 
+  /// The optimizer's learning rate for the next train_step calls (the trainer's schedule).
+  virtual void set_learning_rate(double learning_rate) = 0;
+
   /// One raw action vector per raw observation column; all noise from `rng`.
   virtual Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const = 0;
 

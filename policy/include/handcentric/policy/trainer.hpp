@@ -23,6 +23,12 @@ struct TrainingProgress {
 
 using ProgressCallback = std::function<void(const TrainingProgress&)>;
 
+/// The learning rate of Adam step `step` (1..config.steps) under config.lr_schedule:
+/// constant: learning_rate; cosine: learning_rate * (1 + cos(pi (step - 1) / steps)) / 2, so the
+/// first step uses learning_rate and the last one learning_rate * O(1/steps^2), never 0.
+/// Throws InvalidArgument for a step outside 1..steps.
+double learning_rate_at(const PolicyConfig& config, int step);
+
 /// Trains `config.head` on `scenes` with `config.representation`. Dimensions and point counts
 /// in the returned policy's config come from the data. `progress` (optional) is called about
 /// every `report_every` steps and after the last step. Throws InvalidArgument for a bad config

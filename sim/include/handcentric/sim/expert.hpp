@@ -11,6 +11,9 @@
 //        cost = sum_i |q_{i+1} - 2 q_i + q_{i-1}|^2          (smoothness: squared accelerations,
 //                                                              theta scaled by kAngleScale cm/rad)
 //             + w_via |q_m - via|^2                          (a random via point: diverse demos)
+//             + w_arr |q_{N-1} - (q_N + s e_y)|^2              (arrival along the hole axis: the
+//                                                              acceleration at q_N, continuing
+//                                                              into the insertion, s = |q_0 - q_N|/N)
 //             + w_col sum_i penalty(q_i)                     (hinge on a smooth clearance proxy)
 //      with preconditioned gradient steps q <- q - eta A^{-1} grad, A the quadratic part;
 //   2. insertion: straight down the hole axis to the tip kInsertionDepth deep;
@@ -43,6 +46,7 @@ struct ExpertOptions {
   int iterations = 60;       ///< optimizer steps
   bool random_via = true;    ///< false: no via point (the deterministic closed-loop expert)
   int attempts = 8;          ///< random via points tried per scene before it counts as unsolved
+  double arrival_weight = 10.0;  ///< w_arr; 0 = the old approach that turns down in one step
 };
 
 struct ExpertPlan {
