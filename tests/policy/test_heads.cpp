@@ -106,11 +106,13 @@ TEST_CASE("every_head_overfits_one_chunk_per_observation", "[unit]") {
   // velocity / the noise, whose optimum (a - x_t) / (1 - t) gets arbitrarily steep as t -> 1
   // (abar -> 0): a small network keeps a residual there (0.06-0.12 after 2000 steps, from ~2
   // at the start), so their loss bound is 0.15 and the real check is the sampled chunk (the
-  // untrained network misses it by > 1).
+  // untrained network misses it by > 1). With the default cosine schedule: under a constant
+  // rate of 1e-2 the result depends on the noise stream (DDPM ended 0.2-0.4 from the demo).
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae}) {
     INFO(to_string(head));
     // DDPM needs more steps: its 10 DDIM steps start from abar ~ 2e-7 (ddpm_head.cpp).
-    const auto [loss, distance_to_demo] = overfit_one_chunk(head, head == HeadKind::ddpm ? 4000 : 2000);
+    const auto [loss, distance_to_demo] =
+        overfit_one_chunk(head, head == HeadKind::ddpm ? 4000 : 2000, LearningRateSchedule::cosine);
     INFO("final loss " << loss << ", worst distance " << distance_to_demo);
     CHECK(distance_to_demo < 0.2);
     CHECK(loss < (head == HeadKind::cvae ? 1e-3 : 0.15));

@@ -7,6 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <random>
 #include <string>
@@ -238,6 +239,32 @@ TEST_CASE("every_kernel_set_computes_silu_norm_and_adam_like_the_reference", "[u
         CHECK(std::abs(v[i] - v1) <= 1e-6);
         CHECK(std::abs(p[i] - p1) <= 1e-6);
       }
+    }
+  }
+}
+
+TEST_CASE("every_kernel_set_draws_the_same_box_muller_normals", "[unit]") {
+  // The pair of each 64-bit draw (kernels::BoxMuller) against the formula in double, for
+  // every tail length of the vector loops, including the extremes of both 24-bit fields.
+  std::mt19937_64 rng(17);
+  std::vector<std::uint64_t> bits(70);
+  for (std::uint64_t& b : bits) b = rng();
+  bits[0] = 0;                      // u1 = 2^-24 (the largest radius), u2 = 0
+  bits[1] = ~std::uint64_t{0};      // u1 = 1 (radius 0), u2 = 1 - 2^-24
+  bits[2] = std::uint64_t{0x400000} << 8;  // u2 = 1/4 exactly: a quadrant boundary
+  for (KernelIsa isa : supported_sets()) {
+    for (std::ptrdiff_t pairs : {1, 7, 8, 9, 15, 16, 17, 70}) {
+      std::vector<float> out(2 * pairs + 1, 99.0f);
+      kernels::kernels_for(isa).normal_pairs(pairs, bits.data(), out.data());
+      for (std::ptrdiff_t i = 0; i < pairs; ++i) {
+        const double u1 = (kernels::BoxMuller::high24(bits[i]) + 1.0) * 0x1.0p-24;
+        const double u2 = kernels::BoxMuller::low24(bits[i]) * 0x1.0p-24;
+        const double radius = std::sqrt(-2.0 * std::log(u1)), angle = 2.0 * M_PI * u2;
+        INFO(to_string(isa) << " pairs " << pairs << " i " << i);
+        CHECK(std::abs(out[2 * i] - radius * std::cos(angle)) < 3e-6);
+        CHECK(std::abs(out[2 * i + 1] - radius * std::sin(angle)) < 3e-6);
+      }
+      CHECK(out[2 * pairs] == 99.0f);  // nothing written past the end
     }
   }
 }

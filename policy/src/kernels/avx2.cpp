@@ -4,7 +4,9 @@
 #include <immintrin.h>
 
 #include <cmath>
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <utility>
 
 #include "kernel_set.hpp"
@@ -211,10 +213,81 @@ HC_AVX2 void adam(const AdamUpdate& u) {
   });
 }
 
+// ln x for x in [2^-24, 1], as in avx512.cpp, with the exponent and mantissa from the bits.
+HC_AVX2 __m256 log_unit_ps(__m256 x) {
+  const __m256i bits = _mm256_castps_si256(x);
+  __m256 e = _mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_srli_epi32(bits, 23), _mm256_set1_epi32(127)));
+  __m256 m = _mm256_castsi256_ps(_mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi32(0x007FFFFF)),
+                                                 _mm256_set1_epi32(0x3F800000)));  // [1, 2)
+  const __m256 big = _mm256_cmp_ps(m, _mm256_set1_ps(1.41421356f), _CMP_GT_OQ);
+  m = _mm256_blendv_ps(m, _mm256_mul_ps(m, _mm256_set1_ps(0.5f)), big);
+  e = _mm256_add_ps(e, _mm256_and_ps(big, _mm256_set1_ps(1.0f)));
+  const __m256 one = _mm256_set1_ps(1.0f);
+  const __m256 s = _mm256_div_ps(_mm256_sub_ps(m, one), _mm256_add_ps(m, one)), s2 = _mm256_mul_ps(s, s);
+  __m256 series = _mm256_set1_ps(1.0f / 9.0f);
+  series = _mm256_fmadd_ps(series, s2, _mm256_set1_ps(1.0f / 7.0f));
+  series = _mm256_fmadd_ps(series, s2, _mm256_set1_ps(1.0f / 5.0f));
+  series = _mm256_fmadd_ps(series, s2, _mm256_set1_ps(1.0f / 3.0f));
+  series = _mm256_fmadd_ps(series, s2, one);
+  return _mm256_fmadd_ps(e, _mm256_set1_ps(0.693147180559945f), _mm256_mul_ps(_mm256_add_ps(s, s), series));
+}
+
+// cos and sin of 2 pi u for u in [0, 1), as in avx512.cpp.
+HC_AVX2 void cos_sin_turns_ps(__m256 u, __m256& c, __m256& s) {
+  const __m256 q = _mm256_round_ps(_mm256_mul_ps(u, _mm256_set1_ps(4.0f)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  const __m256 t = _mm256_mul_ps(_mm256_fnmadd_ps(q, _mm256_set1_ps(0.25f), u), _mm256_set1_ps(6.28318530717958648f));
+  const __m256 t2 = _mm256_mul_ps(t, t);
+  __m256 sin_t = _mm256_set1_ps(1.0f / 362880.0f);
+  sin_t = _mm256_fmadd_ps(sin_t, t2, _mm256_set1_ps(-1.0f / 5040.0f));
+  sin_t = _mm256_fmadd_ps(sin_t, t2, _mm256_set1_ps(1.0f / 120.0f));
+  sin_t = _mm256_fmadd_ps(sin_t, t2, _mm256_set1_ps(-1.0f / 6.0f));
+  sin_t = _mm256_fmadd_ps(_mm256_mul_ps(sin_t, t2), t, t);
+  __m256 cos_t = _mm256_set1_ps(1.0f / 40320.0f);
+  cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(-1.0f / 720.0f));
+  cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(1.0f / 24.0f));
+  cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(-0.5f));
+  cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(1.0f));
+  // Quadrant k = q mod 4: (cos, sin) = (c, s), (-s, c), (-c, -s), (s, -c); signs by xor.
+  const __m256i k = _mm256_and_si256(_mm256_cvtps_epi32(q), _mm256_set1_epi32(3));
+  const __m256 odd = _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(k, _mm256_set1_epi32(1)), _mm256_set1_epi32(1)));
+  const __m256i sign = _mm256_set1_epi32(static_cast<int>(0x80000000u));
+  const __m256i cos_sign = _mm256_slli_epi32(_mm256_and_si256(_mm256_add_epi32(k, _mm256_set1_epi32(1)), _mm256_set1_epi32(2)), 30);
+  const __m256i sin_sign = _mm256_slli_epi32(_mm256_and_si256(k, _mm256_set1_epi32(2)), 30);
+  c = _mm256_xor_ps(_mm256_blendv_ps(cos_t, sin_t, odd), _mm256_castsi256_ps(_mm256_and_si256(cos_sign, sign)));
+  s = _mm256_xor_ps(_mm256_blendv_ps(sin_t, cos_t, odd), _mm256_castsi256_ps(_mm256_and_si256(sin_sign, sign)));
+}
+
+HC_AVX2 void normal_pairs(std::ptrdiff_t pairs, const std::uint64_t* bits, float* out) {
+  for (std::ptrdiff_t i = 0; i < pairs; i += 8) {
+    const int count = static_cast<int>(std::min<std::ptrdiff_t>(8, pairs - i));
+    alignas(32) std::int32_t high[8] = {0, 0, 0, 0, 0, 0, 0, 0}, low[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    for (int k = 0; k < count; ++k) {
+      high[k] = static_cast<std::int32_t>(BoxMuller::high24(bits[i + k]));
+      low[k] = static_cast<std::int32_t>(BoxMuller::low24(bits[i + k]));
+    }
+    const __m256 scale = _mm256_set1_ps(BoxMuller::kTwoPow24Inverse);
+    const __m256 u1 = _mm256_mul_ps(
+        _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_load_si256(reinterpret_cast<const __m256i*>(high)), _mm256_set1_epi32(1))),
+        scale);
+    const __m256 u2 = _mm256_mul_ps(_mm256_cvtepi32_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(low))), scale);
+    const __m256 radius = _mm256_sqrt_ps(_mm256_mul_ps(_mm256_set1_ps(-2.0f), log_unit_ps(u1)));
+    __m256 c, s;
+    cos_sin_turns_ps(u2, c, s);
+    c = _mm256_mul_ps(radius, c);
+    s = _mm256_mul_ps(radius, s);
+    // Interleave (c0, s0, c1, s1, ...): unpack within 128-bit lanes, then order the lanes.
+    const __m256 lo = _mm256_unpacklo_ps(c, s), hi = _mm256_unpackhi_ps(c, s);
+    alignas(32) float pairs_out[16];
+    _mm256_store_ps(pairs_out, _mm256_permute2f128_ps(lo, hi, 0x20));
+    _mm256_store_ps(pairs_out + 8, _mm256_permute2f128_ps(lo, hi, 0x31));
+    for (int k = 0; k < 2 * count; ++k) out[2 * i + k] = pairs_out[k];
+  }
+}
+
 }  // namespace
 
 const KernelSet& avx2_kernels() {
-  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam};
+  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam, normal_pairs};
   return set;
 }
 

@@ -2,6 +2,8 @@
 // It is also the reference the vector sets are tested against (tests/policy/test_kernels.cpp).
 #include <Eigen/Core>
 #include <cmath>
+#include <cstdint>
+#include <numbers>
 
 #include "kernel_set.hpp"
 
@@ -71,10 +73,21 @@ void adam(const AdamUpdate& u) {
   p -= u.step_size * m / (v.sqrt() * u.inv_sqrt_bias2 + u.epsilon);
 }
 
+void normal_pairs(std::ptrdiff_t pairs, const std::uint64_t* bits, float* out) {
+  for (std::ptrdiff_t i = 0; i < pairs; ++i) {
+    const float u1 = static_cast<float>(BoxMuller::high24(bits[i]) + 1) * BoxMuller::kTwoPow24Inverse;
+    const float u2 = static_cast<float>(BoxMuller::low24(bits[i])) * BoxMuller::kTwoPow24Inverse;
+    const float radius = std::sqrt(-2.0f * std::log(u1));
+    const float angle = 2.0f * std::numbers::pi_v<float> * u2;
+    out[2 * i] = radius * std::cos(angle);
+    out[2 * i + 1] = radius * std::sin(angle);
+  }
+}
+
 }  // namespace
 
 const KernelSet& generic_kernels() {
-  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam};
+  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam, normal_pairs};
   return set;
 }
 

@@ -6,6 +6,7 @@
 // Storage is column-major throughout, as in Eigen: element (i, j) of an r x c matrix with
 // leading dimension ld is data[i + j * ld]. op(X) is X or X^T as stored.
 #include <cstddef>
+#include <cstdint>
 
 #include "handcentric/policy/kernels.hpp"
 
@@ -69,6 +70,16 @@ struct ExpPolynomial {
                                   4.1665795894e-2f, 1.6666665459e-1f, 5.0000001201e-1f};
 };
 
+/// Box-Muller from one 64-bit draw per pair of normals (gaussian.hpp): with the top 24 bits
+/// of each 32-bit half, u1 = (hi + 1) 2^-24 in (0, 1] and u2 = lo 2^-24 in [0, 1), both exact
+/// in float; r = sqrt(-2 ln u1) (at most sqrt(48 ln 2) = 5.77: the tails beyond 5.77 sigma,
+/// probability 8e-9, are cut), and the pair is (r cos 2 pi u2, r sin 2 pi u2).
+struct BoxMuller {
+  static std::uint32_t high24(std::uint64_t bits) { return static_cast<std::uint32_t>(bits >> 40); }
+  static std::uint32_t low24(std::uint64_t bits) { return static_cast<std::uint32_t>(bits >> 8) & 0xFFFFFFu; }
+  static constexpr float kTwoPow24Inverse = 0x1.0p-24f;
+};
+
 /// One instruction set's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
 struct KernelSet {
   void (*gemm)(const Gemm& problem);
@@ -82,6 +93,8 @@ struct KernelSet {
   /// sum of g_i^2, in double.
   double (*squared_norm)(std::ptrdiff_t n, const float* g);
   void (*adam)(const AdamUpdate& update);
+  /// out[2 i], out[2 i + 1] = the BoxMuller pair of bits[i], i < pairs.
+  void (*normal_pairs)(std::ptrdiff_t pairs, const std::uint64_t* bits, float* out);
 };
 
 const KernelSet& generic_kernels();
