@@ -219,33 +219,28 @@ HC_AVX2 __m256 log_unit_ps(__m256 x) {
   __m256 e = _mm256_cvtepi32_ps(_mm256_sub_epi32(_mm256_srli_epi32(bits, 23), _mm256_set1_epi32(127)));
   __m256 m = _mm256_castsi256_ps(_mm256_or_si256(_mm256_and_si256(bits, _mm256_set1_epi32(0x007FFFFF)),
                                                  _mm256_set1_epi32(0x3F800000)));  // [1, 2)
-  const __m256 big = _mm256_cmp_ps(m, _mm256_set1_ps(1.41421356f), _CMP_GT_OQ);
+  const __m256 big = _mm256_cmp_ps(m, _mm256_set1_ps(BoxMullerPolynomials::kSqrt2), _CMP_GT_OQ);
   m = _mm256_blendv_ps(m, _mm256_mul_ps(m, _mm256_set1_ps(0.5f)), big);
   e = _mm256_add_ps(e, _mm256_and_ps(big, _mm256_set1_ps(1.0f)));
   const __m256 one = _mm256_set1_ps(1.0f);
   const __m256 s = _mm256_div_ps(_mm256_sub_ps(m, one), _mm256_add_ps(m, one)), s2 = _mm256_mul_ps(s, s);
-  __m256 series = _mm256_set1_ps(1.0f / 9.0f);
-  series = _mm256_fmadd_ps(series, s2, _mm256_set1_ps(1.0f / 7.0f));
-  series = _mm256_fmadd_ps(series, s2, _mm256_set1_ps(1.0f / 5.0f));
-  series = _mm256_fmadd_ps(series, s2, _mm256_set1_ps(1.0f / 3.0f));
+  __m256 series = _mm256_set1_ps(BoxMullerPolynomials::kLog[0]);
+  for (int i = 1; i < 4; ++i) series = _mm256_fmadd_ps(series, s2, _mm256_set1_ps(BoxMullerPolynomials::kLog[i]));
   series = _mm256_fmadd_ps(series, s2, one);
-  return _mm256_fmadd_ps(e, _mm256_set1_ps(0.693147180559945f), _mm256_mul_ps(_mm256_add_ps(s, s), series));
+  return _mm256_fmadd_ps(e, _mm256_set1_ps(BoxMullerPolynomials::kLn2), _mm256_mul_ps(_mm256_add_ps(s, s), series));
 }
 
 // cos and sin of 2 pi u for u in [0, 1), as in avx512.cpp.
 HC_AVX2 void cos_sin_turns_ps(__m256 u, __m256& c, __m256& s) {
   const __m256 q = _mm256_round_ps(_mm256_mul_ps(u, _mm256_set1_ps(4.0f)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  const __m256 t = _mm256_mul_ps(_mm256_fnmadd_ps(q, _mm256_set1_ps(0.25f), u), _mm256_set1_ps(6.28318530717958648f));
+  const __m256 t = _mm256_mul_ps(_mm256_fnmadd_ps(q, _mm256_set1_ps(0.25f), u), _mm256_set1_ps(BoxMullerPolynomials::kTwoPi));
   const __m256 t2 = _mm256_mul_ps(t, t);
-  __m256 sin_t = _mm256_set1_ps(1.0f / 362880.0f);
-  sin_t = _mm256_fmadd_ps(sin_t, t2, _mm256_set1_ps(-1.0f / 5040.0f));
-  sin_t = _mm256_fmadd_ps(sin_t, t2, _mm256_set1_ps(1.0f / 120.0f));
-  sin_t = _mm256_fmadd_ps(sin_t, t2, _mm256_set1_ps(-1.0f / 6.0f));
+  __m256 sin_t = _mm256_set1_ps(BoxMullerPolynomials::kSin[0]), cos_t = _mm256_set1_ps(BoxMullerPolynomials::kCos[0]);
+  for (int i = 1; i < 4; ++i) {
+    sin_t = _mm256_fmadd_ps(sin_t, t2, _mm256_set1_ps(BoxMullerPolynomials::kSin[i]));
+    cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(BoxMullerPolynomials::kCos[i]));
+  }
   sin_t = _mm256_fmadd_ps(_mm256_mul_ps(sin_t, t2), t, t);
-  __m256 cos_t = _mm256_set1_ps(1.0f / 40320.0f);
-  cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(-1.0f / 720.0f));
-  cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(1.0f / 24.0f));
-  cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(-0.5f));
   cos_t = _mm256_fmadd_ps(cos_t, t2, _mm256_set1_ps(1.0f));
   // Quadrant k = q mod 4: (cos, sin) = (c, s), (-s, c), (-c, -s), (s, -c); signs by xor.
   const __m256i k = _mm256_and_si256(_mm256_cvtps_epi32(q), _mm256_set1_epi32(3));

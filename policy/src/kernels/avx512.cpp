@@ -292,34 +292,29 @@ HC_AVX512 void adam(const AdamUpdate& u) {
 HC_AVX512 __m512 log_unit_ps(__m512 x) {
   __m512 e = _mm512_getexp_ps(x);
   __m512 m = _mm512_getmant_ps(x, _MM_MANT_NORM_1_2, _MM_MANT_SIGN_src);
-  const __mmask16 big = _mm512_cmp_ps_mask(m, _mm512_set1_ps(1.41421356f), _CMP_GT_OQ);
+  const __mmask16 big = _mm512_cmp_ps_mask(m, _mm512_set1_ps(BoxMullerPolynomials::kSqrt2), _CMP_GT_OQ);
   m = _mm512_mask_mul_ps(m, big, m, _mm512_set1_ps(0.5f));
   e = _mm512_mask_add_ps(e, big, e, _mm512_set1_ps(1.0f));
   const __m512 one = _mm512_set1_ps(1.0f);
   const __m512 s = _mm512_div_ps(_mm512_sub_ps(m, one), _mm512_add_ps(m, one)), s2 = _mm512_mul_ps(s, s);
-  __m512 series = _mm512_set1_ps(1.0f / 9.0f);
-  series = _mm512_fmadd_ps(series, s2, _mm512_set1_ps(1.0f / 7.0f));
-  series = _mm512_fmadd_ps(series, s2, _mm512_set1_ps(1.0f / 5.0f));
-  series = _mm512_fmadd_ps(series, s2, _mm512_set1_ps(1.0f / 3.0f));
+  __m512 series = _mm512_set1_ps(BoxMullerPolynomials::kLog[0]);
+  for (int i = 1; i < 4; ++i) series = _mm512_fmadd_ps(series, s2, _mm512_set1_ps(BoxMullerPolynomials::kLog[i]));
   series = _mm512_fmadd_ps(series, s2, one);
-  return _mm512_fmadd_ps(e, _mm512_set1_ps(0.693147180559945f), _mm512_mul_ps(_mm512_add_ps(s, s), series));
+  return _mm512_fmadd_ps(e, _mm512_set1_ps(BoxMullerPolynomials::kLn2), _mm512_mul_ps(_mm512_add_ps(s, s), series));
 }
 
 // cos and sin of 2 pi u for u in [0, 1): q = round(4 u), t = 2 pi (u - q / 4) in [-pi/4, pi/4]
 // (u - q / 4 is exact), Taylor polynomials to t^9 / t^8 (error < 3e-8), then the quadrant q.
 HC_AVX512 void cos_sin_turns_ps(__m512 u, __m512& c, __m512& s) {
   const __m512 q = _mm512_roundscale_ps(_mm512_mul_ps(u, _mm512_set1_ps(4.0f)), _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  const __m512 t = _mm512_mul_ps(_mm512_fnmadd_ps(q, _mm512_set1_ps(0.25f), u), _mm512_set1_ps(6.28318530717958648f));
+  const __m512 t = _mm512_mul_ps(_mm512_fnmadd_ps(q, _mm512_set1_ps(0.25f), u), _mm512_set1_ps(BoxMullerPolynomials::kTwoPi));
   const __m512 t2 = _mm512_mul_ps(t, t);
-  __m512 sin_t = _mm512_set1_ps(1.0f / 362880.0f);
-  sin_t = _mm512_fmadd_ps(sin_t, t2, _mm512_set1_ps(-1.0f / 5040.0f));
-  sin_t = _mm512_fmadd_ps(sin_t, t2, _mm512_set1_ps(1.0f / 120.0f));
-  sin_t = _mm512_fmadd_ps(sin_t, t2, _mm512_set1_ps(-1.0f / 6.0f));
+  __m512 sin_t = _mm512_set1_ps(BoxMullerPolynomials::kSin[0]), cos_t = _mm512_set1_ps(BoxMullerPolynomials::kCos[0]);
+  for (int i = 1; i < 4; ++i) {
+    sin_t = _mm512_fmadd_ps(sin_t, t2, _mm512_set1_ps(BoxMullerPolynomials::kSin[i]));
+    cos_t = _mm512_fmadd_ps(cos_t, t2, _mm512_set1_ps(BoxMullerPolynomials::kCos[i]));
+  }
   sin_t = _mm512_fmadd_ps(_mm512_mul_ps(sin_t, t2), t, t);
-  __m512 cos_t = _mm512_set1_ps(1.0f / 40320.0f);
-  cos_t = _mm512_fmadd_ps(cos_t, t2, _mm512_set1_ps(-1.0f / 720.0f));
-  cos_t = _mm512_fmadd_ps(cos_t, t2, _mm512_set1_ps(1.0f / 24.0f));
-  cos_t = _mm512_fmadd_ps(cos_t, t2, _mm512_set1_ps(-0.5f));
   cos_t = _mm512_fmadd_ps(cos_t, t2, _mm512_set1_ps(1.0f));
   // Quadrant k = q mod 4: (cos, sin) = (c, s), (-s, c), (-c, -s), (s, -c).
   const __m512i k = _mm512_and_si512(_mm512_cvtps_epi32(q), _mm512_set1_epi32(3));

@@ -80,6 +80,17 @@ struct BoxMuller {
   static constexpr float kTwoPow24Inverse = 0x1.0p-24f;
 };
 
+/// The polynomials of the vector Box-Muller (avx2.cpp, avx512.cpp), coefficients highest first.
+/// ln m for m in [sqrt(1/2), sqrt(2)): 2 s (1 + s^2/3 + ... + s^8/9), s = (m - 1) / (m + 1).
+/// sin t and cos t for |t| <= pi/4 by Taylor: t + t^3 (kSin...), 1 + t^2 (kCos...).
+struct BoxMullerPolynomials {
+  static constexpr float kLn2 = 0.693147180559945f, kSqrt2 = 1.41421356f;
+  static constexpr float kTwoPi = 6.28318530717958648f;
+  static constexpr float kLog[4] = {1.0f / 9.0f, 1.0f / 7.0f, 1.0f / 5.0f, 1.0f / 3.0f};
+  static constexpr float kSin[4] = {1.0f / 362880.0f, -1.0f / 5040.0f, 1.0f / 120.0f, -1.0f / 6.0f};
+  static constexpr float kCos[4] = {1.0f / 40320.0f, -1.0f / 720.0f, 1.0f / 24.0f, -0.5f};
+};
+
 /// One instruction set's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
 struct KernelSet {
   void (*gemm)(const Gemm& problem);
