@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/demos.hpp"
@@ -109,7 +110,8 @@ int run_train(const TrainOptions& options) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "trained " << trained.name() << " on " << scenes.size() << " scenes from " << used << " demos: "
             << config.steps << " steps, final loss " << last_loss << ", " << static_cast<long>(last_rate)
-            << " samples/s, " << clock_text(seconds) << " -> " << options.out << "\n";
+            << " samples/s (" << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
+            << " -> " << options.out << "\n";
   return 0;
 }
 

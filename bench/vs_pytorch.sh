@@ -36,7 +36,10 @@ fi
 echo "pytorch's BLAS: $(readlink -f /usr/lib/x86_64-linux-gnu/libblas.so.3 2>/dev/null || echo unknown)"
 echo "handcentric's kernels: ${HANDCENTRIC_KERNELS:-best for this CPU}"
 
-ours_json="$("$bench" --benchmark_filter='BM_flow_train_step_batch256|BM_flow_sample_10_euler_steps_batch1' \
+# Both sides pinned: one thread on core 0 (two threads on cores 0 and 1), when taskset exists.
+pin() { if command -v taskset >/dev/null; then taskset -c "$1" "${@:2}"; else "${@:2}"; fi; }
+
+ours_json="$(pin 0 "$bench" --benchmark_filter='BM_flow_train_step_batch256|BM_flow_sample_10_euler_steps_batch1' \
   --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"
 read -r ours_rate ours_sample_us < <("$python" -c '
 import json, sys
@@ -47,7 +50,9 @@ print(rate, sample)' <<<"$ours_json")
 
 torch_best=0
 for threads in 1 2; do
-  line="$("$python" "$here/vs_pytorch.py" --threads "$threads")"
+  cores=0
+  if [[ "$threads" -eq 2 ]]; then cores=0,1; fi
+  line="$(pin "$cores" "$python" "$here/vs_pytorch.py" --threads "$threads")"
   echo "pytorch: $line"
   rate="$("$python" -c 'import json,sys; print(json.loads(sys.argv[1])["train_samples_per_s"])' "$line")"
   if "$python" -c 'import sys; sys.exit(0 if float(sys.argv[1]) > float(sys.argv[2]) else 1)' "$rate" "$torch_best"; then
