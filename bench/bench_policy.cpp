@@ -3,6 +3,9 @@
 // -> 24, SiLU, Adam, batch 256; and sampling latency at batch 1 (10 Euler steps). Numbers are
 // recorded in docs/BENCHMARKS.md ("## Policy") with the commands that produced them.
 #include <benchmark/benchmark.h>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include <random>
 
@@ -75,6 +78,41 @@ BENCHMARK(BM_flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ddpm_sample_10_ddim_steps_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_cvae_sample_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_c8flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond);
+
+#if defined(__x86_64__)
+// The host's speed probe: AVX-512 FMAs on 24 independent registers, no memory traffic. Its
+// GFLOP/s (items/s x 1e-9) is the ceiling of the training kernels at that moment; on a shared
+// host it drifts (docs/BENCHMARKS.md), so it is run beside the numbers it qualifies.
+__attribute__((target("avx512f"), noipa)) float fma_probe(long iterations) {
+  __m512 acc[24];
+  for (int i = 0; i < 24; ++i) acc[i] = _mm512_set1_ps(0.001f * static_cast<float>(i));
+  const __m512 x = _mm512_set1_ps(0.999f), y = _mm512_set1_ps(1e-4f);
+  for (long it = 0; it < iterations; ++it) {
+#pragma GCC unroll 24
+    for (int i = 0; i < 24; ++i) acc[i] = _mm512_fmadd_ps(acc[i], x, y);
+  }
+  __m512 sum = acc[0];
+  for (int i = 1; i < 24; ++i) sum = _mm512_add_ps(sum, acc[i]);
+  alignas(64) float lanes[16];
+  _mm512_store_ps(lanes, sum);  // (not _mm512_reduce_add_ps: GCC 12 warns inside it)
+  float total = 0.0f;
+  for (float lane : lanes) total += lane;
+  return total;
+}
+
+void BM_avx512_fma_peak(benchmark::State& state) {
+  if (!__builtin_cpu_supports("avx512f")) {
+    state.SkipWithError("no AVX-512 on this CPU");
+    return;
+  }
+  constexpr long kIterations = 1 << 20;
+  long iterations = kIterations;
+  benchmark::DoNotOptimize(iterations);  // opaque: the loop cannot be folded
+  for (auto _ : state) benchmark::DoNotOptimize(fma_probe(iterations));
+  state.SetItemsProcessed(state.iterations() * kIterations * 24 * 32);  // flops: 24 FMAs x 16 lanes x 2
+}
+BENCHMARK(BM_avx512_fma_peak)->Unit(benchmark::kMillisecond);
+#endif
 
 // One network evaluation at batch 1 (the inner loop of sampling): 57 -> 256 -> 256 -> 256 -> 24.
 void BM_mlp_infer_batch1(benchmark::State& state) {
