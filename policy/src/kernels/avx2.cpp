@@ -62,52 +62,104 @@ struct Avx2Kernel {
   }
 };
 
-// y(rows) = A(rows x k) x (+ bias), rows <= 8 V; the last of the V ymm accumulators is masked.
-template <int V>
-HC_AVX2 void gemv_block(int rows, int k, const float* a, long lda, const float* x, const float* bias, float* y) {
-  const int tail = rows - 8 * (V - 1);  // 1..8 rows in the last vector
-  alignas(32) int lanes[8];
-  for (int i = 0; i < 8; ++i) lanes[i] = i < tail ? -1 : 0;
-  const __m256i last = _mm256_load_si256(reinterpret_cast<const __m256i*>(lanes));
-  __m256 acc[V];
-  #pragma GCC unroll 32
-  for (int v = 0; v + 1 < V; ++v) acc[v] = bias != nullptr ? _mm256_loadu_ps(bias + 8 * v) : _mm256_setzero_ps();
-  acc[V - 1] = bias != nullptr ? _mm256_maskload_ps(bias + 8 * (V - 1), last) : _mm256_setzero_ps();
+// Narrow products (n <= kNarrowMax columns), as in avx512.cpp: A streamed in place, each loaded
+// vector of A used for all N columns, N x V ymm accumulators (N V <= 12 of the 16 registers).
+// Columns of A that start 16 bytes past a 32-byte boundary (Eigen's 16-byte heap) are read
+// from 4 lanes earlier, so no load splits a cache line; the first and last vectors are masked.
+// op(B)(p, j) = b[p * b_step + j * b_stride].
+constexpr int kNarrowMax = 16;
+
+template <int N, int V>
+HC_AVX2 void narrow_block(int shift, int rows, int k, const float* a, long lda, const float* b, long b_step,
+                          long b_stride, const float* bias, float* c, long ldc) {
+  const int lanes = shift + rows;  // in 8 (V - 1) + 1 .. 8 V
+  alignas(32) int head_lanes[8], tail_lanes[8];
+  for (int i = 0; i < 8; ++i) {
+    head_lanes[i] = i >= shift && (V > 1 || i < lanes) ? -1 : 0;
+    tail_lanes[i] = 8 * (V - 1) + i < lanes && (V > 1 || i >= shift) ? -1 : 0;
+  }
+  const __m256i head = _mm256_load_si256(reinterpret_cast<const __m256i*>(head_lanes));
+  const __m256i tail = _mm256_load_si256(reinterpret_cast<const __m256i*>(tail_lanes));
+  a -= shift;
+  c -= shift;
+  if (bias != nullptr) bias -= shift;
+  const auto load = [&](const float* p, int v) HC_AVX2 {
+    return v == 0 ? _mm256_maskload_ps(p, head) : v + 1 == V ? _mm256_maskload_ps(p, tail) : _mm256_loadu_ps(p);
+  };
+  __m256 acc[N][V];
+  #pragma GCC unroll 16
+  for (int v = 0; v < V; ++v) {
+    const __m256 start = bias != nullptr ? load(bias + 8 * v, v) : _mm256_setzero_ps();
+    #pragma GCC unroll 16
+    for (int j = 0; j < N; ++j) acc[j][v] = start;
+  }
   for (int p = 0; p < k; ++p) {
     const float* column = a + p * lda;
-    const __m256 xp = _mm256_broadcast_ss(x + p);
-    #pragma GCC unroll 32
-    for (int v = 0; v < V; v += 8) _mm_prefetch(reinterpret_cast<const char*>(column + 4 * lda + 8 * v), _MM_HINT_T0);
-    #pragma GCC unroll 32
-    for (int v = 0; v + 1 < V; ++v) acc[v] = _mm256_fmadd_ps(_mm256_loadu_ps(column + 8 * v), xp, acc[v]);
-    acc[V - 1] = _mm256_fmadd_ps(_mm256_maskload_ps(column + 8 * (V - 1), last), xp, acc[V - 1]);
+    const float* b_row = b + p * b_step;
+    #pragma GCC unroll 16
+    for (int v = 0; v < V; ++v) {
+      const __m256 a_v = load(column + 8 * v, v);
+      #pragma GCC unroll 16
+      for (int j = 0; j < N; ++j) acc[j][v] = _mm256_fmadd_ps(a_v, _mm256_broadcast_ss(b_row + j * b_stride), acc[j][v]);
+    }
   }
-  #pragma GCC unroll 32
-  for (int v = 0; v + 1 < V; ++v) _mm256_storeu_ps(y + 8 * v, acc[v]);
-  _mm256_maskstore_ps(y + 8 * (V - 1), last, acc[V - 1]);
+  #pragma GCC unroll 16
+  for (int j = 0; j < N; ++j) {
+    float* cj = c + j * ldc;
+    #pragma GCC unroll 16
+    for (int v = 0; v < V; ++v) {
+      if (v == 0) {
+        _mm256_maskstore_ps(cj, head, acc[j][0]);
+      } else if (v + 1 == V) {
+        _mm256_maskstore_ps(cj + 8 * v, tail, acc[j][v]);
+      } else {
+        _mm256_storeu_ps(cj + 8 * v, acc[j][v]);
+      }
+    }
+  }
 }
 
-template <int... V>
-HC_AVX2 void gemv_rows(int vectors, int rows, int k, const float* a, long lda, const float* x, const float* bias,
-                       float* y, std::integer_sequence<int, V...>) {
-  ((vectors == V + 1 ? gemv_block<V + 1>(rows, k, a, lda, x, bias, y) : void()), ...);
+template <int N, int... V>
+HC_AVX2 void narrow_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* b,
+                         long b_step, long b_stride, const float* bias, float* c, long ldc,
+                         std::integer_sequence<int, V...>) {
+  ((vectors == V + 1 ? narrow_block<N, V + 1>(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc) : void()),
+   ...);
 }
 
-HC_AVX2 void gemv(const Gemm& g) {
-  constexpr int kBlockRows = 96;  // 12 accumulators of the 16 ymm registers
-  for (int i0 = 0; i0 < g.m; i0 += kBlockRows) {
-    const int rows = std::min(kBlockRows, g.m - i0);
-    gemv_rows((rows + 7) / 8, rows, g.k, g.a + i0, g.lda, g.b, g.row_bias ? g.row_bias + i0 : nullptr, g.c + i0,
-              std::make_integer_sequence<int, 12>{});
+// Columns j0 .. j0 + N of C.
+template <int N>
+HC_AVX2 void narrow_columns(const Gemm& g, int j0) {
+  constexpr int kVectors = 12 / N;
+  const long b_step = g.op_b == Op::none ? 1 : g.ldb, b_stride = g.op_b == Op::none ? g.ldb : 1;
+  const auto address = reinterpret_cast<std::uintptr_t>(g.a);
+  const int shift = (g.lda % 8 == 0 && address % 4 == 0) ? static_cast<int>(address % 32 / 4) : 0;
+  const int block_rows = 8 * kVectors - shift;
+  for (int i0 = 0; i0 < g.m; i0 += block_rows) {
+    const int rows = std::min(block_rows, g.m - i0);
+    const int block_shift = i0 == 0 ? shift : 0;  // later blocks start on a 32-byte boundary
+    narrow_rows<N>((block_shift + rows + 7) / 8, block_shift, rows, g.k, g.a + i0, g.lda, g.b + j0 * b_stride, b_step,
+                   b_stride, g.row_bias ? g.row_bias + i0 : nullptr, g.c + i0 + static_cast<long>(j0) * g.ldc, g.ldc,
+                   std::make_integer_sequence<int, kVectors>{});
   }
+}
+
+template <int... N>
+HC_AVX2 void narrow_dispatch(const Gemm& g, int j0, int columns, std::integer_sequence<int, N...>) {
+  ((columns == N + 1 ? narrow_columns<N + 1>(g, j0) : void()), ...);
+}
+
+// op(A) = A, n <= kNarrowMax: groups of up to 4 columns (3 vectors of rows each).
+HC_AVX2 void narrow(const Gemm& g) {
+  for (int j0 = 0; j0 < g.n; j0 += 4) narrow_dispatch(g, j0, std::min(4, g.n - j0), std::make_integer_sequence<int, 4>{});
 }
 
 HC_AVX2 void gemm(const Gemm& g) {
   if (trivial_gemm(g)) {
     apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
-  } else if (g.n == 1 && g.op_a == Op::none && (g.op_b == Op::none || g.ldb == 1)) {
-    gemv(g);
-    apply_epilogue(g, 0, g.m, 0, 1, silu_forward, silu);
+  } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
+    narrow(g);
+    apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
   } else {
     blocked_gemm<Avx2Kernel>(g);
   }
