@@ -5,8 +5,8 @@
 // used after kernel_isa_supported(KernelIsa::avx512) said yes.
 #include <immintrin.h>
 
-#include <cstddef>
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 
