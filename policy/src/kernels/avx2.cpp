@@ -3,8 +3,8 @@
 // kernel_isa_supported(KernelIsa::avx2) said yes.
 #include <immintrin.h>
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
