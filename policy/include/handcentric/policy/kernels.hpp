@@ -30,6 +30,8 @@ KernelIsa best_kernel_isa();
 /// An unknown or unsupported HANDCENTRIC_KERNELS throws InvalidArgument at first use.
 KernelIsa kernel_isa();
 /// Use `isa` from now on, for the whole process. Throws InvalidArgument when the CPU lacks it.
+/// Switch between computations, not during one: a training step or a sample that is running on
+/// another thread may see both sets.
 void set_kernel_isa(KernelIsa isa);
 
 }  // namespace handcentric::policy
