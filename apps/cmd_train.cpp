@@ -39,6 +39,7 @@ struct TrainOptions {
   int layers = 3;
   double learning_rate = 1e-3;
   std::string lr_schedule = "cosine";
+  double ema = 0.0;
   int euler_steps = 10;
   int time_embedding = 16;
   bool quiet = false;
@@ -68,6 +69,7 @@ int run_train(const TrainOptions& options) {
   config.hidden_layers = options.layers;
   config.learning_rate = options.learning_rate;
   config.lr_schedule = policy::parse_schedule(options.lr_schedule);
+  config.ema_decay = options.ema;
   config.euler_steps = options.euler_steps;
   config.time_embedding = options.time_embedding;
   config.validate();
@@ -134,6 +136,8 @@ void add_train_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--width", options->width, "hidden layer width")->capture_default_str();
   cmd->add_option("--layers", options->layers, "hidden layers")->capture_default_str();
   cmd->add_option("--lr", options->learning_rate, "Adam learning rate")->capture_default_str();
+  cmd->add_option("--ema", options->ema, "keep the moving average of the weights with this decay (0: off; 0.999 is usual)")
+      ->capture_default_str();
   cmd->add_option("--lr-schedule", options->lr_schedule, "constant|cosine (from --lr down to ~0 at the last step)")
       ->capture_default_str();
   cmd->add_option("--euler-steps", options->euler_steps, "Euler steps of the flow sampler")->capture_default_str();

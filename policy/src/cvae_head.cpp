@@ -9,6 +9,7 @@
 #include "handcentric/policy/cvae_loss.hpp"
 #include "handcentric/policy/mlp.hpp"
 #include "handcentric/policy/normalizer.hpp"
+#include "handcentric/policy/weight_average.hpp"
 #include "normalizer_io.hpp"
 
 namespace handcentric::policy {
@@ -32,7 +33,8 @@ class CvaeHead final : public Head {
         decoder_(widths(config, config.cvae_latent + config.observation_dimension, config.action_dimension),
                  config.activation),
         encoder_adam_(encoder_.parameter_count(), options(config)),
-        decoder_adam_(decoder_.parameter_count(), options(config)) {}
+        decoder_adam_(decoder_.parameter_count(), options(config)),
+        decoder_average_(config.ema_decay) {}
 
   HeadKind kind() const override { return HeadKind::cvae; }
 
@@ -54,7 +56,13 @@ class CvaeHead final : public Head {
     const double loss = cvae_loss_and_gradients<float>(encoder_, decoder_, a_, o_, noise_, config_.cvae_kl_weight, buffers_);
     step(decoder_, decoder_adam_);
     step(encoder_, encoder_adam_);
+    decoder_average_.update(decoder_.parameters());
     return loss;
+  }
+
+  // Sampling uses the decoder only, so only the decoder's weights are averaged.
+  void finish_training() override {
+    if (decoder_average_.updates() > 0) decoder_.parameters() = decoder_average_.average();
   }
 
   void set_learning_rate(double learning_rate) override {
@@ -97,6 +105,7 @@ class CvaeHead final : public Head {
   Normalizer action_normalizer_, observation_normalizer_;
   Mlp encoder_, decoder_;
   Adam encoder_adam_, decoder_adam_;
+  WeightAverage decoder_average_;
   Eigen::MatrixXf a_, o_, noise_;
   CvaeBuffers<float> buffers_;
 };

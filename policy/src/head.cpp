@@ -44,7 +44,8 @@ NetworkHead::NetworkHead(const PolicyConfig& config)
       action_normalizer_(config.action_dimension),
       observation_normalizer_(config.observation_dimension),
       network_(network_widths(config, config.action_dimension), config.activation),
-      adam_(network_.parameter_count(), AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}) {}
+      adam_(network_.parameter_count(), AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}),
+      average_(config.ema_decay) {}
 
 void NetworkHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
                           std::mt19937_64& rng) {
@@ -74,7 +75,12 @@ double NetworkHead::regress(const Eigen::MatrixXf& output, const Eigen::MatrixXf
   // Clipping folded into Adam's step: the gradient is read once more, not copied and rewritten.
   const float clip = gradient_clip_scale(network_.gradient(), config_.gradient_clip);
   adam_.step(network_.parameters(), network_.gradient(), clip);
+  average_.update(network_.parameters());
   return loss;
+}
+
+void NetworkHead::finish_training() {
+  if (average_.updates() > 0) network_.parameters() = average_.average();
 }
 
 void NetworkHead::write(ByteWriter& out) const {

@@ -8,6 +8,7 @@
 #include "handcentric/policy/head.hpp"
 #include "handcentric/policy/mlp.hpp"
 #include "handcentric/policy/normalizer.hpp"
+#include "handcentric/policy/weight_average.hpp"
 
 namespace handcentric::policy {
 
@@ -18,6 +19,7 @@ class NetworkHead : public Head {
   void write(ByteWriter& out) const override;
   void read(ByteReader& in) override;
   void set_learning_rate(double learning_rate) override { adam_.set_learning_rate(learning_rate); }
+  void finish_training() override;
 
   const Mlp& network() const { return network_; }
   const Normalizer& action_normalizer() const { return action_normalizer_; }
@@ -37,6 +39,7 @@ class NetworkHead : public Head {
   Normalizer action_normalizer_, observation_normalizer_;
   Mlp network_;
   Adam adam_;
+  WeightAverage average_;
   // Minibatch buffers.
   Eigen::MatrixXf a_, o_, noise_, x_, target_, input_, d_output_;
   Eigen::VectorXd t_;

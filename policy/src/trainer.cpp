@@ -89,6 +89,7 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
       loss_count = 0;
     }
   }
+  head->finish_training();  // the weight average, when config.ema_decay > 0
   return LearnedPolicy(config, representation, head);
 }
 

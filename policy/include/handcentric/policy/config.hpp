@@ -52,6 +52,9 @@ struct PolicyConfig {
   LearningRateSchedule lr_schedule = LearningRateSchedule::cosine;
   double weight_decay = 0.0;  ///< decoupled (AdamW)
   double gradient_clip = 1.0;  ///< global L2 norm; 0 disables
+  /// Keep the exponential moving average of the weights (weight_average.hpp) and put it in the
+  /// model: 0 = off (the default), 0.999 is usual.
+  double ema_decay = 0.0;
   // Sampling and heads.
   int euler_steps = 10;          ///< rectified flow, eq. (5)
   int ddpm_train_steps = 100;    ///< DDPM diffusion steps

@@ -35,6 +35,10 @@ class Head {
   /// The optimizer's learning rate for the next train_step calls (the trainer's schedule).
   virtual void set_learning_rate(double learning_rate) = 0;
 
+  /// Called once after the last train_step: with config.ema_decay > 0 the head's weights
+  /// become their moving average (weight_average.hpp), which is what sample() and write() use.
+  virtual void finish_training() = 0;
+
   /// One raw action vector per raw observation column; all noise from `rng`.
   virtual Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const = 0;
 
