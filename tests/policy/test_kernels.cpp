@@ -274,8 +274,10 @@ TEST_CASE("mlp_on_every_kernel_set_matches_the_double_network", "[unit]") {
   // with the same parameters in float on each kernel set and in double (Eigen).
   KernelSetGuard guard;
   std::mt19937_64 rng(15);
-  for (const std::vector<int>& widths : {std::vector<int>{57, 256, 256, 24}, std::vector<int>{5, 33, 17, 3}}) {
-    MlpT<double> reference(widths, Activation::silu);
+  for (const auto& [widths, activation] : {std::pair{std::vector<int>{57, 256, 256, 24}, Activation::silu},
+                                           std::pair{std::vector<int>{5, 33, 17, 3}, Activation::silu},
+                                           std::pair{std::vector<int>{9, 40, 24, 6}, Activation::relu}}) {
+    MlpT<double> reference(widths, activation);
     reference.initialize(rng);
     Eigen::MatrixXd input(widths.front(), 37), d_output(widths.back(), 37);
     for (Eigen::Index i = 0; i < input.size(); ++i) input(i) = 2.0 * uniform01(rng) - 1.0;
@@ -283,9 +285,9 @@ TEST_CASE("mlp_on_every_kernel_set_matches_the_double_network", "[unit]") {
     const Eigen::MatrixXd output = reference.forward(input);
     const Eigen::MatrixXd d_input = reference.backward(d_output);
     for (KernelIsa isa : supported_sets()) {
-      INFO("kernel set " << to_string(isa) << ", input width " << widths.front());
+      INFO("kernel set " << to_string(isa) << ", input width " << widths.front() << ", " << to_string(activation));
       set_kernel_isa(isa);
-      Mlp net(widths, Activation::silu);
+      Mlp net(widths, activation);
       net.parameters() = reference.parameters().cast<float>();
       const Eigen::MatrixXf out = net.forward(input.cast<float>());
       const Eigen::MatrixXf din = net.backward(d_output.cast<float>());
