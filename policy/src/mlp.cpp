@@ -67,16 +67,11 @@ void activate(Activation activation, const Matrix& z, Matrix& a) {
   }
 }
 
-// delta *= act'(z). SiLU' = s (1 + z (1 - s)) with s = sigmoid(z); ReLU' = [z > 0].
+// delta *= ReLU'(z) = [z > 0]. (SiLU's derivative is in propagate(), from the kept sigmoid.)
 template <typename Matrix>
-void multiply_by_derivative(Activation activation, const Matrix& z, Matrix& delta) {
+void multiply_by_relu_derivative(const Matrix& z, Matrix& delta) {
   using Scalar = typename Matrix::Scalar;
-  if (activation == Activation::silu) {
-    const auto s = Scalar(1) / (Scalar(1) + (-z.array()).exp());
-    delta.array() *= s * (Scalar(1) + z.array() * (Scalar(1) - s));
-  } else {
-    delta.array() *= (z.array() > Scalar(0)).template cast<Scalar>();
-  }
+  delta.array() *= (z.array() > Scalar(0)).template cast<Scalar>();
 }
 
 // The three products of a layer, on column-major storage. float runs on the dispatched kernels
@@ -192,7 +187,7 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
     Matrix& delta = delta_[current];
     if (l + 1 < layers()) {
       if (activation_ == Activation::silu) {
-        // SiLU'(z) = s (1 + z (1 - s)), s = sigmoid(z) from forward().
+        // SiLU'(z) = s (1 + z (1 - s)) = s + a (1 - s), s = sigmoid(z) kept by forward().
         if constexpr (std::is_same_v<Scalar, float>) {
           kernels::active().silu_backward(delta.size(), a_[l + 1].data(), sigmoid_[l].data(), delta.data());
         } else {
@@ -200,7 +195,7 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
           delta.array() *= s * (Scalar(1) + z_[l].array() * (Scalar(1) - s));
         }
       } else {
-        multiply_by_derivative(activation_, z_[l], delta);
+        multiply_by_relu_derivative(z_[l], delta);
       }
     }
     const Eigen::Index n = static_cast<Eigen::Index>(widths_[l + 1]) * widths_[l];

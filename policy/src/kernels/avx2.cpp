@@ -1,4 +1,4 @@
-// AVX2 + FMA kernels (see gemm_avx512.cpp for why every vector function carries the target
+// AVX2 + FMA kernels (see avx512.cpp for why every vector function carries the target
 // attribute and the translation unit does not). avx2_kernels() is only used after
 // kernel_isa_supported(KernelIsa::avx2) said yes.
 #include <immintrin.h>
@@ -20,58 +20,11 @@ namespace {
 HC_AVX2 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
 HC_AVX2 void silu(std::ptrdiff_t n, float* x);
 
-// C tile of 16 x 6 = 12 ymm accumulators; per k: 2 loads of A, 6 broadcasts of B, 12 FMAs.
-struct Avx2Kernel {
-  static constexpr int MR = 16, NR = 6;
-  static constexpr auto epilogue_silu_forward = silu_forward;
-  static constexpr auto epilogue_silu = silu;
-  static constexpr auto pack_a = kernels::pack_a<MR>;
-
-  template <BLayout layout>
-  HC_AVX2 static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc, bool accumulate,
-                           const float* bias) {
-    __m256 acc[NR][2];
-    #pragma GCC unroll 32
-    for (int j = 0; j < NR; ++j) acc[j][0] = acc[j][1] = _mm256_setzero_ps();
-    for (int p = 0; p < kc; ++p) {
-      const __m256 a0 = _mm256_load_ps(a), a1 = _mm256_load_ps(a + 8);
-      #pragma GCC unroll 32
-      for (int j = 0; j < NR; ++j) {
-        const __m256 bj = _mm256_broadcast_ss(layout == BLayout::columns ? b + j * static_cast<long>(ldb) : b + j);
-        acc[j][0] = _mm256_fmadd_ps(a0, bj, acc[j][0]);
-        acc[j][1] = _mm256_fmadd_ps(a1, bj, acc[j][1]);
-      }
-      a += MR;
-      b += layout == BLayout::packed ? NR : layout == BLayout::rows ? ldb : 1;
-    }
-    __m256 add0 = _mm256_setzero_ps(), add1 = _mm256_setzero_ps();
-    if (!accumulate && bias != nullptr) {
-      add0 = _mm256_loadu_ps(bias);
-      add1 = _mm256_loadu_ps(bias + 8);
-    }
-    #pragma GCC unroll 32
-    for (int j = 0; j < NR; ++j) {
-      float* cj = c + static_cast<long>(j) * ldc;
-      if (accumulate) {
-        add0 = _mm256_loadu_ps(cj);
-        add1 = _mm256_loadu_ps(cj + 8);
-      }
-      _mm256_storeu_ps(cj, _mm256_add_ps(acc[j][0], add0));
-      _mm256_storeu_ps(cj + 8, _mm256_add_ps(acc[j][1], add1));
-    }
-  }
-};
-
-// Narrow products (n <= kNarrowMax columns), as in avx512.cpp: A streamed in place, each loaded
-// vector of A used for all N columns, N x V ymm accumulators (N V <= 12 of the 16 registers).
-// Columns of A that start 16 bytes past a 32-byte boundary (Eigen's 16-byte heap) are read
-// from 4 lanes earlier, so no load splits a cache line; the first and last vectors are masked.
-// op(B)(p, j) = b[p * b_step + j * b_stride].
-constexpr int kNarrowMax = 16;
-
+// One narrow product C(rows, 0:N) = A(rows, 0:k) op(B)(0:k, 0:N) (+ bias) with N x V accumulators:
+// the contract of pack.hpp's narrow loop nest ("Narrow products").
 template <int N, int V>
-HC_AVX2 void narrow_block(int shift, int rows, int k, const float* a, long lda, const float* b, long b_step,
-                          long b_stride, const float* bias, float* c, long ldc) {
+HC_AVX2 void narrow_product(int shift, int rows, int k, const float* a, long lda, const float* b, long b_step,
+                            long b_stride, const float* bias, float* c, long ldc) {
   const int lanes = shift + rows;  // in 8 (V - 1) + 1 .. 8 V
   alignas(32) int head_lanes[8], tail_lanes[8];
   for (int i = 0; i < 8; ++i) {
@@ -119,51 +72,50 @@ HC_AVX2 void narrow_block(int shift, int rows, int k, const float* a, long lda, 
   }
 }
 
-template <int N, int... V>
-HC_AVX2 void narrow_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* b,
-                         long b_step, long b_stride, const float* bias, float* c, long ldc,
-                         std::integer_sequence<int, V...>) {
-  ((vectors == V + 1 ? narrow_block<N, V + 1>(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc) : void()),
-   ...);
-}
+// C tile of 16 x 6 = 12 ymm accumulators; per k: 2 loads of A, 6 broadcasts of B, 12 FMAs.
+struct Avx2Kernel {
+  static constexpr int MR = 16, NR = 6;
+  static constexpr int kNarrowLanes = 8, kNarrowAccumulators = 12, kNarrowGroup = 4;
+  template <int N, int V>
+  static constexpr auto narrow_block = &narrow_product<N, V>;
+  static constexpr auto epilogue_silu_forward = silu_forward;
+  static constexpr auto epilogue_silu = silu;
+  static constexpr auto pack_a = kernels::pack_a<MR>;
 
-// Columns j0 .. j0 + N of C.
-template <int N>
-HC_AVX2 void narrow_columns(const Gemm& g, int j0) {
-  constexpr int kVectors = 12 / N;
-  const long b_step = g.op_b == Op::none ? 1 : g.ldb, b_stride = g.op_b == Op::none ? g.ldb : 1;
-  const auto address = reinterpret_cast<std::uintptr_t>(g.a);
-  const int shift = (g.lda % 8 == 0 && address % 4 == 0) ? static_cast<int>(address % 32 / 4) : 0;
-  const int block_rows = 8 * kVectors - shift;
-  for (int i0 = 0; i0 < g.m; i0 += block_rows) {
-    const int rows = std::min(block_rows, g.m - i0);
-    const int block_shift = i0 == 0 ? shift : 0;  // later blocks start on a 32-byte boundary
-    narrow_rows<N>((block_shift + rows + 7) / 8, block_shift, rows, g.k, g.a + i0, g.lda, g.b + j0 * b_stride, b_step,
-                   b_stride, g.row_bias ? g.row_bias + i0 : nullptr, g.c + i0 + static_cast<long>(j0) * g.ldc, g.ldc,
-                   std::make_integer_sequence<int, kVectors>{});
+  template <BLayout layout>
+  HC_AVX2 static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc, bool accumulate,
+                           const float* bias) {
+    __m256 acc[NR][2];
+    #pragma GCC unroll 32
+    for (int j = 0; j < NR; ++j) acc[j][0] = acc[j][1] = _mm256_setzero_ps();
+    for (int p = 0; p < kc; ++p) {
+      const __m256 a0 = _mm256_load_ps(a), a1 = _mm256_load_ps(a + 8);
+      #pragma GCC unroll 32
+      for (int j = 0; j < NR; ++j) {
+        const __m256 bj = _mm256_broadcast_ss(layout == BLayout::columns ? b + j * static_cast<long>(ldb) : b + j);
+        acc[j][0] = _mm256_fmadd_ps(a0, bj, acc[j][0]);
+        acc[j][1] = _mm256_fmadd_ps(a1, bj, acc[j][1]);
+      }
+      a += MR;
+      b += layout == BLayout::packed ? NR : layout == BLayout::rows ? ldb : 1;
+    }
+    __m256 add0 = _mm256_setzero_ps(), add1 = _mm256_setzero_ps();
+    if (!accumulate && bias != nullptr) {
+      add0 = _mm256_loadu_ps(bias);
+      add1 = _mm256_loadu_ps(bias + 8);
+    }
+    #pragma GCC unroll 32
+    for (int j = 0; j < NR; ++j) {
+      float* cj = c + static_cast<long>(j) * ldc;
+      if (accumulate) {
+        add0 = _mm256_loadu_ps(cj);
+        add1 = _mm256_loadu_ps(cj + 8);
+      }
+      _mm256_storeu_ps(cj, _mm256_add_ps(acc[j][0], add0));
+      _mm256_storeu_ps(cj + 8, _mm256_add_ps(acc[j][1], add1));
+    }
   }
-}
-
-template <int... N>
-HC_AVX2 void narrow_dispatch(const Gemm& g, int j0, int columns, std::integer_sequence<int, N...>) {
-  ((columns == N + 1 ? narrow_columns<N + 1>(g, j0) : void()), ...);
-}
-
-// op(A) = A, n <= kNarrowMax: groups of up to 4 columns (3 vectors of rows each).
-HC_AVX2 void narrow(const Gemm& g) {
-  for (int j0 = 0; j0 < g.n; j0 += 4) narrow_dispatch(g, j0, std::min(4, g.n - j0), std::make_integer_sequence<int, 4>{});
-}
-
-HC_AVX2 void gemm(const Gemm& g) {
-  if (trivial_gemm(g)) {
-    apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
-  } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
-    narrow(g);
-    apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
-  } else {
-    blocked_gemm<Avx2Kernel>(g);
-  }
-}
+};
 
 // exp(x) by ExpPolynomial (kernel_set.hpp), 2^n built in the exponent bits; x is
 // clamped to [-87.3, 88.7] so that n + 127 stays a normal exponent.
@@ -334,7 +286,7 @@ HC_AVX2 void normal_pairs(std::ptrdiff_t pairs, const std::uint64_t* bits, float
 }  // namespace
 
 const KernelSet& avx2_kernels() {
-  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam, normal_pairs};
+  static const KernelSet set{vector_gemm<Avx2Kernel>, silu_forward, silu_backward, silu, squared_norm, adam, normal_pairs};
   return set;
 }
 

@@ -21,9 +21,52 @@ namespace {
 HC_AVX512 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
 HC_AVX512 void silu(std::ptrdiff_t n, float* x);
 
+// One narrow product C(rows, 0:N) = A(rows, 0:k) op(B)(0:k, 0:N) (+ bias) with N x V accumulators:
+// the contract of pack.hpp's narrow loop nest ("Narrow products").
+template <int N, int V>
+HC_AVX512 void narrow_product(int shift, int rows, int k, const float* a, long lda, const float* b, long b_step,
+                              long b_stride, const float* bias, float* c, long ldc) {
+  const int lanes = shift + rows;  // in 16 (V - 1) + 1 .. 16 V
+  __mmask16 head = static_cast<__mmask16>(0xFFFFu << shift);
+  const int tail_lanes = lanes - 16 * (V - 1);
+  __mmask16 tail = static_cast<__mmask16>(tail_lanes >= 16 ? 0xFFFFu : (1u << tail_lanes) - 1u);
+  if constexpr (V == 1) head = tail = static_cast<__mmask16>(head & tail);
+  const auto mask = [&](int v) { return v == 0 ? head : v + 1 == V ? tail : static_cast<__mmask16>(0xFFFF); };
+  a -= shift;
+  c -= shift;
+  if (bias != nullptr) bias -= shift;
+  __m512 acc[N][V];
+  #pragma GCC unroll 32
+  for (int v = 0; v < V; ++v) {
+    const __m512 start = bias != nullptr ? _mm512_maskz_loadu_ps(mask(v), bias + 16 * v) : _mm512_setzero_ps();
+    #pragma GCC unroll 16
+    for (int j = 0; j < N; ++j) acc[j][v] = start;
+  }
+  for (int p = 0; p < k; ++p) {
+    const float* column = a + p * lda;
+    const float* b_row = b + p * b_step;
+    // No software prefetch: measured (n = 1), prefetching 2, 4 or 8 columns ahead changed nothing.
+    #pragma GCC unroll 32
+    for (int v = 0; v < V; ++v) {
+      const __m512 a_v = v == 0 || v + 1 == V ? _mm512_maskz_loadu_ps(mask(v), column + 16 * v)
+                                               : _mm512_loadu_ps(column + 16 * v);
+      #pragma GCC unroll 16
+      for (int j = 0; j < N; ++j) acc[j][v] = _mm512_fmadd_ps(a_v, _mm512_set1_ps(b_row[j * b_stride]), acc[j][v]);
+    }
+  }
+  #pragma GCC unroll 16
+  for (int j = 0; j < N; ++j) {
+    #pragma GCC unroll 32
+    for (int v = 0; v < V; ++v) _mm512_mask_storeu_ps(c + j * ldc + 16 * v, mask(v), acc[j][v]);
+  }
+}
+
 // C tile of 32 x 12 = 24 zmm accumulators; per k: 2 loads of A, 12 broadcasts of B, 24 FMAs.
 struct Avx512Kernel {
   static constexpr int MR = 32, NR = 12;
+  static constexpr int kNarrowLanes = 16, kNarrowAccumulators = 24, kNarrowGroup = 8;
+  template <int N, int V>
+  static constexpr auto narrow_block = &narrow_product<N, V>;
   static constexpr auto epilogue_silu_forward = silu_forward;
   static constexpr auto epilogue_silu = silu;
 
@@ -99,102 +142,6 @@ struct Avx512Kernel {
     }
   }
 };
-
-// Narrow products (n <= kNarrowMax columns: batch-1 sampling is n = 1, the C8 average n = 8).
-// Packing A would cost as much as the product, so A is streamed in place, column by column, and
-// each loaded vector of A is used for all N columns of C:
-//   C(rows, 0:N) = A(rows, 0:k) op(B)(0:k, 0:N) (+ bias), with N x V zmm accumulators held over
-// the whole k loop. When every column of A starts `shift` floats past a 64-byte boundary (Eigen
-// aligns its heap to 16 bytes only), the vectors start `shift` lanes early so that each load is
-// one cache line: the first vector masks off its first `shift` lanes and the last one the lanes
-// past the end (masked lanes are neither read nor written). Needs shift + rows <= 16 V.
-// op(B)(p, j) = b[p * b_step + j * b_stride].
-constexpr int kNarrowMax = 16;
-
-template <int N, int V>
-HC_AVX512 void narrow_block(int shift, int rows, int k, const float* a, long lda, const float* b, long b_step,
-                            long b_stride, const float* bias, float* c, long ldc) {
-  const int lanes = shift + rows;  // in 16 (V - 1) + 1 .. 16 V
-  __mmask16 head = static_cast<__mmask16>(0xFFFFu << shift);
-  const int tail_lanes = lanes - 16 * (V - 1);
-  __mmask16 tail = static_cast<__mmask16>(tail_lanes >= 16 ? 0xFFFFu : (1u << tail_lanes) - 1u);
-  if constexpr (V == 1) head = tail = static_cast<__mmask16>(head & tail);
-  const auto mask = [&](int v) { return v == 0 ? head : v + 1 == V ? tail : static_cast<__mmask16>(0xFFFF); };
-  a -= shift;
-  c -= shift;
-  if (bias != nullptr) bias -= shift;
-  __m512 acc[N][V];
-  #pragma GCC unroll 32
-  for (int v = 0; v < V; ++v) {
-    const __m512 start = bias != nullptr ? _mm512_maskz_loadu_ps(mask(v), bias + 16 * v) : _mm512_setzero_ps();
-    #pragma GCC unroll 16
-    for (int j = 0; j < N; ++j) acc[j][v] = start;
-  }
-  for (int p = 0; p < k; ++p) {
-    const float* column = a + p * lda;
-    const float* b_row = b + p * b_step;
-    // No software prefetch: measured (n = 1), prefetching 2, 4 or 8 columns ahead changed nothing.
-    #pragma GCC unroll 32
-    for (int v = 0; v < V; ++v) {
-      const __m512 a_v = v == 0 || v + 1 == V ? _mm512_maskz_loadu_ps(mask(v), column + 16 * v)
-                                               : _mm512_loadu_ps(column + 16 * v);
-      #pragma GCC unroll 16
-      for (int j = 0; j < N; ++j) acc[j][v] = _mm512_fmadd_ps(a_v, _mm512_set1_ps(b_row[j * b_stride]), acc[j][v]);
-    }
-  }
-  #pragma GCC unroll 16
-  for (int j = 0; j < N; ++j) {
-    #pragma GCC unroll 32
-    for (int v = 0; v < V; ++v) _mm512_mask_storeu_ps(c + j * ldc + 16 * v, mask(v), acc[j][v]);
-  }
-}
-
-template <int N, int... V>
-HC_AVX512 void narrow_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* b,
-                           long b_step, long b_stride, const float* bias, float* c, long ldc,
-                           std::integer_sequence<int, V...>) {
-  ((vectors == V + 1 ? narrow_block<N, V + 1>(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc) : void()),
-   ...);
-}
-
-// Columns j0 .. j0 + N of C.
-template <int N>
-HC_AVX512 void narrow_columns(const Gemm& g, int j0) {
-  constexpr int kVectors = N == 1 ? 24 : 24 / N;  // accumulators, of the 32 zmm registers
-  const long b_step = g.op_b == Op::none ? 1 : g.ldb, b_stride = g.op_b == Op::none ? g.ldb : 1;
-  // Columns share their offset from a cache line when lda is a multiple of 16 floats.
-  const auto address = reinterpret_cast<std::uintptr_t>(g.a);
-  const int shift = (g.lda % 16 == 0 && address % 4 == 0) ? static_cast<int>(address % 64 / 4) : 0;
-  const int block_rows = 16 * kVectors - shift;
-  for (int i0 = 0; i0 < g.m; i0 += block_rows) {
-    const int rows = std::min(block_rows, g.m - i0);
-    const int block_shift = i0 == 0 ? shift : 0;  // later blocks start on a line
-    narrow_rows<N>((block_shift + rows + 15) / 16, block_shift, rows, g.k, g.a + i0, g.lda, g.b + j0 * b_stride,
-                   b_step, b_stride, g.row_bias ? g.row_bias + i0 : nullptr, g.c + i0 + static_cast<long>(j0) * g.ldc,
-                   g.ldc, std::make_integer_sequence<int, kVectors>{});
-  }
-}
-
-template <int... N>
-HC_AVX512 void narrow_dispatch(const Gemm& g, int j0, int columns, std::integer_sequence<int, N...>) {
-  ((columns == N + 1 ? narrow_columns<N + 1>(g, j0) : void()), ...);
-}
-
-// op(A) = A, n <= kNarrowMax: groups of up to 8 columns.
-HC_AVX512 void narrow(const Gemm& g) {
-  for (int j0 = 0; j0 < g.n; j0 += 8) narrow_dispatch(g, j0, std::min(8, g.n - j0), std::make_integer_sequence<int, 8>{});
-}
-
-HC_AVX512 void gemm(const Gemm& g) {
-  if (trivial_gemm(g)) {
-    apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
-  } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
-    narrow(g);
-    apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
-  } else {
-    blocked_gemm<Avx512Kernel>(g);
-  }
-}
 
 // exp(x) by ExpPolynomial (kernel_set.hpp), times 2^n by scalef, which also gives 0 and +inf
 // past the ends; x is clamped to +-88.7 first.
@@ -359,7 +306,8 @@ HC_AVX512 void normal_pairs(std::ptrdiff_t pairs, const std::uint64_t* bits, flo
 }  // namespace
 
 const KernelSet& avx512_kernels() {
-  static const KernelSet set{gemm, silu_forward, silu_backward, silu, squared_norm, adam, normal_pairs};
+  static const KernelSet set{vector_gemm<Avx512Kernel>, silu_forward, silu_backward, silu,
+                             squared_norm, adam, normal_pairs};
   return set;
 }
 

@@ -1,14 +1,17 @@
 #pragma once
-// Private: packing and the blocked loop nest of the GEMM in avx2.cpp and avx512.cpp (the BLIS
-// scheme). A block of op(A) is copied into panels of MR rows, each panel k-major
+// Private: the loop nests of the GEMM in avx2.cpp and avx512.cpp: packing and the blocked nest
+// (the BLIS scheme), the narrow products of n <= 16 columns, and vector_gemm that picks one.
+// For the blocked nest, a block of op(A) is copied into panels of MR rows, each panel k-major
 // (panel[k * MR + i]); a block of op(B) into panels of NR columns (panel[k * NR + j]). Rows and
 // columns past the matrix are zero, so the micro-kernel always runs on full MR x NR tiles.
 // Compiled for the build's baseline target (no target attributes): packing is O(mk + kn)
 // against the O(mnk) products, so it does not need vector code.
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <new>
+#include <utility>
 
 #include "kernel_set.hpp"
 
@@ -176,6 +179,74 @@ void blocked_gemm(const Gemm& g) {
         }
       }
     }
+  }
+}
+
+// Narrow products (n <= kNarrowMax columns: batch-1 sampling is n = 1, the C8 average n = 8).
+// Packing A would cost as much as the product, so A is streamed in place, column by column, and
+// each loaded vector of A is used for all N columns of C:
+//   C(rows, 0:N) = A(rows, 0:k) op(B)(0:k, 0:N) (+ bias), with N x V accumulators held over the
+// whole k loop, op(B)(p, j) = b[p * b_step + j * b_stride].
+// When every column of A starts `shift` floats past a boundary of one vector's width (Eigen
+// aligns its heap to 16 bytes only), the vectors start `shift` lanes early so that no load splits
+// a cache line: the first vector masks off its first `shift` lanes and the last one the lanes
+// past the end (masked lanes are neither read nor written). Needs shift + rows <= lanes V.
+// Kernel provides kNarrowLanes (floats per vector), kNarrowAccumulators (N V <= it),
+// kNarrowGroup (columns per pass) and
+//   template <int N, int V> narrow_block(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc).
+constexpr int kNarrowMax = 16;
+
+template <typename Kernel, int N, int... V>
+void narrow_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* b, long b_step,
+                 long b_stride, const float* bias, float* c, long ldc, std::integer_sequence<int, V...>) {
+  ((vectors == V + 1 ? Kernel::template narrow_block<N, V + 1>(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc)
+                     : void()),
+   ...);
+}
+
+// Columns j0 .. j0 + N of C, in blocks of rows that fill the accumulators.
+template <typename Kernel, int N>
+void narrow_columns(const Gemm& g, int j0) {
+  constexpr int kLanes = Kernel::kNarrowLanes, kVectors = Kernel::kNarrowAccumulators / N;
+  const long b_step = g.op_b == Op::none ? 1 : g.ldb, b_stride = g.op_b == Op::none ? g.ldb : 1;
+  // Columns share their offset from a vector boundary when lda is a multiple of the lanes.
+  const auto address = reinterpret_cast<std::uintptr_t>(g.a);
+  const int shift = (g.lda % kLanes == 0 && address % 4 == 0) ? static_cast<int>(address % (4 * kLanes) / 4) : 0;
+  const int block_rows = kLanes * kVectors - shift;
+  for (int i0 = 0; i0 < g.m; i0 += block_rows) {
+    const int rows = std::min(block_rows, g.m - i0);
+    const int block_shift = i0 == 0 ? shift : 0;  // later blocks start on a boundary
+    narrow_rows<Kernel, N>((block_shift + rows + kLanes - 1) / kLanes, block_shift, rows, g.k, g.a + i0, g.lda,
+                           g.b + j0 * b_stride, b_step, b_stride, g.row_bias ? g.row_bias + i0 : nullptr,
+                           g.c + i0 + static_cast<long>(j0) * g.ldc, g.ldc, std::make_integer_sequence<int, kVectors>{});
+  }
+}
+
+template <typename Kernel, int... N>
+void narrow_dispatch(const Gemm& g, int j0, int columns, std::integer_sequence<int, N...>) {
+  ((columns == N + 1 ? narrow_columns<Kernel, N + 1>(g, j0) : void()), ...);
+}
+
+// op(A) = A, n <= kNarrowMax: groups of kNarrowGroup columns.
+template <typename Kernel>
+void narrow_gemm(const Gemm& g) {
+  constexpr int kGroup = Kernel::kNarrowGroup;
+  for (int j0 = 0; j0 < g.n; j0 += kGroup) {
+    narrow_dispatch<Kernel>(g, j0, std::min(kGroup, g.n - j0), std::make_integer_sequence<int, kGroup>{});
+  }
+}
+
+/// KernelSet::gemm of a vector set: the degenerate shapes, the narrow products, or the blocked
+/// product, then the epilogue where the blocked nest has not applied it.
+template <typename Kernel>
+void vector_gemm(const Gemm& g) {
+  if (trivial_gemm(g)) {
+    apply_epilogue(g, 0, g.m, 0, g.n, Kernel::epilogue_silu_forward, Kernel::epilogue_silu);
+  } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
+    narrow_gemm<Kernel>(g);
+    apply_epilogue(g, 0, g.m, 0, g.n, Kernel::epilogue_silu_forward, Kernel::epilogue_silu);
+  } else {
+    blocked_gemm<Kernel>(g);
   }
 }
 
