@@ -112,15 +112,24 @@ void outer(const Delta& delta, const A& a, DW& dW) {
   }
 }
 
-// out (in x batch) = W^T delta.
+// out (in x batch) = W^T delta (float: then times SiLU'(z) of the layer below, s + a (1 - s),
+// when `activation` and `sigmoid`, that layer's a and s, are not null).
 template <typename Scalar, typename W, typename Delta, typename Out>
-void transposed(const W& weights, const Delta& delta, Out& out) {
+void transposed(const W& weights, const Delta& delta, Out& out, const Scalar* activation = nullptr,
+                Scalar* sigmoid = nullptr) {
   out.resize(weights.cols(), delta.cols());
   if constexpr (std::is_same_v<Scalar, float>) {
-    kernels::active().gemm({Op::transpose, Op::none, static_cast<int>(weights.cols()),
-                                 static_cast<int>(delta.cols()), static_cast<int>(weights.rows()), weights.data(),
-                                 static_cast<int>(weights.rows()), delta.data(), static_cast<int>(delta.rows()),
-                                 nullptr, out.data(), static_cast<int>(out.rows())});
+    kernels::Gemm problem{Op::transpose, Op::none, static_cast<int>(weights.cols()), static_cast<int>(delta.cols()),
+                          static_cast<int>(weights.rows()), weights.data(), static_cast<int>(weights.rows()),
+                          delta.data(), static_cast<int>(delta.rows()), nullptr, out.data(),
+                          static_cast<int>(out.rows())};
+    if (activation != nullptr) {
+      problem.epilogue = kernels::Epilogue::silu_derivative;
+      problem.activation = activation;
+      problem.sigmoid = sigmoid;
+      problem.lds = static_cast<int>(out.rows());
+    }
+    kernels::active().gemm(problem);
   } else {
     out.noalias() = weights.transpose() * delta;
   }
@@ -183,12 +192,16 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
   }
   int current = 0;
   delta_[current] = d_output;
+  // float with SiLU: the product W^T delta that hands delta to the layer below also multiplies
+  // it by that layer's SiLU' (the GEMM's epilogue), so the derivative is already applied here.
+  constexpr bool kFloat = std::is_same_v<Scalar, float>;
+  const bool fused_derivative = kFloat && activation_ == Activation::silu;
   for (int l = layers() - 1; l >= 0; --l) {
     Matrix& delta = delta_[current];
-    if (l + 1 < layers()) {
+    if (l + 1 < layers() && !fused_derivative) {
       if (activation_ == Activation::silu) {
         // SiLU'(z) = s (1 + z (1 - s)) = s + a (1 - s), s = sigmoid(z) kept by forward().
-        if constexpr (std::is_same_v<Scalar, float>) {
+        if constexpr (kFloat) {
           kernels::active().silu_backward(delta.size(), a_[l + 1].data(), sigmoid_[l].data(), delta.data());
         } else {
           const auto s = sigmoid_[l].array();
@@ -212,7 +225,11 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
       db.noalias() = delta.rowwise().sum();
     }
     if (l == 0 && !input_gradient) break;
-    transposed<Scalar>(W(l), delta, delta_[1 - current]);
+    if (fused_derivative && l > 0) {
+      transposed<Scalar>(W(l), delta, delta_[1 - current], a_[l].data(), sigmoid_[l - 1].data());
+    } else {
+      transposed<Scalar>(W(l), delta, delta_[1 - current]);
+    }
     current = 1 - current;
   }
   return current;

@@ -147,6 +147,79 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
   }
 }
 
+// The epilogues on every path of the product (blocked, narrow, k = 0): C against the double
+// reference Z followed by SiLU, or by the product with SiLU'(z) = s + a (1 - s) from given s and
+// a (leading dimension lds, unlike C's). Returns the worst error over C in units of the bound;
+// `skip_epilogue` plants a fault in the reference (the epilogue left out), which the check must catch.
+double epilogue_error(Problem& problem, kernels::Epilogue epilogue, int lds, const std::vector<float>& s_in,
+                      const std::vector<float>& a_in, const std::vector<float>& s_out, bool skip_epilogue = false) {
+  double worst = 0.0;
+  for (int j = 0; j < problem.n; ++j) {
+    for (int i = 0; i < problem.m; ++i) {
+      double z = problem.bias ? problem.row_bias[i] : 0.0, magnitude = std::abs(z);
+      for (int p = 0; p < problem.k; ++p) {
+        z += static_cast<double>(problem.A(i, p)) * problem.B(p, j);
+        magnitude += std::abs(static_cast<double>(problem.A(i, p)) * problem.B(p, j));
+      }
+      const long at = i + static_cast<long>(j) * problem.ldc, at_s = i + static_cast<long>(j) * lds;
+      double expected = z, bound = 4.0 * std::max(problem.k, 1) * 6e-8 * magnitude + 1e-30;
+      if (!skip_epilogue && epilogue == kernels::Epilogue::silu) {
+        const double sigmoid = 1.0 / (1.0 + std::exp(-z));
+        expected = z * sigmoid;
+        bound = bound * 1.1 + 1e-6 * std::abs(expected) + 1e-30;  // SiLU' <= 1.1, plus the sigmoid's error
+        if (!s_out.empty()) worst = std::max(worst, std::abs(s_out[at_s] - sigmoid) / (bound + 1e-6 * sigmoid));
+      } else if (!skip_epilogue && epilogue == kernels::Epilogue::silu_derivative) {
+        const double derivative = s_in[at_s] + a_in[at_s] * (1.0 - s_in[at_s]);
+        const double terms = std::abs(s_in[at_s]) + std::abs(a_in[at_s] * (1.0 - s_in[at_s]));  // float rounds these
+        expected = z * derivative;
+        bound = bound * std::abs(derivative) + 4.0 * 6e-8 * (std::abs(z) * terms + std::abs(expected)) + 1e-30;
+      }
+      worst = std::max(worst, std::abs(problem.c[at] - expected) / bound);
+    }
+  }
+  return worst;
+}
+
+TEST_CASE("every_kernel_set_applies_the_silu_epilogues_on_every_path", "[unit]") {
+  std::mt19937_64 rng(15);
+  for (KernelIsa isa : supported_sets()) {
+    INFO("kernel set " << to_string(isa));
+    for (const Shape& shape : kShapes) {
+      for (Op op_a : {Op::none, Op::transpose}) {
+        for (kernels::Epilogue epilogue : {kernels::Epilogue::silu, kernels::Epilogue::silu_derivative}) {
+          for (bool keep_sigmoid : {false, true}) {
+            if (epilogue == kernels::Epilogue::silu_derivative && !keep_sigmoid) continue;
+            Problem problem(op_a, Op::none, shape.m, shape.n, shape.k, 3, true, rng);
+            for (float& x : problem.a) x *= 3.0f;  // z spans both tails of the sigmoid
+            const int lds = problem.ldc + 5;
+            const std::size_t size = static_cast<std::size_t>(lds) * std::max(shape.n, 1);
+            std::vector<float> s_in = random_floats(size, rng), a_in = random_floats(size, rng);
+            for (float& x : s_in) x = 0.5f + 0.5f * x;  // a sigmoid is in (0, 1)
+            std::vector<float> s_out(size, -1.0f);
+            kernels::Gemm gemm = problem.gemm();
+            gemm.epilogue = epilogue;
+            gemm.lds = lds;
+            if (epilogue == kernels::Epilogue::silu_derivative) {
+              gemm.sigmoid = s_in.data();
+              gemm.activation = a_in.data();
+            } else if (keep_sigmoid) {
+              gemm.sigmoid = s_out.data();
+            }
+            kernels::kernels_for(isa).gemm(gemm);
+            const std::vector<float>& kept = epilogue == kernels::Epilogue::silu && keep_sigmoid ? s_out : std::vector<float>{};
+            INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a) << " epilogue "
+                      << int(epilogue) << " keep_sigmoid " << keep_sigmoid);
+            CHECK(epilogue_error(problem, epilogue, lds, s_in, a_in, kept) <= 1.0);
+            if (shape.m * shape.n >= 4) {  // planted fault: a reference without the epilogue
+              CHECK(epilogue_error(problem, epilogue, lds, s_in, a_in, kept, /*skip_epilogue=*/true) > 1.0);
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST_CASE("narrow_products_read_columns_at_every_offset_from_a_cache_line", "[unit]") {
   // Batch-1 sampling reads the weights where Eigen put them (16-byte aligned); the AVX-512
   // narrow kernel shifts its vectors to the cache line. Every start offset 0..15 floats,

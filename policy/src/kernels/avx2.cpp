@@ -19,6 +19,7 @@ namespace {
 
 HC_AVX2 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
 HC_AVX2 void silu(std::ptrdiff_t n, float* x);
+HC_AVX2 void silu_backward(std::ptrdiff_t n, const float* a, const float* s, float* delta);
 
 // One narrow product C(rows, 0:N) = A(rows, 0:k) op(B)(0:k, 0:N) (+ bias) with N x V accumulators:
 // the contract of pack.hpp's narrow loop nest ("Narrow products").
@@ -78,8 +79,7 @@ struct Avx2Kernel {
   static constexpr int kNarrowLanes = 8, kNarrowAccumulators = 12, kNarrowGroup = 4;
   template <int N, int V>
   static constexpr auto narrow_block = &narrow_product<N, V>;
-  static constexpr auto epilogue_silu_forward = silu_forward;
-  static constexpr auto epilogue_silu = silu;
+  static constexpr SiluFunctions kSilu{silu_forward, silu, silu_backward};
   static constexpr auto pack_a = kernels::pack_a<MR>;
 
   template <BLayout layout>

@@ -20,6 +20,7 @@ namespace {
 
 HC_AVX512 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
 HC_AVX512 void silu(std::ptrdiff_t n, float* x);
+HC_AVX512 void silu_backward(std::ptrdiff_t n, const float* a, const float* s, float* delta);
 
 // One narrow product C(rows, 0:N) = A(rows, 0:k) op(B)(0:k, 0:N) (+ bias) with N x V accumulators:
 // the contract of pack.hpp's narrow loop nest ("Narrow products").
@@ -67,8 +68,7 @@ struct Avx512Kernel {
   static constexpr int kNarrowLanes = 16, kNarrowAccumulators = 24, kNarrowGroup = 8;
   template <int N, int V>
   static constexpr auto narrow_block = &narrow_product<N, V>;
-  static constexpr auto epilogue_silu_forward = silu_forward;
-  static constexpr auto epilogue_silu = silu;
+  static constexpr SiluFunctions kSilu{silu_forward, silu, silu_backward};
 
   // pack_a<MR> with vector moves: op(A) = A copies two (masked) vectors per k; op(A) = A^T
   // gathers each row panel's k-th column (16 rows at stride lda) from rows that stay in L1.

@@ -95,16 +95,17 @@ bool trivial_gemm(const Gemm& g) {
   return true;
 }
 
-void apply_epilogue(const Gemm& g, int i0, int rows, int j0, int cols,
-                    void (*silu_forward)(std::ptrdiff_t, const float*, float*, float*),
-                    void (*silu)(std::ptrdiff_t, float*)) {
+void apply_epilogue(const Gemm& g, int i0, int rows, int j0, int cols, const SiluFunctions& silu) {
   if (g.epilogue == Epilogue::none) return;
   for (int j = j0; j < j0 + cols; ++j) {
     float* c = g.c + i0 + static_cast<long>(j) * g.ldc;
-    if (g.sigmoid != nullptr) {
-      silu_forward(rows, c, g.sigmoid + i0 + static_cast<long>(j) * g.lds, c);
+    const long s = i0 + static_cast<long>(j) * g.lds;
+    if (g.epilogue == Epilogue::silu_derivative) {
+      silu.backward(rows, g.activation + s, g.sigmoid + s, c);
+    } else if (g.sigmoid != nullptr) {
+      silu.forward(rows, c, g.sigmoid + s, c);
     } else {
-      silu(rows, c);
+      silu.in_place(rows, c);
     }
   }
 }

@@ -15,12 +15,13 @@ using ConstArrayMap = Eigen::Map<const Eigen::ArrayXf>;
 
 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
 void silu(std::ptrdiff_t n, float* x);
+void silu_backward(std::ptrdiff_t n, const float* a, const float* s, float* delta);
 
 void product(const Gemm& g);
 
 void gemm(const Gemm& g) {
   product(g);
-  apply_epilogue(g, 0, g.m, 0, g.n, silu_forward, silu);
+  apply_epilogue(g, 0, g.m, 0, g.n, {silu_forward, silu, silu_backward});
 }
 
 void product(const Gemm& g) {

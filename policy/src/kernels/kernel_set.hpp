@@ -14,15 +14,18 @@ namespace handcentric::policy::kernels {
 
 enum class Op { none, transpose };
 
-/// What happens to C once its sum is complete: nothing, or SiLU in place (a hidden layer's
-/// activation, applied while the block of C is still in L1).
-enum class Epilogue { none, silu };
+/// What happens to C once its sum is complete, while the block of C is still in L1: nothing;
+/// SiLU in place (a hidden layer's activation); or the product by SiLU's derivative (the
+/// backward pass through that activation).
+enum class Epilogue { none, silu, silu_derivative };
 
 /// C (m x n, ldc) = op(A) op(B) + bias 1^T, with op(A) m x k and op(B) k x n; `row_bias` (m
 /// floats) may be null. C must not alias A, B or the bias. k = 0 gives C = bias 1^T (or 0).
 /// n = 1 with op(A) = A is a matrix-vector product (batch-1 sampling) and has its own kernel.
 /// With Epilogue::silu, C = SiLU(Z) for that Z, and `sigmoid` (m x n, lds), when not null,
 /// gets sigmoid(Z) (kept for the backward pass).
+/// With Epilogue::silu_derivative, C = Z * SiLU'(z) elementwise, SiLU'(z) = s + a (1 - s), from
+/// the forward pass's s = `sigmoid` and a = `activation` = SiLU(z) (both m x n, lds, read only).
 struct Gemm {
   Op op_a = Op::none, op_b = Op::none;
   int m = 0, n = 0, k = 0;
@@ -36,17 +39,24 @@ struct Gemm {
   Epilogue epilogue = Epilogue::none;
   float* sigmoid = nullptr;
   int lds = 0;
+  const float* activation = nullptr;
 };
 
 /// Handles the degenerate shapes (m, n or k <= 0; k = 0 writes C = bias 1^T) and returns
 /// true; false for a real product. Every set's gemm starts with it.
 bool trivial_gemm(const Gemm& problem);
 
+/// One set's SiLU functions, as KernelSet has them.
+struct SiluFunctions {
+  void (*forward)(std::ptrdiff_t n, const float* z, float* s, float* a);
+  void (*in_place)(std::ptrdiff_t n, float* x);
+  void (*backward)(std::ptrdiff_t n, const float* a, const float* s, float* delta);
+};
+
 /// Applies problem.epilogue to rows [i0, i0 + rows) of columns [j0, j0 + cols) of C with one
-/// set's SiLU functions (KernelSet::silu_forward when problem.sigmoid is set, else silu).
-void apply_epilogue(const Gemm& problem, int i0, int rows, int j0, int cols,
-                    void (*silu_forward)(std::ptrdiff_t, const float*, float*, float*),
-                    void (*silu)(std::ptrdiff_t, float*));
+/// set's SiLU functions (Epilogue::silu: `forward` when problem.sigmoid is set, else
+/// `in_place`; Epilogue::silu_derivative: `backward`).
+void apply_epilogue(const Gemm& problem, int i0, int rows, int j0, int cols, const SiluFunctions& silu);
 
 /// Adam's update of n parameters (adam.hpp) from g = gradient_scale gradient:
 /// m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g^2, p = decay p - step_size m / (sqrt(v) inv_sqrt_bias2 + eps).

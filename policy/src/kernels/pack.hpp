@@ -112,7 +112,7 @@ enum class BLayout { packed, rows, columns };
 /// then rows). A block of MC x KC of op(A) is packed (it stays in L2 and streams through the
 /// micro-kernel); op(B) is read in place, NR columns at a time (a k x NR block is reused from
 /// L1 by every row panel), except a last partial panel, which is packed with zero padding.
-/// Kernel::epilogue_silu_forward / epilogue_silu apply Gemm::epilogue to each finished block.
+/// Kernel::kSilu (SiluFunctions) applies Gemm::epilogue to each finished block.
 /// Kernel::pack_a has pack_a<MR>'s contract (it may be a faster vector version).
 /// Kernel::tile<BLayout>(kc, a_panel, b, ldb, c, ldc, accumulate, bias) writes a full MR x NR
 /// tile of C: C = A B (+ bias, an MR-float pointer or null) or, when accumulate, C += A B.
@@ -174,7 +174,7 @@ void blocked_gemm(const Gemm& g) {
             }
           }
           if (p0 + kc == g.k) {  // this mc x cols block of C is complete and still in L1
-            apply_epilogue(g, i0, mc, static_cast<int>(j), cols, Kernel::epilogue_silu_forward, Kernel::epilogue_silu);
+            apply_epilogue(g, i0, mc, static_cast<int>(j), cols, Kernel::kSilu);
           }
         }
       }
@@ -241,10 +241,10 @@ void narrow_gemm(const Gemm& g) {
 template <typename Kernel>
 void vector_gemm(const Gemm& g) {
   if (trivial_gemm(g)) {
-    apply_epilogue(g, 0, g.m, 0, g.n, Kernel::epilogue_silu_forward, Kernel::epilogue_silu);
+    apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
   } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
     narrow_gemm<Kernel>(g);
-    apply_epilogue(g, 0, g.m, 0, g.n, Kernel::epilogue_silu_forward, Kernel::epilogue_silu);
+    apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
   } else {
     blocked_gemm<Kernel>(g);
   }
