@@ -1,0 +1,65 @@
+// The products of one training step of the anchor network (57 -> 256 -> 256 -> 256 -> 24, batch
+// 256), one at a time, on the kernel set this CPU runs (or HANDCENTRIC_KERNELS): where a step's
+// time goes, per product. items/s x 1e-9 = GFLOP/s. Uses the private kernel interface
+// (policy/src/kernels/kernel_set.hpp), as tests/policy does.
+#include <benchmark/benchmark.h>
+
+#include <random>
+#include <vector>
+
+#include "handcentric/policy/kernels.hpp"
+#include "kernels/kernel_set.hpp"
+
+using handcentric::policy::kernels::Epilogue;
+using handcentric::policy::kernels::Gemm;
+using handcentric::policy::kernels::Op;
+
+namespace {
+
+constexpr int kBatch = 256;
+
+// C (m x n) = op(A) op(B) (+ bias, for op(B) = B, the forward products) with the epilogue.
+void product(benchmark::State& state, Op op_a, Op op_b, int m, int n, int k, Epilogue epilogue) {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  const auto random = [&](std::size_t size) {
+    std::vector<float> v(size);
+    for (float& x : v) x = uniform(rng);
+    return v;
+  };
+  const int lda = op_a == Op::none ? m : k, ldb = op_b == Op::none ? k : n;
+  const std::vector<float> a = random(static_cast<std::size_t>(lda) * (op_a == Op::none ? k : m));
+  const std::vector<float> b = random(static_cast<std::size_t>(ldb) * (op_b == Op::none ? n : k));
+  const std::vector<float> bias = random(m), activation = random(static_cast<std::size_t>(m) * n);
+  std::vector<float> c(static_cast<std::size_t>(m) * n), sigmoid = random(static_cast<std::size_t>(m) * n);
+  for (float& s : sigmoid) s = 0.5f + 0.5f * s;
+  Gemm gemm{op_a, op_b, m, n, k, a.data(), lda, b.data(), ldb, op_b == Op::none ? bias.data() : nullptr, c.data(), m};
+  gemm.epilogue = epilogue;
+  gemm.sigmoid = sigmoid.data();
+  gemm.lds = m;
+  gemm.activation = activation.data();
+  const auto& kernels = handcentric::policy::kernels::active();
+  for (auto _ : state) {
+    kernels.gemm(gemm);
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 2L * m * n * k);  // flops
+}
+
+// Forward: Z = W X + b (then SiLU on hidden layers, keeping sigmoid(Z)).
+BENCHMARK_CAPTURE(product, forward_first_layer_silu, Op::none, Op::none, 256, kBatch, 57, Epilogue::silu);
+BENCHMARK_CAPTURE(product, forward_hidden_layer_silu, Op::none, Op::none, 256, kBatch, 256, Epilogue::silu);
+BENCHMARK_CAPTURE(product, forward_hidden_layer_no_epilogue, Op::none, Op::none, 256, kBatch, 256, Epilogue::none);
+BENCHMARK_CAPTURE(product, forward_output_layer, Op::none, Op::none, 24, kBatch, 256, Epilogue::none);
+// Backward: dW = delta A^T, and delta_below = (W^T delta) SiLU'.
+BENCHMARK_CAPTURE(product, dw_output_layer, Op::none, Op::transpose, 24, 256, kBatch, Epilogue::none);
+BENCHMARK_CAPTURE(product, dx_output_layer_silu_derivative, Op::transpose, Op::none, 256, kBatch, 24,
+                  Epilogue::silu_derivative);
+BENCHMARK_CAPTURE(product, dw_hidden_layer, Op::none, Op::transpose, 256, 256, kBatch, Epilogue::none);
+BENCHMARK_CAPTURE(product, dx_hidden_layer_silu_derivative, Op::transpose, Op::none, 256, kBatch, 256,
+                  Epilogue::silu_derivative);
+BENCHMARK_CAPTURE(product, dw_first_layer, Op::none, Op::transpose, 256, 57, kBatch, Epilogue::none);
+
+}  // namespace
+
+BENCHMARK_MAIN();
