@@ -61,16 +61,21 @@ mkdir -p "$out/models"
 demos="$out/demos-seed$demo_seed.jsonl"
 [ -f "$demos" ] || "$cli" demos --n 100 --dist train --seed "$demo_seed" --out "$demos"
 
-# One model: train, then evaluate; prints one JSON line.
+# One model: train, then evaluate; prints one JSON line, or fails (and xargs with it) naming the cell.
 run_one() {
   local label="$1" repr="$2" head="$3" n="$4"
   local model="$out/models/$repr-$head-n$n-steps$steps.hcm" start end train ood="null"
+  local cell="$repr/$head on $n demos"
   start=$(date +%s)
   "$cli" train --demos "$demos" --max-demos "$n" --repr "$repr" --head "$head" --steps "$steps" --lr "$lr" \
-    --seed "$train_seed" --out "$model" --quiet >/dev/null
+    --seed "$train_seed" --out "$model" --quiet >/dev/null || { echo "table1.sh: training $cell failed" >&2; return 1; }
   end=$(date +%s)
-  train=$("$cli" eval --model "$model" --dist train --trials "$trials" --seed "$eval_seed" --json)
-  if [ "$n" = "$largest" ]; then ood=$("$cli" eval --model "$model" --dist ood --trials "$trials" --seed "$eval_seed" --json); fi
+  train=$("$cli" eval --model "$model" --dist train --trials "$trials" --seed "$eval_seed" --json) ||
+    { echo "table1.sh: evaluating $cell failed" >&2; return 1; }
+  if [ "$n" = "$largest" ]; then
+    ood=$("$cli" eval --model "$model" --dist ood --trials "$trials" --seed "$eval_seed" --json) ||
+      { echo "table1.sh: evaluating $cell out of distribution failed" >&2; return 1; }
+  fi
   printf '{"policy": "%s", "repr": "%s", "head": "%s", "demos": %s, "steps": %s, "train_seconds": %s, "train": %s, "ood": %s}\n' \
     "$label" "$repr" "$head" "$n" "$steps" "$((end - start))" "$train" "$ood"
 }
@@ -80,10 +85,16 @@ export cli out steps lr train_seed eval_seed trials demos largest
 wall_start=$(date +%s)
 results="$out/results.jsonl"
 : > "$results.tmp"
-for policy in "${policies[@]}"; do
-  IFS='|' read -r label repr head <<< "$policy"
-  for n in "${counts[@]}"; do printf '%s\0%s\0%s\0%s\0' "$label" "$repr" "$head" "$n"; done
-done | xargs -0 -n 4 -P "$jobs" bash -c 'run_one "$@"' _ >> "$results.tmp"
+cells() {
+  for policy in "${policies[@]}"; do
+    IFS='|' read -r label repr head <<< "$policy"
+    for n in "${counts[@]}"; do printf '%s\0%s\0%s\0%s\0' "$label" "$repr" "$head" "$n"; done
+  done
+}
+if ! cells | xargs -0 -n 4 -P "$jobs" bash -c 'run_one "$@"' _ >> "$results.tmp"; then
+  echo "table1.sh: a cell failed (see above); no table written, the finished cells are in $results.tmp" >&2
+  exit 1
+fi
 wall=$(( $(date +%s) - wall_start ))
 mv "$results.tmp" "$results"
 
