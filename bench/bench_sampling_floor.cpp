@@ -16,7 +16,8 @@
 // Each prototype reports max_abs_error, the largest difference of its sampled chunk from the
 // float32 network's (plain loops, std::exp) for the same noise and observation.
 //
-// The prototypes share one vector SiLU (silu_in_place).
+// The prototypes use the library's SiLU kernel, and the float32 one its batch-1 product
+// (policy/src/kernels, the private interface that tests/policy and bench_kernels also use).
 #include <benchmark/benchmark.h>
 
 #if defined(__x86_64__) && defined(__linux__)
@@ -36,6 +37,10 @@
 #include <random>
 #include <thread>
 #include <vector>
+
+#include "kernels/kernel_set.hpp"
+
+namespace kernels = handcentric::policy::kernels;
 
 namespace {
 
@@ -74,27 +79,6 @@ struct Network {
 
 float silu(float z) { return z / (1.0f + std::exp(-z)); }
 
-// SiLU in place on n (a multiple of 16) floats: z / (1 + exp(-z)), exp by Cephes' degree-5
-// polynomial on [-ln2/2, ln2/2] times 2^k (relative error ~1e-7, like the library's kernels).
-__attribute__((target("avx512f"))) void silu_in_place(float* x, int n) {
-  for (int i = 0; i < n; i += 16) {
-    const __m512 z = _mm512_loadu_ps(x + i);
-    const __m512 e = _mm512_min_ps(_mm512_max_ps(_mm512_sub_ps(_mm512_setzero_ps(), z), _mm512_set1_ps(-88.0f)),
-                                   _mm512_set1_ps(88.0f));
-    const __m512 k = _mm512_roundscale_ps(_mm512_mul_ps(e, _mm512_set1_ps(1.44269504f)), _MM_FROUND_TO_NEAREST_INT);
-    __m512 r = _mm512_fnmadd_ps(k, _mm512_set1_ps(0.693359375f), e);
-    r = _mm512_fnmadd_ps(k, _mm512_set1_ps(-2.12194440e-4f), r);
-    __m512 p = _mm512_set1_ps(1.9875691500e-4f);
-    p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(1.3981999507e-3f));
-    p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(8.3334519073e-3f));
-    p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(4.1665795894e-2f));
-    p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(1.6666665459e-1f));
-    p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(5.0000001201e-1f));
-    p = _mm512_fmadd_ps(p, _mm512_mul_ps(r, r), _mm512_add_ps(r, _mm512_set1_ps(1.0f)));
-    const __m512 exp_minus_z = _mm512_scalef_ps(p, k);
-    _mm512_storeu_ps(x + i, _mm512_div_ps(z, _mm512_add_ps(_mm512_set1_ps(1.0f), exp_minus_z)));
-  }
-}
 
 // The network's input at Euler step n: [x (24), t, observation (32)].
 void input_at(const float* x, int n, const float* observation, float* input) {
@@ -166,41 +150,24 @@ std::vector<float> rows_of(const std::vector<float>& w, int out, int in, int r0,
   return part;
 }
 
-// y(0:16 V) = W(0:16 V, 0:cols) x + b, W column-major with leading dimension ldw (64-byte aligned).
-template <int V>
-__attribute__((target("avx512f,fma"))) void gemv(int cols, const float* w, long ldw, const float* x, const float* b,
-                                                 float* y) {
-  __m512 acc[V];
-#pragma GCC unroll 16
-  for (int v = 0; v < V; ++v) acc[v] = _mm512_loadu_ps(b + 16 * v);
-  for (int p = 0; p < cols; ++p) {
-    const __m512 xp = _mm512_set1_ps(x[p]);
-    const float* column = w + p * ldw;
-#pragma GCC unroll 16
-    for (int v = 0; v < V; ++v) acc[v] = _mm512_fmadd_ps(_mm512_load_ps(column + 16 * v), xp, acc[v]);
-  }
-#pragma GCC unroll 16
-  for (int v = 0; v < V; ++v) _mm512_storeu_ps(y + 16 * v, acc[v]);
-}
-
-// Float32, the rows padded to a multiple of 16 so that every column starts on a cache line.
+// Float32 through the library's own kernels (the narrow product with the SiLU epilogue that
+// FlowHead::sample runs), on rows padded to a multiple of 16 so that every column starts on a
+// cache line.
 struct Float32Layer {
-  int in = 0, padded = 0;
+  int in = 0, rows = 0, padded = 0;
   bool silu = true;
   Aligned<float> w, b;
-  Float32Layer(const std::vector<float>& w_part, const std::vector<float>& b_part, int in_, int rows, bool silu_)
-      : in(in_), padded((rows + 15) / 16 * 16), silu(silu_) {
+  Float32Layer(const std::vector<float>& w_part, const std::vector<float>& b_part, int in_, int rows_, bool silu_)
+      : in(in_), rows(rows_), padded((rows_ + 15) / 16 * 16), silu(silu_) {
     w = aligned_zeros<float>(static_cast<std::size_t>(padded) * in);
     b = aligned_zeros<float>(padded);
     for (int k = 0; k < in; ++k) std::copy_n(w_part.data() + static_cast<std::size_t>(k) * rows, rows, w.get() + k * padded);
     std::copy(b_part.begin(), b_part.end(), b.get());
   }
   void operator()(const float* x, float* y) const {
-    if (padded == 128) gemv<8>(in, w.get(), padded, x, b.get(), y);
-    else if (padded == 256) gemv<16>(in, w.get(), padded, x, b.get(), y);
-    else if (padded == 32) gemv<2>(in, w.get(), padded, x, b.get(), y);
-    else std::abort();  // the anchor network has no other widths
-    if (silu) silu_in_place(y, padded);
+    kernels::Gemm product{kernels::Op::none, kernels::Op::none, rows, 1, in, w.get(), padded, x, in, b.get(), y, rows};
+    if (silu) product.epilogue = kernels::Epilogue::silu;
+    kernels::active().gemm(product);
   }
 };
 
@@ -293,7 +260,7 @@ struct AmxLayer {
     alignas(64) std::uint16_t parts[8 * 96];
     split_bf16(x, in, k_tiles, parts);
     product(parts, y);
-    if (silu) silu_in_place(y, q_tiles * 16);
+    if (silu) kernels::active().silu(q_tiles * 16, y);
   }
   // C tiles 0-3 accumulate a group of 4 output tiles; A = tile 4; B rotates over tiles 5-7.
   __attribute__((target("amx-tile,amx-bf16"))) void product(const std::uint16_t* parts, float* y) const {
