@@ -15,14 +15,16 @@ void put_pose(Eigen::VectorXd& out, Eigen::Index slot, const Eigen::Vector3d& tr
   out.segment<3>(kPoseSize * slot + 3) = rotation_vector;
 }
 
-// The observation's point block: eye-in-hand points, then world points, from `offset` on.
-void put_points(Eigen::VectorXd& out, Eigen::Index offset, const Scene& scene) {
+// The observation's point block from `offset` on: eye-in-hand points as they are, then world
+// points mapped by `frame_T_world` (the identity: copied raw; T_0^{-1}: in the hand frame).
+void put_points(Eigen::VectorXd& out, Eigen::Index offset, const Scene& scene,
+                const RigidTransform& frame_T_world) {
   for (const Eigen::Vector3d& point_hand0 : scene.hand_points) {
     out.segment<3>(offset) = point_hand0;
     offset += 3;
   }
   for (const Eigen::Vector3d& point_world : scene.world_points) {
-    out.segment<3>(offset) = point_world;
+    out.segment<3>(offset) = frame_T_world * point_world;
     offset += 3;
   }
 }
@@ -42,7 +44,7 @@ Eigen::VectorXd world_observation(const Scene& scene) {
   for (const RigidTransform& world_T_hand : scene.world_T_hand_history) {
     put_pose(out, slot++, world_T_hand.translation(), world_T_hand.rotation().log());
   }
-  put_points(out, kPoseSize * slot, scene);
+  put_points(out, kPoseSize * slot, scene, RigidTransform::identity());  // third-person: raw
   return out;
 }
 
@@ -178,7 +180,9 @@ Eigen::VectorXd HandCentricRepresentation::encode_observation(const Scene& scene
     const RigidTransform hand0_T_hand = world_T_hand0.inverse_compose(world_T_hand);  // eq. (3)
     put_pose(out, slot++, hand0_T_hand.translation(), hand0_T_hand.rotation().log());
   }
-  put_points(out, kPoseSize * slot, scene);
+  // A third-person point q seen in the hand frame, T_0^{-1} q: (g T_0)^{-1} (g q) = T_0^{-1} q,
+  // so a calibrated fixed camera keeps the observation invariant, as eq. (9) does for poses.
+  put_points(out, kPoseSize * slot, scene, world_T_hand0.inverse());
   return out;
 }
 

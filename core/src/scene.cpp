@@ -1,5 +1,6 @@
 #include "handcentric/core/scene.hpp"
 
+#include <cmath>
 #include <string>
 
 #include "handcentric/core/errors.hpp"
@@ -25,6 +26,11 @@ void Scene::validate_observation() const {
   }
   require_finite_points(world_points, "world");
   require_finite_points(hand_points, "eye-in-hand");
+  for (const auto& [name, value] : scalars) {
+    if (!std::isfinite(value)) {
+      throw InvalidScene("scalar '" + name + "' is not finite: " + format_number(value));
+    }
+  }
 }
 
 void Scene::validate() const {
@@ -49,6 +55,9 @@ Scene operator*(const RigidTransform& g, const Scene& scene) {
     moved.world_points.push_back(g * point_world);
   }
   moved.hand_points = scene.hand_points;  // eye-in-hand: unchanged (Sec. 3.2)
+  moved.extra_poses.reserve(scene.extra_poses.size());
+  for (const auto& [name, world_T_other] : scene.extra_poses) moved.extra_poses.emplace_back(name, g * world_T_other);
+  moved.scalars = scene.scalars;
   return moved;
 }
 

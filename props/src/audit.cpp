@@ -5,8 +5,10 @@
 #include <sstream>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
 namespace {
@@ -19,11 +21,23 @@ std::string row_label(Component component, Mode mode) {
   return to_string(component) + (mode == Mode::distribution ? " (in distribution)" : "");
 }
 
-// "yes 3.1e-15" / "NO  2.0e+00": the mark and the largest error (distribution: energy distance).
+std::string view_heading(View view) {
+  return view == View::eye_in_hand ? "eye-in-hand view (no world points: Theorem 1's setting)"
+                                   : "third-person view (1-8 world points that move with g)";
+}
+
+// "yes 3.1e-15" / "NO  2.0e+00": the mark and the largest error (in distribution: the larger
+// difference of the laws' moments, or the energy distance, marked '~' for an energy test).
 std::string cell_text(const Verdict& verdict) {
   char text[40];
-  std::snprintf(text, sizeof(text), "%-3s %8.1e", verdict.invariant ? "yes" : "NO", verdict.max_error);
+  std::snprintf(text, sizeof(text), "%-3s %8.1e%s", verdict.invariant ? "yes" : "NO", verdict.max_error,
+                verdict.method == Method::energy_test ? "~" : "");
   return text;
+}
+
+std::string cell_name(const Verdict& verdict) {
+  return row_label(verdict.component, verdict.mode) + " under " + to_string(verdict.group) + ", " +
+         to_string(verdict.view);
 }
 
 std::string indent(const std::string& text, const std::string& prefix) {
@@ -41,15 +55,37 @@ std::vector<std::string> auditable_names() {
   return names;
 }
 
+Precision parse_precision(const std::string& name) {
+  if (name == "float64") return Precision::float64;
+  if (name == "float32") return Precision::float32;
+  throw InvalidArgument("unknown --precision '" + name + "'; use float64 (the default) or float32");
+}
+
+double audit_relative_tolerance(const AuditOptions& options) {
+  const double relative = options.relative_tolerance;
+  if (!(relative >= 0.0 && relative < 1.0)) {
+    throw InvalidArgument("--tolerance must be a number in (0, 1), got " + format_number(relative) +
+                          "; e.g. --tolerance 1e-6, or --precision float32");
+  }
+  if (relative > 0.0) return relative;
+  return options.precision == Precision::float32 ? kFloat32RelativeTolerance : kRelativeTolerance;
+}
+
 ClassifierOptions classifier_options(const AuditOptions& options) {
   if (options.cases < 1) {
     throw InvalidArgument("--cases must be at least 1, got " + std::to_string(options.cases));
   }
+  if (options.views.empty() || options.groups.empty()) {
+    throw InvalidArgument("an audit needs at least one view and one group");
+  }
   ClassifierOptions classifier;
   classifier.groups = options.groups;
+  classifier.views = options.views;
   classifier.check.cases = options.cases;
   classifier.check.seed = options.seed;
+  classifier.check.relative_tolerance = audit_relative_tolerance(options);
   classifier.distribution.cases = std::max(10, (options.cases + 99) / 100);
+  classifier.injectivity_cases = std::max(100, options.cases / 5);
   return classifier;
 }
 
@@ -76,29 +112,50 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
                  bool witnesses) {
   constexpr std::size_t kLabel = 30, kCell = 14;
   for (const Classification& classification : classifications) {
-    out << classification.name << "\n  " << pad("component", kLabel);
-    for (Group group : options.groups) out << " | " << pad(to_string(group), kCell);
-    out << "\n";
-    std::vector<const Verdict*> failing;
-    for (Mode mode : {Mode::pointwise, Mode::distribution}) {
-      for (Component component : {Component::actions, Component::observation, Component::flow_input,
-                                  Component::flow_target, Component::policy}) {
-        bool any = false;
-        std::string row = "  " + pad(row_label(component, mode), kLabel);
-        for (Group group : options.groups) {
-          const Verdict* verdict = find_verdict(classification, component, mode, group);
-          if (verdict == nullptr) continue;
-          any = true;
-          row += " | " + pad(cell_text(*verdict), kCell);
-          if (!verdict->invariant && verdict->witness) failing.push_back(verdict);
+    out << classification.name << "\n";
+    std::vector<const Verdict*> failing, noted;
+    for (View view : options.views) {
+      out << "  " << view_heading(view) << "\n  " << pad("component", kLabel);
+      for (Group group : options.groups) out << " | " << pad(to_string(group), kCell);
+      out << "\n";
+      for (Mode mode : {Mode::pointwise, Mode::distribution}) {
+        for (Component component : {Component::actions, Component::observation, Component::flow_input,
+                                    Component::flow_target, Component::policy}) {
+          bool any = false;
+          std::string row = "  " + pad(row_label(component, mode), kLabel);
+          for (Group group : options.groups) {
+            const Verdict* verdict = find_verdict(classification, component, mode, group, view);
+            if (verdict == nullptr) continue;
+            any = true;
+            row += " | " + pad(cell_text(*verdict), kCell);
+            if (!verdict->invariant && verdict->witness) failing.push_back(verdict);
+            if (!verdict->note.empty()) noted.push_back(verdict);
+          }
+          if (any) out << row << "\n";
         }
-        if (any) out << row << "\n";
+      }
+    }
+    for (const Verdict* verdict : noted) out << "  note: " << cell_name(*verdict) << ": " << verdict->note << "\n";
+    for (const Verdict& verdict : classification.verdicts) {
+      if (verdict.invariant && verdict.detectable_shift) {
+        out << "  note: " << cell_name(verdict) << " was decided by an energy test (not affine in eps): it "
+            << "would have found a mean shift of " << format_number(*verdict.detectable_shift)
+            << " or more with 90% power; smaller differences can hide\n";
+      }
+    }
+    if (const auto& injectivity = classification.injectivity) {
+      if (injectivity->injective == false) {
+        out << "  !!! NOT INJECTIVE: " << injectivity->how << ". Its invariances say nothing useful: a policy "
+            << "trained on it cannot tell these chunks apart.\n"
+            << indent(format_collision(*injectivity->collision), "      ");
+      } else {
+        out << "  injective: " << (injectivity->injective ? "yes" : "not decided") << " (" << injectivity->how << ")\n";
       }
     }
     if (witnesses) {
       for (const Verdict* verdict : failing) {
-        out << "  witness: " << row_label(verdict->component, verdict->mode) << " under " << to_string(verdict->group)
-            << " (seed " << verdict->seed << ", shrunk by RapidCheck; replay with the same --seed)\n"
+        out << "  witness: " << cell_name(*verdict) << " (seed " << verdict->seed
+            << ", shrunk by RapidCheck; replay with the same --seed)\n"
             << indent(format_witness(*verdict->witness), "    ");
       }
     }

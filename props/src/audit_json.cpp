@@ -29,25 +29,75 @@ nlohmann::json points(const std::vector<Eigen::Vector3d>& xs) {
   return array;
 }
 
-nlohmann::json witness_json(const Witness& w, Mode mode) {
+nlohmann::json number_or_inf(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json("inf"); }
+
+// A scene as the --exec protocol sends it (extra poses and scalars only when it has them).
+nlohmann::json scene_json(const Scene& scene) {
   nlohmann::json history = nlohmann::json::array(), chunk = nlohmann::json::array();
-  for (const auto& T : w.scene.world_T_hand_history) history.push_back(matrix16(T));
-  for (const auto& T : w.scene.world_T_hand_chunk) chunk.push_back(matrix16(T));
+  for (const auto& T : scene.world_T_hand_history) history.push_back(matrix16(T));
+  for (const auto& T : scene.world_T_hand_chunk) chunk.push_back(matrix16(T));
+  nlohmann::json out = {{"history", history}, {"chunk", chunk}, {"hand_points", points(scene.hand_points)},
+                        {"world_points", points(scene.world_points)}};
+  if (!scene.extra_poses.empty()) {
+    nlohmann::json extra = nlohmann::json::object();
+    for (const auto& [name, T] : scene.extra_poses) extra[name] = matrix16(T);
+    out["extra_poses"] = extra;
+  }
+  if (!scene.scalars.empty()) {
+    nlohmann::json scalars = nlohmann::json::object();
+    for (const auto& [name, value] : scene.scalars) scalars[name] = value;
+    out["scalars"] = scalars;
+  }
+  return out;
+}
+
+nlohmann::json witness_json(const Witness& w, Method method) {
   nlohmann::json out = {
       {"g", matrix16(w.g)},
-      {"scene", {{"history", history}, {"chunk", chunk}, {"hand_points", points(w.scene.hand_points)},
-                 {"world_points", points(w.scene.world_points)}}},
+      {"scene", scene_json(w.scene)},
       {"before", numbers(w.before)},
       {"after", numbers(w.after)},
-      {"error", std::isfinite(w.error) ? nlohmann::json(w.error) : nlohmann::json("inf")},
+      {"error", number_or_inf(w.error)},
   };
-  if (mode == Mode::distribution) {
+  if (method == Method::energy_test) {
     out["p_value"] = w.p_value;
     out["alpha"] = w.tolerance;
   } else {
     out["tolerance"] = w.tolerance;
   }
+  if (!w.detail.empty()) out["detail"] = w.detail;
   return out;
+}
+
+nlohmann::json injectivity_json(const Injectivity& injectivity) {
+  nlohmann::json out = {{"injective", injectivity.injective ? nlohmann::json(*injectivity.injective) : nlohmann::json(nullptr)},
+                        {"how", injectivity.how},
+                        {"cases", injectivity.cases},
+                        {"round_trips", injectivity.round_trips},
+                        {"collision", nullptr},
+                        {"round_trip_failure", nullptr}};
+  if (const auto& c = injectivity.collision) {
+    out["collision"] = {{"first", scene_json(c->first)},   {"second", scene_json(c->second)},
+                        {"actions", numbers(c->actions_first)}, {"actions_second", numbers(c->actions_second)},
+                        {"chunk_distance", c->chunk_distance}, {"action_distance", c->action_distance},
+                        {"tolerance", c->tolerance}};
+  }
+  if (const auto& r = injectivity.round_trip_failure) {
+    nlohmann::json decoded = nlohmann::json::array();
+    for (const auto& T : r->decoded) decoded.push_back(matrix16(T));
+    out["round_trip_failure"] = {{"scene", scene_json(r->scene)}, {"decoded", decoded}, {"error", number_or_inf(r->error)},
+                                 {"tolerance", r->tolerance}};
+  }
+  return out;
+}
+
+// {view: {component: {mode: {group: invariant}}}}
+nlohmann::json summary_json(const Classification& classification) {
+  nlohmann::json summary = nlohmann::json::object();
+  for (const Verdict& v : classification.verdicts) {
+    summary[to_string(v.view)][to_string(v.component)][to_string(v.mode)][to_string(v.group)] = v.invariant;
+  }
+  return summary;
 }
 
 }  // namespace
@@ -61,17 +111,31 @@ std::string audit_json(const std::vector<Classification>& classifications) {
           {"component", to_string(v.component)},
           {"group", to_string(v.group)},
           {"mode", to_string(v.mode)},
+          {"view", to_string(v.view)},
           {"invariant", v.invariant},
-          {"max_error", std::isfinite(v.max_error) ? nlohmann::json(v.max_error) : nlohmann::json("inf")},
+          {"max_error", number_or_inf(v.max_error)},
           {"cases", v.cases},
           {"near_identity_cases", v.near_identity_cases},
           {"seed", v.seed},
-          {"witness", v.witness ? witness_json(*v.witness, v.mode) : nlohmann::json(nullptr)},
+          {"relative_tolerance", v.relative_tolerance},
+          {"witness", v.witness ? witness_json(*v.witness, v.method) : nlohmann::json(nullptr)},
       };
-      if (v.mode == Mode::distribution) check["min_p_value"] = v.min_p_value;
+      if (v.mode == Mode::distribution) {
+        check["method"] = to_string(v.method);
+        if (v.method == Method::energy_test) check["min_p_value"] = v.min_p_value;
+        if (v.detectable_shift) check["detectable_shift"] = *v.detectable_shift;
+      }
+      if (!v.note.empty()) check["note"] = v.note;
       checks.push_back(check);
     }
-    representations.push_back({{"name", classification.name}, {"checks", checks}});
+    nlohmann::json representation = {{"name", classification.name}, {"summary", summary_json(classification)}};
+    if (classification.injectivity) {
+      representation["injective"] = classification.injectivity->injective ? nlohmann::json(*classification.injectivity->injective)
+                                                                          : nlohmann::json(nullptr);
+      representation["injectivity"] = injectivity_json(*classification.injectivity);
+    }
+    representation["checks"] = checks;
+    representations.push_back(representation);
   }
   return nlohmann::json({{"representations", representations}}).dump(2) + "\n";
 }

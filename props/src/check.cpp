@@ -36,6 +36,18 @@ void load_rapidcheck_configuration_quietly() {
 
 }  // namespace
 
+void run_silently(const std::function<void()>& property, const std::string& description, std::uint64_t seed,
+                  int cases) {
+  load_rapidcheck_configuration_quietly();
+  rc::detail::TestParams params;  // not rc::detail::configuration(): it reads RC_PARAMS and prints
+  params.seed = seed;
+  params.maxSuccess = cases;
+  rc::detail::TestMetadata metadata;
+  metadata.id = metadata.description = description;
+  rc::detail::TestListenerAdapter silent;  // the caller records the result; print nothing
+  rc::detail::checkTestable(property, metadata, params, silent);
+}
+
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget) {
   if (cases < 1) throw InvalidArgument("a check needs at least 1 case, got " + std::to_string(cases));
@@ -47,14 +59,16 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   verdict.component = component;
   verdict.group = group;
   verdict.mode = mode;
+  verdict.view = view_of(options.shape);
   verdict.seed = options.seed;
+  verdict.relative_tolerance = options.relative_tolerance;
   bool searching = true;  // false once the first failure is seen: then RapidCheck shrinks
   std::exception_ptr error;
   const SceneShape shape = options.shape;
   int shrink_evaluations = 0;
   auto property = [&] {
     if (error) return;  // a broken function under test: let RapidCheck finish at once
-    if (!searching && ++shrink_evaluations > shrink_budget) return;  // budget spent: keep the witness
+    if (!searching && ++shrink_evaluations > (options.shrink ? shrink_budget : 0)) return;  // budget spent: keep the witness
     const Scene scene = *props::scene(shape);
     const RigidTransform g = *group_element(group);
     CaseOutcome outcome;
@@ -81,14 +95,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
       RC_FAIL("not invariant");
     }
   };
-  load_rapidcheck_configuration_quietly();
-  rc::detail::TestParams params;  // not rc::detail::configuration(): it reads RC_PARAMS and prints
-  params.seed = options.seed;
-  params.maxSuccess = cases;
-  rc::detail::TestMetadata metadata;
-  metadata.id = metadata.description = to_string(component) + " under " + to_string(group);
-  rc::detail::TestListenerAdapter silent;  // the verdict carries the result; print nothing
-  rc::detail::checkTestable(property, metadata, params, silent);
+  run_silently(property, to_string(component) + " under " + to_string(group), options.seed, cases);
   if (error) std::rethrow_exception(error);
   verdict.invariant = !verdict.witness.has_value() && verdict.cases >= 1;
   return verdict;
@@ -145,11 +152,24 @@ SceneShape eye_in_hand_shape() {
   return shape;
 }
 
-CheckOptions eye_in_hand_options() {
+SceneShape third_person_shape() {
+  SceneShape shape;
+  shape.min_world_points = 1;
+  shape.max_world_points = 8;
+  return shape;
+}
+
+SceneShape shape_for(View view) { return view == View::eye_in_hand ? eye_in_hand_shape() : third_person_shape(); }
+
+View view_of(const SceneShape& shape) { return shape.max_world_points > 0 ? View::third_person : View::eye_in_hand; }
+
+CheckOptions options_for(View view) {
   CheckOptions options;
-  options.shape = eye_in_hand_shape();
+  options.shape = shape_for(view);
   return options;
 }
+
+CheckOptions eye_in_hand_options() { return options_for(View::eye_in_hand); }
 
 Eigen::VectorXd fixed_noise(Eigen::Index n, std::uint64_t seed) {
   // The first n normals of one stream: cache a long prefix per thread (seeding a Mersenne

@@ -21,4 +21,9 @@ using CaseFunction = std::function<CaseOutcome(const Scene& scene, const RigidTr
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget);
 
+/// Runs a RapidCheck property (it calls RC_FAIL to fail) for `cases` cases from `seed`, printing
+/// nothing: the caller records what it needs from inside the property.
+void run_silently(const std::function<void()>& property, const std::string& description, std::uint64_t seed,
+                  int cases);
+
 }  // namespace handcentric::props::detail

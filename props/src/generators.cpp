@@ -148,7 +148,7 @@ rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, doubl
 }  // namespace
 
 rc::Gen<Scene> scene(SceneShape shape) {
-  return rc::gen::apply(
+  auto geometry = rc::gen::apply(
       [](const RigidTransform& world_T_hand0, const Twist& forward, const Twist& backward,
          int history, int chunk, const std::vector<Eigen::Vector3d>& hand_points,
          const std::vector<Eigen::Vector3d>& world_points) {
@@ -174,6 +174,19 @@ rc::Gen<Scene> scene(SceneShape shape) {
       rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
       points(shape.min_hand_points, shape.max_hand_points, 1.0),
       points(shape.min_world_points, shape.max_world_points, 10.0));
+  if (shape.extra_pose_names.empty() && shape.scalar_names.empty()) return geometry;
+  // Named extras: one random pose per name (anywhere, any orientation), one number per scalar.
+  const auto poses = rc::gen::container<std::vector<RigidTransform>>(shape.extra_pose_names.size(),
+                                                                     combine(rotation(), translation(10.0)));
+  const auto numbers = rc::gen::container<std::vector<double>>(shape.scalar_names.size(), symmetric(1.0));
+  return rc::gen::apply(
+      [names = shape.extra_pose_names, scalar_names = shape.scalar_names](
+          Scene s, const std::vector<RigidTransform>& world_T_extra, const std::vector<double>& values) {
+        for (std::size_t i = 0; i < names.size(); ++i) s.extra_poses.emplace_back(names[i], world_T_extra[i]);
+        for (std::size_t i = 0; i < scalar_names.size(); ++i) s.scalars.emplace_back(scalar_names[i], values[i]);
+        return s;
+      },
+      geometry, poses, numbers);
 }
 
 }  // namespace handcentric::props

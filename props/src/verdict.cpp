@@ -38,6 +38,17 @@ std::string to_string(Component component) {
 
 std::string to_string(Mode mode) { return mode == Mode::pointwise ? "pointwise" : "distribution"; }
 
+std::string to_string(View view) { return view == View::eye_in_hand ? "eye_in_hand" : "third_person"; }
+
+std::string to_string(Method method) {
+  switch (method) {
+    case Method::compared: return "compared";
+    case Method::exact_gaussian: return "exact_gaussian";
+    case Method::energy_test: return "energy_test";
+  }
+  return "?";
+}
+
 std::string format_witness(const Witness& witness) {
   std::ostringstream out;
   const Scene& s = witness.scene;
@@ -52,9 +63,13 @@ std::string format_witness(const Witness& witness) {
   }
   for (const auto& x : s.hand_points) out << "  eye-in-hand point: " << format_matrix(x) << "\n";
   for (const auto& x : s.world_points) out << "  world point: " << format_matrix(x) << "\n";
-  out << "before: " << vector_text(witness.before) << "\n"
-      << "after:  " << vector_text(witness.after) << "\n"
-      << "error " << format_number(witness.error);
+  for (const auto& [name, T] : s.extra_poses) out << "  extra pose '" << name << "': " << pose_text(T) << "\n";
+  for (const auto& [name, value] : s.scalars) out << "  scalar '" << name << "': " << format_number(value) << "\n";
+  const bool law = !witness.detail.empty();
+  out << (law ? "mean before: " : "before: ") << vector_text(witness.before) << "\n"
+      << (law ? "mean after:  " : "after:  ") << vector_text(witness.after) << "\n";
+  if (law) out << witness.detail << "\n";
+  out << "error " << format_number(witness.error);
   if (witness.p_value < 1.0) {
     out << " (energy distance), p = " << format_number(witness.p_value);
   } else {

@@ -5,8 +5,10 @@
 //   actions     : for k = 1..K, [translation (3), rotation vector (3)]          -> 6K numbers
 //   observation : for h = 0..H, [translation (3), rotation vector (3)] of T_{-h},
 //                 then the eye-in-hand points (3 each), then the world points (3 each)
-// A world point is a third-person view: it is copied as seen in the world frame, so a
-// representation that includes one cannot be invariant (Theorem 1's eye-in-hand assumption).
+// A world point is a third-person view (a fixed camera's point, in the world frame). absolute,
+// relative and relative_diff copy it raw, so their observation is not invariant with one
+// (Theorem 1 assumes eye-in-hand views); hand_centric expresses it in the hand frame,
+// T_0^{-1} q, which no global transform changes.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
@@ -38,6 +40,13 @@ class Representation {
   /// non-finite entry.
   virtual std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& actions,
                                                      const RigidTransform& world_T_hand0) const = 0;
+
+  /// decode_actions with the whole observation at hand (history, points, extra poses, scalars),
+  /// for a decoder that reads more than T_0 (a plug-in's may). By default: T_0 only.
+  virtual std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
+                                                      const Scene& observation) const {
+    return decode_actions(actions, observation.world_T_hand0());
+  }
 };
 
 }  // namespace handcentric

@@ -5,11 +5,16 @@
 //   world_T_hand_chunk[k-1] = T_k,    k = 1..K   (the action chunk a_{1:K})
 //   world_points            third-person view: points in the world frame
 //   hand_points             eye-in-hand view: points in the current hand frame (Sec. 3.2)
+//   extra_poses             other named world-frame poses (the episode's start pose, a second
+//                           arm's hand): they move with the scene
+//   scalars                 named numbers no transform changes (a gripper's width)
 //
 // A global rigid transform g acts as in Sec. 2.2: g * scene moves every pose (T -> g T) and
-// every world point (x -> g x), and leaves the eye-in-hand points alone, because the camera,
+// every world point (x -> g x), and leaves the eye-in-hand points and the scalars alone, because the camera,
 // the hand and the objects move together (the proposition behind Lemma 2).
 #include <Eigen/Core>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "handcentric/core/rigid_transform.hpp"
@@ -21,6 +26,10 @@ struct Scene {
   std::vector<RigidTransform> world_T_hand_chunk;    ///< [k-1] = T_k
   std::vector<Eigen::Vector3d> world_points;         ///< world frame
   std::vector<Eigen::Vector3d> hand_points;          ///< frame of the hand at T_0
+  /// Named world-frame poses besides the hand's (world_T_name), in a fixed order.
+  std::vector<std::pair<std::string, RigidTransform>> extra_poses;
+  /// Named numbers that a global transform leaves alone, in a fixed order.
+  std::vector<std::pair<std::string, double>> scalars;
 
   /// T_0, the hand now. Precondition: the history is not empty (see validate()).
   const RigidTransform& world_T_hand0() const { return world_T_hand_history.front(); }
@@ -34,12 +43,13 @@ struct Scene {
   /// Throws InvalidScene naming the problem: empty history, empty chunk, non-finite point.
   void validate() const;
 
-  /// What a policy may read (history and points; the chunk is not looked at): throws
-  /// InvalidScene for an empty history or a non-finite point.
+  /// What a policy may read (history, points, extra poses, scalars; the chunk is not looked
+  /// at): throws InvalidScene for an empty history, a non-finite point or scalar.
   void validate_observation() const;
 };
 
-/// g * scene (Sec. 2.2's "T~ o"): poses and world points move, eye-in-hand points do not.
+/// g * scene (Sec. 2.2's "T~ o"): poses (extra ones too) and world points move, eye-in-hand
+/// points and scalars do not.
 Scene operator*(const RigidTransform& g, const Scene& scene);
 
 }  // namespace handcentric

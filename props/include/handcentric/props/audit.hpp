@@ -1,8 +1,8 @@
 #pragma once
 // The audit behind `handcentric audit` and the main report: classify representations (the
-// built-ins, ActionFlow's target, or a plug-in), then render one table per representation (a
-// row per component and mode, a column per group, a mark and the largest error, failing cells'
-// witnesses below) or the JSON document of docs/AUDIT.md.
+// built-ins, ActionFlow's target, or a plug-in), then render one table per representation and
+// view (a row per component and mode, a column per group, a mark and the largest error; notes,
+// injectivity and failing cells' witnesses below) or the JSON document of docs/AUDIT.md.
 #include <memory>
 #include <ostream>
 #include <string>
@@ -12,31 +12,48 @@
 
 namespace handcentric::props {
 
+/// The arithmetic a representation is computed in, which sets the pointwise tolerance.
+enum class Precision { float64, float32 };
+
+/// "float64" -> float64, "float32" -> float32; throws InvalidArgument naming the value otherwise.
+Precision parse_precision(const std::string& name);
+
 struct AuditOptions {
   std::vector<Group> groups = all_groups();
+  std::vector<View> views = {View::eye_in_hand, View::third_person};
   int cases = kDefaultCases;       ///< pointwise cases per cell
   std::uint64_t seed = 1;
+  Precision precision = Precision::float64;
+  /// REL of the tolerance REL * (1 + L); 0 = from `precision` (kRelativeTolerance for float64,
+  /// kFloat32RelativeTolerance for float32).
+  double relative_tolerance = 0.0;
 };
+
+/// The REL an audit uses: options.relative_tolerance if set, else the precision's. Throws
+/// InvalidArgument for a negative, non-finite or >= 1 tolerance.
+double audit_relative_tolerance(const AuditOptions& options);
 
 /// The names `--repr` accepts: the four built-ins, then "actionflow".
 std::vector<std::string> auditable_names();
 
-/// Classifier options for an audit: eye-in-hand scenes; pointwise cells run options.cases
-/// cases, distribution cells max(10, ceil(cases / 100)) (each with 32 noise draws and a
-/// permutation test).
+/// Classifier options for an audit: options.views, options.groups, the tolerance of
+/// audit_relative_tolerance; pointwise cells run options.cases cases, distribution cells
+/// max(10, ceil(cases / 100)), injectivity max(100, cases / 5) chunk pairs.
 ClassifierOptions classifier_options(const AuditOptions& options);
 
 /// Audits the named built-ins (empty = all of auditable_names()). Throws InvalidArgument
 /// naming an unknown name and the valid ones.
 std::vector<Classification> audit_builtins(const std::vector<std::string>& names, const AuditOptions& options);
 
-/// Human output: one table per classification, witnesses of failing cells below it.
-/// `witnesses` = false prints the tables only (the main report).
+/// Human output: per classification, one table per view, then notes, injectivity (a loud
+/// warning when a map is not injective) and, with `witnesses`, the failing cells' witnesses.
+/// `witnesses` = false prints the tables and the warnings only (the main report).
 void print_audit(std::ostream& out, const std::vector<Classification>& classifications,
                  const AuditOptions& options, bool witnesses = true);
 
-/// {"representations": [{"name": ..., "checks": [{"component", "group", "mode", "invariant",
-/// "max_error", "cases", "seed", "witness"}]}]} (docs/AUDIT.md).
+/// {"representations": [{"name": ..., "injective": true|false|null, "summary": {view:
+/// {component: {mode: {group: bool}}}}, "checks": [{"component", "group", "mode", "view",
+/// "method", "invariant", "max_error", "cases", "seed", "witness", ...}]}]} (docs/AUDIT.md).
 std::string audit_json(const std::vector<Classification>& classifications);
 
 }  // namespace handcentric::props

@@ -31,10 +31,26 @@ struct CheckOptions {
   /// The pointwise tolerance is relative_tolerance * (1 + L) (tolerance.hpp). 1e-9 suits double
   /// arithmetic; a policy computed in float needs ~1e-4.
   double relative_tolerance = kRelativeTolerance;
+  /// Shrink a failing case to a small witness (false: keep the first failure as it was found,
+  /// for a re-check that only needs the yes or no).
+  bool shrink = true;
 };
 
-/// Eye-in-hand scenes (no world points): Theorem 1's assumption, the audit's default.
+/// Eye-in-hand scenes (no world points): Theorem 1's assumption.
 SceneShape eye_in_hand_shape();
+
+/// Third-person scenes: one to eight world points (up to 10 m out) that move with g, beside up
+/// to three eye-in-hand points: a fixed camera's view, outside Theorem 1's assumption.
+SceneShape third_person_shape();
+
+/// eye_in_hand_shape() or third_person_shape().
+SceneShape shape_for(View view);
+
+/// The view a shape's scenes show: third_person when they may carry world points.
+View view_of(const SceneShape& shape);
+
+/// CheckOptions with shape_for(view).
+CheckOptions options_for(View view);
 
 /// CheckOptions with eye_in_hand_shape().
 CheckOptions eye_in_hand_options();

@@ -1,9 +1,11 @@
 #pragma once
 // The classifier: for one representation (or flow target), which groups leave each component
-// invariant, pointwise and in distribution (issue 3, item 4).
+// invariant, pointwise and in distribution, in each view (eye-in-hand, third-person), and
+// whether the representation keeps the information in the chunk (injectivity.hpp).
 //
-//   representation : actions, observation (pointwise); the input and the target of its
-//                    rectified flow (eq. 5), pointwise and in distribution.
+//   representation : actions, observation (pointwise); the input and the target of its flow:
+//                    the rectified flow of eq. (5), or a flow of its own (a plug-in's),
+//                    pointwise and in distribution.
 //   flow target    : its input and target, pointwise and in distribution.
 // And what the paper says each built-in should give (App. A), to assert and to report against.
 #include <memory>
@@ -15,42 +17,70 @@
 #include "handcentric/core/representation.hpp"
 #include "handcentric/props/check.hpp"
 #include "handcentric/props/distribution.hpp"
+#include "handcentric/props/injectivity.hpp"
 #include "handcentric/props/verdict.hpp"
 
 namespace handcentric::props {
 
 struct ClassifierOptions {
-  CheckOptions check = eye_in_hand_options();  ///< eye-in-hand scenes: Theorem 1's setting
+  /// cases, seed, tolerance and scene sizes; the world points are set per view.
+  CheckOptions check = eye_in_hand_options();
   DistributionOptions distribution = {};
   std::vector<Group> groups = all_groups();
+  std::vector<View> views = {View::eye_in_hand, View::third_person};
   bool observation = true;   ///< check the observation (off for a plug-in that sends none)
-  bool flow = true;          ///< check the rectified flow of a representation
+  bool flow = true;          ///< check the flow of a representation
   bool in_distribution = true;
+  bool injectivity = true;   ///< run check_injectivity on a representation
+  int injectivity_cases = 200;  ///< chunk pairs it tries (on third-person scenes)
+  /// When a cell fails at a tolerance below float32 rounding, re-check it at
+  /// kFloat32RelativeTolerance and say in the verdict's note if it would pass there.
+  bool float32_note = true;
 };
 
 struct Classification {
   std::string name;
-  std::vector<Verdict> verdicts;  ///< one per (component, mode, group) checked
+  std::vector<Verdict> verdicts;            ///< one per (view, component, mode, group) checked
+  std::optional<Injectivity> injectivity;   ///< representations only
 };
 
+/// `flow`: the flow to audit; null = the rectified flow of `representation` (eq. 5).
 Classification classify_representation(std::shared_ptr<const Representation> representation,
-                                       const ClassifierOptions& options = {});
+                                       const ClassifierOptions& options = {},
+                                       std::shared_ptr<const FlowTarget> flow = nullptr);
 
 Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
                                     const ClassifierOptions& options = {});
 
-/// The groups whose verdict for (component, mode) held, in all_groups() order.
-std::vector<Group> invariant_groups(const Classification& classification, Component component, Mode mode);
+/// `check` with the scenes of `view` (its world-point counts), everything else kept.
+CheckOptions with_view(CheckOptions check, View view);
 
-/// The verdict for (component, mode, group), or null when it was not checked.
-const Verdict* find_verdict(const Classification& classification, Component component, Mode mode, Group group);
+/// The groups whose verdict for (component, mode, view) held, in all_groups() order.
+std::vector<Group> invariant_groups(const Classification& classification, Component component, Mode mode,
+                                    View view = View::eye_in_hand);
 
-/// What App. A of the paper says (and what we assert) for a built-in: the groups that leave
-/// (component, mode) invariant. Empty optional for a name or component the paper is silent on.
-///   absolute: none. relative, relative_diff: actions and flow target under translation only,
-///   observation (world proprioception) under none. hand_centric: everything under all five.
-///   actionflow: pointwise none; flow target in distribution under rotation and c8 only.
-std::optional<std::vector<Group>> paper_expectation(const std::string& name, Component component, Mode mode);
+/// The verdict for (component, mode, group, view), or null when it was not checked.
+const Verdict* find_verdict(const Classification& classification, Component component, Mode mode, Group group,
+                            View view = View::eye_in_hand);
+
+/// What we assert for a built-in, and on what authority.
+struct Expectation {
+  std::vector<Group> groups;  ///< the groups that leave (component, mode) invariant
+  std::string basis;          ///< "paper, App. A" or why we expect it where the paper is silent
+};
+
+/// The expectation for a built-in's (component, mode) in `view`; empty for a name or component
+/// the paper and this library are silent on.
+///   eye_in_hand (the paper's setting, App. A): absolute none; relative, relative_diff: actions
+///     and flow target under translation only, observation and flow input under none;
+///     hand_centric everything under all five; actionflow pointwise none, flow target in
+///     distribution under rotation and c8 only.
+///   third_person: the same cells, but on this library's authority, not the paper's (Theorem 1
+///     assumes eye-in-hand views): world points are copied raw by absolute, relative,
+///     relative_diff and ActionFlow's input (never invariant), and taken into the hand frame,
+///     T_0^{-1} q, by hand_centric (invariant under all five).
+std::optional<Expectation> paper_expectation(const std::string& name, Component component, Mode mode,
+                                             View view = View::eye_in_hand);
 
 /// The cells of `classification` that differ from paper_expectation, one line each.
 std::vector<std::string> mismatches_with_paper(const Classification& classification);

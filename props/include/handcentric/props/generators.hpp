@@ -6,6 +6,9 @@
 // and exactly pi. Every generator shrinks toward simpler values (smaller numbers, fewer poses).
 #include <rapidcheck.h>
 
+#include <string>
+#include <vector>
+
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/core/rotation.hpp"
 #include "handcentric/core/scene.hpp"
@@ -41,10 +44,15 @@ struct SceneShape {
   int max_hand_points = 3;
   int min_world_points = 0;  ///< above 0, the count is drawn in [min, max] (a fixed count: min = max)
   int min_hand_points = 0;
+  /// Named world-frame poses to generate (e.g. "start"): random poses that move with g.
+  std::vector<std::string> extra_pose_names;
+  /// Named scalars to generate (e.g. "gripper"): numbers in [-1, 1] that g leaves alone.
+  std::vector<std::string> scalar_names;
 };
 
 /// A scene: a random start pose, a smooth but rotating chunk (constant twist per step with a
-/// random twist), a history the same way backwards, eye-in-hand and world points.
+/// random twist), a history the same way backwards, eye-in-hand and world points, and the
+/// extra poses and scalars the shape names.
 rc::Gen<Scene> scene(SceneShape shape = {});
 
 }  // namespace handcentric::props

@@ -1,41 +1,42 @@
 #pragma once
-// A representation written in any language, spoken to over a pipe (docs/AUDIT.md, "--exec").
+// A representation written in any language, spoken to over a pipe (docs/AUDIT.md, "--exec"):
+// a Subprocess (subprocess.hpp) that speaks the JSON Lines protocol of plugin_protocol.hpp.
 //
-// The command is started once, through /bin/sh -c, and answers JSON Lines on stdin/stdout:
-//   request : {"id": n, "history": [H+1 matrices, [0] = T_0], "chunk": [K matrices],
-//              "hand_points": [[x, y, z], ...], "world_points": [[x, y, z], ...]}
-//             (each matrix 16 numbers, row-major 4x4)
-//   response: {"id": n, "actions": [numbers], "observation": [numbers]}  (observation optional)
-// Every way a plug-in can misbehave becomes a PluginError with a one-line message: the command
-// is not found, exits early (its stderr is quoted), answers something that is not JSON, the
-// wrong id, a NaN or Inf, a vector whose length changes between scenes of the same shape, or
-// nothing within the timeout (read with poll(), so the audit never hangs).
+// The first request is a handshake: a small probe scene. A version-2 plug-in may answer it
+// with a hello naming the extra poses and scalars it wants, and whether it decodes and answers
+// flow requests; the probe is then asked again. Names given to the constructor (the command
+// line's --extra-poses and --scalars) are sent whatever the hello says.
+//
+// Every way a plug-in can misbehave becomes a PluginError: the first line says what happened
+// (not found, exited, not JSON, wrong id, NaN, a length that changes between scenes of one
+// shape, no answer within the timeout), and, when the plug-in wrote on stderr, the last 20
+// lines of it follow, indented (a Python traceback keeps its last line).
 //
 // Answers are cached by request, so a scene is sent once however many checks read it. Not
-// thread-safe. Constructing one ignores SIGPIPE for the process (a dead plug-in must give an
-// error, not kill the audit).
+// thread-safe.
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <unordered_map>
+#include <vector>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representation.hpp"
+#include "handcentric/props/plugin_protocol.hpp"
+#include "handcentric/props/subprocess.hpp"
 
 namespace handcentric::props {
 
-/// A plug-in that failed: not found, crashed, wrong answer, too slow.
-class PluginError : public Error {
- public:
-  using Error::Error;
-};
-
 class PipeRepresentation final : public Representation {
  public:
-  /// Starts `command`. Throws InvalidArgument for an empty command or a timeout <= 0,
-  /// PluginError if the process cannot be started.
-  PipeRepresentation(std::string command, double timeout_seconds);
+  /// Starts `command`. Throws InvalidArgument for an empty command, a timeout <= 0 or an
+  /// empty or repeated name; PluginError if the process cannot be started. Nothing is sent
+  /// until the first question.
+  PipeRepresentation(std::string command, double timeout_seconds,
+                     std::vector<std::string> extra_pose_names = {}, std::vector<std::string> scalar_names = {});
   ~PipeRepresentation() override;
   PipeRepresentation(const PipeRepresentation&) = delete;
   PipeRepresentation& operator=(const PipeRepresentation&) = delete;
@@ -44,13 +45,22 @@ class PipeRepresentation final : public Representation {
   Eigen::VectorXd encode_actions(const Scene& scene) const override;
   /// Empty when the plug-in sends no observation.
   Eigen::VectorXd encode_observation(const Scene& scene) const override;
-  bool can_decode() const override { return false; }
-  /// Throws InvalidArgument: a plug-in only encodes.
+  /// Whether the plug-in declared "decode" in its hello.
+  bool can_decode() const override;
+  /// The plug-in's decode answer for T_0 alone (a scene with history {T_0} and no points).
   std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& actions,
                                              const RigidTransform& world_T_hand0) const override;
+  /// The plug-in's decode answer. Throws InvalidArgument when it does not decode.
+  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions, const Scene& observation) const override;
 
-  /// Whether the plug-in sent an "observation" (asks it about a small scene if not asked yet).
+  /// The handshake's result (runs it if it has not run): protocol, names, decode, flow.
+  const PluginCapabilities& capabilities() const;
+  /// Whether the plug-in sent an "observation" (runs the handshake if it has not run).
   bool provides_observation() const;
+  /// Its own flow for (scene, eps, t): {flow_input, flow_target}. Throws InvalidArgument when
+  /// the plug-in did not declare "flow".
+  FlowSample flow(const Scene& scene, const Eigen::VectorXd& eps, double t) const;
+
   /// Requests actually sent (cache misses).
   int requests_sent() const { return next_id_; }
   /// Seconds spent in ask() for requests sent (formatting, writing, waiting, parsing), and the
@@ -59,29 +69,39 @@ class PipeRepresentation final : public Representation {
   double seconds_waiting() const { return seconds_waiting_; }
 
  private:
-  struct Answer {
-    Eigen::VectorXd actions;
-    Eigen::VectorXd observation;
-    bool has_observation = false;
-  };
-  const Answer& ask(const Scene& scene) const;
-  std::string read_line(int id) const;
+  const PluginReply& ask(const Scene& scene, RequestKind kind, const std::string& body) const;
+  PluginReply exchange(RequestKind kind, const std::string& body, bool hello_allowed) const;
+  [[noreturn]] void fail(const std::string& what) const;
   [[noreturn]] void fail_exited(const std::string& when) const;
-  std::string drain_stderr() const;
+  void check_lengths(const Scene& scene, const PluginReply& reply, int id) const;
+  Scene with_extras(const Scene& scene) const;
 
   std::string command_;
   double timeout_seconds_;
-  mutable int pid_ = -1;
-  int to_child_ = -1, from_child_ = -1;
-  mutable int child_stderr_ = -1;
+  std::vector<std::string> forced_extra_poses_, forced_scalars_;
+  mutable Subprocess process_;
+  mutable std::optional<PluginCapabilities> capabilities_;
+  mutable bool has_observation_ = false;
   mutable int next_id_ = 0;
-  mutable std::string buffer_;  ///< bytes read past the last newline
-  mutable std::unordered_map<std::string, Answer> cache_;
+  mutable std::unordered_map<std::string, PluginReply> cache_;
   /// (H, K, #hand points, #world points) -> (actions length, observation length, has observation)
   mutable std::map<std::tuple<int, int, int, int>, std::tuple<Eigen::Index, Eigen::Index, bool>> lengths_;
   mutable bool dead_ = false;
-  mutable std::string stderr_tail_;
-  mutable double seconds_asking_ = 0.0, seconds_waiting_ = 0.0;  ///< the last 4000 bytes of its stderr
+  mutable double seconds_asking_ = 0.0, seconds_waiting_ = 0.0;
+};
+
+/// A plug-in's own flow (declared "flow" in its hello) as a FlowTarget: eps has the length of
+/// the plug-in's actions, and each (scene, eps, t) is one flow request.
+class PipeFlowTarget final : public FlowTarget {
+ public:
+  /// Throws InvalidArgument for a null plug-in or one that did not declare "flow".
+  explicit PipeFlowTarget(std::shared_ptr<const PipeRepresentation> plugin);
+  std::string name() const override;
+  Eigen::Index noise_dimension(const Scene& scene) const override;
+  FlowSample operator()(const Scene& scene, const Eigen::VectorXd& eps, double t) const override;
+
+ private:
+  std::shared_ptr<const PipeRepresentation> plugin_;
 };
 
 }  // namespace handcentric::props

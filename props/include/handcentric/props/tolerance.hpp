@@ -17,6 +17,14 @@
 namespace handcentric::props {
 
 constexpr double kRelativeTolerance = 1e-9;
+
+// float32 rounding (`--precision float32`): 1e-4 is about 1700 units of float32 rounding
+// (2^-24 = 6e-8). A pose pipeline in float32 rounds its inputs and each of a few dozen products
+// at the scene's length scale (~1e-7 (1 + L) each); a rotation vector taken through acos near pi
+// loses up to sqrt(2^-24) = 2.4e-4 in the angle, which 1e-4 (1 + L) covers for L >= 1.4 m (the
+// audit's scenes start up to 17 m out). Real symmetry breaking in the audit's scenes is
+// O(0.01) and above, far over it.
+constexpr double kFloat32RelativeTolerance = 1e-4;
 constexpr double kNearIdentity = 1e-6;
 
 /// L: the largest translation norm of any pose or point of the scene (0 for an empty scene).

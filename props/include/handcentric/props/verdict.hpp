@@ -21,36 +21,61 @@ namespace handcentric::props {
 enum class Component { actions, observation, flow_input, flow_target, policy };
 
 /// pointwise: f(g * s) = f(s) for each case, with fixed noise eps and time t.
-/// distribution: the samples of f(s, eps), eps ~ N(0, I) redrawn, and of f(g * s, eps) are
-/// indistinguishable by a two-sample test (distribution.hpp).
+/// distribution: the law of f(s, eps), eps ~ N(0, I), equals the law of f(g * s, eps)
+/// (distribution.hpp says how that is decided).
 enum class Mode { pointwise, distribution };
+
+/// Which scenes a check ran on. eye_in_hand: no world points (Theorem 1's assumption);
+/// third_person: one to eight world-frame points that move with g, beside eye-in-hand points.
+enum class View { eye_in_hand, third_person };
+
+/// How an in-distribution verdict was decided (pointwise checks compare values: `compared`).
+///   exact_gaussian: the component is affine in eps on every case (checked), so its law is the
+///                   Gaussian N(f(0), J J^T); the two laws were compared exactly, up to rounding.
+///   energy_test   : some case was not affine in eps; a permutation test of the energy distance
+///                   decided, and a "yes" only means no difference was found (detectable_shift).
+enum class Method { compared, exact_gaussian, energy_test };
 
 /// "actions", "observation", "flow_input", "flow_target", "policy".
 std::string to_string(Component component);
 /// "pointwise", "distribution".
 std::string to_string(Mode mode);
+/// "eye_in_hand", "third_person".
+std::string to_string(View view);
+/// "compared", "exact_gaussian", "energy_test".
+std::string to_string(Method method);
 
 /// A counterexample: the scene, g, and the two outputs compared.
 struct Witness {
   Scene scene;
   RigidTransform g;
-  Eigen::VectorXd before;  ///< f(scene)            (policy: g * a(o), flattened)
-  Eigen::VectorXd after;   ///< f(g * scene)        (policy: a(g * o), flattened)
-  double error = 0.0;      ///< pointwise: |after - before|_inf; distribution: energy distance
-  double tolerance = 0.0;  ///< what error had to stay below (pointwise)
-  double p_value = 1.0;    ///< distribution mode: the permutation p-value (else 1)
+  Eigen::VectorXd before;  ///< f(scene)            (policy: g * a(o), flattened; exact law: its mean)
+  Eigen::VectorXd after;   ///< f(g * scene)        (policy: a(g * o), flattened; exact law: its mean)
+  double error = 0.0;      ///< |after - before|_inf; exact law: max(mean, covariance difference);
+                           ///< energy test: the energy distance
+  double tolerance = 0.0;  ///< what error had to stay below (energy test: the level alpha)
+  double p_value = 1.0;    ///< energy test: the permutation p-value (else 1)
+  std::string detail;      ///< exact law: which moment differs and by how much
 };
 
 struct Verdict {
   Component component = Component::actions;
   Group group = Group::se3;
   Mode mode = Mode::pointwise;
+  View view = View::eye_in_hand;
+  Method method = Method::compared;
   bool invariant = false;    ///< the check held on every case (and on at least one far case)
   double max_error = 0.0;    ///< largest error seen (before shrinking)
   double min_p_value = 1.0;  ///< distribution mode: smallest p-value seen
   int cases = 0;             ///< cases run with g far from the identity (tolerance.hpp)
   int near_identity_cases = 0;  ///< cases run with g near the identity (run, not counted)
   std::uint64_t seed = 0;
+  double relative_tolerance = 0.0;  ///< the REL of the pointwise tolerance REL * (1 + L)
+  /// energy_test "yes": the smallest mean shift (Euclidean norm, in the component's units) the
+  /// test detects with 90% power at this sample size and level (distribution.hpp).
+  std::optional<double> detectable_shift;
+  /// A remark the reader needs, e.g. that a failure would pass at float32 rounding.
+  std::string note;
   std::optional<Witness> witness;  ///< present when !invariant
 };
 

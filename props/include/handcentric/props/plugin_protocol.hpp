@@ -1,0 +1,70 @@
+#pragma once
+// The --exec protocol's messages (docs/AUDIT.md, "--exec"): requests written as JSON Lines,
+// replies parsed and validated. No I/O here: subprocess.hpp moves the bytes.
+//
+// Version 2 (every request carries "protocol": 2; a version-1 plug-in ignores that field):
+//   encode : {"id", "protocol", "history", "chunk", "hand_points", "world_points"
+//             [, "extra_poses": {name: [16]}, "scalars": {name: x}] [, "eps": [...], "t": x]}
+//            -> {"id", "actions" [, "observation"] [, "flow_input", "flow_target"]}
+//   decode : {"id", "protocol", "decode": [actions], "history", "hand_points", "world_points"
+//             [, extras]} -> {"id", "chunk": [[16], ...]}
+//   hello  : a plug-in may answer the first request it reads with
+//            {"id", "hello": {"protocol": 2, "extra_poses": [names], "scalars": [names],
+//             "decode": bool, "flow": bool}} instead; the audit then asks again.
+// Matrices are 16 numbers, row-major 4x4.
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "handcentric/core/rigid_transform.hpp"
+#include "handcentric/core/scene.hpp"
+#include "handcentric/props/subprocess.hpp"
+
+namespace handcentric::props {
+
+constexpr int kProtocolVersion = 2;
+
+/// What a plug-in said about itself in its hello (or what flags asked for).
+struct PluginCapabilities {
+  int protocol = 1;
+  std::vector<std::string> extra_pose_names;
+  std::vector<std::string> scalar_names;
+  bool decode = false;
+  bool flow = false;
+};
+
+/// The noise and time of a flow request.
+struct FlowQuery {
+  const Eigen::VectorXd* eps = nullptr;
+  double t = 0.0;
+};
+
+/// The body of an encode request (everything after the id; also the cache key).
+std::string encode_request_body(const Scene& scene, const std::optional<FlowQuery>& flow = std::nullopt);
+/// The body of a decode request: the observation (no chunk) and the actions to decode.
+std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& observation);
+/// The whole line: {"id": id, "protocol": 2, <body>}\n.
+std::string request_line(int id, const std::string& body);
+
+/// A parsed reply. Exactly one of hello / encode / chunk is filled, as the request asked.
+struct PluginReply {
+  std::optional<PluginCapabilities> hello;
+  Eigen::VectorXd actions, observation, flow_input, flow_target;
+  bool has_observation = false, has_flow = false;
+  std::vector<RigidTransform> chunk;  ///< decode replies
+};
+
+enum class RequestKind { encode, flow, decode };
+
+/// Parses and validates `line` as the reply to request `id` of `kind`; `who` names the plug-in
+/// in messages. Throws PluginError with a one-line message for anything else: not JSON, a
+/// non-finite number, a wrong id, a missing field, a matrix that is not 16 finite numbers with
+/// last row 0 0 0 1.
+PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
+                        bool hello_allowed);
+
+/// `text` as one line (newlines -> '|'), cut at `limit` characters.
+std::string one_line(std::string text, std::size_t limit = 200);
+
+}  // namespace handcentric::props

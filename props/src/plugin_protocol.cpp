@@ -1,0 +1,247 @@
+#include "handcentric/props/plugin_protocol.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "handcentric/core/format.hpp"
+
+namespace handcentric::props {
+namespace {
+
+void append_number(std::string& out, double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.17g", value);
+  out += text;
+}
+
+void append_matrix(std::string& out, const RigidTransform& T) {
+  const Eigen::Matrix4d M = T.matrix();
+  out += '[';
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      if (r + c > 0) out += ", ";
+      append_number(out, M(r, c));
+    }
+  }
+  out += ']';
+}
+
+void append_poses(std::string& out, const std::vector<RigidTransform>& poses) {
+  out += '[';
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    if (i > 0) out += ", ";
+    append_matrix(out, poses[i]);
+  }
+  out += ']';
+}
+
+void append_points(std::string& out, const std::vector<Eigen::Vector3d>& points) {
+  out += '[';
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    out += i > 0 ? ", [" : "[";
+    for (int j = 0; j < 3; ++j) {
+      if (j > 0) out += ", ";
+      append_number(out, points[i](j));
+    }
+    out += ']';
+  }
+  out += ']';
+}
+
+void append_vector(std::string& out, const Eigen::VectorXd& v) {
+  out += '[';
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    if (i > 0) out += ", ";
+    append_number(out, v(i));
+  }
+  out += ']';
+}
+
+// A JSON string literal of a name (names come from the plug-in's hello or the command line).
+void append_name(std::string& out, const std::string& name) { out += nlohmann::json(name).dump(); }
+
+// History, points and extras: what every request carries.
+void append_observation(std::string& out, const Scene& scene) {
+  out += "\"history\": ";
+  append_poses(out, scene.world_T_hand_history);
+  out += ", \"hand_points\": ";
+  append_points(out, scene.hand_points);
+  out += ", \"world_points\": ";
+  append_points(out, scene.world_points);
+  if (!scene.extra_poses.empty()) {
+    out += ", \"extra_poses\": {";
+    for (std::size_t i = 0; i < scene.extra_poses.size(); ++i) {
+      if (i > 0) out += ", ";
+      append_name(out, scene.extra_poses[i].first);
+      out += ": ";
+      append_matrix(out, scene.extra_poses[i].second);
+    }
+    out += '}';
+  }
+  if (!scene.scalars.empty()) {
+    out += ", \"scalars\": {";
+    for (std::size_t i = 0; i < scene.scalars.size(); ++i) {
+      if (i > 0) out += ", ";
+      append_name(out, scene.scalars[i].first);
+      out += ": ";
+      append_number(out, scene.scalars[i].second);
+    }
+    out += '}';
+  }
+}
+
+std::string reply_to(const std::string& who, int id) { return who + " answered request " + std::to_string(id); }
+
+Eigen::VectorXd read_numbers(const nlohmann::json& value, const std::string& field, int id, const std::string& who) {
+  if (!value.is_array()) throw PluginError(reply_to(who, id) + " with \"" + field + "\" that is not an array of numbers");
+  Eigen::VectorXd v(static_cast<Eigen::Index>(value.size()));
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    if (!value[i].is_number()) {
+      throw PluginError(reply_to(who, id) + " with \"" + field + "\"[" + std::to_string(i) + "] = " +
+                        one_line(value[i].dump(), 40) + ", not a number");
+    }
+    const double x = value[i].get<double>();
+    if (!std::isfinite(x)) {
+      throw PluginError(reply_to(who, id) + " with a non-finite \"" + field + "\"[" + std::to_string(i) +
+                        "] = " + format_number(x) + "; send finite numbers only");
+    }
+    v(static_cast<Eigen::Index>(i)) = x;
+  }
+  return v;
+}
+
+std::vector<std::string> read_names(const nlohmann::json& hello, const char* field, int id, const std::string& who) {
+  std::vector<std::string> names;
+  if (!hello.contains(field) || hello[field].is_null()) return names;
+  if (!hello[field].is_array()) throw PluginError(reply_to(who, id) + " with a hello whose \"" + field + "\" is not a list of names");
+  for (const auto& name : hello[field]) {
+    if (!name.is_string() || name.get<std::string>().empty()) {
+      throw PluginError(reply_to(who, id) + " with a hello whose \"" + field + "\" holds " + one_line(name.dump(), 40) +
+                        ", not a name");
+    }
+    names.push_back(name.get<std::string>());
+  }
+  return names;
+}
+
+bool read_flag(const nlohmann::json& hello, const char* field, int id, const std::string& who) {
+  if (!hello.contains(field) || hello[field].is_null()) return false;
+  if (!hello[field].is_boolean()) throw PluginError(reply_to(who, id) + " with a hello whose \"" + field + "\" is not true or false");
+  return hello[field].get<bool>();
+}
+
+// A world-frame pose: 16 finite numbers, row-major, last row 0 0 0 1. The rotation block is
+// taken as it is (a float32 plug-in's is orthonormal to ~1e-7 only); distances compare it.
+RigidTransform read_pose(const nlohmann::json& value, std::size_t k, int id, const std::string& who) {
+  const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", id, who);
+  if (v.size() != 16 || v(12) != 0.0 || v(13) != 0.0 || v(14) != 0.0 || v(15) != 1.0) {
+    throw PluginError(reply_to(who, id) + " with \"chunk\"[" + std::to_string(k) +
+                      "] that is not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)");
+  }
+  Eigen::Matrix3d R;
+  R << v(0), v(1), v(2), v(4), v(5), v(6), v(8), v(9), v(10);
+  return RigidTransform::unchecked(R, Eigen::Vector3d(v(3), v(7), v(11)));
+}
+
+}  // namespace
+
+std::string one_line(std::string text, std::size_t limit) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.pop_back();
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = '|';
+  }
+  if (text.size() > limit) text = text.substr(0, limit) + "...";
+  return text;
+}
+
+std::string encode_request_body(const Scene& scene, const std::optional<FlowQuery>& flow) {
+  std::string out;
+  append_observation(out, scene);
+  out += ", \"chunk\": ";
+  append_poses(out, scene.world_T_hand_chunk);
+  if (flow) {
+    out += ", \"eps\": ";
+    append_vector(out, *flow->eps);
+    out += ", \"t\": ";
+    append_number(out, flow->t);
+  }
+  return out;
+}
+
+std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& observation) {
+  std::string out = "\"decode\": ";
+  append_vector(out, actions);
+  out += ", ";
+  append_observation(out, observation);
+  return out;
+}
+
+std::string request_line(int id, const std::string& body) {
+  return "{\"id\": " + std::to_string(id) + ", \"protocol\": " + std::to_string(kProtocolVersion) + ", " + body + "}\n";
+}
+
+PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who, bool hello_allowed) {
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(line);
+  } catch (const nlohmann::json::exception& e) {
+    // JSON has no NaN or Infinity; Python's json module writes them anyway, and 1e999 overflows.
+    const bool non_finite = line.find("NaN") != std::string::npos || line.find("Infinity") != std::string::npos ||
+                            std::string(e.what()).find("overflow") != std::string::npos;
+    throw PluginError(reply_to(who, id) +
+                      (non_finite ? " with a non-finite number (NaN, Infinity or an overflow, e.g. 1e999 -> inf), "
+                                    "which is not JSON; send finite numbers only: "
+                                  : " with a line that is not JSON: ") +
+                      "'" + one_line(line, 120) + "'");
+  }
+  if (!json.is_object() || !json.contains("id")) {
+    throw PluginError(reply_to(who, id) + " without an \"id\": '" + one_line(line, 120) + "'");
+  }
+  if (!json["id"].is_number_integer() || json["id"].get<long long>() != id) {
+    throw PluginError(reply_to(who, id) + " with id " + one_line(json["id"].dump(), 40) +
+                      "; answer each request, in order, with its own id");
+  }
+  PluginReply reply;
+  if (json.contains("hello")) {
+    const nlohmann::json& hello = json["hello"];
+    if (!hello_allowed) throw PluginError(reply_to(who, id) + " with a hello; a hello may only answer the first request");
+    if (!hello.is_object()) throw PluginError(reply_to(who, id) + " with a hello that is not an object");
+    PluginCapabilities capabilities;
+    capabilities.protocol = hello.contains("protocol") && hello["protocol"].is_number_integer() ? hello["protocol"].get<int>() : 2;
+    if (capabilities.protocol < 2 || capabilities.protocol > kProtocolVersion) {
+      throw PluginError(reply_to(who, id) + " with a hello for protocol " + std::to_string(capabilities.protocol) +
+                        "; this audit speaks protocols 1 and " + std::to_string(kProtocolVersion));
+    }
+    capabilities.extra_pose_names = read_names(hello, "extra_poses", id, who);
+    capabilities.scalar_names = read_names(hello, "scalars", id, who);
+    capabilities.decode = read_flag(hello, "decode", id, who);
+    capabilities.flow = read_flag(hello, "flow", id, who);
+    reply.hello = capabilities;
+    return reply;
+  }
+  if (kind == RequestKind::decode) {
+    if (!json.contains("chunk") || !json["chunk"].is_array() || json["chunk"].empty()) {
+      throw PluginError(reply_to(who, id) + ", a decode request, without a \"chunk\" of poses: '" + one_line(line, 120) + "'");
+    }
+    for (std::size_t k = 0; k < json["chunk"].size(); ++k) reply.chunk.push_back(read_pose(json["chunk"][k], k, id, who));
+    return reply;
+  }
+  if (!json.contains("actions")) throw PluginError(reply_to(who, id) + " without \"actions\": '" + one_line(line, 120) + "'");
+  reply.actions = read_numbers(json["actions"], "actions", id, who);
+  if (reply.actions.size() == 0) throw PluginError(reply_to(who, id) + " with no actions");
+  reply.has_observation = json.contains("observation") && !json["observation"].is_null();
+  if (reply.has_observation) reply.observation = read_numbers(json["observation"], "observation", id, who);
+  if (kind == RequestKind::flow) {
+    if (!json.contains("flow_input") || !json.contains("flow_target")) {
+      throw PluginError(reply_to(who, id) + ", a flow request (it carries eps and t), without \"flow_input\" and "
+                        "\"flow_target\"; answer them, or do not declare \"flow\" in the hello");
+    }
+    reply.flow_input = read_numbers(json["flow_input"], "flow_input", id, who);
+    reply.flow_target = read_numbers(json["flow_target"], "flow_target", id, who);
+    reply.has_flow = true;
+  }
+  return reply;
+}
+
+}  // namespace handcentric::props
