@@ -4,7 +4,7 @@
 
     def encode(history, chunk, hand_points, world_points):
         ...                      # history (H+1,4,4), chunk (K,4,4), points (n,3), (m,3)
-        return actions           # or (actions, observation), or {"actions": ..., "observation": ...}
+        return actions           # or (actions, observation), or {"actions": .., "observation": ..}
 
     if __name__ == "__main__":
         hp.serve(encode)
@@ -105,9 +105,9 @@ def _matrix(value, what):
     return np.array(m).reshape(4, 4) if np is not None else [m[0:4], m[4:8], m[8:12], m[12:16]]
 
 
-def _matrices(request, key, allow_empty):
+def _matrices(request, key):
     value = request.get(key)
-    if not isinstance(value, list) or (not value and not allow_empty):
+    if not isinstance(value, list) or not value:
         raise _Malformed("'%s' must be a non-empty list of matrices" % key)
     ms = [_matrix(m, "%s[%d]" % (key, i)) for i, m in enumerate(value)]
     return np.array(ms).reshape(len(ms), 4, 4) if np is not None else ms
@@ -251,8 +251,9 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
 
     def answer(request):
         rid = request["id"]
-        history = _matrices(request, "history", allow_empty=False)
-        hand_points, world_points = _points(request, "hand_points"), _points(request, "world_points")
+        history = _matrices(request, "history")
+        hand_points = _points(request, "hand_points")
+        world_points = _points(request, "world_points")
         named = (_named(request, "extra_poses", extra_poses, _matrix),
                  _named(request, "scalars", scalars, _scalar))
         if "decode" in request:
@@ -266,7 +267,7 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                 actions = np.array(actions)
             return {"id": rid, "chunk": _chunk(call(decode, rid, (actions, history, hand_points,
                                                      world_points), named))}
-        chunk = _matrices(request, "chunk", allow_empty=False)
+        chunk = _matrices(request, "chunk")
         encoded = call(encode, rid, (history, chunk, hand_points, world_points), named)
         actions, observation = _split_encoded(encoded)
         reply = {"id": rid, "actions": _flatten(actions, "actions")}
@@ -283,8 +284,6 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             if np is not None:
                 eps = np.array(eps)
             pair = call(flow, rid, (history, chunk, hand_points, world_points, eps, t), named)
-            if isinstance(pair, dict):
-                pair = (pair.get("flow_input"), pair.get("flow_target"))
             if not isinstance(pair, (tuple, list)) or len(pair) != 2:
                 raise _BadResult("flow must return the pair (flow_input, flow_target)")
             reply["flow_input"] = _flatten(pair[0], "flow_input")

@@ -44,7 +44,7 @@ def _find_helper():
 
 _find_helper()
 try:
-    import numpy as np
+    import numpy  # noqa: F401 (the helpers below need it: fail here, with a clear line)
     import handcentric_plugin as hp
 except ImportError as error:  # one clear line: the audit quotes our stderr
     sys.exit("repr.py: %s (with %s). It needs NumPy (Debian: python3-numpy) and "

@@ -18,7 +18,6 @@ import sys
 
 HERE = os.path.dirname(os.path.realpath(__file__))
 sys.path.insert(0, os.path.normpath(os.path.join(HERE, "..", "..", "..", "python")))  # the helper
-import numpy as np  # noqa: E402
 import handcentric_plugin as hp  # noqa: E402
 
 
