@@ -83,10 +83,6 @@ def request(scene, rid=0, **fields):
     return r
 
 
-def flat(values):
-    return np.concatenate([np.ravel(v) for v in values]) if len(values) else np.zeros(0)
-
-
 def encoded(encode, scene, **kwargs):
     """encode's (actions, observation) on a scene, flattened, as serve() would send them."""
     actions, observation = encode(scene["history"], scene["chunk"], scene["hand_points"],
@@ -616,7 +612,7 @@ def test_constant_zeros_gives_6k_zeros_whatever_the_scene():
 
 # ----------------------------------------------------------------------------- v2_everything
 
-def v2_fields(rng, scene):
+def v2_fields(rng):
     return {"extra_poses": {"start": random_pose(rng).ravel().tolist()},
             "scalars": {"gripper": 0.04}}
 
@@ -628,7 +624,7 @@ def roundtrip_error(argv):
     worst, rid = 0.0, 0
     for _ in range(5):
         scene = random_scene(rng, K=int(rng.integers(1, 5)))
-        fields = v2_fields(rng, scene)
+        fields = v2_fields(rng)
         answer = audit.ask(request(scene, rid, **fields))
         if "hello" in answer:  # the first request: answered with the hello, so ask again
             answer = audit.ask(request(scene, rid, **fields))
