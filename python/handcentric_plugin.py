@@ -1,0 +1,415 @@
+"""Write a `handcentric audit --exec` plug-in in a few lines.
+
+    import handcentric_plugin as hp
+
+    def encode(history, chunk, hand_points, world_points):
+        ...                      # history (H+1,4,4), chunk (K,4,4), points (n,3), (m,3)
+        return actions           # or (actions, observation), or {"actions": .., "observation": ..}
+
+    if __name__ == "__main__":
+        hp.serve(encode)
+
+The protocol (JSON Lines, docs/AUDIT.md, section "--exec"): the audit writes one request per line
+on our stdin, we answer one line per request on stdout, in order, echoing its "id".
+
+  request : {"id": n, "history": [[16 numbers], ...], "chunk": [[16 numbers], ...],
+             "hand_points": [[x, y, z], ...], "world_points": [[x, y, z], ...]}
+  answer  : {"id": n, "actions": [numbers], "observation": [numbers]}      (observation optional)
+
+Matrices are world_T_hand, 16 numbers, row-major 4x4. `history[0]` is T_0, the hand NOW, then
+T_-1, T_-2, ... (newest first); `history[::-1]` gives them oldest first. `chunk` holds T_1..T_K.
+`hand_points` are eye-in-hand points (hand frame at T_0), `world_points` world-frame points.
+
+Protocol v2 (the audit adds "protocol": 2 to every request; v1 audits do not; we ignore it):
+  hello        when serve() is given decode, flow, extra_poses or scalars (or hello=True), the
+               FIRST request is answered with {"id": n, "hello": {"protocol": 2, "extra_poses":
+               [names], "scalars": [names], "decode": bool, "flow": bool}} instead of an answer;
+               the audit then sends it again with the fields asked for.
+  extra_poses  requests carry "extra_poses": {name: [16 numbers]} (world-frame poses that move
+               with the global transform: the episode's start pose, a second arm's hand) and
+               "scalars": {name: number} (numbers the transform leaves alone: gripper width).
+               The functions then get keyword arguments extra_poses={name: (4,4)} and
+               scalars={name: float} (both, whenever either list is declared).
+  decode       {"id": n, "decode": [actions], "history", "hand_points", "world_points", ...} (no
+               chunk) -> {"id": n, "chunk": [[16 numbers], ...]} from decode(actions, history,
+               hand_points, world_points) returning the world-frame poses T_1..T_K, (K,4,4).
+  flow         a request with "eps": [as many numbers as the actions] and "t": number is answered
+               with actions (and observation) plus "flow_input" and "flow_target" from
+               flow(history, chunk, hand_points, world_points, eps, t) returning the pair
+               (flow_input, flow_target).
+
+The functions get NumPy float64 arrays when NumPy imports (empty point lists have shape (0,3)),
+nested Python lists otherwise ((H+1) x 4 x 4, K x 4 x 4, n x 3). They may return NumPy arrays of
+any real dtype (float32 too), lists or tuples, nested or flat: everything is flattened to Python
+floats. They must be functions of their inputs only: the audit asks each distinct scene once.
+
+Failures, so that the audit can say what went wrong (it quotes the tail of our stderr):
+  an exception in a user function   full traceback on stderr, exit status 1
+  a non-finite or malformed result  one line naming the field and index on stderr, exit status 1
+  a malformed request line          one line on stderr, exit status 2
+  end of input (the audit is done)  serve() returns, so the script exits with status 0
+
+Output: serve() flushes after every line, so `python3 -u` is not needed. A plug-in that writes
+its own loop must flush after each answer (or run under `python3 -u`): on a pipe, Python holds
+stdout in an 8 KiB buffer and the audit would wait for an answer that never comes. While a user
+function runs, print() goes to stderr, so debugging output cannot corrupt the protocol.
+
+The geometry helpers below (rotation_vector, rotation_matrix, inverse, relative_pose,
+relative_points, pose_vector, pose_matrix) need NumPy; serve() does not.
+"""
+import contextlib
+import json
+import math
+import numbers
+import sys
+import traceback
+
+try:
+    import numpy as np
+except ImportError:  # serve() still works, on nested lists
+    np = None
+
+PROTOCOL = 2
+
+
+class _Malformed(Exception):
+    """The audit sent a line we cannot read as a request: exit status 2."""
+
+
+class _BadResult(Exception):
+    """A user function returned something we cannot send: exit status 1."""
+
+
+def _die(status, message):
+    sys.stderr.write(message.rstrip("\n") + "\n")
+    sys.stderr.flush()
+    sys.exit(status)
+
+
+# ----------------------------------------------------------------------------- reading requests
+
+def _is_number(x):
+    return isinstance(x, (int, float)) and not isinstance(x, bool)
+
+
+def _numbers(value, count, what):
+    """A JSON list of `count` numbers, as Python floats."""
+    if not isinstance(value, list) or len(value) != count or not all(map(_is_number, value)):
+        raise _Malformed("%s must be a list of %d numbers" % (what, count))
+    return [float(x) for x in value]
+
+
+def _matrix(value, what):
+    """16 row-major numbers -> a (4,4) array, or 4 lists of 4 without NumPy."""
+    m = _numbers(value, 16, what)
+    return np.array(m).reshape(4, 4) if np is not None else [m[0:4], m[4:8], m[8:12], m[12:16]]
+
+
+def _matrices(request, key):
+    value = request.get(key)
+    if not isinstance(value, list) or not value:
+        raise _Malformed("'%s' must be a non-empty list of matrices" % key)
+    ms = [_matrix(m, "%s[%d]" % (key, i)) for i, m in enumerate(value)]
+    return np.array(ms).reshape(len(ms), 4, 4) if np is not None else ms
+
+
+def _points(request, key):
+    value = request.get(key, [])
+    if not isinstance(value, list):
+        raise _Malformed("'%s' must be a list of [x, y, z]" % key)
+    ps = [_numbers(p, 3, "%s[%d]" % (key, i)) for i, p in enumerate(value)]
+    return np.array(ps).reshape(len(ps), 3) if np is not None else ps
+
+
+def _named(request, key, names, read):
+    """The declared names of request[key] ({name: value}); a missing one is an error."""
+    given = request.get(key, {})
+    if not isinstance(given, dict):
+        raise _Malformed("'%s' must be an object {name: value}" % key)
+    missing = [name for name in names if name not in given]
+    if missing:
+        raise _Malformed("request has no %s %s (the plug-in declared %s; the audit sends them "
+                         "after the hello)" % (key, ", ".join(map(repr, missing)), list(names)))
+    return {name: read(given[name], "%s[%r]" % (key, name)) for name in names}
+
+
+def _scalar(value, what):
+    if not _is_number(value):
+        raise _Malformed("%s must be a number" % what)
+    return float(value)
+
+
+def _parse(line):
+    try:
+        request = json.loads(line)
+    except ValueError as error:
+        raise _Malformed("not JSON (%s)" % error)
+    if not isinstance(request, dict):
+        raise _Malformed("not a JSON object")
+    if not isinstance(request.get("id"), int) or isinstance(request.get("id"), bool):
+        raise _Malformed("no integer 'id'")
+    return request
+
+
+# ----------------------------------------------------------------------------- writing answers
+
+def _flatten(value, field):
+    """Any nesting of arrays, lists, tuples and real numbers -> a flat list of finite floats."""
+    out = []
+
+    def walk(x):
+        if np is not None and isinstance(x, np.ndarray):
+            if x.dtype.kind in "biuf":  # bool, integers, floats of any width (float32 too)
+                out.extend(x.astype(np.float64).ravel().tolist())
+            elif x.dtype.kind == "O":
+                for item in x.ravel():
+                    walk(item)
+            else:
+                raise _BadResult("'%s' has an array of dtype %s; it must hold real numbers"
+                                 % (field, x.dtype))
+        elif isinstance(x, (list, tuple)):
+            for item in x:
+                walk(item)
+        elif isinstance(x, numbers.Real):  # Python and NumPy scalars
+            out.append(float(x))
+        else:
+            raise _BadResult("'%s' holds a %s; it must hold real numbers"
+                             % (field, type(x).__name__))
+
+    walk(value)
+    for i, x in enumerate(out):
+        if not math.isfinite(x):
+            raise _BadResult("'%s' has a non-finite number at index %d: %r" % (field, i, x))
+    return out
+
+
+def _split_encoded(result):
+    """encode's result: actions, (actions, observation) or {"actions", "observation"}."""
+    if isinstance(result, dict):
+        unknown = set(result) - {"actions", "observation"}
+        if "actions" not in result or unknown:
+            raise _BadResult("encode returned a dict with keys %s; it needs 'actions' and may "
+                             "have 'observation'" % sorted(result))
+        return result["actions"], result.get("observation")
+    # A tuple of two sequences is (actions, observation); a tuple of numbers is the actions.
+    if isinstance(result, tuple) and len(result) == 2 and not isinstance(result[0], numbers.Real):
+        return result
+    return result, None
+
+
+def _chunk(result):
+    """decode's result -> K lists of 16 numbers, each the matrix of a rigid transform."""
+    if np is not None and isinstance(result, np.ndarray) and result.shape[-2:] != (4, 4) \
+            and not (result.ndim == 2 and result.shape[1] == 16):
+        raise _BadResult("decode returned an array of shape %s; it must be (K, 4, 4)"
+                         % (result.shape,))
+    flat = _flatten(result, "chunk")
+    if not flat or len(flat) % 16:
+        raise _BadResult("decode returned %d numbers; it must return K 4x4 matrices" % len(flat))
+    chunk = [flat[i:i + 16] for i in range(0, len(flat), 16)]
+    for k, m in enumerate(chunk):
+        if max(abs(a - b) for a, b in zip(m[12:], (0.0, 0.0, 0.0, 1.0))) > 1e-9:
+            raise _BadResult("decode's pose %d has last row %s, not [0, 0, 0, 1]" % (k, m[12:]))
+    return chunk
+
+
+# ----------------------------------------------------------------------------- the loop
+
+def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=None,
+          stdin=None, stdout=None):
+    """Answer the audit's requests until end of input (see the module docstring).
+
+    encode(history, chunk, hand_points, world_points) -> actions | (actions, observation) | dict
+    decode(actions, history, hand_points, world_points) -> (K,4,4) world-frame poses T_1..T_K
+    flow(history, chunk, hand_points, world_points, eps, t) -> (flow_input, flow_target)
+    extra_poses, scalars: names the requests must carry; the functions then get the keyword
+        arguments extra_poses={name: (4,4)} and scalars={name: float}.
+    hello: None = send the v2 hello when any of the above is declared; True / False force it.
+    stdin, stdout: text streams (default sys.stdin, sys.stdout).
+    """
+    stdin = sys.stdin if stdin is None else stdin
+    out = sys.stdout if stdout is None else stdout  # taken now: print() is redirected below
+    extra_poses, scalars = tuple(extra_poses), tuple(scalars)
+    declared = bool(extra_poses or scalars)
+    if hello is None:
+        hello = declared or decode is not None or flow is not None
+    hello_body = {"protocol": PROTOCOL, "extra_poses": list(extra_poses),
+                  "scalars": list(scalars), "decode": decode is not None, "flow": flow is not None}
+
+    def call(function, request_id, args, named):
+        kwargs = {"extra_poses": named[0], "scalars": named[1]} if declared else {}
+        try:
+            # A stray print() in user code would be read as an answer: send it to stderr.
+            with contextlib.redirect_stdout(sys.stderr):
+                return function(*args, **kwargs)
+        except Exception:
+            sys.stderr.write("handcentric_plugin: %s raised on request %d:\n"
+                             % (getattr(function, "__name__", "the plug-in"), request_id))
+            traceback.print_exc(file=sys.stderr)
+            sys.stderr.flush()
+            sys.exit(1)
+
+    def answer(request):
+        rid = request["id"]
+        history = _matrices(request, "history")
+        hand_points = _points(request, "hand_points")
+        world_points = _points(request, "world_points")
+        named = (_named(request, "extra_poses", extra_poses, _matrix),
+                 _named(request, "scalars", scalars, _scalar))
+        if "decode" in request:
+            if decode is None:
+                raise _Malformed("a decode request, but the plug-in declared no decode")
+            actions = request["decode"]
+            if not isinstance(actions, list) or not actions or not all(map(_is_number, actions)):
+                raise _Malformed("'decode' must be a non-empty list of numbers")
+            actions = [float(x) for x in actions]
+            if np is not None:
+                actions = np.array(actions)
+            return {"id": rid, "chunk": _chunk(call(decode, rid, (actions, history, hand_points,
+                                                     world_points), named))}
+        chunk = _matrices(request, "chunk")
+        encoded = call(encode, rid, (history, chunk, hand_points, world_points), named)
+        actions, observation = _split_encoded(encoded)
+        reply = {"id": rid, "actions": _flatten(actions, "actions")}
+        if not reply["actions"]:
+            raise _BadResult("encode returned no actions")
+        if observation is not None:
+            reply["observation"] = _flatten(observation, "observation")
+        if "eps" in request or "t" in request:
+            if flow is None:
+                raise _Malformed("a flow request (eps, t), but the plug-in declared no flow")
+            eps = _numbers(request.get("eps"), len(reply["actions"]),
+                           "'eps' (as long as the actions)")
+            t = _scalar(request.get("t"), "'t'")
+            if np is not None:
+                eps = np.array(eps)
+            pair = call(flow, rid, (history, chunk, hand_points, world_points, eps, t), named)
+            if not isinstance(pair, (tuple, list)) or len(pair) != 2:
+                raise _BadResult("flow must return the pair (flow_input, flow_target)")
+            reply["flow_input"] = _flatten(pair[0], "flow_input")
+            reply["flow_target"] = _flatten(pair[1], "flow_target")
+        return reply
+
+    line_number = 0
+    first = True
+    while True:
+        line = stdin.readline()
+        if not line:
+            return  # end of input: the audit is done
+        line_number += 1
+        if not line.strip():
+            continue
+        rid = None
+        try:
+            request = _parse(line)
+            rid = request["id"]
+            if first and hello:
+                reply = {"id": rid, "hello": hello_body}
+            else:
+                reply = answer(request)
+        except _Malformed as error:
+            text = line.strip()
+            text = text if len(text) <= 120 else text[:117] + "..."
+            _die(2, "handcentric_plugin: malformed request on line %d: %s: %s"
+                 % (line_number, error, text))
+        except _BadResult as error:
+            _die(1, "handcentric_plugin: bad result for request %d: %s" % (rid, error))
+        first = False
+        out.write(json.dumps(reply, allow_nan=False) + "\n")
+        out.flush()  # the audit waits for this line before it sends the next request
+
+
+# ----------------------------------------------------------------------------- SE(3) helpers
+# NumPy only. They keep the dtype of their input, so a float32 plug-in stays float32.
+
+def _need_numpy():
+    if np is None:
+        raise ImportError("handcentric_plugin's geometry helpers need NumPy")
+
+
+def _real(x):
+    """x as an array of floats: float32 stays float32, integers become float64."""
+    x = np.asarray(x)
+    return x.astype(np.result_type(x, np.float32), copy=False)
+
+
+def rotation_vector(R):
+    """r(R) = angle * axis with angle in [0, pi]; accurate near 0 and near pi."""
+    _need_numpy()
+    R = _real(R)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])  # 2 sin(angle) axis
+    cos_angle = np.clip(0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1), -1, 1)
+    sin_angle = 0.5 * np.linalg.norm(w)
+    angle = np.arctan2(sin_angle, cos_angle)  # atan2 stays accurate where acos and asin are not
+    if angle < 1e-6:  # first order, error O(angle^3): r = vee(R - R^T) / 2
+        return 0.5 * w
+    if angle < 0.5 * np.pi:  # w / (2 sin) loses digits only as sin -> 0, i.e. near pi
+        return (angle / (2 * sin_angle)) * w
+    # Past pi/2, read the axis off the symmetric part instead: (R + R^T) / 2 - cos I =
+    # (1 - cos) axis axis^T exactly, with 1 - cos >= 1, in its largest column; the sign from w.
+    # (Using 1 + R_ii instead of R_ii - cos would leave an error of (pi - angle)^2 / 2.)
+    i = int(np.argmax(np.diag(R)))
+    column = 0.5 * (R[:, i] + R[i, :])
+    column[i] = R[i, i] - cos_angle
+    axis = column / np.linalg.norm(column)
+    if axis @ w < 0:
+        axis = -axis
+    return angle * axis
+
+
+def rotation_matrix(r):
+    """exp([r]x) (Rodrigues), accurate near 0."""
+    _need_numpy()
+    r = _real(r)
+    angle = np.linalg.norm(r)
+    K = np.array([[0, -r[2], r[1]], [r[2], 0, -r[0]], [-r[1], r[0], 0]], dtype=r.dtype)
+    if angle < 1e-4:  # Taylor: the next terms are below 1e-18
+        a, b = 1 - angle ** 2 / 6, 0.5 - angle ** 2 / 24
+    else:  # 1 - cos written as 2 sin^2(angle/2): no cancellation
+        a, b = np.sin(angle) / angle, 2 * (np.sin(angle / 2) / angle) ** 2
+    return np.eye(3, dtype=r.dtype) + a * K + b * (K @ K)
+
+
+def inverse(T):
+    """T^-1 = [R^T, -R^T p] of a rigid transform."""
+    _need_numpy()
+    T = _real(T)
+    out = np.eye(4, dtype=T.dtype)
+    out[:3, :3] = T[:3, :3].T
+    out[:3, 3] = -(T[:3, :3].T @ T[:3, 3])
+    return out
+
+
+def relative_pose(T0, T):
+    """T0^-1 T, with the translation as R0^T (p - p0): subtracting first keeps the digits that
+    R0^T p - R0^T p0 loses when both translations are large."""
+    _need_numpy()
+    T0, T = _real(T0), _real(T)
+    out = np.eye(4, dtype=np.result_type(T0, T))
+    out[:3, :3] = T0[:3, :3].T @ T[:3, :3]
+    out[:3, 3] = T0[:3, :3].T @ (T[:3, 3] - T0[:3, 3])
+    return out
+
+
+def relative_points(T0, points):
+    """World points q, (n,3), in the frame of T0: R0^T (q - p0)."""
+    _need_numpy()
+    T0, points = _real(T0), _real(points)
+    return (points - T0[:3, 3]) @ T0[:3, :3]  # row i: (q_i - p0)^T R0 = (R0^T (q_i - p0))^T
+
+
+def pose_vector(T):
+    """[translation, rotation vector] of a rigid transform: 6 numbers."""
+    _need_numpy()
+    T = _real(T)
+    return np.concatenate([T[:3, 3], rotation_vector(T[:3, :3])])
+
+
+def pose_matrix(v):
+    """The inverse of pose_vector: 6 numbers [t, r] -> [[exp(r), t], [0, 1]]."""
+    _need_numpy()
+    v = _real(v)
+    out = np.eye(4, dtype=v.dtype)
+    out[:3, :3] = rotation_matrix(v[3:6])
+    out[:3, 3] = v[:3]
+    return out
