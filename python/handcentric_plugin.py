@@ -105,10 +105,30 @@ def _matrix(value, what):
     return np.array(m).reshape(4, 4) if np is not None else [m[0:4], m[4:8], m[8:12], m[12:16]]
 
 
+def _fast_array(value, width):
+    """value as an (n, width) float64 array when it is a plain list of lists of numbers, else
+    None (then the careful path below checks it item by item and names what is wrong). A JSON
+    true/false would pass np.array as 1.0/0.0, so a request holding one never takes this path."""
+    if np is None or _fast_array.has_booleans:
+        return None
+    try:
+        a = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    # null becomes NaN in np.array: anything non-finite goes the careful way too.
+    return a if a.ndim == 2 and a.shape[1] == width and np.isfinite(a).all() else None
+
+
+_fast_array.has_booleans = True  # set per request by _parse
+
+
 def _matrices(request, key):
     value = request.get(key)
     if not isinstance(value, list) or not value:
         raise _Malformed("'%s' must be a non-empty list of matrices" % key)
+    fast = _fast_array(value, 16)
+    if fast is not None:
+        return fast.reshape(len(value), 4, 4)
     ms = [_matrix(m, "%s[%d]" % (key, i)) for i, m in enumerate(value)]
     return np.array(ms).reshape(len(ms), 4, 4) if np is not None else ms
 
@@ -117,6 +137,9 @@ def _points(request, key):
     value = request.get(key, [])
     if not isinstance(value, list):
         raise _Malformed("'%s' must be a list of [x, y, z]" % key)
+    fast = _fast_array(value, 3) if value else None
+    if fast is not None:
+        return fast
     ps = [_numbers(p, 3, "%s[%d]" % (key, i)) for i, p in enumerate(value)]
     return np.array(ps).reshape(len(ps), 3) if np is not None else ps
 
@@ -140,6 +163,7 @@ def _scalar(value, what):
 
 
 def _parse(line):
+    _fast_array.has_booleans = "true" in line or "false" in line
     try:
         request = json.loads(line)
     except ValueError as error:
@@ -334,27 +358,36 @@ def _real(x):
 
 
 def rotation_vector(R):
-    """r(R) = angle * axis with angle in [0, pi]; accurate near 0 and near pi."""
+    """r(R) = angle * axis with angle in [0, pi]; accurate near 0 and near pi. R may be one
+    (3, 3) matrix or a stack (..., 3, 3): a stack is done in one pass (a plug-in's time goes
+    into per-pose Python calls otherwise)."""
     _need_numpy()
     R = _real(R)
-    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])  # 2 sin(angle) axis
-    cos_angle = np.clip(0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1), -1, 1)
-    sin_angle = 0.5 * np.linalg.norm(w)
+    shape = R.shape[:-2]
+    R = R.reshape(-1, 3, 3)
+    w = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], axis=-1)  # 2 sin axis
+    cos_angle = np.clip(0.5 * (R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2] - 1), -1, 1)
+    sin_angle = 0.5 * np.linalg.norm(w, axis=-1)
     angle = np.arctan2(sin_angle, cos_angle)  # atan2 stays accurate where acos and asin are not
-    if angle < 1e-6:  # first order, error O(angle^3): r = vee(R - R^T) / 2
-        return 0.5 * w
-    if angle < 0.5 * np.pi:  # w / (2 sin) loses digits only as sin -> 0, i.e. near pi
-        return (angle / (2 * sin_angle)) * w
-    # Past pi/2, read the axis off the symmetric part instead: (R + R^T) / 2 - cos I =
-    # (1 - cos) axis axis^T exactly, with 1 - cos >= 1, in its largest column; the sign from w.
-    # (Using 1 + R_ii instead of R_ii - cos would leave an error of (pi - angle)^2 / 2.)
-    i = int(np.argmax(np.diag(R)))
-    column = 0.5 * (R[:, i] + R[i, :])
-    column[i] = R[i, i] - cos_angle
-    axis = column / np.linalg.norm(column)
-    if axis @ w < 0:
-        axis = -axis
-    return angle * axis
+    out = np.empty_like(w)
+    small = angle < 1e-6  # first order, error O(angle^3): r = vee(R - R^T) / 2
+    out[small] = 0.5 * w[small]
+    middle = ~small & (angle < 0.5 * np.pi)  # w / (2 sin) loses digits only as sin -> 0, i.e. near pi
+    out[middle] = (angle[middle] / (2 * sin_angle[middle]))[:, None] * w[middle]
+    large = ~small & ~middle
+    if large.any():
+        # Past pi/2, read the axis off the symmetric part instead: (R + R^T) / 2 - cos I =
+        # (1 - cos) axis axis^T exactly, with 1 - cos >= 1, in its largest column; the sign from
+        # w. (Using 1 + R_ii instead of R_ii - cos would leave an error of (pi - angle)^2 / 2.)
+        Rl = R[large]
+        n = np.arange(len(Rl))
+        i = np.argmax(np.diagonal(Rl, axis1=1, axis2=2), axis=1)
+        column = 0.5 * (Rl[n, :, i] + Rl[n, i, :])
+        column[n, i] = Rl[n, i, i] - cos_angle[large]
+        axis = column / np.linalg.norm(column, axis=-1, keepdims=True)
+        sign = np.where(np.einsum("ij,ij->i", axis, w[large]) < 0, -1, 1).astype(axis.dtype)
+        out[large] = (angle[large] * sign)[:, None] * axis
+    return out.reshape(shape + (3,))
 
 
 def rotation_matrix(r):
@@ -382,12 +415,13 @@ def inverse(T):
 
 def relative_pose(T0, T):
     """T0^-1 T, with the translation as R0^T (p - p0): subtracting first keeps the digits that
-    R0^T p - R0^T p0 loses when both translations are large."""
+    R0^T p - R0^T p0 loses when both translations are large. T may be a stack (..., 4, 4)."""
     _need_numpy()
     T0, T = _real(T0), _real(T)
-    out = np.eye(4, dtype=np.result_type(T0, T))
-    out[:3, :3] = T0[:3, :3].T @ T[:3, :3]
-    out[:3, 3] = T0[:3, :3].T @ (T[:3, 3] - T0[:3, 3])
+    out = np.zeros(T.shape, dtype=np.result_type(T0, T))
+    out[..., :3, :3] = T0[:3, :3].T @ T[..., :3, :3]
+    out[..., :3, 3] = (T[..., :3, 3] - T0[:3, 3]) @ T0[:3, :3]  # row: (p - p0)^T R0 = (R0^T (p - p0))^T
+    out[..., 3, 3] = 1
     return out
 
 
@@ -399,10 +433,11 @@ def relative_points(T0, points):
 
 
 def pose_vector(T):
-    """[translation, rotation vector] of a rigid transform: 6 numbers."""
+    """[translation, rotation vector] of a rigid transform: 6 numbers (a stack (..., 4, 4)
+    gives (..., 6))."""
     _need_numpy()
     T = _real(T)
-    return np.concatenate([T[:3, 3], rotation_vector(T[:3, :3])])
+    return np.concatenate([T[..., :3, 3], rotation_vector(T[..., :3, :3])], axis=-1)
 
 
 def pose_matrix(v):

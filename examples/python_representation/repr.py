@@ -52,16 +52,15 @@ except ImportError as error:  # one clear line: the audit quotes our stderr
              "share/handcentric/python, or $HANDCENTRIC_PYTHON)." % (error, sys.executable))
 
 
-def hand_centric(T0, T):
-    """T_0^-1 T as [translation, rotation vector]: 6 numbers."""
-    return hp.pose_vector(hp.relative_pose(T0, T))
+def hand_centric(T0, poses):
+    """T_0^-1 T for each pose of a stack (n, 4, 4), as [translation, rotation vector]: (n, 6)."""
+    return hp.pose_vector(hp.relative_pose(T0, poses))
 
 
 def encode(history, chunk, hand_points, world_points):
     T0 = history[0]  # history is newest first: index 0 is the hand now
-    actions = [hand_centric(T0, T) for T in chunk]
-    observation = [hand_centric(T0, T) for T in history]
-    observation += [hand_points, hp.relative_points(T0, world_points)]
+    actions = hand_centric(T0, chunk)  # eqs. (1)-(2)
+    observation = [hand_centric(T0, history), hand_points, hp.relative_points(T0, world_points)]  # eq. (3)
     return actions, observation
 
 

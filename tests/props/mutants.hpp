@@ -2,9 +2,12 @@
 // Planted faults for the props suite (besides tests/core/mutants.hpp): each check below is also
 // run on one of these and must fail there.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representations.hpp"
 #include "../core/mutants.hpp"  // ForgetsRotationOnTranslation, UsesR0ForR0Transpose
@@ -44,6 +47,136 @@ class BiasedNoiseActionFlow final : public FlowTarget {
 
  private:
   ActionFlowTarget inner_;
+};
+
+/// The world-frame "delta" pose mode some public codebases ship: per k, p_k - p_{k-1} and
+/// r(R_k R_{k-1}^T), with T_0 before T_1. Translation-invariant only, and injective given T_0.
+class WorldDelta final : public Representation {
+ public:
+  std::string name() const override { return "world_delta"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    scene.validate();
+    Eigen::VectorXd out(6 * scene.chunk_length());
+    RigidTransform previous = scene.world_T_hand0();
+    for (int k = 0; k < scene.chunk_length(); ++k) {
+      const RigidTransform& current = scene.world_T_hand_chunk[static_cast<std::size_t>(k)];
+      out.segment<3>(6 * k) = current.translation() - previous.translation();
+      out.segment<3>(6 * k + 3) =
+          Rotation::from_matrix_unchecked(current.rotation().matrix() * previous.rotation().matrix().transpose()).log();
+      previous = current;
+    }
+    return out;
+  }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_observation(scene);
+  }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& world_T_hand0) const override {
+    std::vector<RigidTransform> chunk;
+    RigidTransform previous = world_T_hand0;
+    for (Eigen::Index k = 0; 6 * k < a.size(); ++k) {
+      previous = RigidTransform::unchecked(Rotation::exp(a.segment<3>(6 * k + 3)).matrix() * previous.rotation().matrix(),
+                                           previous.translation() + a.segment<3>(6 * k));
+      chunk.push_back(previous);
+    }
+    return chunk;
+  }
+};
+
+/// hand_centric whose observation copies world points raw, as a fixed camera's point cloud in
+/// the world frame: not invariant once a scene has world points (the third-person view).
+class RawWorldPoints final : public Representation {
+ public:
+  std::string name() const override { return "mutant_raw_world_points"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override { return HandCentricRepresentation().encode_actions(scene); }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    Eigen::VectorXd out = HandCentricRepresentation().encode_observation(scene);
+    Eigen::Index offset = out.size() - 3 * static_cast<Eigen::Index>(scene.world_points.size());
+    for (const Eigen::Vector3d& point_world : scene.world_points) {
+      out.segment<3>(offset) = point_world;
+      offset += 3;
+    }
+    return out;
+  }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& world_T_hand0) const override {
+    return HandCentricRepresentation().decode_actions(a, world_T_hand0);
+  }
+};
+
+/// Six zeros per action: invariant under every group, and useless (not injective).
+class ConstantZeros final : public Representation {
+ public:
+  std::string name() const override { return "mutant_constant_zeros"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override { return Eigen::VectorXd::Zero(6 * scene.chunk_length()); }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_observation(scene);
+  }
+  bool can_decode() const override { return false; }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd&, const RigidTransform&) const override {
+    throw InvalidArgument("mutant_constant_zeros cannot decode");
+  }
+};
+
+/// hand_centric translations only: drops every rotation (not injective), still SE(3)-invariant.
+class TranslationsOnly final : public Representation {
+ public:
+  std::string name() const override { return "mutant_translations_only"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    const Eigen::VectorXd full = HandCentricRepresentation().encode_actions(scene);
+    Eigen::VectorXd out(full.size() / 2);
+    for (Eigen::Index k = 0; 6 * k < full.size(); ++k) out.segment<3>(3 * k) = full.segment<3>(6 * k);
+    return out;
+  }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_observation(scene);
+  }
+  bool can_decode() const override { return false; }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd&, const RigidTransform&) const override {
+    throw InvalidArgument("mutant_translations_only cannot decode");
+  }
+};
+
+/// hand_centric computed in float32, as codebases that cast poses to float do: invariant up to
+/// float32 rounding, not at 1e-9.
+class Float32HandCentric final : public Representation {
+ public:
+  std::string name() const override { return "float32_hand_centric"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    scene.validate();
+    const Eigen::Matrix4f world_T_hand0 = scene.world_T_hand0().matrix().cast<float>();
+    const Eigen::Matrix4f hand0_T_world = world_T_hand0.inverse();
+    Eigen::VectorXd out(6 * scene.chunk_length());
+    for (int k = 0; k < scene.chunk_length(); ++k) {
+      const Eigen::Matrix4f hand0_T_handk = hand0_T_world * scene.world_T_hand_chunk[static_cast<std::size_t>(k)].matrix().cast<float>();
+      out.segment<3>(6 * k) = hand0_T_handk.block<3, 1>(0, 3).cast<double>();
+      // The rotation vector of the float32 matrix, taken in double: the rounding is float32's.
+      const Eigen::AngleAxisd angle_axis(hand0_T_handk.block<3, 3>(0, 0).cast<double>());
+      out.segment<3>(6 * k + 3) = angle_axis.angle() * angle_axis.axis();
+    }
+    return out;
+  }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_observation(scene).cast<float>().cast<double>();
+  }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& world_T_hand0) const override {
+    return HandCentricRepresentation().decode_actions(a, world_T_hand0);
+  }
+};
+
+/// A flow whose target is a - eps^3 (elementwise): not affine in eps, so in distribution it is
+/// decided by the energy test.
+class CubedNoiseFlow final : public FlowTarget {
+ public:
+  explicit CubedNoiseFlow(std::shared_ptr<const Representation> representation) : inner_(std::move(representation)) {}
+  std::string name() const override { return "mutant_cubed_noise_flow"; }
+  Eigen::Index noise_dimension(const Scene& scene) const override { return inner_.noise_dimension(scene); }
+  FlowSample operator()(const Scene& scene, const Eigen::VectorXd& eps, double t) const override {
+    FlowSample sample = inner_(scene, Eigen::VectorXd::Zero(eps.size()), t);
+    sample.target -= eps.array().cube().matrix();
+    return sample;
+  }
+
+ private:
+  RectifiedFlow inner_;
 };
 
 }  // namespace handcentric::test

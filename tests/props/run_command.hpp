@@ -37,13 +37,16 @@ inline CommandResult run_command(const std::string& command) {
   return result;
 }
 
-/// The `handcentric` binary and the Python example plug-in, from CMake.
+/// The `handcentric` binary, the Python with NumPy, and the plug-ins, from CMake.
 inline std::string cli() { return HANDCENTRIC_CLI; }
+inline std::string python() { return HANDCENTRIC_PYTHON; }
 inline std::string python_example() {
-  return std::string("python3 ") + HANDCENTRIC_SOURCE_DIR + "/examples/python_representation/repr.py";
+  return python() + " " + HANDCENTRIC_SOURCE_DIR + "/examples/python_representation/repr.py";
 }
-inline std::string faulty_plugin(const std::string& mode) {
-  return std::string("python3 ") + HANDCENTRIC_SOURCE_DIR + "/tests/props/plugins/faulty.py " + mode;
+/// `python tests/props/plugins/<file> [arguments]`.
+inline std::string test_plugin(const std::string& file, const std::string& arguments = "") {
+  return python() + " " + HANDCENTRIC_SOURCE_DIR + "/tests/props/plugins/" + file + (arguments.empty() ? "" : " " + arguments);
 }
+inline std::string faulty_plugin(const std::string& mode) { return test_plugin("faulty.py", mode); }
 
 }  // namespace handcentric::test

@@ -14,11 +14,19 @@ TEST_CASE("audit_json_lists_every_check_of_a_builtin", "[unit]") {
   const auto json = nlohmann::json::parse(result.out);
   const auto& relative = json.at("representations").at(0);
   CHECK(relative.at("name") == "relative");
-  REQUIRE(relative.at("checks").size() == 6);  // 4 pointwise components + 2 in distribution
+  REQUIRE(relative.at("checks").size() == 12);  // (4 pointwise components + 2 in distribution) x 2 views
   const auto& actions = relative.at("checks").at(0);
   CHECK(actions.at("component") == "actions");
   CHECK(actions.at("group") == "rotation");
   CHECK(actions.at("mode") == "pointwise");
+  CHECK(actions.at("view") == "eye_in_hand");
+  CHECK(relative.at("checks").at(6).at("view") == "third_person");
+  CHECK(relative.at("injective") == true);
+  CHECK(relative.at("summary").at("eye_in_hand").at("flow_target").at("distribution").at("rotation") == false);
+  CHECK(relative.at("summary").at("third_person").at("actions").at("pointwise").at("rotation") == false);
+  for (const auto& check : relative.at("checks")) {
+    if (check.at("mode") == "distribution") CHECK(check.at("method") == "exact_gaussian");
+  }
   CHECK(actions.at("invariant") == false);
   CHECK(actions.at("seed") == 3);
   CHECK(actions.at("witness").at("g").size() == 16);
@@ -33,11 +41,13 @@ TEST_CASE("python_plugin_audit_matches_the_builtin_hand_centric", "[unit]") {
   REQUIRE(result.exit_code == 0);
   const auto json = nlohmann::json::parse(result.out);
   const auto& checks = json.at("representations").at(0).at("checks");
-  CHECK(checks.size() == 30);  // actions, observation, flow input, flow target x 5 groups + 2 x 5 in distribution
+  // (actions, observation, flow input, flow target x 5 groups + 2 x 5 in distribution) x 2 views
+  CHECK(checks.size() == 60);
   for (const auto& check : checks) {
     INFO(check.dump());
     CHECK(check.at("invariant") == true);
   }
+  CHECK(json.at("representations").at(0).at("injective").is_null());  // no decoder: undecided
 }
 
 TEST_CASE("audit_errors_are_one_line_with_exit_code_1_and_usage_errors_exit_2", "[unit]") {
@@ -76,6 +86,132 @@ TEST_CASE("a_plugin_without_observation_is_audited_on_actions_and_flow_only", "[
   INFO(result.err);
   REQUIRE(result.exit_code == 0);
   const auto checks = nlohmann::json::parse(result.out).at("representations").at(0).at("checks");
-  CHECK(checks.size() == 25);  // actions, flow input, flow target x 5 groups + 2 x 5 in distribution
+  CHECK(checks.size() == 50);  // (actions, flow input, flow target x 5 groups + 2 x 5 in distribution) x 2 views
   for (const auto& check : checks) CHECK(check.at("component") != "observation");
+  // Six zeros whatever the chunk: invariant under everything, and useless.
+  CHECK(nlohmann::json::parse(result.out).at("representations").at(0).at("injective") == false);
+}
+
+namespace {
+
+// The audit's JSON for a plug-in command (with extra arguments), parsed; the test fails on a
+// non-zero exit.
+nlohmann::json audit_plugin(const std::string& plugin, const std::string& arguments) {
+  const auto result = test::run_command(test::cli() + " audit --exec '" + plugin + "' " + arguments + " --json");
+  INFO(result.err);
+  REQUIRE(result.exit_code == 0);
+  return nlohmann::json::parse(result.out).at("representations").at(0);
+}
+
+const nlohmann::json& cell(const nlohmann::json& representation, const std::string& view, const std::string& component,
+                           const std::string& mode, const std::string& group) {
+  return representation.at("summary").at(view).at(component).at(mode).at(group);
+}
+
+}  // namespace
+
+TEST_CASE("a_plugin_that_copies_world_points_is_not_invariant_in_the_third_person_view", "[unit]") {
+  const auto raw = audit_plugin(test::test_plugin("world_points_raw.py"), "--cases 60 --group se3");
+  CHECK(cell(raw, "eye_in_hand", "observation", "pointwise", "se3") == true);   // nothing to copy
+  CHECK(cell(raw, "third_person", "observation", "pointwise", "se3") == false);
+  CHECK(cell(raw, "third_person", "actions", "pointwise", "se3") == true);
+  for (const auto& check : raw.at("checks")) {
+    if (check.at("view") == "third_person" && check.at("component") == "observation") {
+      // The shrunk witness has world points, and they are what differs.
+      CHECK(check.at("witness").at("scene").at("world_points").size() >= 1);
+    }
+  }
+}
+
+TEST_CASE("float32_rounding_is_named_and_precision_float32_accepts_it", "[unit]") {
+  const std::string plugin = test::test_plugin("float32_hand_centric.py");
+  const auto strict = audit_plugin(plugin, "--cases 60 --group se3 --view eye_in_hand");
+  bool noted = false;
+  for (const auto& check : strict.at("checks")) {
+    if (check.at("invariant") == false) {
+      INFO(check.dump());
+      CHECK_THAT(check.at("note").get<std::string>(), Contains("float32") && Contains("--precision float32"));
+      noted = true;
+    }
+  }
+  CHECK(noted);
+  const auto loose = audit_plugin(plugin, "--cases 60 --precision float32");
+  for (const auto& check : loose.at("checks")) {
+    INFO(check.dump());
+    CHECK(check.at("invariant") == true);
+    CHECK(check.at("relative_tolerance") == 1e-4);
+  }
+  // The same with the number itself.
+  CHECK(audit_plugin(plugin, "--cases 30 --group rotation --tolerance 1e-4").at("checks").at(0).at("invariant") == true);
+  for (const char* bad : {"--tolerance -1", "--tolerance 2", "--precision float16"}) {
+    const auto result = test::run_command(test::cli() + " audit --repr hand_centric --cases 5 " + bad);
+    CHECK(result.exit_code == 1);
+    CHECK_THAT(result.err, Contains("--tolerance") || Contains("float16"));
+  }
+}
+
+TEST_CASE("the_world_delta_mode_is_translation_invariant_only_in_distribution_too", "[unit]") {
+  const auto delta = audit_plugin(test::test_plugin("delta_world.py"), "--cases 60 --view eye_in_hand");
+  for (const char* group : {"rotation", "se2", "se3", "c8"}) {
+    CHECK(cell(delta, "eye_in_hand", "flow_target", "distribution", group) == false);
+  }
+  CHECK(cell(delta, "eye_in_hand", "flow_target", "distribution", "translation") == true);
+  for (const auto& check : delta.at("checks")) {
+    if (check.at("mode") == "distribution") CHECK(check.at("method") == "exact_gaussian");
+  }
+}
+
+TEST_CASE("protocol_v2_plugin_gets_its_extras_decodes_and_answers_its_own_flow", "[unit]") {
+  // Its flow is asked at every noise vector the exact check probes: keep to one group.
+  const auto v2 = audit_plugin(test::test_plugin("v2_everything.py"), "--cases 40 --group se3");
+  CHECK(v2.at("injective") == true);  // it decodes, and the round trip holds
+  for (const auto& check : v2.at("checks")) {
+    INFO(check.dump());
+    CHECK(check.at("invariant") == true);
+    if (check.at("mode") == "distribution") CHECK(check.at("method") == "exact_gaussian");
+  }
+  // The witness scenes carry the extras the hello asked for.
+  CHECK(v2.at("injectivity").at("round_trips").get<int>() > 0);
+  bool has_extras = false;
+  for (const auto& check : audit_plugin(test::test_plugin("v2_everything.py"), "--cases 20 --group rotation --view "
+                                        "eye_in_hand --extra-poses left_hand").at("checks")) {
+    has_extras |= check.at("invariant") == true;
+  }
+  CHECK(has_extras);
+}
+
+TEST_CASE("actionflow_through_the_flow_request_is_rotation_invariant_in_distribution_only", "[unit]") {
+  const auto actionflow = audit_plugin(test::test_plugin("actionflow_v2.py"), "--cases 40 --view eye_in_hand");
+  for (const char* group : {"rotation", "c8"}) {
+    CHECK(cell(actionflow, "eye_in_hand", "flow_target", "distribution", group) == true);
+    CHECK(cell(actionflow, "eye_in_hand", "flow_target", "pointwise", group) == false);
+  }
+  for (const char* group : {"translation", "se2", "se3"}) {
+    CHECK(cell(actionflow, "eye_in_hand", "flow_target", "distribution", group) == false);
+  }
+}
+
+TEST_CASE("a_plugin_that_never_flushes_is_told_about_buffering", "[unit]") {
+  const auto result = test::run_command(test::cli() + " audit --exec '" + test::test_plugin("no_flush.py") +
+                                        "' --timeout 0.5 --cases 5");
+  CHECK(result.exit_code == 1);
+  CHECK_THAT(result.err, Contains("flush") && Contains("python3 -u"));
+}
+
+TEST_CASE("a_plugin_traceback_keeps_its_last_lines", "[unit]") {
+  const auto result = test::run_command(test::cli() + " audit --exec '" + test::test_plugin("stderr_long.py") +
+                                        "' --cases 5");
+  CHECK(result.exit_code == 1);
+  INFO(result.err);
+  CHECK_THAT(result.err, Contains("exited with status 1") && Contains("line 40 of 40") &&
+                             Contains("RuntimeError: stderr_long: planted failure after 40 lines"));
+  // The last 20 lines: the traceback's end is kept, the first numbered lines are gone.
+  CHECK(result.err.find("line 1 of 40") == std::string::npos);
+}
+
+TEST_CASE("the_text_audit_warns_loudly_about_a_map_that_is_not_injective", "[unit]") {
+  const auto result = test::run_command(test::cli() + " audit --exec '" + test::test_plugin("constant_zeros.py") +
+                                        "' --cases 30 --group se3");
+  CHECK(result.exit_code == 0);
+  CHECK_THAT(result.out, Contains("NOT INJECTIVE") && Contains("both encode to"));
 }

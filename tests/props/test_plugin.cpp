@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <chrono>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "handcentric/core/representations.hpp"
@@ -50,10 +51,11 @@ TEST_CASE("python_example_plugin_encodes_like_the_builtin_hand_centric", "[unit]
   plugin.encode_actions(small_scene(1));  // the second time comes from the cache
   CHECK(plugin.requests_sent() <= sent + 1);
   CHECK_FALSE(plugin.can_decode());
+  CHECK(plugin.capabilities().protocol == 1);  // no hello
   CHECK_THROWS_AS(plugin.decode_actions(Eigen::VectorXd::Zero(6), RigidTransform()), InvalidArgument);
 }
 
-TEST_CASE("bad_plugins_give_one_line_errors", "[unit]") {
+TEST_CASE("bad_plugins_give_errors_whose_first_line_says_what_happened", "[unit]") {
   const std::string not_found = plugin_error("handcentric_no_such_plugin_xyz --flag");
   CHECK_THAT(not_found, Contains("command not found") && Contains("handcentric_no_such_plugin_xyz"));
   CHECK_THAT(plugin_error("echo 'plug-in crashed' >&2; exit 3"),
@@ -64,11 +66,94 @@ TEST_CASE("bad_plugins_give_one_line_errors", "[unit]") {
   CHECK_THAT(plugin_error(test::faulty_plugin("wrong_id")), Contains("request 0 with id 1"));
   CHECK_THAT(plugin_error(test::faulty_plugin("nan")), Contains("NaN"));
   CHECK_THAT(plugin_error(test::faulty_plugin("big")), Contains("non-finite") && Contains("inf"));
+  // The handshake's probe is request 0, so the seventh number comes with the first real scene.
   CHECK_THAT(plugin_error(test::faulty_plugin("length")), Contains("changed its vector lengths") &&
-                                                              Contains("actions 6 then 7"));
-  for (const char* mode : {"not_json", "wrong_id", "nan", "length", "exit_early"}) {
+                                                              Contains("actions 7 then 6"));
+  // Without stderr the message is one line; with stderr, its lines follow, indented.
+  for (const char* mode : {"not_json", "wrong_id", "nan", "length"}) {
     CHECK(plugin_error(test::faulty_plugin(mode)).find('\n') == std::string::npos);
   }
+  const std::string early = plugin_error(test::faulty_plugin("exit_early"));
+  CHECK(early.substr(0, early.find('\n')).find("exited with status 3") != std::string::npos);
+  CHECK_THAT(early, Contains("\n    faulty plug-in: giving up on request"));
+}
+
+TEST_CASE("subprocess_keeps_the_last_20_lines_of_stderr_and_reaps_once", "[unit]") {
+  // The first-lines reader is the planted fault: a traceback's last line is what matters.
+  auto keeps_the_end = [](const std::string& tail) {
+    return tail.find("line 40\n") != std::string::npos && tail.find("line 21\n") != std::string::npos &&
+           tail.find("line 20\n") == std::string::npos;
+  };
+  std::string tail;
+  {
+    props::Subprocess child("for i in $(seq 1 40); do echo line $i >&2; done; exit 4");
+    const props::Subprocess::Exit exit = child.finish(5.0);
+    CHECK(exit.exited);
+    CHECK(exit.status == 4);
+    CHECK(child.finish(0.0).status == 4);  // reaped once; later calls give the same answer
+    tail = child.stderr_tail();
+  }
+  CHECK(keeps_the_end(tail));
+  std::string first_lines;  // what a reader of the first 20 lines would have kept
+  for (int i = 1; i <= 20; ++i) first_lines += "line " + std::to_string(i) + "\n";
+  CHECK_FALSE(keeps_the_end(first_lines));
+  // Lines are cut at kStderrLineBytes, so a child cannot make the tail grow without bound.
+  props::Subprocess noisy("head -c 100000 /dev/zero | tr '\\0' x >&2");
+  noisy.finish(5.0);
+  CHECK(noisy.stderr_tail().size() <= props::Subprocess::kStderrLineBytes + 1);
+}
+
+TEST_CASE("subprocess_reads_with_a_deadline_and_sees_a_closed_stdout", "[unit]") {
+  props::Subprocess cat("cat");
+  REQUIRE(cat.write_all("hello\n", 1.0) == props::Subprocess::Outcome::done);
+  std::string line;
+  REQUIRE(cat.read_line(line, 1.0) == props::Subprocess::Outcome::done);
+  CHECK(line == "hello");
+  CHECK(cat.read_line(line, 0.05) == props::Subprocess::Outcome::timed_out);
+  props::Subprocess quiet("exit 0");
+  CHECK(quiet.read_line(line, 5.0) == props::Subprocess::Outcome::closed);
+}
+
+TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
+  using props::RequestKind;
+  const std::string who = "plug-in 'x'";
+  const auto hello = props::parse_reply(
+      R"({"id": 0, "hello": {"protocol": 2, "extra_poses": ["start"], "scalars": ["gripper"], "decode": true}})", 0,
+      RequestKind::encode, who, true);
+  REQUIRE(hello.hello.has_value());
+  CHECK(hello.hello->extra_pose_names == std::vector<std::string>{"start"});
+  CHECK(hello.hello->scalar_names == std::vector<std::string>{"gripper"});
+  CHECK(hello.hello->decode);
+  CHECK_FALSE(hello.hello->flow);
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 3, "hello": {}})", 3, RequestKind::encode, who, false),
+                    Contains("only answer the first request"));
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"protocol": 9}})", 0, RequestKind::encode, who, true),
+                    Contains("protocol 9"));
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"scalars": [1]}})", 0, RequestKind::encode, who, true),
+                    Contains("not a name"));
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 1, "actions": [1]})", 1, RequestKind::flow, who, false),
+                    Contains("flow_input"));
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 1, "chunk": [[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 2]]})", 1,
+                                       RequestKind::decode, who, false),
+                    Contains("last row 0 0 0 1"));
+  const auto decoded = props::parse_reply(R"({"id": 1, "chunk": [[1, 0, 0, 5, 0, 1, 0, 6, 0, 0, 1, 7, 0, 0, 0, 1]]})",
+                                          1, RequestKind::decode, who, false);
+  REQUIRE(decoded.chunk.size() == 1);
+  CHECK(decoded.chunk[0].translation() == Eigen::Vector3d(5, 6, 7));
+  // Requests: the extras and the flow query go on the wire.
+  Scene scene = small_scene(3);
+  scene.extra_poses = {{"start", RigidTransform::identity()}};
+  scene.scalars = {{"gripper", 0.25}};
+  const Eigen::VectorXd eps = Eigen::VectorXd::Ones(2);
+  const std::string line = props::request_line(7, props::encode_request_body(scene, props::FlowQuery{&eps, 0.5}));
+  const auto json = nlohmann::json::parse(line);
+  CHECK(json.at("id") == 7);
+  CHECK(json.at("protocol") == 2);
+  CHECK(json.at("extra_poses").at("start").size() == 16);
+  CHECK(json.at("scalars").at("gripper") == 0.25);
+  CHECK(json.at("eps").size() == 2);
+  CHECK(json.at("t") == 0.5);
+  CHECK(nlohmann::json::parse(props::request_line(8, props::decode_request_body(eps, scene))).at("decode").size() == 2);
 }
 
 TEST_CASE("a_silent_plugin_times_out_instead_of_hanging", "[unit]") {

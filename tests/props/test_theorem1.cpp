@@ -95,14 +95,19 @@ TEST_CASE("outer_policies_on_absolute_relative_and_relative_diff_yield_checked_w
   }
 }
 
-TEST_CASE("a_third_person_view_breaks_theorem_1_for_hand_centric_actions", "[property]") {
-  // One world-frame point in the observation: Theorem 1's eye-in-hand assumption is violated.
-  const auto hand_centric = std::make_shared<HandCentricRepresentation>();
-  const props::RandomOuterPolicy policy(hand_centric, observation_dimension(1), kChunk, {32, 32}, 7);
+TEST_CASE("a_third_person_view_copied_raw_breaks_theorem_1_and_one_in_the_hand_frame_does_not", "[property]") {
+  // One world-frame point copied raw into the observation: Theorem 1's eye-in-hand assumption is
+  // violated, and the outer policy is no longer equivariant.
+  const props::RandomOuterPolicy raw(std::make_shared<test::RawWorldPoints>(), observation_dimension(1), kChunk,
+                                     {32, 32}, 7);
   for (Group group : {Group::translation, Group::rotation, Group::se3}) {
     INFO(props::to_string(group));
-    require_checked_witness(policy, props::check_equivariance(policy, group, policy_options(1)), 99);
+    require_checked_witness(raw, props::check_equivariance(raw, group, policy_options(1)), 99);
   }
+  // hand_centric takes the point into the hand frame (T_0^{-1} q): equivariant again.
+  const props::RandomOuterPolicy hand(std::make_shared<HandCentricRepresentation>(), observation_dimension(1), kChunk,
+                                      {32, 32}, 7);
+  CHECK(props::check_equivariance(hand, Group::se3, policy_options(1)).invariant);
 }
 
 TEST_CASE("mutant_decoder_that_forgets_R0_is_not_equivariant", "[property]") {
