@@ -36,6 +36,19 @@ void load_rapidcheck_configuration_quietly() {
 
 }  // namespace
 
+double inf_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
+  if (a.size() == 0) return 0.0;
+  return (a - b).lpNorm<Eigen::Infinity>();
+}
+
+double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<RigidTransform>& b) {
+  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
+  double worst = 0.0;
+  for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, distance(a[k], b[k]));
+  return worst;
+}
+
 void run_silently(const std::function<void()>& property, const std::string& description, std::uint64_t seed,
                   int cases) {
   load_rapidcheck_configuration_quietly();
@@ -107,12 +120,6 @@ namespace {
 
 constexpr int kPointwiseShrinkBudget = 1000;
 
-double inf_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
-  if (a.size() == 0) return 0.0;
-  return (a - b).lpNorm<Eigen::Infinity>();
-}
-
 // Each pose as [p, r(R)], one after the other.
 Eigen::VectorXd flatten(const std::vector<RigidTransform>& chunk) {
   Eigen::VectorXd v(6 * static_cast<Eigen::Index>(chunk.size()));
@@ -121,14 +128,6 @@ Eigen::VectorXd flatten(const std::vector<RigidTransform>& chunk) {
     v.segment<3>(6 * static_cast<Eigen::Index>(k) + 3) = chunk[k].rotation().log();
   }
   return v;
-}
-
-// max_k distance(a_k, b_k); infinite for different lengths.
-double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<RigidTransform>& b) {
-  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
-  double worst = 0.0;
-  for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, distance(a[k], b[k]));
-  return worst;
 }
 
 struct Equivariance {
@@ -214,7 +213,7 @@ Verdict check_invariance(const SceneFunction& f, Component component, Group grou
     outcome.witness.g = g;
     outcome.witness.before = f(scene);
     outcome.witness.after = f(moved);
-    outcome.witness.error = inf_distance(outcome.witness.before, outcome.witness.after);
+    outcome.witness.error = detail::inf_distance(outcome.witness.before, outcome.witness.after);
     outcome.witness.tolerance = pointwise_tolerance(scene, moved, relative);
     outcome.holds = outcome.witness.error <= outcome.witness.tolerance;  // false for NaN
     return outcome;
@@ -223,7 +222,7 @@ Verdict check_invariance(const SceneFunction& f, Component component, Group grou
 }
 
 double recompute_error(const SceneFunction& f, const Witness& witness) {
-  return inf_distance(f(witness.scene), f(witness.g * witness.scene));
+  return detail::inf_distance(f(witness.scene), f(witness.g * witness.scene));
 }
 
 Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOptions& options) {
@@ -236,7 +235,7 @@ Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOp
     outcome.witness.g = g;
     outcome.witness.before = flatten(sides.g_a);
     outcome.witness.after = flatten(sides.a_g);
-    outcome.witness.error = chunk_distance(sides.g_a, sides.a_g);  // eq. (4)
+    outcome.witness.error = detail::chunk_distance(sides.g_a, sides.a_g);  // eq. (4)
     outcome.witness.tolerance = pointwise_tolerance(scene, g * scene, relative);
     outcome.holds = outcome.witness.error <= outcome.witness.tolerance;
     return outcome;
@@ -246,7 +245,7 @@ Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOp
 
 double recompute_equivariance_error(const ChunkPolicy& policy, const Witness& witness, std::uint64_t noise_seed) {
   const Equivariance sides = both_sides(policy, witness.scene, witness.g, noise_seed);
-  return chunk_distance(sides.g_a, sides.a_g);
+  return detail::chunk_distance(sides.g_a, sides.a_g);
 }
 
 }  // namespace handcentric::props

@@ -21,6 +21,12 @@ using CaseFunction = std::function<CaseOutcome(const Scene& scene, const RigidTr
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget);
 
+/// |a - b|_inf; infinite for different lengths, 0 for two empty vectors.
+double inf_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
+
+/// max_k distance(a_k, b_k) of two chunks; infinite for different lengths.
+double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<RigidTransform>& b);
+
 /// Runs a RapidCheck property (it calls RC_FAIL to fail) for `cases` cases from `seed`, printing
 /// nothing: the caller records what it needs from inside the property.
 void run_silently(const std::function<void()>& property, const std::string& description, std::uint64_t seed,

@@ -58,17 +58,8 @@ std::vector<RigidTransform> changed_chunk(const Scene& first, Change change, int
   return chunk;
 }
 
-double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<RigidTransform>& b) {
-  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
-  double worst = 0.0;
-  for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, distance(a[k], b[k]));
-  return worst;
-}
-
-double inf_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
-  if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
-  return a.size() == 0 ? 0.0 : (a - b).lpNorm<Eigen::Infinity>();
-}
+using detail::chunk_distance;
+using detail::inf_distance;
 
 }  // namespace
 
