@@ -1,24 +1,12 @@
 #include "handcentric/props/pipe_representation.hpp"
 
 #include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <cstdio>
 #include <set>
 
 #include "handcentric/core/format.hpp"
 
 namespace handcentric::props {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-// A duration as the user typed it: 0.3, not 0.29999999999999999.
-std::string seconds_text(double seconds) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", seconds);
-  return text;
-}
 
 void require_names(const std::vector<std::string>& names, const std::string& flag) {
   std::set<std::string> seen;
@@ -43,80 +31,16 @@ std::vector<std::string> merged(std::vector<std::string> first, const std::vecto
 PipeRepresentation::PipeRepresentation(std::string command, double timeout_seconds,
                                        std::vector<std::string> extra_pose_names, std::vector<std::string> scalar_names)
     : command_(std::move(command)),
-      timeout_seconds_(timeout_seconds),
       forced_extra_poses_(std::move(extra_pose_names)),
       forced_scalars_(std::move(scalar_names)),
-      process_([this] {
-        if (command_.find_first_not_of(" \t") == std::string::npos) {
-          throw InvalidArgument("--exec needs a command, got an empty one; e.g. --exec 'python3 repr.py'");
-        }
-        if (!(timeout_seconds_ > 0.0) || !std::isfinite(timeout_seconds_)) {
-          throw InvalidArgument("--timeout must be a positive number of seconds, got " + format_number(timeout_seconds_));
-        }
-        require_names(forced_extra_poses_, "--extra-poses");
-        require_names(forced_scalars_, "--scalars");
-        return command_;
-      }()) {}
+      connection_(command_, timeout_seconds) {
+  require_names(forced_extra_poses_, "--extra-poses");
+  require_names(forced_scalars_, "--scalars");
+}
 
 PipeRepresentation::~PipeRepresentation() = default;
 
 std::string PipeRepresentation::name() const { return "exec: " + command_; }
-
-void PipeRepresentation::fail(const std::string& what) const {
-  dead_ = true;
-  const std::string tail = process_.stderr_tail();
-  if (tail.empty()) throw PluginError(what + " (nothing on stderr)");
-  std::string quoted;
-  std::size_t begin = 0;
-  for (std::size_t end; (end = tail.find('\n', begin)) != std::string::npos; begin = end + 1) {
-    quoted += "\n    " + tail.substr(begin, end - begin);
-  }
-  throw PluginError(what + "; its stderr (last lines):" + quoted);
-}
-
-void PipeRepresentation::fail_exited(const std::string& when) const {
-  const Subprocess::Exit exit = process_.finish(1.0);
-  if (exit.exited && exit.status == 127) {
-    fail("plug-in command not found: '" + command_ + "'; check the program name and path");
-  }
-  fail("plug-in '" + command_ + "' " + exit.describe() + " " + when);
-}
-
-PluginReply PipeRepresentation::exchange(RequestKind kind, const std::string& body, bool hello_allowed) const {
-  if (dead_) throw PluginError("plug-in '" + command_ + "' failed earlier and was stopped");
-  const int id = next_id_++;
-  const auto started = Clock::now();
-  switch (process_.write_all(request_line(id, body), timeout_seconds_)) {
-    case Subprocess::Outcome::done: break;
-    case Subprocess::Outcome::closed: fail_exited("before reading request " + std::to_string(id));
-    case Subprocess::Outcome::timed_out:
-      process_.kill();
-      fail("plug-in '" + command_ + "' did not read request " + std::to_string(id) + " within " +
-           seconds_text(timeout_seconds_) + " s; raise --timeout if it is just slow");
-  }
-  const auto written = Clock::now();
-  std::string line;
-  switch (process_.read_line(line, timeout_seconds_)) {
-    case Subprocess::Outcome::done: break;
-    case Subprocess::Outcome::closed: fail_exited("before answering request " + std::to_string(id));
-    case Subprocess::Outcome::timed_out:
-      process_.kill();
-      fail("plug-in '" + command_ + "' gave no answer to request " + std::to_string(id) + " within " +
-           seconds_text(timeout_seconds_) +
-           " s; a plug-in must write one line per request and flush it (Python: print(..., flush=True) or "
-           "sys.stdout.flush(), or run it as python3 -u: a pipe is block-buffered), or raise --timeout if it is "
-           "just slow");
-  }
-  seconds_waiting_ += std::chrono::duration<double>(Clock::now() - written).count();
-  PluginReply reply;
-  try {
-    reply = parse_reply(line, id, kind, "plug-in '" + command_ + "'", hello_allowed);
-  } catch (const PluginError& e) {
-    fail(e.what());
-  }
-  seconds_asking_ += std::chrono::duration<double>(Clock::now() - started).count();
-  return reply;
-}
 
 void PipeRepresentation::check_lengths(const Scene& scene, const PluginReply& reply, int id) const {
   const auto shape = std::make_tuple(scene.history_length(), scene.chunk_length(),
@@ -124,7 +48,7 @@ void PipeRepresentation::check_lengths(const Scene& scene, const PluginReply& re
   const auto lengths = std::make_tuple(reply.actions.size(), reply.observation.size(), reply.has_observation);
   const auto [known, inserted] = lengths_.emplace(shape, lengths);
   if (!inserted && known->second != lengths) {
-    fail("plug-in '" + command_ + "' changed its vector lengths between scenes of the same shape (H = " +
+    connection_.fail("plug-in '" + command_ + "' changed its vector lengths between scenes of the same shape (H = " +
          std::to_string(std::get<0>(shape)) + ", K = " + std::to_string(std::get<1>(shape)) + ", " +
          std::to_string(std::get<2>(shape)) + " eye-in-hand and " + std::to_string(std::get<3>(shape)) +
          " world points): actions " + std::to_string(std::get<0>(known->second)) + " then " +
@@ -151,7 +75,7 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   probe.world_T_hand_history = {RigidTransform::identity()};
   probe.world_T_hand_chunk = {RigidTransform::from_translation(Eigen::Vector3d(0.1, 0.0, 0.0))};
   Scene asked = with_extras(probe);
-  PluginReply reply = exchange(RequestKind::encode, encode_request_body(asked), /*hello_allowed=*/true);
+  PluginReply reply = connection_.exchange(RequestKind::encode, encode_request_body(asked), /*hello_allowed=*/true);
   PluginCapabilities capabilities;
   if (reply.hello) capabilities = *reply.hello;
   capabilities.extra_pose_names = merged(capabilities.extra_pose_names, forced_extra_poses_);
@@ -159,9 +83,9 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   capabilities_ = capabilities;
   if (reply.hello) {
     asked = with_extras(probe);
-    reply = exchange(RequestKind::encode, encode_request_body(asked), false);
+    reply = connection_.exchange(RequestKind::encode, encode_request_body(asked), false);
   }
-  check_lengths(asked, reply, next_id_ - 1);
+  check_lengths(asked, reply, connection_.last_id());
   has_observation_ = reply.has_observation;
   std::string key(1, 'e');
   key += encode_request_body(asked);
@@ -175,8 +99,8 @@ const PluginReply& PipeRepresentation::ask(const Scene& scene, RequestKind kind,
   if (const auto hit = cache_.find(key); hit != cache_.end()) return hit->second;
   capabilities();
   if (const auto hit = cache_.find(key); hit != cache_.end()) return hit->second;  // the probe itself
-  PluginReply reply = exchange(kind, body, false);
-  if (kind != RequestKind::decode) check_lengths(scene, reply, next_id_ - 1);
+  PluginReply reply = connection_.exchange(kind, body, false);
+  if (kind != RequestKind::decode) check_lengths(scene, reply, connection_.last_id());
   if (cache_.size() > 200000) cache_.clear();  // bounded memory over long audits
   return cache_.emplace(key, std::move(reply)).first->second;
 }

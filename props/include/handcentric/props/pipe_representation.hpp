@@ -1,6 +1,6 @@
 #pragma once
 // A representation written in any language, spoken to over a pipe (docs/AUDIT.md, "--exec"):
-// a Subprocess (subprocess.hpp) that speaks the JSON Lines protocol of plugin_protocol.hpp.
+// a PluginConnection (plugin_connection.hpp) that speaks the protocol of plugin_protocol.hpp.
 //
 // The first request is a handshake: a small probe scene. A version-2 plug-in may answer it
 // with a hello naming the extra poses and scalars it wants, and whether it decodes and answers
@@ -25,8 +25,8 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representation.hpp"
+#include "handcentric/props/plugin_connection.hpp"
 #include "handcentric/props/plugin_protocol.hpp"
-#include "handcentric/props/subprocess.hpp"
 
 namespace handcentric::props {
 
@@ -62,32 +62,25 @@ class PipeRepresentation final : public Representation {
   FlowSample flow(const Scene& scene, const Eigen::VectorXd& eps, double t) const;
 
   /// Requests actually sent (cache misses).
-  int requests_sent() const { return next_id_; }
-  /// Seconds spent in ask() for requests sent (formatting, writing, waiting, parsing), and the
-  /// part of it spent waiting for the plug-in's answer: their difference is the pipe's overhead.
-  double seconds_asking() const { return seconds_asking_; }
-  double seconds_waiting() const { return seconds_waiting_; }
+  int requests_sent() const { return connection_.requests_sent(); }
+  /// Seconds spent exchanging requests sent, and the part spent waiting for the plug-in's
+  /// answer (plugin_connection.hpp): their difference is the pipe's overhead.
+  double seconds_asking() const { return connection_.seconds_asking(); }
+  double seconds_waiting() const { return connection_.seconds_waiting(); }
 
  private:
   const PluginReply& ask(const Scene& scene, RequestKind kind, const std::string& body) const;
-  PluginReply exchange(RequestKind kind, const std::string& body, bool hello_allowed) const;
-  [[noreturn]] void fail(const std::string& what) const;
-  [[noreturn]] void fail_exited(const std::string& when) const;
   void check_lengths(const Scene& scene, const PluginReply& reply, int id) const;
   Scene with_extras(const Scene& scene) const;
 
   std::string command_;
-  double timeout_seconds_;
   std::vector<std::string> forced_extra_poses_, forced_scalars_;
-  mutable Subprocess process_;
+  mutable PluginConnection connection_;
   mutable std::optional<PluginCapabilities> capabilities_;
   mutable bool has_observation_ = false;
-  mutable int next_id_ = 0;
   mutable std::unordered_map<std::string, PluginReply> cache_;
   /// (H, K, #hand points, #world points) -> (actions length, observation length, has observation)
   mutable std::map<std::tuple<int, int, int, int>, std::tuple<Eigen::Index, Eigen::Index, bool>> lengths_;
-  mutable bool dead_ = false;
-  mutable double seconds_asking_ = 0.0, seconds_waiting_ = 0.0;
 };
 
 /// A plug-in's own flow (declared "flow" in its hello) as a FlowTarget: eps has the length of

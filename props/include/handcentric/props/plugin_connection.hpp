@@ -1,0 +1,48 @@
+#pragma once
+// One plug-in process and the request/answer exchange with it (docs/AUDIT.md, "--exec"): a
+// Subprocess (subprocess.hpp) that sends protocol lines (plugin_protocol.hpp) and turns every
+// way the plug-in can misbehave into a PluginError. The first line of the message says what
+// happened; when the plug-in wrote on stderr, its last 20 lines follow, indented. After a
+// failure the connection refuses further requests. Not thread-safe.
+#include <string>
+
+#include "handcentric/props/plugin_protocol.hpp"
+#include "handcentric/props/subprocess.hpp"
+
+namespace handcentric::props {
+
+class PluginConnection {
+ public:
+  /// Starts `command`. Throws InvalidArgument for an empty command or a timeout <= 0,
+  /// PluginError if the process cannot be started.
+  PluginConnection(std::string command, double timeout_seconds);
+
+  /// Sends request `body` (the next id) and returns its parsed, validated answer.
+  PluginReply exchange(RequestKind kind, const std::string& body, bool hello_allowed);
+  /// Throws PluginError(what + the stderr tail) and refuses further requests.
+  [[noreturn]] void fail(const std::string& what);
+
+  const std::string& command() const { return command_; }
+  /// "plug-in 'COMMAND'", for messages.
+  std::string who() const { return "plug-in '" + command_ + "'"; }
+  /// The id of the last request sent (-1 before the first).
+  int last_id() const { return next_id_ - 1; }
+  /// Requests sent.
+  int requests_sent() const { return next_id_; }
+  /// Seconds spent exchanging (formatting, writing, waiting, parsing), and the part of it spent
+  /// waiting for the plug-in's answer: their difference is the pipe's overhead.
+  double seconds_asking() const { return seconds_asking_; }
+  double seconds_waiting() const { return seconds_waiting_; }
+
+ private:
+  [[noreturn]] void fail_exited(const std::string& when);
+
+  std::string command_;
+  double timeout_seconds_;
+  Subprocess process_;
+  int next_id_ = 0;
+  bool dead_ = false;
+  double seconds_asking_ = 0.0, seconds_waiting_ = 0.0;
+};
+
+}  // namespace handcentric::props
