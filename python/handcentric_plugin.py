@@ -239,8 +239,21 @@ def _chunk(result):
 
 # ----------------------------------------------------------------------------- the loop
 
+def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, stdin=None,
+                 stdout=None):
+    """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
+
+    policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
+    noise: the standard normals the request carries (256 unless `noise=n` asks for n); use them
+        as the policy's only randomness, so that one noise vector gives one chunk.
+    extra_poses, scalars, hello, stdin, stdout: as for serve().
+    """
+    serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, stdin=stdin, stdout=stdout,
+          _policy=policy, _noise=noise)
+
+
 def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=None,
-          stdin=None, stdout=None):
+          stdin=None, stdout=None, _policy=None, _noise=None):
     """Answer the audit's requests until end of input (see the module docstring).
 
     encode(history, chunk, hand_points, world_points) -> actions | (actions, observation) | dict
@@ -256,9 +269,11 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
     extra_poses, scalars = tuple(extra_poses), tuple(scalars)
     declared = bool(extra_poses or scalars)
     if hello is None:
-        hello = declared or decode is not None or flow is not None
+        hello = declared or decode is not None or flow is not None or _noise is not None
     hello_body = {"protocol": PROTOCOL, "extra_poses": list(extra_poses),
                   "scalars": list(scalars), "decode": decode is not None, "flow": flow is not None}
+    if _noise is not None:
+        hello_body["noise"] = int(_noise)
 
     def call(function, request_id, args, named):
         kwargs = {"extra_poses": named[0], "scalars": named[1]} if declared else {}
@@ -280,6 +295,16 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         world_points = _points(request, "world_points")
         named = (_named(request, "extra_poses", extra_poses, _matrix),
                  _named(request, "scalars", scalars, _scalar))
+        if _policy is not None:
+            if "noise" not in request:
+                raise _Malformed("a policy plug-in needs 'noise' in every request (run it with "
+                                 "--policy-exec, not --exec)")
+            value = request["noise"]
+            if not isinstance(value, list) or not value or not all(map(_is_number, value)):
+                raise _Malformed("'noise' must be a non-empty list of numbers")
+            noise = np.array(value, dtype=np.float64) if np is not None else [float(x) for x in value]
+            return {"id": rid, "chunk": _chunk(call(_policy, rid, (history, hand_points, world_points,
+                                                                    noise), named))}
         if "decode" in request:
             if decode is None:
                 raise _Malformed("a decode request, but the plug-in declared no decode")

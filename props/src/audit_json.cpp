@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "handcentric/props/audit.hpp"
+#include "handcentric/props/policy_audit.hpp"
 
 namespace handcentric::props {
 namespace {
@@ -138,6 +139,41 @@ std::string audit_json(const std::vector<Classification>& classifications) {
     representations.push_back(representation);
   }
   return nlohmann::json({{"representations", representations}}).dump(2) + "\n";
+}
+
+}  // namespace handcentric::props
+
+namespace handcentric::props {
+
+std::string policy_audit_json(const std::vector<Classification>& policies) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const Classification& policy : policies) {
+    nlohmann::json checks = nlohmann::json::array(), summary = nlohmann::json::object();
+    for (const Verdict& v : policy.verdicts) {
+      nlohmann::json check = {
+          {"group", to_string(v.group)},
+          {"mode", to_string(v.mode)},
+          {"view", to_string(v.view)},
+          {"equivariant", v.invariant},
+          {"max_error", number_or_inf(v.max_error)},
+          {"cases", v.cases},
+          {"near_identity_cases", v.near_identity_cases},
+          {"seed", v.seed},
+          {"relative_tolerance", v.relative_tolerance},
+          {"witness", v.witness ? witness_json(*v.witness, v.method) : nlohmann::json(nullptr)},
+      };
+      if (v.mode == Mode::distribution) {
+        check["method"] = to_string(v.method);
+        if (v.method == Method::energy_test) check["min_p_value"] = v.min_p_value;
+        if (v.detectable_shift) check["detectable_shift"] = *v.detectable_shift;
+      }
+      if (!v.note.empty()) check["note"] = v.note;
+      checks.push_back(check);
+      summary[to_string(v.view)][to_string(v.mode)][to_string(v.group)] = v.invariant;
+    }
+    out.push_back({{"name", policy.name}, {"summary", summary}, {"checks", checks}});
+  }
+  return nlohmann::json({{"policies", out}}).dump(2) + "\n";
 }
 
 }  // namespace handcentric::props

@@ -36,6 +36,15 @@ void load_rapidcheck_configuration_quietly() {
 
 }  // namespace
 
+Eigen::VectorXd flatten(const std::vector<RigidTransform>& chunk) {
+  Eigen::VectorXd v(6 * static_cast<Eigen::Index>(chunk.size()));
+  for (std::size_t k = 0; k < chunk.size(); ++k) {
+    v.segment<3>(6 * static_cast<Eigen::Index>(k)) = chunk[k].translation();
+    v.segment<3>(6 * static_cast<Eigen::Index>(k) + 3) = chunk[k].rotation().log();
+  }
+  return v;
+}
+
 double inf_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   if (a.size() != b.size()) return std::numeric_limits<double>::infinity();
   if (a.size() == 0) return 0.0;
@@ -119,16 +128,6 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
 namespace {
 
 constexpr int kPointwiseShrinkBudget = 1000;
-
-// Each pose as [p, r(R)], one after the other.
-Eigen::VectorXd flatten(const std::vector<RigidTransform>& chunk) {
-  Eigen::VectorXd v(6 * static_cast<Eigen::Index>(chunk.size()));
-  for (std::size_t k = 0; k < chunk.size(); ++k) {
-    v.segment<3>(6 * static_cast<Eigen::Index>(k)) = chunk[k].translation();
-    v.segment<3>(6 * static_cast<Eigen::Index>(k) + 3) = chunk[k].rotation().log();
-  }
-  return v;
-}
 
 struct Equivariance {
   std::vector<RigidTransform> g_a;  // g * a(o)
@@ -233,8 +232,8 @@ Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOp
     const Equivariance sides = both_sides(policy, scene, g, noise_seed);
     outcome.witness.scene = scene;
     outcome.witness.g = g;
-    outcome.witness.before = flatten(sides.g_a);
-    outcome.witness.after = flatten(sides.a_g);
+    outcome.witness.before = detail::flatten(sides.g_a);
+    outcome.witness.after = detail::flatten(sides.a_g);
     outcome.witness.error = detail::chunk_distance(sides.g_a, sides.a_g);  // eq. (4)
     outcome.witness.tolerance = pointwise_tolerance(scene, g * scene, relative);
     outcome.holds = outcome.witness.error <= outcome.witness.tolerance;

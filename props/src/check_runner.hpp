@@ -5,7 +5,10 @@
 // handcentric::Error raised by the function under test instead of shrinking it.
 #include <functional>
 
+#include <string>
+
 #include "handcentric/props/check.hpp"
+#include "handcentric/props/distribution.hpp"
 
 namespace handcentric::props::detail {
 
@@ -20,6 +23,37 @@ using CaseFunction = std::function<CaseOutcome(const Scene& scene, const RigidTr
 /// evaluations (then every further candidate passes, and the last failure is the witness).
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget);
+
+/// Two functions of the noise whose laws (eps ~ N(0, I)) a distribution check compares:
+/// f(s, .) and f(g s, .) for a flow; g * a(o, .) and a(g o, .) for a policy.
+struct NoisePair {
+  std::function<Eigen::VectorXd(const Eigen::VectorXd&)> before, after;
+  Eigen::Index noise_dimension = 0;
+  std::string name;  ///< for errors: what changed length
+};
+
+/// What a check's cases saw, for its verdict: whether any needed the energy test, and the
+/// largest dimension and spread it tested (for the detectable shift).
+struct LawStatistics {
+  bool any_energy = false;
+  Eigen::Index largest_dimension = 0;
+  double largest_spread = 0.0;
+};
+
+/// One in-distribution case: exact Gaussian laws where both sides are affine in eps, else the
+/// energy test (distribution.hpp). The witness's scene and g are left for the caller.
+CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOptions& options,
+                         const DistributionOptions& distribution, LawStatistics& statistics);
+
+/// Sets the verdict's method and, for an energy-test "yes", its detectable shift.
+void finish_distribution_verdict(Verdict& verdict, const LawStatistics& statistics,
+                                 const DistributionOptions& distribution);
+
+/// Throws InvalidArgument naming the bad values of `distribution`.
+void require_distribution_options(const DistributionOptions& distribution);
+
+/// Each pose as [p, r(R)], one after the other (a policy's witness).
+Eigen::VectorXd flatten(const std::vector<RigidTransform>& chunk);
 
 /// |a - b|_inf; infinite for different lengths, 0 for two empty vectors.
 double inf_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b);

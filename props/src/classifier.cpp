@@ -9,8 +9,8 @@
 namespace handcentric::props {
 namespace {
 
-// A failure at a tolerance tighter than float32 rounding that passes at float32 rounding is
-// worth a sentence: the map is probably right and computed in float32.
+}  // namespace
+
 Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
                           const std::function<Verdict(const CheckOptions&)>& recheck) {
   if (!options.float32_note || verdict.invariant || verdict.method == Method::energy_test ||
@@ -27,6 +27,8 @@ Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
   }
   return verdict;
 }
+
+namespace {
 
 void classify_flow(const std::shared_ptr<const FlowTarget>& target, const ClassifierOptions& options, View view,
                    Classification& out) {

@@ -74,7 +74,60 @@ Eigen::MatrixXd pooled_distances(const Eigen::MatrixXd& x, const Eigen::MatrixXd
   return D;
 }
 
+// The regularized incomplete beta function I_x(a, b), by its continued fraction (modified Lentz),
+// on the side of x where the fraction converges fast (x < (a + 1) / (a + b + 2)).
+double incomplete_beta(double a, double b, double x) {
+  if (x <= 0.0) return 0.0;
+  if (x >= 1.0) return 1.0;
+  if (x > (a + 1.0) / (a + b + 2.0)) return 1.0 - incomplete_beta(b, a, 1.0 - x);
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x)) / a;
+  constexpr double kTiny = 1e-300;
+  double f = 1.0, c = 1.0, d = 0.0;
+  for (int i = 0; i <= 400; ++i) {
+    const int m = i / 2;
+    double numerator;
+    if (i == 0) {
+      numerator = 1.0;
+    } else if (i % 2 == 0) {
+      numerator = (m * (b - m) * x) / ((a + 2.0 * m - 1.0) * (a + 2.0 * m));
+    } else {
+      numerator = -((a + m) * (a + b + m) * x) / ((a + 2.0 * m) * (a + 2.0 * m + 1.0));
+    }
+    d = 1.0 + numerator * d;
+    d = 1.0 / (std::abs(d) < kTiny ? kTiny : d);
+    c = 1.0 + numerator / c;
+    if (std::abs(c) < kTiny) c = kTiny;
+    f *= c * d;
+    if (std::abs(1.0 - c * d) < 1e-14) break;
+  }
+  return front * (f - 1.0);
+}
+
 }  // namespace
+
+double student_t_two_sided_p(double t, double degrees_of_freedom) {
+  if (!(degrees_of_freedom > 0.0)) throw InvalidArgument("Student's t needs positive degrees of freedom");
+  if (!std::isfinite(t)) return std::isnan(t) ? 1.0 : 0.0;
+  return incomplete_beta(0.5 * degrees_of_freedom, 0.5, degrees_of_freedom / (degrees_of_freedom + t * t));
+}
+
+double paired_mean_test(const Eigen::MatrixXd& differences, double tolerance) {
+  const Eigen::Index n = differences.rows(), d = differences.cols();
+  if (n < 2 || d == 0) return 1.0;
+  double smallest = 1.0;
+  for (Eigen::Index j = 0; j < d; ++j) {
+    const Eigen::VectorXd column = differences.col(j);
+    const double mean = column.mean();
+    const double sd = std::sqrt((column.array() - mean).square().sum() / static_cast<double>(n - 1));
+    if (!(sd > tolerance)) {
+      // No spread: the mean difference is a constant, seen exactly.
+      if (std::abs(mean) > tolerance) return 0.0;
+      continue;
+    }
+    smallest = std::min(smallest, student_t_two_sided_p(mean / (sd / std::sqrt(static_cast<double>(n))), n - 1.0));
+  }
+  return std::min(1.0, smallest * static_cast<double>(d));  // Bonferroni over the coordinates
+}
 
 double energy_distance(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
   require_samples(x, y);
@@ -136,6 +189,20 @@ std::optional<GaussianLaw> affine_law(const std::function<Eigen::VectorXd(const 
   GaussianLaw law;
   Eigen::VectorXd eps = Eigen::VectorXd::Zero(n);
   law.mean = f(eps);
+  std::mt19937_64 rng(seed);
+  auto normals = [&rng, n] {
+    Eigen::VectorXd v(n);
+    for (Eigen::Index j = 0; j < n; ++j) v(j) = standard_normal(rng);
+    return v;
+  };
+  // A cheap necessary test first (4 evaluations, where probing takes n + 1): an affine map is
+  // additive about f(0). Most maps that are not affine (a sampler through a network) fail it.
+  {
+    const Eigen::VectorXd u = normals(), v = normals();
+    const Eigen::VectorXd fu = f(u), fv = f(v), fuv = f(u + v);
+    if (fu.size() != law.mean.size() || fv.size() != law.mean.size() || fuv.size() != law.mean.size()) return std::nullopt;
+    if (law.mean.size() > 0 && !((fuv - fu - fv + law.mean).cwiseAbs().maxCoeff() <= 2.0 * tolerance)) return std::nullopt;
+  }
   law.noise_map.resize(law.mean.size(), n);
   for (Eigen::Index j = 0; j < n; ++j) {
     eps(j) = 1.0;
@@ -145,9 +212,8 @@ std::optional<GaussianLaw> affine_law(const std::function<Eigen::VectorXd(const 
     law.noise_map.col(j) = column - law.mean;
   }
   // Affine maps agree with mean + J eps everywhere; verify it where nothing was probed.
-  std::mt19937_64 rng(seed);
   for (int c = 0; c < checks; ++c) {
-    for (Eigen::Index j = 0; j < n; ++j) eps(j) = standard_normal(rng);
+    eps = normals();
     const Eigen::VectorXd value = f(eps);
     if (value.size() != law.mean.size()) return std::nullopt;
     const Eigen::VectorXd predicted = law.mean + law.noise_map * eps;
@@ -220,120 +286,151 @@ double energy_test_detectable_shift(Eigen::Index dimension, int samples, double 
   return high;
 }
 
+namespace detail {
+
+CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOptions& options,
+                         const DistributionOptions& distribution, LawStatistics& statistics) {
+  const double alpha = distribution.family_alpha / distribution.cases;  // Bonferroni
+  const int samples = distribution.samples;
+  CaseOutcome outcome;
+  const std::optional<GaussianLaw> law =
+      affine_law(pair.before, pair.noise_dimension, tolerance, options.noise_seed, distribution.affinity_checks);
+  const std::optional<GaussianLaw> moved_law =
+      law ? affine_law(pair.after, pair.noise_dimension, tolerance, options.noise_seed, distribution.affinity_checks)
+          : std::nullopt;
+  if (law && moved_law) {
+    // Exact: two Gaussian laws are one iff their means and covariances agree.
+    const LawDifference difference = law_difference(*law, *moved_law);
+    const double covariance_tolerance = tolerance * difference.covariance_scale;
+    outcome.witness.before = law->mean;
+    outcome.witness.after = moved_law->mean;
+    outcome.witness.error = std::max(difference.mean, difference.covariance);
+    outcome.witness.tolerance = tolerance;
+    outcome.witness.detail = "Gaussian laws (affine in eps): means differ by " + format_number(difference.mean) +
+                             ", covariances by " + format_number(difference.covariance) + " (tolerance " +
+                             format_number(tolerance) + ", covariance " + format_number(covariance_tolerance) + ")";
+    outcome.holds = difference.mean <= tolerance && difference.covariance <= covariance_tolerance;
+    return outcome;
+  }
+  statistics.any_energy = true;
+  const Eigen::Index noise = pair.noise_dimension;
+  std::mt19937_64 shared(options.noise_seed), fresh(options.noise_seed ^ 0x9e3779b97f4a7c15ULL);
+  auto draw = [noise](std::mt19937_64& rng) {
+    Eigen::VectorXd eps(noise);
+    for (Eigen::Index j = 0; j < noise; ++j) eps(j) = standard_normal(rng);
+    return eps;
+  };
+  // x: before(eps_i); same_eps: after(eps_i) (the same draws); y: after(eps'_i) (fresh draws).
+  Eigen::MatrixXd x, same_eps;
+  double pointwise = 0.0;
+  for (int i = 0; i < samples; ++i) {
+    const Eigen::VectorXd eps = draw(shared);
+    const Eigen::VectorXd u = pair.before(eps);
+    const Eigen::VectorXd v = pair.after(eps);
+    if (i == 0) {
+      x.resize(samples, u.size());
+      same_eps.resize(samples, v.size());
+    }
+    if (u.size() != x.cols() || v.size() != same_eps.cols()) {
+      throw InvalidArgument(pair.name + " changed length between noise draws");
+    }
+    x.row(i) = u.transpose();
+    same_eps.row(i) = v.transpose();
+    pointwise = u.size() == v.size() ? std::max(pointwise, u.size() ? (u - v).lpNorm<Eigen::Infinity>() : 0.0)
+                                     : std::numeric_limits<double>::infinity();
+  }
+  statistics.largest_dimension = std::max(statistics.largest_dimension, x.cols());
+  if (x.cols() > 0) {
+    const Eigen::RowVectorXd mean = x.colwise().mean();
+    const double variance = (x.rowwise() - mean).squaredNorm() / (static_cast<double>(samples - 1) * x.cols());
+    statistics.largest_spread = std::max(statistics.largest_spread, std::sqrt(variance));
+  }
+  outcome.witness.before = x.row(0).transpose();
+  outcome.witness.tolerance = alpha;
+  if (pointwise <= tolerance) {
+    // The same value on every shared draw: the two distributions are the same one, no test needed.
+    outcome.witness.after = same_eps.row(0).transpose();
+    outcome.witness.error = energy_distance(x, same_eps);
+    outcome.witness.p_value = 1.0;
+    return outcome;
+  }
+  if (x.cols() != same_eps.cols()) {  // different lengths: different laws
+    outcome.witness.after = same_eps.row(0).transpose();
+    outcome.witness.error = std::numeric_limits<double>::infinity();
+    outcome.witness.p_value = 0.0;
+    outcome.holds = false;
+    return outcome;
+  }
+  // Not pointwise: test before(eps) against after(eps') with independent draws (a permutation
+  // test needs exchangeable samples; shared draws would not be).
+  // Two tests at alpha / 2 each: the energy test (a permutation test: exact level, little power
+  // against a mean shift in many dimensions) and the paired test of the mean difference on the
+  // shared draws (equal laws have equal means, so E[before - after] = 0: Student's t per
+  // coordinate, Bonferroni; its level is asymptotic, and a mean that moves by a constant, as
+  // when a policy mixes frames, stands out at once).
+  Eigen::MatrixXd y(samples, same_eps.cols());
+  for (int i = 0; i < samples; ++i) y.row(i) = pair.after(draw(fresh)).transpose();
+  const TwoSampleResult test = energy_test(x, y, permutations_for(0.5 * alpha), options.seed, 0.5 * alpha);
+  const double paired = paired_mean_test(x - same_eps, tolerance);
+  outcome.witness.after = y.row(0).transpose();
+  outcome.witness.error = test.energy_distance;
+  outcome.witness.p_value = std::min(1.0, 2.0 * std::min(test.p_value, paired));
+  outcome.witness.detail = "energy test p = " + format_number(test.p_value) + ", paired mean test p = " +
+                           format_number(paired) + " (each at level " + format_number(0.5 * alpha) + ")";
+  outcome.holds = test.p_value >= 0.5 * alpha && paired >= 0.5 * alpha;
+  return outcome;
+}
+
+void finish_distribution_verdict(Verdict& verdict, const LawStatistics& statistics,
+                                 const DistributionOptions& distribution) {
+  verdict.method = statistics.any_energy ? Method::energy_test : Method::exact_gaussian;
+  if (verdict.method == Method::energy_test && verdict.invariant && statistics.largest_dimension > 0) {
+    verdict.detectable_shift = energy_test_detectable_shift(statistics.largest_dimension, distribution.samples,
+                                                            distribution.family_alpha / distribution.cases) *
+                               statistics.largest_spread;
+  }
+}
+
+void require_distribution_options(const DistributionOptions& distribution) {
+  if (distribution.cases < 1 || distribution.samples < 2 ||
+      !(distribution.family_alpha > 0.0 && distribution.family_alpha < 1.0) || distribution.affinity_checks < 1) {
+    throw InvalidArgument(
+        "distribution options need cases >= 1, samples >= 2, 0 < alpha < 1 and affinity_checks >= 1, got cases " +
+        std::to_string(distribution.cases) + ", samples " + std::to_string(distribution.samples) + ", alpha " +
+        format_number(distribution.family_alpha) + ", affinity_checks " + std::to_string(distribution.affinity_checks));
+  }
+}
+
+}  // namespace detail
+
 Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, Component component, Group group,
                                       const CheckOptions& options, const DistributionOptions& distribution) {
   if (!target) throw InvalidArgument("check_distribution_invariance needs a flow target, got null");
   if (component != Component::flow_input && component != Component::flow_target) {
     throw InvalidArgument("in-distribution checks are about flow_input or flow_target, got " + to_string(component));
   }
-  if (distribution.cases < 1 || distribution.samples < 2 || !(distribution.family_alpha > 0.0 && distribution.family_alpha < 1.0) ||
-      distribution.affinity_checks < 1) {
-    throw InvalidArgument("distribution options need cases >= 1, samples >= 2, 0 < alpha < 1 and affinity_checks >= 1, got cases " +
-                          std::to_string(distribution.cases) + ", samples " + std::to_string(distribution.samples) +
-                          ", alpha " + format_number(distribution.family_alpha) + ", affinity_checks " +
-                          std::to_string(distribution.affinity_checks));
-  }
-  const double alpha = distribution.family_alpha / distribution.cases;  // Bonferroni
-  const int permutations = permutations_for(alpha);
-  const int samples = distribution.samples;
-  auto part = [component](const FlowSample& sample) -> const Eigen::VectorXd& {
-    return component == Component::flow_input ? sample.input : sample.target;
-  };
-  bool any_energy = false;
-  Eigen::Index largest_dimension = 0;
-  double largest_spread = 0.0;  // the RMS per-coordinate standard deviation, largest over energy cases
-  auto law_of = [&](const Scene& scene, double tolerance) {
-    const auto f = [&](const Eigen::VectorXd& eps) { return part((*target)(scene, eps, options.flow_time)); };
-    return affine_law(f, target->noise_dimension(scene), tolerance, options.noise_seed, distribution.affinity_checks);
-  };
+  detail::require_distribution_options(distribution);
+  detail::LawStatistics statistics;
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
     const Scene moved = g * scene;
-    const double tolerance = pointwise_tolerance(scene, moved, options.relative_tolerance);
-    detail::CaseOutcome outcome;
+    auto part_of = [&](const Scene& s) {
+      return [&target, &options, component, s](const Eigen::VectorXd& eps) -> Eigen::VectorXd {
+        const FlowSample sample = (*target)(s, eps, options.flow_time);
+        return component == Component::flow_input ? sample.input : sample.target;
+      };
+    };
+    const detail::NoisePair pair{part_of(scene), part_of(moved), target->noise_dimension(scene),
+                                 target->name() + ": the " + to_string(component)};
+    detail::CaseOutcome outcome =
+        detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance), options, distribution,
+                             statistics);
     outcome.witness.scene = scene;
     outcome.witness.g = g;
-    const std::optional<GaussianLaw> law = law_of(scene, tolerance);
-    const std::optional<GaussianLaw> moved_law = law ? law_of(moved, tolerance) : std::nullopt;
-    if (law && moved_law) {
-      // Exact: two Gaussian laws are one iff their means and covariances agree.
-      const LawDifference difference = law_difference(*law, *moved_law);
-      const double covariance_tolerance = tolerance * difference.covariance_scale;
-      outcome.witness.before = law->mean;
-      outcome.witness.after = moved_law->mean;
-      outcome.witness.error = std::max(difference.mean, difference.covariance);
-      outcome.witness.tolerance = tolerance;
-      outcome.witness.detail = "Gaussian laws (affine in eps): means differ by " + format_number(difference.mean) +
-                               ", covariances by " + format_number(difference.covariance) + " (tolerance " +
-                               format_number(tolerance) + ", covariance " + format_number(covariance_tolerance) + ")";
-      outcome.holds = difference.mean <= tolerance && difference.covariance <= covariance_tolerance;
-      return outcome;
-    }
-    any_energy = true;
-    const Eigen::Index noise = target->noise_dimension(scene);
-    std::mt19937_64 shared(options.noise_seed), fresh(options.noise_seed ^ 0x9e3779b97f4a7c15ULL);
-    auto draw = [noise](std::mt19937_64& rng) {
-      Eigen::VectorXd eps(noise);
-      for (Eigen::Index j = 0; j < noise; ++j) eps(j) = standard_normal(rng);
-      return eps;
-    };
-    // x: f(s, eps_i); same_eps: f(g s, eps_i) (the same draws); y: f(g s, eps'_i) (fresh draws).
-    Eigen::MatrixXd x, same_eps;
-    double pointwise = 0.0;
-    for (int i = 0; i < samples; ++i) {
-      const Eigen::VectorXd eps = draw(shared);
-      const Eigen::VectorXd u = part((*target)(scene, eps, options.flow_time));
-      const Eigen::VectorXd v = part((*target)(moved, eps, options.flow_time));
-      if (i == 0) {
-        x.resize(samples, u.size());
-        same_eps.resize(samples, v.size());
-      }
-      if (u.size() != x.cols() || v.size() != same_eps.cols()) {
-        throw InvalidArgument(target->name() + ": the " + to_string(component) + " changed length between noise draws");
-      }
-      x.row(i) = u.transpose();
-      same_eps.row(i) = v.transpose();
-      pointwise = u.size() == v.size() ? std::max(pointwise, u.size() ? (u - v).lpNorm<Eigen::Infinity>() : 0.0)
-                                       : std::numeric_limits<double>::infinity();
-    }
-    largest_dimension = std::max(largest_dimension, x.cols());
-    if (x.cols() > 0) {
-      const Eigen::RowVectorXd mean = x.colwise().mean();
-      const double variance = (x.rowwise() - mean).squaredNorm() / (static_cast<double>(samples - 1) * x.cols());
-      largest_spread = std::max(largest_spread, std::sqrt(variance));
-    }
-    outcome.witness.before = x.row(0).transpose();
-    outcome.witness.tolerance = alpha;
-    if (pointwise <= tolerance) {
-      // The same value on every shared draw: the two distributions are the same one, no test needed.
-      outcome.witness.after = same_eps.row(0).transpose();
-      outcome.witness.error = energy_distance(x, same_eps);
-      outcome.witness.p_value = 1.0;
-      return outcome;
-    }
-    if (x.cols() != same_eps.cols()) {  // different lengths: different laws
-      outcome.witness.after = same_eps.row(0).transpose();
-      outcome.witness.error = std::numeric_limits<double>::infinity();
-      outcome.witness.p_value = 0.0;
-      outcome.holds = false;
-      return outcome;
-    }
-    // Not pointwise: test f(s, eps) against f(g s, eps') with independent draws (a permutation
-    // test needs exchangeable samples; shared draws would not be).
-    Eigen::MatrixXd y(samples, same_eps.cols());
-    for (int i = 0; i < samples; ++i) y.row(i) = part((*target)(moved, draw(fresh), options.flow_time)).transpose();
-    const TwoSampleResult test = energy_test(x, y, permutations, options.seed, alpha);
-    outcome.witness.after = y.row(0).transpose();
-    outcome.witness.error = test.energy_distance;
-    outcome.witness.p_value = test.p_value;
-    outcome.holds = test.p_value >= alpha;
     return outcome;
   };
   Verdict verdict = detail::run_check(run_case, component, group, Mode::distribution, options, distribution.cases,
                                       distribution.shrink_budget);
-  verdict.method = any_energy ? Method::energy_test : Method::exact_gaussian;
-  if (verdict.method == Method::energy_test && verdict.invariant && largest_dimension > 0) {
-    verdict.detectable_shift = energy_test_detectable_shift(largest_dimension, samples, alpha) * largest_spread;
-  }
+  detail::finish_distribution_verdict(verdict, statistics, distribution);
   return verdict;
 }
 

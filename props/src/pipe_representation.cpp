@@ -1,30 +1,10 @@
 #include "handcentric/props/pipe_representation.hpp"
 
-#include <algorithm>
-#include <set>
 
 #include "handcentric/core/format.hpp"
 
 namespace handcentric::props {
 namespace {
-
-void require_names(const std::vector<std::string>& names, const std::string& flag) {
-  std::set<std::string> seen;
-  for (const std::string& name : names) {
-    if (name.empty() || !seen.insert(name).second) {
-      throw InvalidArgument(flag + " needs distinct, non-empty names, got '" + name + "' " +
-                            (name.empty() ? "(empty)" : "twice") + "; e.g. " + flag + " start,left_hand");
-    }
-  }
-}
-
-// `first` followed by the names of `second` it lacks.
-std::vector<std::string> merged(std::vector<std::string> first, const std::vector<std::string>& second) {
-  for (const std::string& name : second) {
-    if (std::find(first.begin(), first.end(), name) == first.end()) first.push_back(name);
-  }
-  return first;
-}
 
 }  // namespace
 
@@ -34,8 +14,8 @@ PipeRepresentation::PipeRepresentation(std::string command, double timeout_secon
       forced_extra_poses_(std::move(extra_pose_names)),
       forced_scalars_(std::move(scalar_names)),
       connection_(command_, timeout_seconds) {
-  require_names(forced_extra_poses_, "--extra-poses");
-  require_names(forced_scalars_, "--scalars");
+  require_distinct_names(forced_extra_poses_, "--extra-poses");
+  require_distinct_names(forced_scalars_, "--scalars");
 }
 
 PipeRepresentation::~PipeRepresentation() = default;
@@ -59,13 +39,8 @@ void PipeRepresentation::check_lengths(const Scene& scene, const PluginReply& re
 }
 
 Scene PipeRepresentation::with_extras(const Scene& scene) const {
-  Scene out = scene;
-  const PluginCapabilities* known = capabilities_ ? &*capabilities_ : nullptr;
-  const auto poses = known ? known->extra_pose_names : forced_extra_poses_;
-  const auto scalars = known ? known->scalar_names : forced_scalars_;
-  for (const std::string& name : poses) out.extra_poses.emplace_back(name, RigidTransform::identity());
-  for (const std::string& name : scalars) out.scalars.emplace_back(name, 0.0);
-  return out;
+  if (capabilities_) return with_named_extras(scene, capabilities_->extra_pose_names, capabilities_->scalar_names);
+  return with_named_extras(scene, forced_extra_poses_, forced_scalars_);
 }
 
 const PluginCapabilities& PipeRepresentation::capabilities() const {
@@ -78,8 +53,8 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   PluginReply reply = connection_.exchange(RequestKind::encode, encode_request_body(asked), /*hello_allowed=*/true);
   PluginCapabilities capabilities;
   if (reply.hello) capabilities = *reply.hello;
-  capabilities.extra_pose_names = merged(capabilities.extra_pose_names, forced_extra_poses_);
-  capabilities.scalar_names = merged(capabilities.scalar_names, forced_scalars_);
+  capabilities.extra_pose_names = merged_names(capabilities.extra_pose_names, forced_extra_poses_);
+  capabilities.scalar_names = merged_names(capabilities.scalar_names, forced_scalars_);
   capabilities_ = capabilities;
   if (reply.hello) {
     asked = with_extras(probe);

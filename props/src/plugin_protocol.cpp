@@ -1,6 +1,8 @@
 #include "handcentric/props/plugin_protocol.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -146,6 +148,37 @@ RigidTransform read_pose(const nlohmann::json& value, std::size_t k, int id, con
 
 }  // namespace
 
+void require_distinct_names(const std::vector<std::string>& names, const std::string& flag) {
+  std::set<std::string> seen;
+  for (const std::string& name : names) {
+    if (name.empty() || !seen.insert(name).second) {
+      throw InvalidArgument(flag + " needs distinct, non-empty names, got '" + name + "' " +
+                            (name.empty() ? "(empty)" : "twice") + "; e.g. " + flag + " start,left_hand");
+    }
+  }
+}
+
+std::vector<std::string> merged_names(std::vector<std::string> first, const std::vector<std::string>& second) {
+  for (const std::string& name : second) {
+    if (std::find(first.begin(), first.end(), name) == first.end()) first.push_back(name);
+  }
+  return first;
+}
+
+Scene with_named_extras(Scene scene, const std::vector<std::string>& pose_names,
+                        const std::vector<std::string>& scalar_names) {
+  auto has = [](const auto& named, const std::string& name) {
+    return std::any_of(named.begin(), named.end(), [&name](const auto& entry) { return entry.first == name; });
+  };
+  for (const std::string& name : pose_names) {
+    if (!has(scene.extra_poses, name)) scene.extra_poses.emplace_back(name, RigidTransform::identity());
+  }
+  for (const std::string& name : scalar_names) {
+    if (!has(scene.scalars, name)) scene.scalars.emplace_back(name, 0.0);
+  }
+  return scene;
+}
+
 std::string one_line(std::string text, std::size_t limit) {
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.pop_back();
   for (char& c : text) {
@@ -174,6 +207,14 @@ std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& obs
   append_vector(out, actions);
   out += ", ";
   append_observation(out, observation);
+  return out;
+}
+
+std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise) {
+  std::string out;
+  append_observation(out, observation);
+  out += ", \"noise\": ";
+  append_vector(out, noise);
   return out;
 }
 
@@ -217,12 +258,21 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     capabilities.scalar_names = read_names(hello, "scalars", id, who);
     capabilities.decode = read_flag(hello, "decode", id, who);
     capabilities.flow = read_flag(hello, "flow", id, who);
+    if (hello.contains("noise") && !hello["noise"].is_null()) {
+      if (!hello["noise"].is_number_integer() || hello["noise"].get<long long>() < 1 ||
+          hello["noise"].get<long long>() > 1000000) {
+        throw PluginError(reply_to(who, id) + " with a hello whose \"noise\" is " + one_line(hello["noise"].dump(), 40) +
+                          ", not a length between 1 and 1000000");
+      }
+      capabilities.noise = hello["noise"].get<int>();
+    }
     reply.hello = capabilities;
     return reply;
   }
-  if (kind == RequestKind::decode) {
+  if (kind == RequestKind::decode || kind == RequestKind::policy) {
     if (!json.contains("chunk") || !json["chunk"].is_array() || json["chunk"].empty()) {
-      throw PluginError(reply_to(who, id) + ", a decode request, without a \"chunk\" of poses: '" + one_line(line, 120) + "'");
+      throw PluginError(reply_to(who, id) + (kind == RequestKind::decode ? ", a decode request," : ", a policy request,") +
+                        " without a \"chunk\" of poses: '" + one_line(line, 120) + "'");
     }
     for (std::size_t k = 0; k < json["chunk"].size(); ++k) reply.chunk.push_back(read_pose(json["chunk"][k], k, id, who));
     return reply;

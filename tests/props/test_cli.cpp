@@ -226,3 +226,74 @@ TEST_CASE("the_text_audit_warns_loudly_about_a_map_that_is_not_injective", "[uni
   CHECK(result.exit_code == 0);
   CHECK_THAT(result.out, Contains("NOT INJECTIVE") && Contains("both encode to"));
 }
+
+TEST_CASE("policy_exec_audits_a_whole_policy_and_finds_each_planted_fault", "[unit]") {
+  auto policy = [](const std::string& fault) {
+    const auto result = test::run_command(test::cli() + " audit --policy-exec '" +
+                                          test::test_plugin("policy_hand_centric.py", fault) +
+                                          "' --cases 40 --view eye_in_hand --json");
+    INFO(result.err);
+    REQUIRE(result.exit_code == 0);
+    return nlohmann::json::parse(result.out).at("policies").at(0);
+  };
+  const auto right = policy("");
+  for (const auto& check : right.at("checks")) CHECK(check.at("equivariant") == true);
+  const auto world_noise = policy("world_noise");
+  CHECK(world_noise.at("summary").at("eye_in_hand").at("pointwise").at("rotation") == false);
+  CHECK(world_noise.at("summary").at("eye_in_hand").at("distribution").at("rotation") == true);
+  CHECK(world_noise.at("summary").at("eye_in_hand").at("pointwise").at("translation") == true);
+  const auto forgets = policy("forgets_T0");
+  for (const auto& check : forgets.at("checks")) CHECK(check.at("equivariant") == false);
+  const auto velocity = policy("world_velocity");
+  CHECK(velocity.at("summary").at("eye_in_hand").at("pointwise").at("translation") == true);
+  CHECK(velocity.at("summary").at("eye_in_hand").at("distribution").at("rotation") == false);
+}
+
+TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[unit]") {
+  const auto pass = test::run_command(test::cli() + " audit --repr hand_centric --cases 30 --expect se3,actions:c8");
+  CHECK(pass.exit_code == 0);
+  const auto fail = test::run_command(test::cli() + " audit --repr relative --cases 30 --expect actions:rotation");
+  CHECK(fail.exit_code == 1);
+  CHECK_THAT(fail.err, Contains("expected invariance does not hold") && Contains("g: r = "));
+  const auto policy = test::run_command(test::cli() + " audit --policy-exec '" +
+                                        test::test_plugin("policy_hand_centric.py", "world_noise") +
+                                        "' --cases 20 --group rotation --view eye_in_hand --expect rotation --json");
+  CHECK(policy.exit_code == 1);
+  CHECK_THAT(policy.err, Contains("expected equivariance does not hold"));
+  const auto empty = test::run_command(test::cli() + " audit --repr hand_centric --group se3 --cases 5 --expect c8");
+  CHECK(empty.exit_code == 1);
+  CHECK_THAT(empty.err, Contains("matches no check"));
+  const auto bad = test::run_command(test::cli() + " audit --repr hand_centric --cases 5 --expect hands:se3");
+  CHECK(bad.exit_code == 1);
+  CHECK_THAT(bad.err, Contains("'hands'"));
+}
+
+TEST_CASE("audit_model_finds_a_trained_hand_centric_policy_equivariant_and_an_absolute_one_not", "[unit]") {
+  const std::string dir = "/tmp/handcentric_test_audit_model";
+  REQUIRE(test::run_command("rm -rf " + dir + " && mkdir -p " + dir).exit_code == 0);
+  REQUIRE(test::run_command(test::cli() + " demos --n 5 --dist train --seed 1 --out " + dir + "/d.jsonl").exit_code == 0);
+  for (const char* repr : {"hand_centric", "absolute"}) {
+    const auto trained = test::run_command(test::cli() + " train --demos " + dir + "/d.jsonl --repr " + repr +
+                                           " --steps 50 --seed 1 --out " + dir + "/" + repr + ".model");
+    INFO(trained.err);
+    REQUIRE(trained.exit_code == 0);
+  }
+  auto audit = [&](const std::string& repr) {
+    const auto result = test::run_command(test::cli() + " audit --model " + dir + "/" + repr +
+                                          ".model --cases 30 --json");
+    INFO(result.err);
+    REQUIRE(result.exit_code == 0);
+    return nlohmann::json::parse(result.out).at("policies").at(0);
+  };
+  const auto hand = audit("hand_centric");
+  CHECK_FALSE(hand.at("summary").contains("third_person"));  // the model takes no world points
+  for (const auto& check : hand.at("checks")) {
+    INFO(check.dump());
+    CHECK(check.at("equivariant") == true);
+  }
+  const auto absolute = audit("absolute");
+  for (const auto& check : absolute.at("checks")) {
+    if (check.at("mode") == "pointwise") CHECK(check.at("equivariant") == false);
+  }
+  test::run_command("rm -rf " + dir);
+}

@@ -8,6 +8,7 @@
 //                    pointwise and in distribution.
 //   flow target    : its input and target, pointwise and in distribution.
 // And what the paper says each built-in should give (App. A), to assert and to report against.
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -51,6 +52,13 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
 
 Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
                                     const ClassifierOptions& options = {});
+
+/// A failure at a tolerance tighter than float32 rounding that passes at float32 rounding is
+/// worth a sentence: the map is probably right and computed in float32. If options ask for it
+/// and `verdict` failed below kFloat32RelativeTolerance, reruns `recheck` there (no shrinking)
+/// and sets the verdict's note when it holds.
+Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
+                          const std::function<Verdict(const CheckOptions&)>& recheck);
 
 /// `check` with the scenes of `view` (its world-point counts), everything else kept.
 CheckOptions with_view(CheckOptions check, View view);

@@ -10,10 +10,12 @@
 //     Two Gaussian laws are equal iff their means and covariances are: compared up to rounding.
 //     This covers the rectified flow of every representation (a - eps, t a + (1 - t) eps) and
 //     ActionFlow's target: the question has an exact answer, so no test is run.
-//   energy_test: otherwise, the energy distance (Szekely & Rizzo) between f(s, eps_i) and
-//     f(g s, eps'_i) and its permutation p-value (or p = 1 when f(g s, eps_i) = f(s, eps_i) on
-//     every shared draw). A "yes" then means "no difference found", and the verdict states the
-//     smallest mean shift the test finds with 90% power (energy_test_detectable_shift).
+//   energy_test: otherwise, two tests at half the level each (or p = 1 when f(g s, eps_i) =
+//     f(s, eps_i) on every shared draw): the energy distance (Szekely & Rizzo) between
+//     f(s, eps_i) and f(g s, eps'_i) with its permutation p-value, and a paired test of the mean
+//     of f(s, eps_i) - f(g s, eps_i), which equal laws make zero. A "yes" then means "no
+//     difference found", and the verdict states the smallest mean shift the energy test alone
+//     finds with 90% power (energy_test_detectable_shift; the pair finds at least as much).
 // docs/AUDIT.md has the numbers (samples, permutations, level) and why.
 #include <Eigen/Core>
 #include <cstdint>
@@ -54,6 +56,14 @@ struct DistributionOptions {
 
 /// Permutations used for a per-case level alpha: enough that p can fall below it twice over.
 int permutations_for(double alpha_per_case);
+
+/// Two-sided p-value of Student's t statistic `t` with the given degrees of freedom.
+double student_t_two_sided_p(double t, double degrees_of_freedom);
+
+/// The paired test of "the rows of `differences` have mean zero": Student's t per column,
+/// Bonferroni over the columns (a column with no spread above `tolerance` rejects when its mean
+/// is above it). Returns the adjusted p-value.
+double paired_mean_test(const Eigen::MatrixXd& differences, double tolerance);
 
 /// The law of f(eps), eps ~ N(0, I), when f is affine: f(eps) = mean + noise_map eps, so the
 /// law is N(mean, noise_map noise_map^T).

@@ -8,9 +8,11 @@
 //            -> {"id", "actions" [, "observation"] [, "flow_input", "flow_target"]}
 //   decode : {"id", "protocol", "decode": [actions], "history", "hand_points", "world_points"
 //             [, extras]} -> {"id", "chunk": [[16], ...]}
+//   policy : {"id", "protocol", "history", "hand_points", "world_points" [, extras],
+//             "noise": [numbers]} -> {"id", "chunk": [[16], ...]}   (a whole policy, eq. 4)
 //   hello  : a plug-in may answer the first request it reads with
 //            {"id", "hello": {"protocol": 2, "extra_poses": [names], "scalars": [names],
-//             "decode": bool, "flow": bool}} instead; the audit then asks again.
+//             "decode": bool, "flow": bool, "noise": n}} instead; the audit then asks again.
 // Matrices are 16 numbers, row-major 4x4.
 #include <Eigen/Core>
 #include <optional>
@@ -32,7 +34,11 @@ struct PluginCapabilities {
   std::vector<std::string> scalar_names;
   bool decode = false;
   bool flow = false;
+  int noise = 0;  ///< a policy's noise length; 0: the default (kPolicyNoise)
 };
+
+/// The noise a policy request carries unless the plug-in's hello asks for another length.
+constexpr int kPolicyNoise = 256;
 
 /// The noise and time of a flow request.
 struct FlowQuery {
@@ -44,6 +50,8 @@ struct FlowQuery {
 std::string encode_request_body(const Scene& scene, const std::optional<FlowQuery>& flow = std::nullopt);
 /// The body of a decode request: the observation (no chunk) and the actions to decode.
 std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& observation);
+/// The body of a policy request: the observation (no chunk) and the noise.
+std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise);
 /// The whole line: {"id": id, "protocol": 2, <body>}\n.
 std::string request_line(int id, const std::string& body);
 
@@ -52,10 +60,10 @@ struct PluginReply {
   std::optional<PluginCapabilities> hello;
   Eigen::VectorXd actions, observation, flow_input, flow_target;
   bool has_observation = false, has_flow = false;
-  std::vector<RigidTransform> chunk;  ///< decode replies
+  std::vector<RigidTransform> chunk;  ///< decode and policy replies
 };
 
-enum class RequestKind { encode, flow, decode };
+enum class RequestKind { encode, flow, decode, policy };
 
 /// Parses and validates `line` as the reply to request `id` of `kind`; `who` names the plug-in
 /// in messages. Throws PluginError with a one-line message for anything else: not JSON, a
@@ -63,6 +71,15 @@ enum class RequestKind { encode, flow, decode };
 /// last row 0 0 0 1.
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
                         bool hello_allowed);
+
+/// Throws InvalidArgument naming `flag` for an empty or repeated name.
+void require_distinct_names(const std::vector<std::string>& names, const std::string& flag);
+/// `first` followed by the names of `second` it lacks (a hello's names, then a flag's).
+std::vector<std::string> merged_names(std::vector<std::string> first, const std::vector<std::string>& second);
+
+/// A scene with an identity pose and a zero for each name it lacks (the handshake's probe).
+Scene with_named_extras(Scene scene, const std::vector<std::string>& pose_names,
+                        const std::vector<std::string>& scalar_names);
 
 /// `text` as one line (newlines -> '|'), cut at `limit` characters.
 std::string one_line(std::string text, std::size_t limit = 200);

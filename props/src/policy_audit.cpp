@@ -1,0 +1,116 @@
+#include "handcentric/props/policy_audit.hpp"
+
+#include <cstring>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/props/tolerance.hpp"
+#include "check_runner.hpp"
+
+namespace handcentric::props {
+namespace {
+
+constexpr int kShrinkBudget = 1000;
+
+std::vector<RigidTransform> moved_by(const RigidTransform& g, const std::vector<RigidTransform>& chunk) {
+  std::vector<RigidTransform> out;
+  out.reserve(chunk.size());
+  for (const RigidTransform& world_T_handk : chunk) out.push_back(g * world_T_handk);
+  return out;
+}
+
+// Each pose as [p, R row-major]: 12 numbers on which g acts affinely (R -> R~ R, p -> R~ p + p~),
+// so a chunk affine in the noise stays affine after g.
+Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk) {
+  Eigen::VectorXd v(12 * static_cast<Eigen::Index>(chunk.size()));
+  for (std::size_t k = 0; k < chunk.size(); ++k) {
+    const Eigen::Index at = 12 * static_cast<Eigen::Index>(k);
+    v.segment<3>(at) = chunk[k].translation();
+    const Eigen::Matrix3d& R = chunk[k].rotation().matrix();
+    for (int r = 0; r < 3; ++r) v.segment<3>(at + 3 + 3 * r) = R.row(r).transpose();
+  }
+  return v;
+}
+
+}  // namespace
+
+SeededPolicy::SeededPolicy(std::shared_ptr<const ChunkPolicy> policy) : policy_(std::move(policy)) {
+  if (!policy_) throw InvalidArgument("SeededPolicy needs a policy, got null");
+}
+
+std::vector<RigidTransform> SeededPolicy::act(const Scene& observation, const Eigen::VectorXd& noise) const {
+  // FNV-1a over the noise's bytes: the same vector, the same seed.
+  std::uint64_t seed = 1469598103934665603ULL;
+  for (Eigen::Index i = 0; i < noise.size(); ++i) {
+    std::uint64_t bits = 0;
+    const double x = noise(i);
+    std::memcpy(&bits, &x, sizeof(bits));
+    for (int b = 0; b < 8; ++b) seed = (seed ^ ((bits >> (8 * b)) & 0xffU)) * 1099511628211ULL;
+  }
+  return policy_->act(observation, seed);
+}
+
+Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group, const CheckOptions& options) {
+  const Eigen::VectorXd noise = fixed_noise(policy.noise_dimension(), options.noise_seed);
+  const double relative = options.relative_tolerance;
+  auto run_case = [&](const Scene& scene, const RigidTransform& g) {
+    detail::CaseOutcome outcome;
+    const std::vector<RigidTransform> g_a = moved_by(g, policy.act(scene, noise));
+    const std::vector<RigidTransform> a_g = policy.act(g * scene, noise);
+    outcome.witness.scene = scene;
+    outcome.witness.g = g;
+    outcome.witness.before = detail::flatten(g_a);
+    outcome.witness.after = detail::flatten(a_g);
+    outcome.witness.error = detail::chunk_distance(g_a, a_g);  // eq. (4)
+    outcome.witness.tolerance = pointwise_tolerance(scene, g * scene, relative);
+    outcome.holds = outcome.witness.error <= outcome.witness.tolerance;  // false for NaN
+    return outcome;
+  };
+  return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options, options.cases, kShrinkBudget);
+}
+
+Verdict check_policy_distribution(const NoisyPolicy& policy, Group group, const CheckOptions& options,
+                                  const DistributionOptions& distribution) {
+  detail::require_distribution_options(distribution);
+  detail::LawStatistics statistics;
+  auto run_case = [&](const Scene& scene, const RigidTransform& g) {
+    const Scene moved = g * scene;
+    detail::NoisePair pair;
+    pair.before = [&policy, &scene, g](const Eigen::VectorXd& noise) {
+      return flatten_affine(moved_by(g, policy.act(scene, noise)));
+    };
+    pair.after = [&policy, &moved](const Eigen::VectorXd& noise) { return flatten_affine(policy.act(moved, noise)); };
+    pair.noise_dimension = policy.noise_dimension();
+    pair.name = policy.name() + ": the chunk";
+    detail::CaseOutcome outcome = detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance),
+                                                       options, distribution, statistics);
+    outcome.witness.scene = scene;
+    outcome.witness.g = g;
+    return outcome;
+  };
+  Verdict verdict = detail::run_check(run_case, Component::policy, group, Mode::distribution, options, distribution.cases,
+                                      distribution.shrink_budget);
+  detail::finish_distribution_verdict(verdict, statistics, distribution);
+  return verdict;
+}
+
+Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy, const ClassifierOptions& options) {
+  if (!policy) throw InvalidArgument("classify_policy needs a policy, got null");
+  Classification out;
+  out.name = policy->name();
+  for (View view : options.views) {
+    const CheckOptions check = with_view(options.check, view);
+    for (Group group : options.groups) {
+      out.verdicts.push_back(with_float32_note(check_policy_equivariance(*policy, group, check), options,
+                                               [&](const CheckOptions& o) { return check_policy_equivariance(*policy, group, o); }));
+    }
+    if (!options.in_distribution) continue;
+    for (Group group : options.groups) {
+      out.verdicts.push_back(with_float32_note(
+          check_policy_distribution(*policy, group, check, options.distribution), options,
+          [&](const CheckOptions& o) { return check_policy_distribution(*policy, group, o, options.distribution); }));
+    }
+  }
+  return out;
+}
+
+}  // namespace handcentric::props
