@@ -25,7 +25,7 @@ void require_property(const std::string& description, Testable&& testable) {
 template <typename Testable>
 PropertyOutcome require_falsified(const std::string& description, Testable&& testable) {
   const PropertyOutcome outcome =
-      run_property(description, std::forward<Testable>(testable), test_params(), Expect::failure);
+      run_property(description, std::forward<Testable>(testable), property_params(), Expect::failure);
   INFO(description << " was expected to FAIL (planted fault), but held on " << outcome.cases
                    << " cases; seed " << outcome.seed);
   REQUIRE_FALSE(outcome.passed);

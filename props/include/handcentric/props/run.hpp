@@ -5,12 +5,16 @@
 //
 // Seeds: RC_PARAMS="seed=S" sets S; without it, properties run with kDefaultSeed, so a test run
 // is deterministic. A failure message always names its seed and how to replay it.
+//
+// Only RapidCheck's public API appears here: a property's arguments are drawn with
+// rc::gen::arbitrary inside a property of no arguments, and the run itself happens in run.cpp.
 #include <rapidcheck.h>
-#include <rapidcheck/detail/TestListenerAdapter.h>
 
 #include <cstdint>
-#include <sstream>
+#include <functional>
 #include <string>
+#include <tuple>
+#include <type_traits>
 
 namespace handcentric::props {
 
@@ -26,44 +30,62 @@ struct PropertyOutcome {
   std::string message;         ///< RapidCheck's full message plus how to replay
 };
 
-/// The test parameters from RC_PARAMS (max_success, max_size, ...), with kDefaultSeed and
-/// kDefaultCases unless RC_PARAMS names them.
-rc::detail::TestParams test_params();
+/// Seed and case count of a property run.
+struct PropertyParams {
+  std::uint64_t seed = kDefaultSeed;
+  int cases = kDefaultCases;
+};
+
+/// RC_PARAMS's seed and max_success where it names them, else kDefaultSeed and kDefaultCases.
+PropertyParams property_params();
 
 /// Whether a failure is news (print RapidCheck's "to reproduce" line at exit) or the expected
 /// result of a planted fault (stay quiet: the outcome carries the counterexample).
 enum class Expect { pass, failure };
 
-/// Runs `testable` (a callable whose arguments RapidCheck generates) under `params`.
+/// Runs a property of no arguments (it draws its values with *gen and fails with RC_ASSERT).
+PropertyOutcome run_nullary_property(const std::string& description, const std::function<void()>& property,
+                                     const PropertyParams& params = property_params(), Expect expect = Expect::pass);
+
+namespace detail {
+
+template <typename F>
+struct Arguments : Arguments<decltype(&std::decay_t<F>::operator())> {};
+template <typename C, typename R, typename... A>
+struct Arguments<R (C::*)(A...) const> {
+  using Result = R;
+  using Tuple = std::tuple<std::decay_t<A>...>;
+};
+template <typename C, typename R, typename... A>
+struct Arguments<R (C::*)(A...)> : Arguments<R (C::*)(A...) const> {};
+template <typename R, typename... A>
+struct Arguments<R (*)(A...)> {
+  using Result = R;
+  using Tuple = std::tuple<std::decay_t<A>...>;
+};
+
+// Draws each argument in order (a braced list evaluates left to right), then calls.
+template <typename Testable, typename... A>
+void call_with_arbitrary(Testable& testable, std::tuple<A...>*) {
+  std::tuple<A...> arguments{*rc::gen::arbitrary<A>()...};
+  if constexpr (std::is_same_v<decltype(std::apply(testable, arguments)), bool>) {
+    RC_ASSERT(std::apply(testable, arguments));
+  } else {
+    std::apply(testable, arguments);
+  }
+}
+
+}  // namespace detail
+
+/// Runs `testable` (a callable whose arguments RapidCheck generates with rc::gen::arbitrary;
+/// it may return bool or assert with RC_ASSERT) under `params`.
 template <typename Testable>
 PropertyOutcome run_property(const std::string& description, Testable&& testable,
-                             const rc::detail::TestParams& params = test_params(),
-                             Expect expect = Expect::pass) {
-  rc::detail::TestMetadata metadata;
-  metadata.id = description;
-  metadata.description = description;
-  rc::detail::TestListenerAdapter quiet;
-  const auto result =
-      expect == Expect::pass
-          ? rc::detail::checkTestable(std::forward<Testable>(testable), metadata, params)
-          : rc::detail::checkTestable(std::forward<Testable>(testable), metadata, params, quiet);
-  PropertyOutcome outcome;
-  outcome.seed = params.seed;
-  std::ostringstream message;
-  rc::detail::printResultMessage(result, message);
-  if (result.template is<rc::detail::SuccessResult>()) {
-    outcome.passed = true;
-    outcome.cases = result.template get<rc::detail::SuccessResult>().numSuccess;
-  } else if (result.template is<rc::detail::FailureResult>()) {
-    const auto& failure = result.template get<rc::detail::FailureResult>();
-    outcome.cases = failure.numSuccess + 1;
-    std::ostringstream example;
-    for (const auto& [type, value] : failure.counterExample) example << type << ":\n" << value << "\n";
-    outcome.counterexample = example.str();
-  }
-  message << "\nseed " << params.seed << "; replay with RC_PARAMS=\"seed=" << params.seed << "\"";
-  outcome.message = message.str();
-  return outcome;
+                             const PropertyParams& params = property_params(), Expect expect = Expect::pass) {
+  using Tuple = typename detail::Arguments<Testable>::Tuple;
+  return run_nullary_property(
+      description, [&testable] { detail::call_with_arbitrary(testable, static_cast<Tuple*>(nullptr)); }, params,
+      expect);
 }
 
 }  // namespace handcentric::props
