@@ -19,10 +19,14 @@ function(handcentric_library module)
   handcentric_warnings(${target})
   # errno is never read: lets sqrt/sin/cos inline and fuse (no ABI or result change).
   target_compile_options(${target} PRIVATE -fno-math-errno)
-  install(TARGETS ${target} EXPORT handcentricTargets
+  # One export set per module: find_package(handcentric COMPONENTS core props) loads only those
+  # modules and looks only for their dependencies (handcentricConfig.cmake.in).
+  install(TARGETS ${target} EXPORT handcentric_${module}Targets
           ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
           LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
   install(DIRECTORY include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+  install(EXPORT handcentric_${module}Targets NAMESPACE handcentric::
+          DESTINATION ${CMAKE_INSTALL_LIBDIR}/cmake/handcentric)
 endfunction()
 
 # handcentric_test(<name> SOURCES ... DEPS ... LABELS ...): one Catch2 executable per folder.
