@@ -112,7 +112,8 @@ int run_sim_section(std::ostream& out) {
   return status;
 }
 
-const ReportSection sim_section(40, "sim", run_sim_section);
+const ReportSection sim_section(40, "sim",
+                                 [](std::ostream& out, const ReportOptions&) { return run_sim_section(out); });
 
 }  // namespace
 }  // namespace handcentric::apps

@@ -52,7 +52,8 @@ int run_proofs_section(std::ostream& out) {
 }
 
 const CommandRegistration prove_command("prove", add_prove_command);
-const ReportSection proofs_section(20, "proofs", run_proofs_section);
+const ReportSection proofs_section(20, "proofs",
+                                 [](std::ostream& out, const ReportOptions&) { return run_proofs_section(out); });
 
 }  // namespace
 }  // namespace handcentric::apps

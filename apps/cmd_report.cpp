@@ -13,17 +13,6 @@
 namespace handcentric::apps {
 namespace {
 
-struct ReportOptions {
-  int cases = 1000;
-  std::uint64_t seed = 1;
-};
-
-// The options `handcentric report` parsed (defaults for plain `handcentric`).
-ReportOptions& current_options() {
-  static ReportOptions options;
-  return options;
-}
-
 int run_audit_section(const ReportOptions& options, std::ostream& out) {
   props::AuditOptions audit;
   audit.cases = options.cases;
@@ -57,15 +46,12 @@ void add_report_command(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand("report", "the main report (what plain `handcentric` runs)");
   cmd->add_option("--cases", options->cases, "cases per pointwise cell of the audit section")->capture_default_str();
   cmd->add_option("--seed", options->seed, "seed of the audit section")->capture_default_str();
-  cmd->callback([options, &exit_code] {
-    current_options() = *options;
-    exit_code = run_main_report(std::cout);
-  });
+  cmd->callback([options, &exit_code] { exit_code = run_main_report(std::cout, *options); });
 }
 
 const CommandRegistration report_command("report", add_report_command);
-const ReportSection audit_section(10, "audit", [](std::ostream& out) {
-  return run_audit_section(current_options(), out);
+const ReportSection audit_section(10, "audit", [](std::ostream& out, const ReportOptions& options) {
+  return run_audit_section(options, out);
 });
 
 }  // namespace

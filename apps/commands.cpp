@@ -39,10 +39,10 @@ std::vector<RegisteredSection> report_sections() {
   return list;
 }
 
-int run_main_report(std::ostream& out) {
+int run_main_report(std::ostream& out, const ReportOptions& options) {
   int status = 0;
   for (const RegisteredSection& section : report_sections()) {
-    if (section.run(out) != 0) status = 1;
+    if (section.run(out, options) != 0) status = 1;
     out << "\n";
   }
   return status;

@@ -8,6 +8,7 @@
 // A command's callback sets `exit_code`. Errors: handcentric::Error -> one line on stderr and
 // exit 1 (main.cpp); usage errors -> exit 2 (CLI11).
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <functional>
 #include <ostream>
 #include <string>
@@ -29,9 +30,15 @@ struct RegisteredCommand {
 /// All registered commands, sorted by name.
 std::vector<RegisteredCommand> registered_commands();
 
+/// What `handcentric report` lets a user set (plain `handcentric` uses the defaults).
+struct ReportOptions {
+  int cases = 1000;        ///< cases per pointwise cell of the audit section
+  std::uint64_t seed = 1;  ///< seed of the audit section
+};
+
 /// One part of the main report (plain `handcentric` / `handcentric report`), printed in `order`.
 /// `run` returns 0 when everything it checked matched the paper, 1 otherwise.
-using RunSection = std::function<int(std::ostream& out)>;
+using RunSection = std::function<int(std::ostream& out, const ReportOptions& options)>;
 
 struct ReportSection {
   ReportSection(int order, std::string name, RunSection run);
@@ -47,6 +54,6 @@ struct RegisteredSection {
 std::vector<RegisteredSection> report_sections();
 
 /// Prints every section; returns 0 when all returned 0.
-int run_main_report(std::ostream& out);
+int run_main_report(std::ostream& out, const ReportOptions& options = {});
 
 }  // namespace handcentric::apps

@@ -1,4 +1,4 @@
-// Policy speed (issue 5): training throughput of the flow head on the anchor network of
+// Policy speed: training throughput of the flow head on the anchor network of
 // bench/vs_pytorch.sh, 57 inputs (24 noisy action + 1 time + 32 observation) -> 256 -> 256 -> 256
 // -> 24, SiLU, Adam, batch 256; and sampling latency at batch 1 (10 Euler steps). Numbers are
 // recorded in docs/BENCHMARKS.md ("## Policy") with the commands that produced them.

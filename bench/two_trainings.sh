@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Issue 5's goal "two independent trainings on the two cores each keep >= 90% of one alone":
-# the training benchmark alone on core 0, then one copy on each of cores 0 and 1 at the same
+# Do two independent trainings on the two cores each keep >= 90% of the speed of one alone?
+# It runs the training benchmark alone on core 0, then one copy on each of cores 0 and 1 at the same
 # time. Prints the three rates and, last, `kept: X Y` = each concurrent rate / the solo rate.
 #
 #   bench/two_trainings.sh [BUILD_DIR]        (default: build; needs 2 cores and taskset)

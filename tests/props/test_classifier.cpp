@@ -1,5 +1,5 @@
-// The classifier on every built-in, asserted cell by cell against App. A of the paper (issue 3,
-// item 4), and on a mutant whose classification must differ.
+// The classifier on every built-in, asserted cell by cell against App. A of the paper, in both
+// views, and on mutants whose classification must differ.
 #include <catch2/catch.hpp>
 #include <functional>
 #include <memory>

@@ -1,4 +1,4 @@
-// Exact collision at the clearance (issue 6): the checker sees a 0.01 gap that Box2D's skin
+// Exact collision at the clearance: the checker sees a 0.01 gap that Box2D's skin
 // hides, the tilt that closes the gap, and motions that pass through a wall between free poses.
 #include <box2d/b2_collision.h>
 #include <box2d/b2_polygon_shape.h>

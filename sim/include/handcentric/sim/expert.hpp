@@ -46,7 +46,7 @@ struct ExpertOptions {
   int iterations = 60;       ///< optimizer steps
   bool random_via = true;    ///< false: no via point (the deterministic closed-loop expert)
   int attempts = 8;          ///< random via points tried per scene before it counts as unsolved
-  double arrival_weight = 10.0;  ///< w_arr; 0 = the old approach that turns down in one step
+  double arrival_weight = 10.0;  ///< w_arr; 0 turns down into the hole in one step
 };
 
 struct ExpertPlan {
