@@ -58,6 +58,7 @@ PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body
   switch (process_.write_all(request_line(id, body), timeout_seconds_)) {
     case Subprocess::Outcome::done: break;
     case Subprocess::Outcome::closed: fail_exited("before reading request " + std::to_string(id));
+    case Subprocess::Outcome::too_long: break;  // writing has no line limit
     case Subprocess::Outcome::timed_out:
       process_.kill();
       fail(who() + " did not read request " + std::to_string(id) + " within " + seconds_text(timeout_seconds_) +
@@ -68,6 +69,10 @@ PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body
   switch (process_.read_line(line, timeout_seconds_)) {
     case Subprocess::Outcome::done: break;
     case Subprocess::Outcome::closed: fail_exited("before answering request " + std::to_string(id));
+    case Subprocess::Outcome::too_long:
+      process_.kill();
+      fail(who() + " answered request " + std::to_string(id) + " with a line longer than " +
+           std::to_string(Subprocess::kMaxLineBytes >> 20) + " MiB; answers are one line of JSON, far shorter");
     case Subprocess::Outcome::timed_out:
       process_.kill();
       fail(who() + " gave no answer to request " + std::to_string(id) + " within " + seconds_text(timeout_seconds_) +

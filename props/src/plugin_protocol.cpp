@@ -223,6 +223,26 @@ std::string request_line(int id, const std::string& body) {
 }
 
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who, bool hello_allowed) {
+  // Nesting first, outside strings: a parser recursing into 10^6 brackets would overflow the stack.
+  int depth = 0, deepest = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      deepest = std::max(deepest, ++depth);
+      if (deepest > kMaxReplyDepth) {
+        throw PluginError(reply_to(who, id) + " with JSON nested deeper than " + std::to_string(kMaxReplyDepth) +
+                          " levels; an answer needs 3");
+      }
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
   nlohmann::json json;
   try {
     json = nlohmann::json::parse(line);

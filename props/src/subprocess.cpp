@@ -34,7 +34,8 @@ std::string Subprocess::Exit::describe() const {
   return "closed its stdout";
 }
 
-Subprocess::Subprocess(std::string command) : command_(std::move(command)) {
+Subprocess::Subprocess(std::string command, std::size_t max_line_bytes)
+    : command_(std::move(command)), max_line_bytes_(max_line_bytes) {
   ::signal(SIGPIPE, SIG_IGN);  // a dead child gives EPIPE, which the caller reports
   int in[2], out[2], err[2];
   if (pipe2(in, O_CLOEXEC) != 0) throw PluginError("cannot create pipes for '" + command_ + "': " + std::strerror(errno));
@@ -149,6 +150,7 @@ Subprocess::Outcome Subprocess::read_line(std::string& line, double timeout) {
       if (!line.empty() && line.back() == '\r') line.pop_back();
       return Outcome::done;
     }
+    if (stdout_buffer_.size() > max_line_bytes_) return Outcome::too_long;
     if (stdout_ < 0) return Outcome::closed;
     pollfd fds[2] = {{stdout_, POLLIN, 0}, {stderr_, POLLIN, 0}};
     const int ready = poll(fds, stderr_ >= 0 ? 2 : 1, remaining_ms(deadline));
@@ -186,6 +188,7 @@ Subprocess::Exit Subprocess::finish(double grace) {
     }
     if (got < 0 && errno != EINTR) break;
     if (remaining_ms(deadline) == 0) break;
+    drain_stderr(false);  // a child blocked on a full stderr pipe could not exit
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (!result.reaped) {

@@ -168,3 +168,17 @@ TEST_CASE("pipe_representation_rejects_an_empty_command_and_a_bad_timeout", "[un
   CHECK_THROWS_WITH(props::PipeRepresentation("cat", 0.0), Contains("--timeout"));
   CHECK_THROWS_WITH(props::PipeRepresentation("cat", std::nan("")), Contains("--timeout"));
 }
+
+TEST_CASE("plugin_replies_are_bounded_in_length_and_nesting", "[unit]") {
+  // A reply line over the limit stops the reading before more of it is kept.
+  props::Subprocess endless("head -c 5000 /dev/zero | tr '\\0' x", 1024);
+  std::string line;
+  CHECK(endless.read_line(line, 5.0) == props::Subprocess::Outcome::too_long);
+  const std::string deep = "{\"id\": 0, \"actions\": " + std::string(1000, '[') + std::string(1000, ']') + "}";
+  CHECK_THROWS_WITH(props::parse_reply(deep, 0, props::RequestKind::encode, "plug-in 'x'", false),
+                    Contains("nested deeper than"));
+  // Brackets inside strings do not count.
+  CHECK_THROWS_WITH(props::parse_reply("{\"id\": 0, \"note\": \"" + std::string(100, '[') + "\"}", 0,
+                                       props::RequestKind::encode, "plug-in 'x'", false),
+                    Contains("without \"actions\""));
+}

@@ -26,6 +26,8 @@
 namespace handcentric::props {
 
 constexpr int kProtocolVersion = 2;
+/// The deepest JSON nesting a reply may have (a reply needs 3: object, chunk, pose).
+constexpr int kMaxReplyDepth = 32;
 
 /// What a plug-in said about itself in its hello (or what flags asked for).
 struct PluginCapabilities {
@@ -66,9 +68,9 @@ struct PluginReply {
 enum class RequestKind { encode, flow, decode, policy };
 
 /// Parses and validates `line` as the reply to request `id` of `kind`; `who` names the plug-in
-/// in messages. Throws PluginError with a one-line message for anything else: not JSON, a
-/// non-finite number, a wrong id, a missing field, a matrix that is not 16 finite numbers with
-/// last row 0 0 0 1.
+/// in messages. Throws PluginError with a one-line message for anything else: not JSON, nested
+/// deeper than kMaxReplyDepth, a non-finite number, a wrong id, a missing field, a matrix that
+/// is not 16 finite numbers with last row 0 0 0 1.
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
                         bool hello_allowed);
 

@@ -33,14 +33,17 @@ class Subprocess {
     int signal = 0;
     std::string describe() const;  ///< "exited with status 3", "was killed by signal 9", ...
   };
-  enum class Outcome { done, timed_out, closed };
+  enum class Outcome { done, timed_out, closed, too_long };
 
   static constexpr int kStderrLines = 20;          ///< stderr lines kept
   static constexpr std::size_t kStderrLineBytes = 1000;  ///< longer lines are cut there
+  /// The longest stdout line read_line accepts by default: 64 MiB, far above any answer (a
+  /// chunk of 10^4 poses is ~3 MB), far below what would strain memory.
+  static constexpr std::size_t kMaxLineBytes = std::size_t{64} << 20;
 
   /// Starts `command` through /bin/sh -c. Throws PluginError if the pipes or the process
   /// cannot be made.
-  explicit Subprocess(std::string command);
+  explicit Subprocess(std::string command, std::size_t max_line_bytes = kMaxLineBytes);
   ~Subprocess();
   Subprocess(const Subprocess&) = delete;
   Subprocess& operator=(const Subprocess&) = delete;
@@ -48,7 +51,8 @@ class Subprocess {
   /// Writes all of `bytes` to the child's stdin within `timeout` seconds.
   Outcome write_all(const std::string& bytes, double timeout);
   /// Reads one line (without its newline, "\r" dropped) from the child's stdout within
-  /// `timeout` seconds; `line` is set only for Outcome::done.
+  /// `timeout` seconds; `line` is set only for Outcome::done. A line longer than
+  /// max_line_bytes gives Outcome::too_long before more of it is buffered.
   Outcome read_line(std::string& line, double timeout);
   /// The last kStderrLines lines the child wrote on stderr (drained first).
   std::string stderr_tail();
@@ -66,6 +70,7 @@ class Subprocess {
   void close_fd(int& fd);
 
   std::string command_;
+  std::size_t max_line_bytes_;
   int pid_ = -1;
   int stdin_ = -1, stdout_ = -1, stderr_ = -1;
   std::string stdout_buffer_;    ///< bytes read past the last newline
