@@ -59,20 +59,23 @@ struct Expectation {
 };
 
 props::Component parse_component(const std::string& name) {
-  for (props::Component c : {props::Component::actions, props::Component::observation, props::Component::flow_input,
-                             props::Component::flow_target, props::Component::policy}) {
+  for (props::Component c :
+       {props::Component::actions, props::Component::observation, props::Component::flow_input,
+        props::Component::flow_target, props::Component::policy}) {
     if (props::to_string(c) == name) return c;
   }
-  throw InvalidArgument("unknown component '" + name +
-                        "' in --expect; use actions, observation, flow_input, flow_target or policy, e.g. "
-                        "--expect actions:se3");
+  throw InvalidArgument(
+      "unknown component '" + name +
+      "' in --expect; use actions, observation, flow_input, flow_target or policy, e.g. "
+      "--expect actions:se3");
 }
 
 std::vector<Expectation> parse_expectations(const std::vector<std::string>& items) {
   std::vector<Expectation> out;
   for (const std::string& item : items) {
     const std::size_t colon = item.find(':');
-    Expectation e{std::nullopt, props::parse_group(colon == std::string::npos ? item : item.substr(colon + 1))};
+    Expectation e{std::nullopt,
+                  props::parse_group(colon == std::string::npos ? item : item.substr(colon + 1))};
     if (colon != std::string::npos) e.component = parse_component(item.substr(0, colon));
     out.push_back(e);
   }
@@ -81,7 +84,8 @@ std::vector<Expectation> parse_expectations(const std::vector<std::string>& item
 
 // The verdicts an --expect list asks to hold that do not; each failing one with its witness on
 // stderr. A group nothing was checked under is an error: an empty gate must not pass.
-int gate(const std::vector<props::Classification>& results, const std::vector<Expectation>& expectations) {
+int gate(const std::vector<props::Classification>& results,
+         const std::vector<Expectation>& expectations) {
   int failed = 0;
   for (const Expectation& e : expectations) {
     int checked = 0;
@@ -91,35 +95,41 @@ int gate(const std::vector<props::Classification>& results, const std::vector<Ex
         ++checked;
         if (v.invariant) continue;
         ++failed;
-        std::cerr << "handcentric audit: expected " << (v.component == props::Component::policy ? "equivariance" : "invariance")
+        std::cerr << "handcentric audit: expected "
+                  << (v.component == props::Component::policy ? "equivariance" : "invariance")
                   << " does not hold: " << c.name << ", " << props::to_string(v.component) << " ("
                   << props::to_string(v.mode) << ", " << props::to_string(v.view) << ") under "
-                  << props::to_string(v.group) << (v.note.empty() ? "" : "; note: " + v.note) << "\n";
+                  << props::to_string(v.group) << (v.note.empty() ? "" : "; note: " + v.note)
+                  << "\n";
         if (v.witness) std::cerr << props::format_witness(*v.witness) << "\n";
       }
     }
     if (checked == 0) {
-      throw InvalidArgument("--expect " + std::string(e.component ? props::to_string(*e.component) + ":" : "") +
-                            props::to_string(e.group) + " matches no check that ran; widen --group or --view");
+      throw InvalidArgument(
+          "--expect " + std::string(e.component ? props::to_string(*e.component) + ":" : "") +
+          props::to_string(e.group) + " matches no check that ran; widen --group or --view");
     }
   }
   return failed == 0 ? 0 : 1;
 }
 
 // A model's scenes must have its H and point counts; it sees world points only if trained on them.
-props::ClassifierOptions model_options(const policy::PolicyConfig& config, props::ClassifierOptions classifier) {
+props::ClassifierOptions model_options(const policy::PolicyConfig& config,
+                                       props::ClassifierOptions classifier) {
   props::SceneShape& shape = classifier.check.shape;
   shape.min_history = shape.max_history = config.history_length;
   shape.min_hand_points = shape.max_hand_points = config.hand_points;
-  const props::View only = config.world_points > 0 ? props::View::third_person : props::View::eye_in_hand;
+  const props::View only =
+      config.world_points > 0 ? props::View::third_person : props::View::eye_in_hand;
   std::vector<props::View> views;
   for (props::View v : classifier.views) {
     if (v == only) views.push_back(v);
   }
   if (views.empty()) {
     throw InvalidArgument("this model was trained with " + std::to_string(config.world_points) +
-                          " world points, so it can only be audited in the " + props::to_string(only) +
-                          " view; use --view " + props::to_string(only) + " or all");
+                          " world points, so it can only be audited in the " +
+                          props::to_string(only) + " view; use --view " + props::to_string(only) +
+                          " or all");
   }
   classifier.views = views;
   return classifier;
@@ -139,8 +149,8 @@ int run_audit(const AuditCommandOptions& options) {
   std::vector<props::Classification> results;
   bool policies = false;
   if (!options.exec.empty()) {
-    auto plugin = std::make_shared<props::PipeRepresentation>(options.exec, options.timeout, options.extra_poses,
-                                                              options.scalars);
+    auto plugin = std::make_shared<props::PipeRepresentation>(options.exec, options.timeout,
+                                                              options.extra_poses, options.scalars);
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
     props::ClassifierOptions classifier = props::classifier_options(audit);
     classifier.observation = plugin->provides_observation();
@@ -150,8 +160,8 @@ int run_audit(const AuditCommandOptions& options) {
     if (capabilities.flow) flow = std::make_shared<props::PipeFlowTarget>(plugin);
     results.push_back(props::classify_representation(plugin, classifier, flow));
   } else if (!options.policy_exec.empty()) {
-    auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout, options.extra_poses,
-                                                      options.scalars);
+    auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout,
+                                                      options.extra_poses, options.scalars);
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
     props::ClassifierOptions classifier = props::classifier_options(audit);
     classifier.check.shape.extra_pose_names = capabilities.extra_pose_names;
@@ -159,15 +169,20 @@ int run_audit(const AuditCommandOptions& options) {
     results.push_back(props::classify_policy(plugin, classifier));
     policies = true;
   } else if (!options.model.empty()) {
-    if (plugin_names) throw InvalidArgument("--extra-poses and --scalars are for plug-ins; a model reads neither");
+    if (plugin_names)
+      throw InvalidArgument("--extra-poses and --scalars are for plug-ins; a model reads neither");
     auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(options.model));
-    const props::ClassifierOptions classifier = model_options(model->config(), props::classifier_options(audit));
+    const props::ClassifierOptions classifier =
+        model_options(model->config(), props::classifier_options(audit));
     audit.views = classifier.views;
-    results.push_back(props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier));
+    results.push_back(
+        props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier));
     results.back().name = "model " + options.model + " (" + model->name() + ")";
     policies = true;
   } else {
-    if (plugin_names) throw InvalidArgument("--extra-poses and --scalars are for plug-ins; the built-ins read neither");
+    if (plugin_names)
+      throw InvalidArgument(
+          "--extra-poses and --scalars are for plug-ins; the built-ins read neither");
     results = props::audit_builtins(options.representations, audit);
   }
   if (options.json) {
@@ -175,36 +190,47 @@ int run_audit(const AuditCommandOptions& options) {
     return gate(results, expectations);
   }
   const props::ClassifierOptions used = props::classifier_options(audit);
-  std::cout << "handcentric audit: " << audit.cases << " (scene, g) cases per pointwise cell, "
-            << used.distribution.cases << " per in-distribution cell, seed " << audit.seed << "; tolerance "
-            << relative << " (1 + L)" << (options.tolerance > 0.0 ? " (--tolerance)"
-                                          : audit.precision == props::Precision::float32 ? " (float32 rounding)" : "")
-            << "\n"
-            << (policies ? "'yes' = equivariant, a(g o, n) = g a(o, n) (eq. 4); pointwise with the same noise n, in "
-                           "distribution with n ~ N(0, I). "
-                         : "'yes' = invariant. ")
-            << "The number is the largest error seen: pointwise the largest difference; in distribution, exactly "
-               "for maps affine in the noise, the larger difference of the two Gaussian laws' means and "
-               "covariances, else (marked ~) the energy distance of a permutation test at level "
-            << used.distribution.family_alpha << " per cell. Rules: docs/AUDIT.md\n\n";
+  std::cout
+      << "handcentric audit: " << audit.cases << " (scene, g) cases per pointwise cell, "
+      << used.distribution.cases << " per in-distribution cell, seed " << audit.seed
+      << "; tolerance " << relative << " (1 + L)"
+      << (options.tolerance > 0.0                        ? " (--tolerance)"
+          : audit.precision == props::Precision::float32 ? " (float32 rounding)"
+                                                         : "")
+      << "\n"
+      << (policies ? "'yes' = equivariant, a(g o, n) = g a(o, n) (eq. 4); pointwise with the same "
+                     "noise n, in "
+                     "distribution with n ~ N(0, I). "
+                   : "'yes' = invariant. ")
+      << "The number is the largest error seen: pointwise the largest difference; in distribution, "
+         "exactly "
+         "for maps affine in the noise, the larger difference of the two Gaussian laws' means and "
+         "covariances, else (marked ~) the energy distance of a permutation test at level "
+      << used.distribution.family_alpha << " per cell. Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
   return gate(results, expectations);
 }
 
 void add_audit_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<AuditCommandOptions>();
-  CLI::App* cmd = app.add_subcommand("audit", "which global transforms each representation is invariant under, and why not");
-  auto* repr = cmd->add_option("--repr", options->representations,
-                               "a built-in to audit (absolute, relative, relative_diff, hand_centric, actionflow); "
-                               "repeatable; default: all");
-  cmd->add_option("--group", options->group, "translation|rotation|se2|se3|c8|all")->capture_default_str();
-  cmd->add_option("--view", options->view,
-                  "eye_in_hand (no world points: Theorem 1's setting), third_person (1-8 world points that "
-                  "move with g) or all")
+  CLI::App* cmd = app.add_subcommand(
+      "audit", "which global transforms each representation is invariant under, and why not");
+  auto* repr = cmd->add_option(
+      "--repr", options->representations,
+      "a built-in to audit (absolute, relative, relative_diff, hand_centric, actionflow); "
+      "repeatable; default: all");
+  cmd->add_option("--group", options->group, "translation|rotation|se2|se3|c8|all")
       ->capture_default_str();
-  cmd->add_option("--cases", options->cases, "cases per pointwise check (in distribution: max(10, cases/100))")
+  cmd->add_option(
+         "--view", options->view,
+         "eye_in_hand (no world points: Theorem 1's setting), third_person (1-8 world points that "
+         "move with g) or all")
       ->capture_default_str();
-  cmd->add_option("--seed", options->seed, "RapidCheck seed: the same seed gives the same cases and witnesses")
+  cmd->add_option("--cases", options->cases,
+                  "cases per pointwise check (in distribution: max(10, cases/100))")
+      ->capture_default_str();
+  cmd->add_option("--seed", options->seed,
+                  "RapidCheck seed: the same seed gives the same cases and witnesses")
       ->capture_default_str();
   cmd->add_option("--tolerance", options->tolerance,
                   "REL in the pointwise tolerance REL * (1 + L); default 1e-9 (float64 rounding)");
@@ -213,26 +239,34 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--timeout", options->timeout, "seconds to wait for each answer of a plug-in")
       ->capture_default_str();
-  cmd->add_option("--extra-poses", options->extra_poses,
-                  "names of world-frame poses to send a plug-in (they move with g), e.g. start,left_hand; "
-                  "a plug-in can also ask for them in its hello")
+  cmd->add_option(
+         "--extra-poses", options->extra_poses,
+         "names of world-frame poses to send a plug-in (they move with g), e.g. start,left_hand; "
+         "a plug-in can also ask for them in its hello")
       ->delimiter(',');
-  cmd->add_option("--scalars", options->scalars,
-                  "names of numbers to send a plug-in (g leaves them alone), e.g. gripper; a plug-in can "
-                  "also ask for them in its hello")
+  cmd->add_option(
+         "--scalars", options->scalars,
+         "names of numbers to send a plug-in (g leaves them alone), e.g. gripper; a plug-in can "
+         "also ask for them in its hello")
       ->delimiter(',');
-  cmd->add_option("--expect", options->expect,
-                  "a gate: exit 1 with the witness unless every check under GROUP holds (COMPONENT:GROUP for "
-                  "one component), e.g. --expect se3 or --expect actions:se3,observation:translation")
+  cmd->add_option(
+         "--expect", options->expect,
+         "a gate: exit 1 with the witness unless every check under GROUP holds (COMPONENT:GROUP "
+         "for "
+         "one component), e.g. --expect se3 or --expect actions:se3,observation:translation")
       ->delimiter(',');
-  cmd->add_flag("--json", options->json, "print the JSON document of docs/AUDIT.md instead of tables");
-  auto* exec = cmd->add_option("--exec", options->exec,
-                               "audit a representation written in any language: COMMAND speaks JSON Lines "
-                               "(docs/AUDIT.md)");
-  auto* policy_exec = cmd->add_option("--policy-exec", options->policy_exec,
-                                      "audit a whole policy written in any language (eq. 4): COMMAND answers the "
-                                      "world chunk for an observation and a noise vector (docs/AUDIT.md)");
-  auto* model = cmd->add_option("--model", options->model, "audit a trained model of this library (eq. 4)");
+  cmd->add_flag("--json", options->json,
+                "print the JSON document of docs/AUDIT.md instead of tables");
+  auto* exec =
+      cmd->add_option("--exec", options->exec,
+                      "audit a representation written in any language: COMMAND speaks JSON Lines "
+                      "(docs/AUDIT.md)");
+  auto* policy_exec =
+      cmd->add_option("--policy-exec", options->policy_exec,
+                      "audit a whole policy written in any language (eq. 4): COMMAND answers the "
+                      "world chunk for an observation and a noise vector (docs/AUDIT.md)");
+  auto* model =
+      cmd->add_option("--model", options->model, "audit a trained model of this library (eq. 4)");
   exec->excludes(repr)->excludes(policy_exec)->excludes(model);
   policy_exec->excludes(repr)->excludes(model);
   model->excludes(repr);

@@ -26,13 +26,18 @@ int run_audit_section(const ReportOptions& options, std::ostream& out) {
   props::print_audit(out, results, audit, /*witnesses=*/false);
   std::vector<std::string> mismatches;
   for (const auto& classification : results) {
-    for (auto& line : props::mismatches_with_paper(classification)) mismatches.push_back(std::move(line));
+    for (auto& line : props::mismatches_with_paper(classification))
+      mismatches.push_back(std::move(line));
   }
   if (mismatches.empty()) {
-    out << "Every cell matches App. A of the paper in the eye-in-hand view: absolute - no symmetry (eqs. 11, "
-           "13); relative and relative_diff - translation only (eq. 16); hand_centric - all of SE(3) (eqs. 9, "
-           "23, 26); ActionFlow - pointwise none, in distribution rotations only (eq. 29). The third-person "
-           "cells match the same pattern, on this library's rule for world points (copied raw by absolute, "
+    out << "Every cell matches App. A of the paper in the eye-in-hand view: absolute - no symmetry "
+           "(eqs. 11, "
+           "13); relative and relative_diff - translation only (eq. 16); hand_centric - all of "
+           "SE(3) (eqs. 9, "
+           "23, 26); ActionFlow - pointwise none, in distribution rotations only (eq. 29). The "
+           "third-person "
+           "cells match the same pattern, on this library's rule for world points (copied raw by "
+           "absolute, "
            "relative, relative_diff and ActionFlow; taken into the hand frame by hand_centric).\n";
     return 0;
   }
@@ -44,7 +49,8 @@ int run_audit_section(const ReportOptions& options, std::ostream& out) {
 void add_report_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<ReportOptions>();
   CLI::App* cmd = app.add_subcommand("report", "the main report (what plain `handcentric` runs)");
-  cmd->add_option("--cases", options->cases, "cases per pointwise cell of the audit section")->capture_default_str();
+  cmd->add_option("--cases", options->cases, "cases per pointwise cell of the audit section")
+      ->capture_default_str();
   cmd->add_option("--seed", options->seed, "seed of the audit section")->capture_default_str();
   cmd->callback([options, &exit_code] { exit_code = run_main_report(std::cout, *options); });
 }

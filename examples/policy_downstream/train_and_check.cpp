@@ -15,7 +15,8 @@ int main() {
   config.steps = 200;
   std::mt19937_64 rng(1);
   std::vector<Scene> scenes;
-  for (int i = 0; i < 64; ++i) scenes.push_back(random_scene(rng, config.history_length, config.chunk_length, 0, 0, 1.0));
+  for (int i = 0; i < 64; ++i)
+    scenes.push_back(random_scene(rng, config.history_length, config.chunk_length, 0, 0, 1.0));
   auto trained = std::make_shared<policy::LearnedPolicy>(policy::train_policy(config, scenes, 1));
   props::CheckOptions options = props::eye_in_hand_options();
   options.shape.min_history = options.shape.max_history = trained->config().history_length;
@@ -23,8 +24,10 @@ int main() {
   options.shape.min_chunk = options.shape.max_chunk = trained->config().chunk_length;
   options.cases = 200;
   const props::SeededPolicy policy(trained);
-  const props::Verdict verdict = props::check_policy_equivariance(policy, props::Group::se3, options);
-  std::cout << trained->name() << ": " << (verdict.invariant ? "SE(3)-equivariant" : "NOT equivariant") << " on "
+  const props::Verdict verdict =
+      props::check_policy_equivariance(policy, props::Group::se3, options);
+  std::cout << trained->name() << ": "
+            << (verdict.invariant ? "SE(3)-equivariant" : "NOT equivariant") << " on "
             << verdict.cases << " cases, largest error " << verdict.max_error << "\n";
   if (verdict.witness) std::cout << props::format_witness(*verdict.witness) << "\n";
   return verdict.invariant ? 0 : 1;

@@ -30,8 +30,8 @@ std::string view_heading(View view) {
 // difference of the laws' moments, or the energy distance, marked '~' for an energy test).
 std::string cell_text(const Verdict& verdict) {
   char text[40];
-  std::snprintf(text, sizeof(text), "%-3s %8.1e%s", verdict.invariant ? "yes" : "NO", verdict.max_error,
-                verdict.method == Method::energy_test ? "~" : "");
+  std::snprintf(text, sizeof(text), "%-3s %8.1e%s", verdict.invariant ? "yes" : "NO",
+                verdict.max_error, verdict.method == Method::energy_test ? "~" : "");
   return text;
 }
 
@@ -89,7 +89,8 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
   return classifier;
 }
 
-std::vector<Classification> audit_builtins(const std::vector<std::string>& names, const AuditOptions& options) {
+std::vector<Classification> audit_builtins(const std::vector<std::string>& names,
+                                           const AuditOptions& options) {
   const ClassifierOptions classifier = classifier_options(options);
   const std::vector<std::string> all = auditable_names();
   std::vector<Classification> out;
@@ -101,15 +102,15 @@ std::vector<Classification> audit_builtins(const std::vector<std::string>& names
     } else {
       std::string valid;
       for (const std::string& n : all) valid += (valid.empty() ? "" : ", ") + n;
-      throw InvalidArgument("unknown representation '" + name + "' for --repr; use one of " + valid +
-                            " (or --exec 'COMMAND' for your own)");
+      throw InvalidArgument("unknown representation '" + name + "' for --repr; use one of " +
+                            valid + " (or --exec 'COMMAND' for your own)");
     }
   }
   return out;
 }
 
-void print_audit(std::ostream& out, const std::vector<Classification>& classifications, const AuditOptions& options,
-                 bool witnesses) {
+void print_audit(std::ostream& out, const std::vector<Classification>& classifications,
+                 const AuditOptions& options, bool witnesses) {
   constexpr std::size_t kLabel = 30, kCell = 14;
   for (const Classification& classification : classifications) {
     out << classification.name << "\n";
@@ -119,8 +120,9 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
       for (Group group : options.groups) out << " | " << pad(to_string(group), kCell);
       out << "\n";
       for (Mode mode : {Mode::pointwise, Mode::distribution}) {
-        for (Component component : {Component::actions, Component::observation, Component::flow_input,
-                                    Component::flow_target, Component::policy}) {
+        for (Component component :
+             {Component::actions, Component::observation, Component::flow_input,
+              Component::flow_target, Component::policy}) {
           bool any = false;
           std::string row = "  " + pad(row_label(component, mode), kLabel);
           for (Group group : options.groups) {
@@ -135,7 +137,8 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
         }
       }
     }
-    for (const Verdict* verdict : noted) out << "  note: " << cell_name(*verdict) << ": " << verdict->note << "\n";
+    for (const Verdict* verdict : noted)
+      out << "  note: " << cell_name(*verdict) << ": " << verdict->note << "\n";
     // One line for the energy-test "yes" cells (marked ~): what they could miss.
     int energy_yes = 0;
     double largest_shift = 0.0;
@@ -148,18 +151,22 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
     if (energy_yes > 0) {
       char shift[32];
       std::snprintf(shift, sizeof(shift), "%.2g", largest_shift);
-      out << "  note: " << energy_yes << " in-distribution 'yes' cell(s) (marked ~) were decided by an energy test, "
+      out << "  note: " << energy_yes
+          << " in-distribution 'yes' cell(s) (marked ~) were decided by an energy test, "
           << "the output not being affine in the noise: each finds a mean shift of " << shift
-          << " or more (the largest over the cells; per cell in the JSON's detectable_shift) with 90% power; "
+          << " or more (the largest over the cells; per cell in the JSON's detectable_shift) with "
+             "90% power; "
              "smaller differences can hide\n";
     }
     if (const auto& injectivity = classification.injectivity) {
       if (injectivity->injective == false) {
-        out << "  !!! NOT INJECTIVE: " << injectivity->how << ". Its invariances say nothing useful: a policy "
+        out << "  !!! NOT INJECTIVE: " << injectivity->how
+            << ". Its invariances say nothing useful: a policy "
             << "trained on it cannot tell these chunks apart.\n"
             << indent(format_collision(*injectivity->collision), "      ");
       } else {
-        out << "  injective: " << (injectivity->injective ? "yes" : "not decided") << " (" << injectivity->how << ")\n";
+        out << "  injective: " << (injectivity->injective ? "yes" : "not decided") << " ("
+            << injectivity->how << ")\n";
       }
     }
     if (witnesses) {

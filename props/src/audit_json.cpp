@@ -30,14 +30,18 @@ nlohmann::json points(const std::vector<Eigen::Vector3d>& xs) {
   return array;
 }
 
-nlohmann::json number_or_inf(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json("inf"); }
+nlohmann::json number_or_inf(double x) {
+  return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json("inf");
+}
 
 // A scene as the --exec protocol sends it (extra poses and scalars only when it has them).
 nlohmann::json scene_json(const Scene& scene) {
   nlohmann::json history = nlohmann::json::array(), chunk = nlohmann::json::array();
   for (const auto& T : scene.world_T_hand_history) history.push_back(matrix16(T));
   for (const auto& T : scene.world_T_hand_chunk) chunk.push_back(matrix16(T));
-  nlohmann::json out = {{"history", history}, {"chunk", chunk}, {"hand_points", points(scene.hand_points)},
+  nlohmann::json out = {{"history", history},
+                        {"chunk", chunk},
+                        {"hand_points", points(scene.hand_points)},
                         {"world_points", points(scene.world_points)}};
   if (!scene.extra_poses.empty()) {
     nlohmann::json extra = nlohmann::json::object();
@@ -54,11 +58,8 @@ nlohmann::json scene_json(const Scene& scene) {
 
 nlohmann::json witness_json(const Witness& w, Method method) {
   nlohmann::json out = {
-      {"g", matrix16(w.g)},
-      {"scene", scene_json(w.scene)},
-      {"before", numbers(w.before)},
-      {"after", numbers(w.after)},
-      {"error", number_or_inf(w.error)},
+      {"g", matrix16(w.g)},        {"scene", scene_json(w.scene)},    {"before", numbers(w.before)},
+      {"after", numbers(w.after)}, {"error", number_or_inf(w.error)},
   };
   if (method == Method::energy_test) {
     out["p_value"] = w.p_value;
@@ -71,22 +72,28 @@ nlohmann::json witness_json(const Witness& w, Method method) {
 }
 
 nlohmann::json injectivity_json(const Injectivity& injectivity) {
-  nlohmann::json out = {{"injective", injectivity.injective ? nlohmann::json(*injectivity.injective) : nlohmann::json(nullptr)},
+  nlohmann::json out = {{"injective", injectivity.injective ? nlohmann::json(*injectivity.injective)
+                                                            : nlohmann::json(nullptr)},
                         {"how", injectivity.how},
                         {"cases", injectivity.cases},
                         {"round_trips", injectivity.round_trips},
                         {"collision", nullptr},
                         {"round_trip_failure", nullptr}};
   if (const auto& c = injectivity.collision) {
-    out["collision"] = {{"first", scene_json(c->first)},   {"second", scene_json(c->second)},
-                        {"actions", numbers(c->actions_first)}, {"actions_second", numbers(c->actions_second)},
-                        {"chunk_distance", c->chunk_distance}, {"action_distance", c->action_distance},
+    out["collision"] = {{"first", scene_json(c->first)},
+                        {"second", scene_json(c->second)},
+                        {"actions", numbers(c->actions_first)},
+                        {"actions_second", numbers(c->actions_second)},
+                        {"chunk_distance", c->chunk_distance},
+                        {"action_distance", c->action_distance},
                         {"tolerance", c->tolerance}};
   }
   if (const auto& r = injectivity.round_trip_failure) {
     nlohmann::json decoded = nlohmann::json::array();
     for (const auto& T : r->decoded) decoded.push_back(matrix16(T));
-    out["round_trip_failure"] = {{"scene", scene_json(r->scene)}, {"decoded", decoded}, {"error", number_or_inf(r->error)},
+    out["round_trip_failure"] = {{"scene", scene_json(r->scene)},
+                                 {"decoded", decoded},
+                                 {"error", number_or_inf(r->error)},
                                  {"tolerance", r->tolerance}};
   }
   return out;
@@ -96,7 +103,8 @@ nlohmann::json injectivity_json(const Injectivity& injectivity) {
 nlohmann::json summary_json(const Classification& classification) {
   nlohmann::json summary = nlohmann::json::object();
   for (const Verdict& v : classification.verdicts) {
-    summary[to_string(v.view)][to_string(v.component)][to_string(v.mode)][to_string(v.group)] = v.invariant;
+    summary[to_string(v.view)][to_string(v.component)][to_string(v.mode)][to_string(v.group)] =
+        v.invariant;
   }
   return summary;
 }
@@ -129,10 +137,12 @@ std::string audit_json(const std::vector<Classification>& classifications) {
       if (!v.note.empty()) check["note"] = v.note;
       checks.push_back(check);
     }
-    nlohmann::json representation = {{"name", classification.name}, {"summary", summary_json(classification)}};
+    nlohmann::json representation = {{"name", classification.name},
+                                     {"summary", summary_json(classification)}};
     if (classification.injectivity) {
-      representation["injective"] = classification.injectivity->injective ? nlohmann::json(*classification.injectivity->injective)
-                                                                          : nlohmann::json(nullptr);
+      representation["injective"] = classification.injectivity->injective
+                                        ? nlohmann::json(*classification.injectivity->injective)
+                                        : nlohmann::json(nullptr);
       representation["injectivity"] = injectivity_json(*classification.injectivity);
     }
     representation["checks"] = checks;

@@ -58,8 +58,8 @@ double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<Ri
   return worst;
 }
 
-void run_silently(const std::function<void()>& property, const std::string& description, std::uint64_t seed,
-                  int cases) {
+void run_silently(const std::function<void()>& property, const std::string& description,
+                  std::uint64_t seed, int cases) {
   load_rapidcheck_configuration_quietly();
   rc::detail::TestParams params;  // not rc::detail::configuration(): it reads RC_PARAMS and prints
   params.seed = seed;
@@ -72,7 +72,8 @@ void run_silently(const std::function<void()>& property, const std::string& desc
 
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget) {
-  if (cases < 1) throw InvalidArgument("a check needs at least 1 case, got " + std::to_string(cases));
+  if (cases < 1)
+    throw InvalidArgument("a check needs at least 1 case, got " + std::to_string(cases));
   if (!(options.relative_tolerance > 0.0) || !std::isfinite(options.relative_tolerance)) {
     throw InvalidArgument("relative_tolerance must be a positive number, got " +
                           std::to_string(options.relative_tolerance));
@@ -90,7 +91,8 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   int shrink_evaluations = 0;
   auto property = [&] {
     if (error) return;  // a broken function under test: let RapidCheck finish at once
-    if (!searching && ++shrink_evaluations > (options.shrink ? shrink_budget : 0)) return;  // budget spent: keep the witness
+    if (!searching && ++shrink_evaluations > (options.shrink ? shrink_budget : 0))
+      return;  // budget spent: keep the witness
     const Scene scene = *props::scene(shape);
     const RigidTransform g = *group_element(group);
     CaseOutcome outcome;
@@ -137,7 +139,8 @@ struct Equivariance {
 Equivariance both_sides(const ChunkPolicy& policy, const Scene& scene, const RigidTransform& g,
                         std::uint64_t noise_seed) {
   Equivariance sides;
-  for (const RigidTransform& world_T_handk : policy.act(scene, noise_seed)) sides.g_a.push_back(g * world_T_handk);
+  for (const RigidTransform& world_T_handk : policy.act(scene, noise_seed))
+    sides.g_a.push_back(g * world_T_handk);
   sides.a_g = policy.act(g * scene, noise_seed);
   return sides;
 }
@@ -157,9 +160,13 @@ SceneShape third_person_shape() {
   return shape;
 }
 
-SceneShape shape_for(View view) { return view == View::eye_in_hand ? eye_in_hand_shape() : third_person_shape(); }
+SceneShape shape_for(View view) {
+  return view == View::eye_in_hand ? eye_in_hand_shape() : third_person_shape();
+}
 
-View view_of(const SceneShape& shape) { return shape.max_world_points > 0 ? View::third_person : View::eye_in_hand; }
+View view_of(const SceneShape& shape) {
+  return shape.max_world_points > 0 ? View::third_person : View::eye_in_hand;
+}
 
 CheckOptions options_for(View view) {
   CheckOptions options;
@@ -167,7 +174,9 @@ CheckOptions options_for(View view) {
   return options;
 }
 
-CheckOptions eye_in_hand_options() { return options_for(View::eye_in_hand); }
+CheckOptions eye_in_hand_options() {
+  return options_for(View::eye_in_hand);
+}
 
 Eigen::VectorXd fixed_noise(Eigen::Index n, std::uint64_t seed) {
   // The first n normals of one stream: cache a long prefix per thread (seeding a Mersenne
@@ -191,19 +200,22 @@ SceneFunction observation_of(std::shared_ptr<const Representation> representatio
   return [representation](const Scene& scene) { return representation->encode_observation(scene); };
 }
 
-SceneFunction flow_input_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed, double t) {
+SceneFunction flow_input_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed,
+                            double t) {
   return [target, noise_seed, t](const Scene& scene) {
     return (*target)(scene, fixed_noise(target->noise_dimension(scene), noise_seed), t).input;
   };
 }
 
-SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed, double t) {
+SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed,
+                             double t) {
   return [target, noise_seed, t](const Scene& scene) {
     return (*target)(scene, fixed_noise(target->noise_dimension(scene), noise_seed), t).target;
   };
 }
 
-Verdict check_invariance(const SceneFunction& f, Component component, Group group, const CheckOptions& options) {
+Verdict check_invariance(const SceneFunction& f, Component component, Group group,
+                         const CheckOptions& options) {
   const double relative = options.relative_tolerance;
   auto run_case = [&f, relative](const Scene& scene, const RigidTransform& g) {
     detail::CaseOutcome outcome;
@@ -217,7 +229,8 @@ Verdict check_invariance(const SceneFunction& f, Component component, Group grou
     outcome.holds = outcome.witness.error <= outcome.witness.tolerance;  // false for NaN
     return outcome;
   };
-  return detail::run_check(run_case, component, group, Mode::pointwise, options, options.cases, kPointwiseShrinkBudget);
+  return detail::run_check(run_case, component, group, Mode::pointwise, options, options.cases,
+                           kPointwiseShrinkBudget);
 }
 
 double recompute_error(const SceneFunction& f, const Witness& witness) {
@@ -239,10 +252,12 @@ Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOp
     outcome.holds = outcome.witness.error <= outcome.witness.tolerance;
     return outcome;
   };
-  return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options, options.cases, kPointwiseShrinkBudget);
+  return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,
+                           options.cases, kPointwiseShrinkBudget);
 }
 
-double recompute_equivariance_error(const ChunkPolicy& policy, const Witness& witness, std::uint64_t noise_seed) {
+double recompute_equivariance_error(const ChunkPolicy& policy, const Witness& witness,
+                                    std::uint64_t noise_seed) {
   const Equivariance sides = both_sides(policy, witness.scene, witness.g, noise_seed);
   return detail::chunk_distance(sides.g_a, sides.a_g);
 }

@@ -13,7 +13,7 @@
 namespace handcentric::props::detail {
 
 struct CaseOutcome {
-  Witness witness;   ///< scene, g, outputs, error, tolerance, p-value of this case
+  Witness witness;  ///< scene, g, outputs, error, tolerance, p-value of this case
   bool holds = true;
 };
 
@@ -63,7 +63,7 @@ double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<Ri
 
 /// Runs a RapidCheck property (it calls RC_FAIL to fail) for `cases` cases from `seed`, printing
 /// nothing: the caller records what it needs from inside the property.
-void run_silently(const std::function<void()>& property, const std::string& description, std::uint64_t seed,
-                  int cases);
+void run_silently(const std::function<void()>& property, const std::string& description,
+                  std::uint64_t seed, int cases);
 
 }  // namespace handcentric::props::detail

@@ -7,9 +7,7 @@
 #include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
                           const std::function<Verdict(const CheckOptions&)>& recheck) {
@@ -21,17 +19,18 @@ Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
   loose.relative_tolerance = kFloat32RelativeTolerance;
   loose.shrink = false;
   if (recheck(loose).invariant) {
-    verdict.note = "fails at tolerance " + format_number(options.check.relative_tolerance) +
-                   " (1 + L) but holds at float32 rounding, " + format_number(kFloat32RelativeTolerance) +
-                   " (1 + L): the errors look like float32 rounding; rerun with --precision float32";
+    verdict.note =
+        "fails at tolerance " + format_number(options.check.relative_tolerance) +
+        " (1 + L) but holds at float32 rounding, " + format_number(kFloat32RelativeTolerance) +
+        " (1 + L): the errors look like float32 rounding; rerun with --precision float32";
   }
   return verdict;
 }
 
 namespace {
 
-void classify_flow(const std::shared_ptr<const FlowTarget>& target, const ClassifierOptions& options, View view,
-                   Classification& out) {
+void classify_flow(const std::shared_ptr<const FlowTarget>& target,
+                   const ClassifierOptions& options, View view, Classification& out) {
   const CheckOptions check = with_view(options.check, view);
   for (Component component : {Component::flow_input, Component::flow_target}) {
     const auto f = [&](std::uint64_t noise_seed, double t) {
@@ -40,16 +39,19 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target, const Classi
     };
     for (Group group : options.groups) {
       const SceneFunction fn = f(check.noise_seed, check.flow_time);
-      out.verdicts.push_back(with_float32_note(check_invariance(fn, component, group, check), options,
-                                               [&](const CheckOptions& o) { return check_invariance(fn, component, group, o); }));
+      out.verdicts.push_back(with_float32_note(
+          check_invariance(fn, component, group, check), options,
+          [&](const CheckOptions& o) { return check_invariance(fn, component, group, o); }));
     }
   }
   if (!options.in_distribution) return;
   for (Component component : {Component::flow_input, Component::flow_target}) {
     for (Group group : options.groups) {
       out.verdicts.push_back(with_float32_note(
-          check_distribution_invariance(target, component, group, check, options.distribution), options,
-          [&](const CheckOptions& o) { return check_distribution_invariance(target, component, group, o, options.distribution); }));
+          check_distribution_invariance(target, component, group, check, options.distribution),
+          options, [&](const CheckOptions& o) {
+            return check_distribution_invariance(target, component, group, o, options.distribution);
+          }));
     }
   }
 }
@@ -68,19 +70,24 @@ CheckOptions with_view(CheckOptions check, View view) {
 }
 
 Classification classify_representation(std::shared_ptr<const Representation> representation,
-                                       const ClassifierOptions& options, std::shared_ptr<const FlowTarget> flow) {
-  if (!representation) throw InvalidArgument("classify_representation needs a representation, got null");
+                                       const ClassifierOptions& options,
+                                       std::shared_ptr<const FlowTarget> flow) {
+  if (!representation)
+    throw InvalidArgument("classify_representation needs a representation, got null");
   Classification out;
   out.name = representation->name();
   if (!flow) flow = std::make_shared<RectifiedFlow>(representation);
   for (View view : options.views) {
     const CheckOptions check = with_view(options.check, view);
-    std::vector<std::pair<Component, SceneFunction>> parts = {{Component::actions, actions_of(representation)}};
-    if (options.observation) parts.emplace_back(Component::observation, observation_of(representation));
+    std::vector<std::pair<Component, SceneFunction>> parts = {
+        {Component::actions, actions_of(representation)}};
+    if (options.observation)
+      parts.emplace_back(Component::observation, observation_of(representation));
     for (const auto& [component, f] : parts) {
       for (Group group : options.groups) {
-        out.verdicts.push_back(with_float32_note(check_invariance(f, component, group, check), options,
-                                                 [&](const CheckOptions& o) { return check_invariance(f, component, group, o); }));
+        out.verdicts.push_back(with_float32_note(
+            check_invariance(f, component, group, check), options,
+            [&](const CheckOptions& o) { return check_invariance(f, component, group, o); }));
       }
     }
     if (options.flow) classify_flow(flow, options, view, out);
@@ -93,7 +100,8 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
   return out;
 }
 
-Classification classify_flow_target(std::shared_ptr<const FlowTarget> target, const ClassifierOptions& options) {
+Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
+                                    const ClassifierOptions& options) {
   if (!target) throw InvalidArgument("classify_flow_target needs a flow target, got null");
   Classification out;
   out.name = target->name();
@@ -101,7 +109,8 @@ Classification classify_flow_target(std::shared_ptr<const FlowTarget> target, co
   return out;
 }
 
-std::vector<Group> invariant_groups(const Classification& classification, Component component, Mode mode, View view) {
+std::vector<Group> invariant_groups(const Classification& classification, Component component,
+                                    Mode mode, View view) {
   std::vector<Group> groups;
   for (Group group : all_groups()) {
     const Verdict* verdict = find_verdict(classification, component, mode, group, view);
@@ -110,25 +119,29 @@ std::vector<Group> invariant_groups(const Classification& classification, Compon
   return groups;
 }
 
-const Verdict* find_verdict(const Classification& classification, Component component, Mode mode, Group group,
-                            View view) {
+const Verdict* find_verdict(const Classification& classification, Component component, Mode mode,
+                            Group group, View view) {
   for (const Verdict& verdict : classification.verdicts) {
-    if (verdict.component == component && verdict.mode == mode && verdict.group == group && verdict.view == view) {
+    if (verdict.component == component && verdict.mode == mode && verdict.group == group &&
+        verdict.view == view) {
       return &verdict;
     }
   }
   return nullptr;
 }
 
-std::optional<Expectation> paper_expectation(const std::string& name, Component component, Mode mode, View view) {
+std::optional<Expectation> paper_expectation(const std::string& name, Component component,
+                                             Mode mode, View view) {
   if (component == Component::policy) return std::nullopt;
   // The third-person cells equal the eye-in-hand ones for every built-in, for the reasons in
   // the header; only the authority differs.
-  const std::string paper = view == View::eye_in_hand
-                                ? "paper, App. A"
-                                : "handcentric: world points raw (absolute, relative, relative_diff, ActionFlow) or "
-                                  "in the hand frame (hand_centric); the paper assumes eye-in-hand views";
-  if (name == "absolute") return Expectation{kNone, paper + (view == View::eye_in_hand ? ", eqs. (11), (13)" : "")};
+  const std::string paper =
+      view == View::eye_in_hand
+          ? "paper, App. A"
+          : "handcentric: world points raw (absolute, relative, relative_diff, ActionFlow) or "
+            "in the hand frame (hand_centric); the paper assumes eye-in-hand views";
+  if (name == "absolute")
+    return Expectation{kNone, paper + (view == View::eye_in_hand ? ", eqs. (11), (13)" : "")};
   if (name == "relative" || name == "relative_diff") {
     // App. A.2, eq. (16): the translation part forgets p~; world proprioception does not.
     if (component == Component::actions || component == Component::flow_target) {
@@ -137,13 +150,16 @@ std::optional<Expectation> paper_expectation(const std::string& name, Component 
     return Expectation{kNone, paper};
   }
   if (name == "hand_centric") {
-    return Expectation{all_groups(), paper + (view == View::eye_in_hand ? ", eqs. (9), (23), (26)" : "")};
+    return Expectation{all_groups(),
+                       paper + (view == View::eye_in_hand ? ", eqs. (9), (23), (26)" : "")};
   }
   if (name == "actionflow") {
     // App. A.4, eq. (29): R_k^T (p_k - eps) changes pointwise under any g; for a rotation about
     // the origin, R~^T eps ~ N(0, I) again, so the target is invariant in distribution only.
-    if (component == Component::flow_target && mode == Mode::distribution) return Expectation{kRotations, paper + ", eq. (29)"};
-    if (component == Component::flow_input || component == Component::flow_target) return Expectation{kNone, paper};
+    if (component == Component::flow_target && mode == Mode::distribution)
+      return Expectation{kRotations, paper + ", eq. (29)"};
+    if (component == Component::flow_input || component == Component::flow_target)
+      return Expectation{kNone, paper};
   }
   return std::nullopt;
 }
@@ -151,14 +167,17 @@ std::optional<Expectation> paper_expectation(const std::string& name, Component 
 std::vector<std::string> mismatches_with_paper(const Classification& classification) {
   std::vector<std::string> lines;
   for (const Verdict& verdict : classification.verdicts) {
-    const auto expected = paper_expectation(classification.name, verdict.component, verdict.mode, verdict.view);
+    const auto expected =
+        paper_expectation(classification.name, verdict.component, verdict.mode, verdict.view);
     if (!expected) continue;
-    const bool should = std::find(expected->groups.begin(), expected->groups.end(), verdict.group) != expected->groups.end();
+    const bool should = std::find(expected->groups.begin(), expected->groups.end(),
+                                  verdict.group) != expected->groups.end();
     if (should != verdict.invariant) {
-      lines.push_back(classification.name + " " + to_string(verdict.component) + " (" + to_string(verdict.mode) + ", " +
-                      to_string(verdict.view) + ") under " + to_string(verdict.group) + ": expected " +
-                      (should ? "invariant" : "not invariant") + " (" + expected->basis + "), found " +
-                      (verdict.invariant ? "invariant" : "not invariant"));
+      lines.push_back(classification.name + " " + to_string(verdict.component) + " (" +
+                      to_string(verdict.mode) + ", " + to_string(verdict.view) + ") under " +
+                      to_string(verdict.group) + ": expected " +
+                      (should ? "invariant" : "not invariant") + " (" + expected->basis +
+                      "), found " + (verdict.invariant ? "invariant" : "not invariant"));
     }
   }
   return lines;

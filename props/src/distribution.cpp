@@ -23,7 +23,8 @@ namespace {
 //   2 S_xy / (n m) - 2 S_xx / n^2 - 2 S_yy / m^2,
 // and S_xx + S_yy = total - S_xy, so only the cross sum is needed when n = m; for n != m the
 // inside sums are computed too.
-double split_energy(const Eigen::MatrixXd& D, const std::vector<Eigen::Index>& order, Eigen::Index n) {
+double split_energy(const Eigen::MatrixXd& D, const std::vector<Eigen::Index>& order,
+                    Eigen::Index n) {
   const Eigen::Index N = static_cast<Eigen::Index>(order.size()), m = N - n;
   double xx = 0.0, yy = 0.0, xy = 0.0;
   for (Eigen::Index a = 0; a < N; ++a) {
@@ -44,8 +45,8 @@ double split_energy(const Eigen::MatrixXd& D, const std::vector<Eigen::Index>& o
 }
 
 // The same for n = m, from the cross sum alone (half the work: the permutation loop).
-double split_energy_equal(const Eigen::MatrixXd& D, const std::vector<Eigen::Index>& order, Eigen::Index n,
-                          double total) {
+double split_energy_equal(const Eigen::MatrixXd& D, const std::vector<Eigen::Index>& order,
+                          Eigen::Index n, double total) {
   double xy = 0.0;
   for (Eigen::Index a = 0; a < n; ++a) {
     const Eigen::Index i = order[static_cast<std::size_t>(a)];
@@ -57,9 +58,10 @@ double split_energy_equal(const Eigen::MatrixXd& D, const std::vector<Eigen::Ind
 
 void require_samples(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
   if (x.rows() == 0 || y.rows() == 0 || x.cols() != y.cols()) {
-    throw InvalidArgument("energy distance needs two non-empty samples of the same dimension, got " +
-                          std::to_string(x.rows()) + " x " + std::to_string(x.cols()) + " and " +
-                          std::to_string(y.rows()) + " x " + std::to_string(y.cols()));
+    throw InvalidArgument(
+        "energy distance needs two non-empty samples of the same dimension, got " +
+        std::to_string(x.rows()) + " x " + std::to_string(x.cols()) + " and " +
+        std::to_string(y.rows()) + " x " + std::to_string(y.cols()));
   }
 }
 
@@ -80,7 +82,9 @@ double incomplete_beta(double a, double b, double x) {
   if (x <= 0.0) return 0.0;
   if (x >= 1.0) return 1.0;
   if (x > (a + 1.0) / (a + b + 2.0)) return 1.0 - incomplete_beta(b, a, 1.0 - x);
-  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) + a * std::log(x) + b * std::log1p(-x)) / a;
+  const double front = std::exp(std::lgamma(a + b) - std::lgamma(a) - std::lgamma(b) +
+                                a * std::log(x) + b * std::log1p(-x)) /
+                       a;
   constexpr double kTiny = 1e-300;
   double f = 1.0, c = 1.0, d = 0.0;
   for (int i = 0; i <= 400; ++i) {
@@ -106,9 +110,11 @@ double incomplete_beta(double a, double b, double x) {
 }  // namespace
 
 double student_t_two_sided_p(double t, double degrees_of_freedom) {
-  if (!(degrees_of_freedom > 0.0)) throw InvalidArgument("Student's t needs positive degrees of freedom");
+  if (!(degrees_of_freedom > 0.0))
+    throw InvalidArgument("Student's t needs positive degrees of freedom");
   if (!std::isfinite(t)) return std::isnan(t) ? 1.0 : 0.0;
-  return incomplete_beta(0.5 * degrees_of_freedom, 0.5, degrees_of_freedom / (degrees_of_freedom + t * t));
+  return incomplete_beta(0.5 * degrees_of_freedom, 0.5,
+                         degrees_of_freedom / (degrees_of_freedom + t * t));
 }
 
 double paired_mean_test(const Eigen::MatrixXd& differences, double tolerance) {
@@ -118,13 +124,15 @@ double paired_mean_test(const Eigen::MatrixXd& differences, double tolerance) {
   for (Eigen::Index j = 0; j < d; ++j) {
     const Eigen::VectorXd column = differences.col(j);
     const double mean = column.mean();
-    const double sd = std::sqrt((column.array() - mean).square().sum() / static_cast<double>(n - 1));
+    const double sd =
+        std::sqrt((column.array() - mean).square().sum() / static_cast<double>(n - 1));
     if (!(sd > tolerance)) {
       // No spread: the mean difference is a constant, seen exactly.
       if (std::abs(mean) > tolerance) return 0.0;
       continue;
     }
-    smallest = std::min(smallest, student_t_two_sided_p(mean / (sd / std::sqrt(static_cast<double>(n))), n - 1.0));
+    smallest = std::min(
+        smallest, student_t_two_sided_p(mean / (sd / std::sqrt(static_cast<double>(n))), n - 1.0));
   }
   return std::min(1.0, smallest * static_cast<double>(d));  // Bonferroni over the coordinates
 }
@@ -136,10 +144,12 @@ double energy_distance(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y) {
   return split_energy(pooled_distances(x, y), order, x.rows());
 }
 
-TwoSampleResult energy_test(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, int permutations, std::uint64_t seed,
-                            double stop_above) {
+TwoSampleResult energy_test(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, int permutations,
+                            std::uint64_t seed, double stop_above) {
   require_samples(x, y);
-  if (permutations < 1) throw InvalidArgument("a permutation test needs at least 1 permutation, got " + std::to_string(permutations));
+  if (permutations < 1)
+    throw InvalidArgument("a permutation test needs at least 1 permutation, got " +
+                          std::to_string(permutations));
   const Eigen::MatrixXd D = pooled_distances(x, y);
   const Eigen::Index n = x.rows();
   std::vector<Eigen::Index> order(static_cast<std::size_t>(x.rows() + y.rows()));
@@ -164,7 +174,8 @@ TwoSampleResult energy_test(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, 
       const auto j = static_cast<std::size_t>((word * static_cast<std::uint64_t>(i + 1)) >> 32);
       std::swap(order[i], order[j]);
     }
-    const double permuted = equal ? split_energy_equal(D, order, n, total) : split_energy(D, order, n);
+    const double permuted =
+        equal ? split_energy_equal(D, order, n, total) : split_energy(D, order, n);
     // A relative slack: a split that equals the observed one up to rounding counts as >=.
     if (permuted >= result.energy_distance - 1e-12 * std::abs(result.energy_distance)) ++at_least;
     // Besag & Clifford (1991): once the p-value cannot fall below stop_above, stop and report
@@ -183,9 +194,11 @@ int permutations_for(double alpha_per_case) {
   return std::max(99, static_cast<int>(std::ceil(2.0 / alpha_per_case)) - 1);
 }
 
-std::optional<GaussianLaw> affine_law(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
-                                      Eigen::Index n, double tolerance, std::uint64_t seed, int checks) {
-  if (n < 0) throw InvalidArgument("affine_law needs a noise dimension >= 0, got " + std::to_string(n));
+std::optional<GaussianLaw> affine_law(
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, Eigen::Index n,
+    double tolerance, std::uint64_t seed, int checks) {
+  if (n < 0)
+    throw InvalidArgument("affine_law needs a noise dimension >= 0, got " + std::to_string(n));
   GaussianLaw law;
   Eigen::VectorXd eps = Eigen::VectorXd::Zero(n);
   law.mean = f(eps);
@@ -200,8 +213,12 @@ std::optional<GaussianLaw> affine_law(const std::function<Eigen::VectorXd(const 
   {
     const Eigen::VectorXd u = normals(), v = normals();
     const Eigen::VectorXd fu = f(u), fv = f(v), fuv = f(u + v);
-    if (fu.size() != law.mean.size() || fv.size() != law.mean.size() || fuv.size() != law.mean.size()) return std::nullopt;
-    if (law.mean.size() > 0 && !((fuv - fu - fv + law.mean).cwiseAbs().maxCoeff() <= 2.0 * tolerance)) return std::nullopt;
+    if (fu.size() != law.mean.size() || fv.size() != law.mean.size() ||
+        fuv.size() != law.mean.size())
+      return std::nullopt;
+    if (law.mean.size() > 0 &&
+        !((fuv - fu - fv + law.mean).cwiseAbs().maxCoeff() <= 2.0 * tolerance))
+      return std::nullopt;
   }
   law.noise_map.resize(law.mean.size(), n);
   for (Eigen::Index j = 0; j < n; ++j) {
@@ -217,7 +234,8 @@ std::optional<GaussianLaw> affine_law(const std::function<Eigen::VectorXd(const 
     const Eigen::VectorXd value = f(eps);
     if (value.size() != law.mean.size()) return std::nullopt;
     const Eigen::VectorXd predicted = law.mean + law.noise_map * eps;
-    if (value.size() > 0 && !((value - predicted).cwiseAbs().maxCoeff() <= tolerance)) return std::nullopt;
+    if (value.size() > 0 && !((value - predicted).cwiseAbs().maxCoeff() <= tolerance))
+      return std::nullopt;
   }
   return law;
 }
@@ -237,15 +255,17 @@ LawDifference law_difference(const GaussianLaw& a, const GaussianLaw& b) {
   difference.covariance_scale = std::max(1.0, covariance_a.cwiseAbs().maxCoeff());
   if (same_map) return difference;
   const Eigen::MatrixXd covariance_b = b.noise_map * b.noise_map.transpose();
-  difference.covariance_scale = std::max(difference.covariance_scale, covariance_b.cwiseAbs().maxCoeff());
+  difference.covariance_scale =
+      std::max(difference.covariance_scale, covariance_b.cwiseAbs().maxCoeff());
   difference.covariance = (covariance_a - covariance_b).cwiseAbs().maxCoeff();
   return difference;
 }
 
 double energy_test_detectable_shift(Eigen::Index dimension, int samples, double alpha) {
   if (dimension < 1 || samples < 2 || !(alpha > 0.0 && alpha < 1.0)) {
-    throw InvalidArgument("energy_test_detectable_shift needs dimension >= 1, samples >= 2 and 0 < alpha < 1, got " +
-                          std::to_string(dimension) + ", " + std::to_string(samples) + ", " + format_number(alpha));
+    throw InvalidArgument(
+        "energy_test_detectable_shift needs dimension >= 1, samples >= 2 and 0 < alpha < 1, got " +
+        std::to_string(dimension) + ", " + std::to_string(samples) + ", " + format_number(alpha));
   }
   Eigen::Index rounded = 1;
   while (rounded < dimension) rounded *= 2;
@@ -294,9 +314,11 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   const int samples = distribution.samples;
   CaseOutcome outcome;
   const std::optional<GaussianLaw> law =
-      affine_law(pair.before, pair.noise_dimension, tolerance, options.noise_seed, distribution.affinity_checks);
+      affine_law(pair.before, pair.noise_dimension, tolerance, options.noise_seed,
+                 distribution.affinity_checks);
   const std::optional<GaussianLaw> moved_law =
-      law ? affine_law(pair.after, pair.noise_dimension, tolerance, options.noise_seed, distribution.affinity_checks)
+      law ? affine_law(pair.after, pair.noise_dimension, tolerance, options.noise_seed,
+                       distribution.affinity_checks)
           : std::nullopt;
   if (law && moved_law) {
     // Exact: two Gaussian laws are one iff their means and covariances agree.
@@ -306,9 +328,10 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
     outcome.witness.after = moved_law->mean;
     outcome.witness.error = std::max(difference.mean, difference.covariance);
     outcome.witness.tolerance = tolerance;
-    outcome.witness.detail = "Gaussian laws (affine in eps): means differ by " + format_number(difference.mean) +
-                             ", covariances by " + format_number(difference.covariance) + " (tolerance " +
-                             format_number(tolerance) + ", covariance " + format_number(covariance_tolerance) + ")";
+    outcome.witness.detail =
+        "Gaussian laws (affine in eps): means differ by " + format_number(difference.mean) +
+        ", covariances by " + format_number(difference.covariance) + " (tolerance " +
+        format_number(tolerance) + ", covariance " + format_number(covariance_tolerance) + ")";
     outcome.holds = difference.mean <= tolerance && difference.covariance <= covariance_tolerance;
     return outcome;
   }
@@ -336,13 +359,15 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
     }
     x.row(i) = u.transpose();
     same_eps.row(i) = v.transpose();
-    pointwise = u.size() == v.size() ? std::max(pointwise, u.size() ? (u - v).lpNorm<Eigen::Infinity>() : 0.0)
-                                     : std::numeric_limits<double>::infinity();
+    pointwise = u.size() == v.size()
+                    ? std::max(pointwise, u.size() ? (u - v).lpNorm<Eigen::Infinity>() : 0.0)
+                    : std::numeric_limits<double>::infinity();
   }
   statistics.largest_dimension = std::max(statistics.largest_dimension, x.cols());
   if (x.cols() > 0) {
     const Eigen::RowVectorXd mean = x.colwise().mean();
-    const double variance = (x.rowwise() - mean).squaredNorm() / (static_cast<double>(samples - 1) * x.cols());
+    const double variance =
+        (x.rowwise() - mean).squaredNorm() / (static_cast<double>(samples - 1) * x.cols());
     statistics.largest_spread = std::max(statistics.largest_spread, std::sqrt(variance));
   }
   outcome.witness.before = x.row(0).transpose();
@@ -370,13 +395,15 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   // when a policy mixes frames, stands out at once).
   Eigen::MatrixXd y(samples, same_eps.cols());
   for (int i = 0; i < samples; ++i) y.row(i) = pair.after(draw(fresh)).transpose();
-  const TwoSampleResult test = energy_test(x, y, permutations_for(0.5 * alpha), options.seed, 0.5 * alpha);
+  const TwoSampleResult test =
+      energy_test(x, y, permutations_for(0.5 * alpha), options.seed, 0.5 * alpha);
   const double paired = paired_mean_test(x - same_eps, tolerance);
   outcome.witness.after = y.row(0).transpose();
   outcome.witness.error = test.energy_distance;
   outcome.witness.p_value = std::min(1.0, 2.0 * std::min(test.p_value, paired));
-  outcome.witness.detail = "energy test p = " + format_number(test.p_value) + ", paired mean test p = " +
-                           format_number(paired) + " (each at level " + format_number(0.5 * alpha) + ")";
+  outcome.witness.detail = "energy test p = " + format_number(test.p_value) +
+                           ", paired mean test p = " + format_number(paired) + " (each at level " +
+                           format_number(0.5 * alpha) + ")";
   outcome.holds = test.p_value >= 0.5 * alpha && paired >= 0.5 * alpha;
   return outcome;
 }
@@ -384,30 +411,37 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
 void finish_distribution_verdict(Verdict& verdict, const LawStatistics& statistics,
                                  const DistributionOptions& distribution) {
   verdict.method = statistics.any_energy ? Method::energy_test : Method::exact_gaussian;
-  if (verdict.method == Method::energy_test && verdict.invariant && statistics.largest_dimension > 0) {
-    verdict.detectable_shift = energy_test_detectable_shift(statistics.largest_dimension, distribution.samples,
-                                                            distribution.family_alpha / distribution.cases) *
-                               statistics.largest_spread;
+  if (verdict.method == Method::energy_test && verdict.invariant &&
+      statistics.largest_dimension > 0) {
+    verdict.detectable_shift =
+        energy_test_detectable_shift(statistics.largest_dimension, distribution.samples,
+                                     distribution.family_alpha / distribution.cases) *
+        statistics.largest_spread;
   }
 }
 
 void require_distribution_options(const DistributionOptions& distribution) {
   if (distribution.cases < 1 || distribution.samples < 2 ||
-      !(distribution.family_alpha > 0.0 && distribution.family_alpha < 1.0) || distribution.affinity_checks < 1) {
+      !(distribution.family_alpha > 0.0 && distribution.family_alpha < 1.0) ||
+      distribution.affinity_checks < 1) {
     throw InvalidArgument(
-        "distribution options need cases >= 1, samples >= 2, 0 < alpha < 1 and affinity_checks >= 1, got cases " +
-        std::to_string(distribution.cases) + ", samples " + std::to_string(distribution.samples) + ", alpha " +
-        format_number(distribution.family_alpha) + ", affinity_checks " + std::to_string(distribution.affinity_checks));
+        "distribution options need cases >= 1, samples >= 2, 0 < alpha < 1 and affinity_checks >= "
+        "1, got cases " +
+        std::to_string(distribution.cases) + ", samples " + std::to_string(distribution.samples) +
+        ", alpha " + format_number(distribution.family_alpha) + ", affinity_checks " +
+        std::to_string(distribution.affinity_checks));
   }
 }
 
 }  // namespace detail
 
-Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, Component component, Group group,
-                                      const CheckOptions& options, const DistributionOptions& distribution) {
+Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, Component component,
+                                      Group group, const CheckOptions& options,
+                                      const DistributionOptions& distribution) {
   if (!target) throw InvalidArgument("check_distribution_invariance needs a flow target, got null");
   if (component != Component::flow_input && component != Component::flow_target) {
-    throw InvalidArgument("in-distribution checks are about flow_input or flow_target, got " + to_string(component));
+    throw InvalidArgument("in-distribution checks are about flow_input or flow_target, got " +
+                          to_string(component));
   }
   detail::require_distribution_options(distribution);
   detail::LawStatistics statistics;
@@ -422,14 +456,14 @@ Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, 
     const detail::NoisePair pair{part_of(scene), part_of(moved), target->noise_dimension(scene),
                                  target->name() + ": the " + to_string(component)};
     detail::CaseOutcome outcome =
-        detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance), options, distribution,
-                             statistics);
+        detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance),
+                             options, distribution, statistics);
     outcome.witness.scene = scene;
     outcome.witness.g = g;
     return outcome;
   };
-  Verdict verdict = detail::run_check(run_case, component, group, Mode::distribution, options, distribution.cases,
-                                      distribution.shrink_budget);
+  Verdict verdict = detail::run_check(run_case, component, group, Mode::distribution, options,
+                                      distribution.cases, distribution.shrink_budget);
   detail::finish_distribution_verdict(verdict, statistics, distribution);
   return verdict;
 }

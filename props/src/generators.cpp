@@ -19,9 +19,8 @@ rc::Gen<double> unit_interval() {
 
 // A uniform number in [-max_abs, max_abs].
 rc::Gen<double> symmetric(double max_abs) {
-  return rc::gen::map(rc::gen::inRange(-kResolution, kResolution + 1), [max_abs](int k) {
-    return max_abs * static_cast<double>(k) / kResolution;
-  });
+  return rc::gen::map(rc::gen::inRange(-kResolution, kResolution + 1),
+                      [max_abs](int k) { return max_abs * static_cast<double>(k) / kResolution; });
 }
 
 // A Haar-uniform unit axis (the axis of a Haar rotation is uniform on the sphere).
@@ -56,9 +55,8 @@ rc::Gen<Eigen::Vector3d> translation_with_edges(double max_abs, bool planar) {
   auto gen = rc::gen::weightedOneOf<Eigen::Vector3d>({
       {8, translation(max_abs)},
       {1, rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero())},
-      {1, rc::gen::map(unit_axis(), [](const Eigen::Vector3d& axis) -> Eigen::Vector3d {
-         return 1e3 * axis;
-       })},
+      {1, rc::gen::map(unit_axis(),
+                       [](const Eigen::Vector3d& axis) -> Eigen::Vector3d { return 1e3 * axis; })},
   });
   if (!planar) return gen;
   return rc::gen::map(gen, [](Eigen::Vector3d p) {
@@ -67,7 +65,8 @@ rc::Gen<Eigen::Vector3d> translation_with_edges(double max_abs, bool planar) {
   });
 }
 
-rc::Gen<RigidTransform> combine(rc::Gen<Rotation> rotations, rc::Gen<Eigen::Vector3d> translations) {
+rc::Gen<RigidTransform> combine(rc::Gen<Rotation> rotations,
+                                rc::Gen<Eigen::Vector3d> translations) {
   return rc::gen::map(rc::gen::tuple(rotations, translations), [](const auto& rp) {
     return RigidTransform(std::get<0>(rp), std::get<1>(rp));
   });
@@ -86,7 +85,9 @@ rc::Gen<Twist> step_twist(double step, double turn) {
 
 rc::Gen<Rotation> haar_rotation() {
   return rc::gen::map(rc::gen::tuple(unit_interval(), unit_interval(), unit_interval()),
-                      [](const auto& u) { return shoemake_rotation(std::get<0>(u), std::get<1>(u), std::get<2>(u)); });
+                      [](const auto& u) {
+                        return shoemake_rotation(std::get<0>(u), std::get<1>(u), std::get<2>(u));
+                      });
 }
 
 rc::Gen<Rotation> rotation_near_pi() {
@@ -110,7 +111,8 @@ rc::Gen<Rotation> rotation() {
 rc::Gen<Eigen::Vector3d> translation(double max_abs) {
   return rc::gen::map(rc::gen::tuple(symmetric(max_abs), symmetric(max_abs), symmetric(max_abs)),
                       [](const auto& xyz) {
-                        return Eigen::Vector3d(std::get<0>(xyz), std::get<1>(xyz), std::get<2>(xyz));
+                        return Eigen::Vector3d(std::get<0>(xyz), std::get<1>(xyz),
+                                               std::get<2>(xyz));
                       });
 }
 
@@ -123,8 +125,9 @@ rc::Gen<RigidTransform> group_element(Group group) {
     case Group::rotation:
       return combine(rotation(), rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
     case Group::se2:
-      return combine(rc::gen::weightedOneOf<Rotation>({{4, rotation_about_z()}, {1, z_rotation_edge_cases()}}),
-                     translation_with_edges(kMaxTranslation, true));
+      return combine(
+          rc::gen::weightedOneOf<Rotation>({{4, rotation_about_z()}, {1, z_rotation_edge_cases()}}),
+          translation_with_edges(kMaxTranslation, true));
     case Group::se3:
       return combine(rotation(), translation_with_edges(kMaxTranslation, false));
     case Group::c8:
@@ -138,11 +141,14 @@ namespace {
 // Between min_count and max_count points; with min_count = 0, RapidCheck's sized container.
 rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, double max_abs) {
   if (min_count <= 0) {
-    return rc::gen::resize(max_count, rc::gen::container<std::vector<Eigen::Vector3d>>(translation(max_abs)));
+    return rc::gen::resize(max_count,
+                           rc::gen::container<std::vector<Eigen::Vector3d>>(translation(max_abs)));
   }
-  return rc::gen::mapcat(rc::gen::inRange(min_count, std::max(min_count, max_count) + 1), [max_abs](int count) {
-    return rc::gen::container<std::vector<Eigen::Vector3d>>(static_cast<std::size_t>(count), translation(max_abs));
-  });
+  return rc::gen::mapcat(rc::gen::inRange(min_count, std::max(min_count, max_count) + 1),
+                         [max_abs](int count) {
+                           return rc::gen::container<std::vector<Eigen::Vector3d>>(
+                               static_cast<std::size_t>(count), translation(max_abs));
+                         });
 }
 
 }  // namespace
@@ -176,14 +182,18 @@ rc::Gen<Scene> scene(SceneShape shape) {
       points(shape.min_world_points, shape.max_world_points, 10.0));
   if (shape.extra_pose_names.empty() && shape.scalar_names.empty()) return geometry;
   // Named extras: one random pose per name (anywhere, any orientation), one number per scalar.
-  const auto poses = rc::gen::container<std::vector<RigidTransform>>(shape.extra_pose_names.size(),
-                                                                     combine(rotation(), translation(10.0)));
-  const auto numbers = rc::gen::container<std::vector<double>>(shape.scalar_names.size(), symmetric(1.0));
+  const auto poses = rc::gen::container<std::vector<RigidTransform>>(
+      shape.extra_pose_names.size(), combine(rotation(), translation(10.0)));
+  const auto numbers =
+      rc::gen::container<std::vector<double>>(shape.scalar_names.size(), symmetric(1.0));
   return rc::gen::apply(
       [names = shape.extra_pose_names, scalar_names = shape.scalar_names](
-          Scene s, const std::vector<RigidTransform>& world_T_extra, const std::vector<double>& values) {
-        for (std::size_t i = 0; i < names.size(); ++i) s.extra_poses.emplace_back(names[i], world_T_extra[i]);
-        for (std::size_t i = 0; i < scalar_names.size(); ++i) s.scalars.emplace_back(scalar_names[i], values[i]);
+          Scene s, const std::vector<RigidTransform>& world_T_extra,
+          const std::vector<double>& values) {
+        for (std::size_t i = 0; i < names.size(); ++i)
+          s.extra_poses.emplace_back(names[i], world_T_extra[i]);
+        for (std::size_t i = 0; i < scalar_names.size(); ++i)
+          s.scalars.emplace_back(scalar_names[i], values[i]);
         return s;
       },
       geometry, poses, numbers);

@@ -12,11 +12,16 @@ const std::vector<Group>& all_groups() {
 
 std::string to_string(Group group) {
   switch (group) {
-    case Group::translation: return "translation";
-    case Group::rotation: return "rotation";
-    case Group::se2: return "se2";
-    case Group::se3: return "se3";
-    case Group::c8: return "c8";
+    case Group::translation:
+      return "translation";
+    case Group::rotation:
+      return "rotation";
+    case Group::se2:
+      return "se2";
+    case Group::se3:
+      return "se3";
+    case Group::c8:
+      return "c8";
   }
   return "unknown";
 }

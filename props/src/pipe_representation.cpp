@@ -1,15 +1,13 @@
 #include "handcentric/props/pipe_representation.hpp"
 
-
 #include "handcentric/core/format.hpp"
 
 namespace handcentric::props {
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 PipeRepresentation::PipeRepresentation(std::string command, double timeout_seconds,
-                                       std::vector<std::string> extra_pose_names, std::vector<std::string> scalar_names)
+                                       std::vector<std::string> extra_pose_names,
+                                       std::vector<std::string> scalar_names)
     : command_(std::move(command)),
       forced_extra_poses_(std::move(extra_pose_names)),
       forced_scalars_(std::move(scalar_names)),
@@ -20,26 +18,35 @@ PipeRepresentation::PipeRepresentation(std::string command, double timeout_secon
 
 PipeRepresentation::~PipeRepresentation() = default;
 
-std::string PipeRepresentation::name() const { return "exec: " + command_; }
+std::string PipeRepresentation::name() const {
+  return "exec: " + command_;
+}
 
 void PipeRepresentation::check_lengths(const Scene& scene, const PluginReply& reply, int id) const {
   const auto shape = std::make_tuple(scene.history_length(), scene.chunk_length(),
-                                     static_cast<int>(scene.hand_points.size()), static_cast<int>(scene.world_points.size()));
-  const auto lengths = std::make_tuple(reply.actions.size(), reply.observation.size(), reply.has_observation);
+                                     static_cast<int>(scene.hand_points.size()),
+                                     static_cast<int>(scene.world_points.size()));
+  const auto lengths =
+      std::make_tuple(reply.actions.size(), reply.observation.size(), reply.has_observation);
   const auto [known, inserted] = lengths_.emplace(shape, lengths);
   if (!inserted && known->second != lengths) {
-    connection_.fail("plug-in '" + command_ + "' changed its vector lengths between scenes of the same shape (H = " +
-         std::to_string(std::get<0>(shape)) + ", K = " + std::to_string(std::get<1>(shape)) + ", " +
-         std::to_string(std::get<2>(shape)) + " eye-in-hand and " + std::to_string(std::get<3>(shape)) +
-         " world points): actions " + std::to_string(std::get<0>(known->second)) + " then " +
-         std::to_string(reply.actions.size()) + " numbers, observation " + std::to_string(std::get<1>(known->second)) +
-         " then " + std::to_string(reply.observation.size()) + " (request " + std::to_string(id) +
-         "); a length may depend on the scene's shape only");
+    connection_.fail("plug-in '" + command_ +
+                     "' changed its vector lengths between scenes of the same shape (H = " +
+                     std::to_string(std::get<0>(shape)) +
+                     ", K = " + std::to_string(std::get<1>(shape)) + ", " +
+                     std::to_string(std::get<2>(shape)) + " eye-in-hand and " +
+                     std::to_string(std::get<3>(shape)) + " world points): actions " +
+                     std::to_string(std::get<0>(known->second)) + " then " +
+                     std::to_string(reply.actions.size()) + " numbers, observation " +
+                     std::to_string(std::get<1>(known->second)) + " then " +
+                     std::to_string(reply.observation.size()) + " (request " + std::to_string(id) +
+                     "); a length may depend on the scene's shape only");
   }
 }
 
 Scene PipeRepresentation::with_extras(const Scene& scene) const {
-  if (capabilities_) return with_named_extras(scene, capabilities_->extra_pose_names, capabilities_->scalar_names);
+  if (capabilities_)
+    return with_named_extras(scene, capabilities_->extra_pose_names, capabilities_->scalar_names);
   return with_named_extras(scene, forced_extra_poses_, forced_scalars_);
 }
 
@@ -50,7 +57,8 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   probe.world_T_hand_history = {RigidTransform::identity()};
   probe.world_T_hand_chunk = {RigidTransform::from_translation(Eigen::Vector3d(0.1, 0.0, 0.0))};
   Scene asked = with_extras(probe);
-  PluginReply reply = connection_.exchange(RequestKind::encode, encode_request_body(asked), /*hello_allowed=*/true);
+  PluginReply reply =
+      connection_.exchange(RequestKind::encode, encode_request_body(asked), /*hello_allowed=*/true);
   PluginCapabilities capabilities;
   if (reply.hello) capabilities = *reply.hello;
   capabilities.extra_pose_names = merged_names(capabilities.extra_pose_names, forced_extra_poses_);
@@ -68,12 +76,14 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   return *capabilities_;
 }
 
-const PluginReply& PipeRepresentation::ask(const Scene& scene, RequestKind kind, const std::string& body) const {
+const PluginReply& PipeRepresentation::ask(const Scene& scene, RequestKind kind,
+                                           const std::string& body) const {
   std::string key(1, kind == RequestKind::encode ? 'e' : kind == RequestKind::flow ? 'f' : 'd');
   key += body;
   if (const auto hit = cache_.find(key); hit != cache_.end()) return hit->second;
   capabilities();
-  if (const auto hit = cache_.find(key); hit != cache_.end()) return hit->second;  // the probe itself
+  if (const auto hit = cache_.find(key); hit != cache_.end())
+    return hit->second;  // the probe itself
   PluginReply reply = connection_.exchange(kind, body, false);
   if (kind != RequestKind::decode) check_lengths(scene, reply, connection_.last_id());
   if (cache_.size() > 200000) cache_.clear();  // bounded memory over long audits
@@ -90,15 +100,17 @@ Eigen::VectorXd PipeRepresentation::encode_observation(const Scene& scene) const
   return ask(scene, RequestKind::encode, encode_request_body(scene)).observation;
 }
 
-bool PipeRepresentation::can_decode() const { return capabilities().decode; }
+bool PipeRepresentation::can_decode() const {
+  return capabilities().decode;
+}
 
 bool PipeRepresentation::provides_observation() const {
   capabilities();
   return has_observation_;
 }
 
-std::vector<RigidTransform> PipeRepresentation::decode_actions(const Eigen::VectorXd& actions,
-                                                               const RigidTransform& world_T_hand0) const {
+std::vector<RigidTransform> PipeRepresentation::decode_actions(
+    const Eigen::VectorXd& actions, const RigidTransform& world_T_hand0) const {
   Scene observation;
   observation.world_T_hand_history = {world_T_hand0};
   return decode_in_scene(actions, with_extras(observation));
@@ -107,38 +119,49 @@ std::vector<RigidTransform> PipeRepresentation::decode_actions(const Eigen::Vect
 std::vector<RigidTransform> PipeRepresentation::decode_in_scene(const Eigen::VectorXd& actions,
                                                                 const Scene& observation) const {
   if (!can_decode()) {
-    throw InvalidArgument("representation '" + name() +
-                          "' is a plug-in that did not declare \"decode\" in a hello: it encodes only");
+    throw InvalidArgument(
+        "representation '" + name() +
+        "' is a plug-in that did not declare \"decode\" in a hello: it encodes only");
   }
   observation.validate_observation();
   return ask(observation, RequestKind::decode, decode_request_body(actions, observation)).chunk;
 }
 
-FlowSample PipeRepresentation::flow(const Scene& scene, const Eigen::VectorXd& eps, double t) const {
+FlowSample PipeRepresentation::flow(const Scene& scene, const Eigen::VectorXd& eps,
+                                    double t) const {
   if (!capabilities().flow) {
-    throw InvalidArgument("representation '" + name() + "' did not declare \"flow\" in a hello: it has no flow of its own");
+    throw InvalidArgument("representation '" + name() +
+                          "' did not declare \"flow\" in a hello: it has no flow of its own");
   }
   scene.validate_observation();
-  const PluginReply& reply = ask(scene, RequestKind::flow, encode_request_body(scene, FlowQuery{&eps, t}));
+  const PluginReply& reply =
+      ask(scene, RequestKind::flow, encode_request_body(scene, FlowQuery{&eps, t}));
   return {reply.flow_input, reply.flow_target};
 }
 
-PipeFlowTarget::PipeFlowTarget(std::shared_ptr<const PipeRepresentation> plugin) : plugin_(std::move(plugin)) {
+PipeFlowTarget::PipeFlowTarget(std::shared_ptr<const PipeRepresentation> plugin)
+    : plugin_(std::move(plugin)) {
   if (!plugin_) throw InvalidArgument("PipeFlowTarget needs a plug-in, got null");
   if (!plugin_->capabilities().flow) {
     throw InvalidArgument("plug-in '" + plugin_->name() + "' did not declare \"flow\" in a hello");
   }
 }
 
-std::string PipeFlowTarget::name() const { return plugin_->name() + " (its own flow)"; }
+std::string PipeFlowTarget::name() const {
+  return plugin_->name() + " (its own flow)";
+}
 
-Eigen::Index PipeFlowTarget::noise_dimension(const Scene& scene) const { return plugin_->encode_actions(scene).size(); }
+Eigen::Index PipeFlowTarget::noise_dimension(const Scene& scene) const {
+  return plugin_->encode_actions(scene).size();
+}
 
-FlowSample PipeFlowTarget::operator()(const Scene& scene, const Eigen::VectorXd& eps, double t) const {
+FlowSample PipeFlowTarget::operator()(const Scene& scene, const Eigen::VectorXd& eps,
+                                      double t) const {
   if (eps.size() != noise_dimension(scene) || !eps.allFinite() || !(t >= 0.0 && t <= 1.0)) {
-    throw InvalidArgument(name() + ": eps must have the length of the actions (" + std::to_string(noise_dimension(scene)) +
-                          ") and be finite, and t in [0, 1]; got length " + std::to_string(eps.size()) + ", t = " +
-                          format_number(t));
+    throw InvalidArgument(name() + ": eps must have the length of the actions (" +
+                          std::to_string(noise_dimension(scene)) +
+                          ") and be finite, and t in [0, 1]; got length " +
+                          std::to_string(eps.size()) + ", t = " + format_number(t));
   }
   return plugin_->flow(scene, eps, t);
 }

@@ -20,10 +20,12 @@ std::string seconds_text(double seconds) {
 
 const std::string& checked(const std::string& command, double timeout_seconds) {
   if (command.find_first_not_of(" \t") == std::string::npos) {
-    throw InvalidArgument("--exec needs a command, got an empty one; e.g. --exec 'python3 repr.py'");
+    throw InvalidArgument(
+        "--exec needs a command, got an empty one; e.g. --exec 'python3 repr.py'");
   }
   if (!(timeout_seconds > 0.0) || !std::isfinite(timeout_seconds)) {
-    throw InvalidArgument("--timeout must be a positive number of seconds, got " + format_number(timeout_seconds));
+    throw InvalidArgument("--timeout must be a positive number of seconds, got " +
+                          format_number(timeout_seconds));
   }
   return command;
 }
@@ -31,7 +33,9 @@ const std::string& checked(const std::string& command, double timeout_seconds) {
 }  // namespace
 
 PluginConnection::PluginConnection(std::string command, double timeout_seconds)
-    : command_(std::move(command)), timeout_seconds_(timeout_seconds), process_(checked(command_, timeout_seconds)) {}
+    : command_(std::move(command)),
+      timeout_seconds_(timeout_seconds),
+      process_(checked(command_, timeout_seconds)) {}
 
 void PluginConnection::fail(const std::string& what) {
   dead_ = true;
@@ -47,37 +51,48 @@ void PluginConnection::fail(const std::string& what) {
 
 void PluginConnection::fail_exited(const std::string& when) {
   const Subprocess::Exit exit = process_.finish(1.0);
-  if (exit.exited && exit.status == 127) fail("plug-in command not found: '" + command_ + "'; check the program name and path");
+  if (exit.exited && exit.status == 127)
+    fail("plug-in command not found: '" + command_ + "'; check the program name and path");
   fail(who() + " " + exit.describe() + " " + when);
 }
 
-PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body, bool hello_allowed) {
+PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body,
+                                       bool hello_allowed) {
   if (dead_) throw PluginError(who() + " failed earlier and was stopped");
   const int id = next_id_++;
   const auto started = Clock::now();
   switch (process_.write_all(request_line(id, body), timeout_seconds_)) {
-    case Subprocess::Outcome::done: break;
-    case Subprocess::Outcome::closed: fail_exited("before reading request " + std::to_string(id));
-    case Subprocess::Outcome::too_long: break;  // writing has no line limit
+    case Subprocess::Outcome::done:
+      break;
+    case Subprocess::Outcome::closed:
+      fail_exited("before reading request " + std::to_string(id));
+    case Subprocess::Outcome::too_long:
+      break;  // writing has no line limit
     case Subprocess::Outcome::timed_out:
       process_.kill();
-      fail(who() + " did not read request " + std::to_string(id) + " within " + seconds_text(timeout_seconds_) +
-           " s; raise --timeout if it is just slow");
+      fail(who() + " did not read request " + std::to_string(id) + " within " +
+           seconds_text(timeout_seconds_) + " s; raise --timeout if it is just slow");
   }
   const auto written = Clock::now();
   std::string line;
   switch (process_.read_line(line, timeout_seconds_)) {
-    case Subprocess::Outcome::done: break;
-    case Subprocess::Outcome::closed: fail_exited("before answering request " + std::to_string(id));
+    case Subprocess::Outcome::done:
+      break;
+    case Subprocess::Outcome::closed:
+      fail_exited("before answering request " + std::to_string(id));
     case Subprocess::Outcome::too_long:
       process_.kill();
       fail(who() + " answered request " + std::to_string(id) + " with a line longer than " +
-           std::to_string(Subprocess::kMaxLineBytes >> 20) + " MiB; answers are one line of JSON, far shorter");
+           std::to_string(Subprocess::kMaxLineBytes >> 20) +
+           " MiB; answers are one line of JSON, far shorter");
     case Subprocess::Outcome::timed_out:
       process_.kill();
-      fail(who() + " gave no answer to request " + std::to_string(id) + " within " + seconds_text(timeout_seconds_) +
-           " s; a plug-in must write one line per request and flush it (Python: print(..., flush=True) or "
-           "sys.stdout.flush(), or run it as python3 -u: a pipe is block-buffered), or raise --timeout if it is "
+      fail(who() + " gave no answer to request " + std::to_string(id) + " within " +
+           seconds_text(timeout_seconds_) +
+           " s; a plug-in must write one line per request and flush it (Python: print(..., "
+           "flush=True) or "
+           "sys.stdout.flush(), or run it as python3 -u: a pipe is block-buffered), or raise "
+           "--timeout if it is "
            "just slow");
   }
   seconds_waiting_ += std::chrono::duration<double>(Clock::now() - written).count();

@@ -61,7 +61,9 @@ void append_vector(std::string& out, const Eigen::VectorXd& v) {
 }
 
 // A JSON string literal of a name (names come from the plug-in's hello or the command line).
-void append_name(std::string& out, const std::string& name) { out += nlohmann::json(name).dump(); }
+void append_name(std::string& out, const std::string& name) {
+  out += nlohmann::json(name).dump();
+}
 
 // History, points and extras: what every request carries.
 void append_observation(std::string& out, const Scene& scene) {
@@ -93,34 +95,43 @@ void append_observation(std::string& out, const Scene& scene) {
   }
 }
 
-std::string reply_to(const std::string& who, int id) { return who + " answered request " + std::to_string(id); }
+std::string reply_to(const std::string& who, int id) {
+  return who + " answered request " + std::to_string(id);
+}
 
-Eigen::VectorXd read_numbers(const nlohmann::json& value, const std::string& field, int id, const std::string& who) {
-  if (!value.is_array()) throw PluginError(reply_to(who, id) + " with \"" + field + "\" that is not an array of numbers");
+Eigen::VectorXd read_numbers(const nlohmann::json& value, const std::string& field, int id,
+                             const std::string& who) {
+  if (!value.is_array())
+    throw PluginError(reply_to(who, id) + " with \"" + field +
+                      "\" that is not an array of numbers");
   Eigen::VectorXd v(static_cast<Eigen::Index>(value.size()));
   for (std::size_t i = 0; i < value.size(); ++i) {
     if (!value[i].is_number()) {
-      throw PluginError(reply_to(who, id) + " with \"" + field + "\"[" + std::to_string(i) + "] = " +
-                        one_line(value[i].dump(), 40) + ", not a number");
+      throw PluginError(reply_to(who, id) + " with \"" + field + "\"[" + std::to_string(i) +
+                        "] = " + one_line(value[i].dump(), 40) + ", not a number");
     }
     const double x = value[i].get<double>();
     if (!std::isfinite(x)) {
-      throw PluginError(reply_to(who, id) + " with a non-finite \"" + field + "\"[" + std::to_string(i) +
-                        "] = " + format_number(x) + "; send finite numbers only");
+      throw PluginError(reply_to(who, id) + " with a non-finite \"" + field + "\"[" +
+                        std::to_string(i) + "] = " + format_number(x) +
+                        "; send finite numbers only");
     }
     v(static_cast<Eigen::Index>(i)) = x;
   }
   return v;
 }
 
-std::vector<std::string> read_names(const nlohmann::json& hello, const char* field, int id, const std::string& who) {
+std::vector<std::string> read_names(const nlohmann::json& hello, const char* field, int id,
+                                    const std::string& who) {
   std::vector<std::string> names;
   if (!hello.contains(field) || hello[field].is_null()) return names;
-  if (!hello[field].is_array()) throw PluginError(reply_to(who, id) + " with a hello whose \"" + field + "\" is not a list of names");
+  if (!hello[field].is_array())
+    throw PluginError(reply_to(who, id) + " with a hello whose \"" + field +
+                      "\" is not a list of names");
   for (const auto& name : hello[field]) {
     if (!name.is_string() || name.get<std::string>().empty()) {
-      throw PluginError(reply_to(who, id) + " with a hello whose \"" + field + "\" holds " + one_line(name.dump(), 40) +
-                        ", not a name");
+      throw PluginError(reply_to(who, id) + " with a hello whose \"" + field + "\" holds " +
+                        one_line(name.dump(), 40) + ", not a name");
     }
     names.push_back(name.get<std::string>());
   }
@@ -129,13 +140,16 @@ std::vector<std::string> read_names(const nlohmann::json& hello, const char* fie
 
 bool read_flag(const nlohmann::json& hello, const char* field, int id, const std::string& who) {
   if (!hello.contains(field) || hello[field].is_null()) return false;
-  if (!hello[field].is_boolean()) throw PluginError(reply_to(who, id) + " with a hello whose \"" + field + "\" is not true or false");
+  if (!hello[field].is_boolean())
+    throw PluginError(reply_to(who, id) + " with a hello whose \"" + field +
+                      "\" is not true or false");
   return hello[field].get<bool>();
 }
 
 // A world-frame pose: 16 finite numbers, row-major, last row 0 0 0 1. The rotation block is
 // taken as it is (a float32 plug-in's is orthonormal to ~1e-7 only); distances compare it.
-RigidTransform read_pose(const nlohmann::json& value, std::size_t k, int id, const std::string& who) {
+RigidTransform read_pose(const nlohmann::json& value, std::size_t k, int id,
+                         const std::string& who) {
   const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", id, who);
   if (v.size() != 16 || v(12) != 0.0 || v(13) != 0.0 || v(14) != 0.0 || v(15) != 1.0) {
     throw PluginError(reply_to(who, id) + " with \"chunk\"[" + std::to_string(k) +
@@ -153,12 +167,14 @@ void require_distinct_names(const std::vector<std::string>& names, const std::st
   for (const std::string& name : names) {
     if (name.empty() || !seen.insert(name).second) {
       throw InvalidArgument(flag + " needs distinct, non-empty names, got '" + name + "' " +
-                            (name.empty() ? "(empty)" : "twice") + "; e.g. " + flag + " start,left_hand");
+                            (name.empty() ? "(empty)" : "twice") + "; e.g. " + flag +
+                            " start,left_hand");
     }
   }
 }
 
-std::vector<std::string> merged_names(std::vector<std::string> first, const std::vector<std::string>& second) {
+std::vector<std::string> merged_names(std::vector<std::string> first,
+                                      const std::vector<std::string>& second) {
   for (const std::string& name : second) {
     if (std::find(first.begin(), first.end(), name) == first.end()) first.push_back(name);
   }
@@ -168,10 +184,12 @@ std::vector<std::string> merged_names(std::vector<std::string> first, const std:
 Scene with_named_extras(Scene scene, const std::vector<std::string>& pose_names,
                         const std::vector<std::string>& scalar_names) {
   auto has = [](const auto& named, const std::string& name) {
-    return std::any_of(named.begin(), named.end(), [&name](const auto& entry) { return entry.first == name; });
+    return std::any_of(named.begin(), named.end(),
+                       [&name](const auto& entry) { return entry.first == name; });
   };
   for (const std::string& name : pose_names) {
-    if (!has(scene.extra_poses, name)) scene.extra_poses.emplace_back(name, RigidTransform::identity());
+    if (!has(scene.extra_poses, name))
+      scene.extra_poses.emplace_back(name, RigidTransform::identity());
   }
   for (const std::string& name : scalar_names) {
     if (!has(scene.scalars, name)) scene.scalars.emplace_back(name, 0.0);
@@ -180,7 +198,8 @@ Scene with_named_extras(Scene scene, const std::vector<std::string>& pose_names,
 }
 
 std::string one_line(std::string text, std::size_t limit) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.pop_back();
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' '))
+    text.pop_back();
   for (char& c : text) {
     if (c == '\n' || c == '\r') c = '|';
   }
@@ -219,25 +238,29 @@ std::string policy_request_body(const Scene& observation, const Eigen::VectorXd&
 }
 
 std::string request_line(int id, const std::string& body) {
-  return "{\"id\": " + std::to_string(id) + ", \"protocol\": " + std::to_string(kProtocolVersion) + ", " + body + "}\n";
+  return "{\"id\": " + std::to_string(id) + ", \"protocol\": " + std::to_string(kProtocolVersion) +
+         ", " + body + "}\n";
 }
 
-PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who, bool hello_allowed) {
+PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
+                        bool hello_allowed) {
   // Nesting first, outside strings: a parser recursing into 10^6 brackets would overflow the stack.
   int depth = 0, deepest = 0;
   bool in_string = false;
   for (std::size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
     if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
+      if (c == '\\')
+        ++i;
+      else if (c == '"')
+        in_string = false;
     } else if (c == '"') {
       in_string = true;
     } else if (c == '[' || c == '{') {
       deepest = std::max(deepest, ++depth);
       if (deepest > kMaxReplyDepth) {
-        throw PluginError(reply_to(who, id) + " with JSON nested deeper than " + std::to_string(kMaxReplyDepth) +
-                          " levels; an answer needs 3");
+        throw PluginError(reply_to(who, id) + " with JSON nested deeper than " +
+                          std::to_string(kMaxReplyDepth) + " levels; an answer needs 3");
       }
     } else if (c == ']' || c == '}') {
       --depth;
@@ -248,13 +271,16 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     json = nlohmann::json::parse(line);
   } catch (const nlohmann::json::exception& e) {
     // JSON has no NaN or Infinity; Python's json module writes them anyway, and 1e999 overflows.
-    const bool non_finite = line.find("NaN") != std::string::npos || line.find("Infinity") != std::string::npos ||
+    const bool non_finite = line.find("NaN") != std::string::npos ||
+                            line.find("Infinity") != std::string::npos ||
                             std::string(e.what()).find("overflow") != std::string::npos;
-    throw PluginError(reply_to(who, id) +
-                      (non_finite ? " with a non-finite number (NaN, Infinity or an overflow, e.g. 1e999 -> inf), "
-                                    "which is not JSON; send finite numbers only: "
-                                  : " with a line that is not JSON: ") +
-                      "'" + one_line(line, 120) + "'");
+    throw PluginError(
+        reply_to(who, id) +
+        (non_finite
+             ? " with a non-finite number (NaN, Infinity or an overflow, e.g. 1e999 -> inf), "
+               "which is not JSON; send finite numbers only: "
+             : " with a line that is not JSON: ") +
+        "'" + one_line(line, 120) + "'");
   }
   if (!json.is_object() || !json.contains("id")) {
     throw PluginError(reply_to(who, id) + " without an \"id\": '" + one_line(line, 120) + "'");
@@ -266,12 +292,18 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
   PluginReply reply;
   if (json.contains("hello")) {
     const nlohmann::json& hello = json["hello"];
-    if (!hello_allowed) throw PluginError(reply_to(who, id) + " with a hello; a hello may only answer the first request");
-    if (!hello.is_object()) throw PluginError(reply_to(who, id) + " with a hello that is not an object");
+    if (!hello_allowed)
+      throw PluginError(reply_to(who, id) +
+                        " with a hello; a hello may only answer the first request");
+    if (!hello.is_object())
+      throw PluginError(reply_to(who, id) + " with a hello that is not an object");
     PluginCapabilities capabilities;
-    capabilities.protocol = hello.contains("protocol") && hello["protocol"].is_number_integer() ? hello["protocol"].get<int>() : 2;
+    capabilities.protocol = hello.contains("protocol") && hello["protocol"].is_number_integer()
+                                ? hello["protocol"].get<int>()
+                                : 2;
     if (capabilities.protocol < 2 || capabilities.protocol > kProtocolVersion) {
-      throw PluginError(reply_to(who, id) + " with a hello for protocol " + std::to_string(capabilities.protocol) +
+      throw PluginError(reply_to(who, id) + " with a hello for protocol " +
+                        std::to_string(capabilities.protocol) +
                         "; this audit speaks protocols 1 and " + std::to_string(kProtocolVersion));
     }
     capabilities.extra_pose_names = read_names(hello, "extra_poses", id, who);
@@ -281,7 +313,8 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     if (hello.contains("noise") && !hello["noise"].is_null()) {
       if (!hello["noise"].is_number_integer() || hello["noise"].get<long long>() < 1 ||
           hello["noise"].get<long long>() > 1000000) {
-        throw PluginError(reply_to(who, id) + " with a hello whose \"noise\" is " + one_line(hello["noise"].dump(), 40) +
+        throw PluginError(reply_to(who, id) + " with a hello whose \"noise\" is " +
+                          one_line(hello["noise"].dump(), 40) +
                           ", not a length between 1 and 1000000");
       }
       capabilities.noise = hello["noise"].get<int>();
@@ -291,20 +324,26 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
   }
   if (kind == RequestKind::decode || kind == RequestKind::policy) {
     if (!json.contains("chunk") || !json["chunk"].is_array() || json["chunk"].empty()) {
-      throw PluginError(reply_to(who, id) + (kind == RequestKind::decode ? ", a decode request," : ", a policy request,") +
-                        " without a \"chunk\" of poses: '" + one_line(line, 120) + "'");
+      throw PluginError(
+          reply_to(who, id) +
+          (kind == RequestKind::decode ? ", a decode request," : ", a policy request,") +
+          " without a \"chunk\" of poses: '" + one_line(line, 120) + "'");
     }
-    for (std::size_t k = 0; k < json["chunk"].size(); ++k) reply.chunk.push_back(read_pose(json["chunk"][k], k, id, who));
+    for (std::size_t k = 0; k < json["chunk"].size(); ++k)
+      reply.chunk.push_back(read_pose(json["chunk"][k], k, id, who));
     return reply;
   }
-  if (!json.contains("actions")) throw PluginError(reply_to(who, id) + " without \"actions\": '" + one_line(line, 120) + "'");
+  if (!json.contains("actions"))
+    throw PluginError(reply_to(who, id) + " without \"actions\": '" + one_line(line, 120) + "'");
   reply.actions = read_numbers(json["actions"], "actions", id, who);
   if (reply.actions.size() == 0) throw PluginError(reply_to(who, id) + " with no actions");
   reply.has_observation = json.contains("observation") && !json["observation"].is_null();
-  if (reply.has_observation) reply.observation = read_numbers(json["observation"], "observation", id, who);
+  if (reply.has_observation)
+    reply.observation = read_numbers(json["observation"], "observation", id, who);
   if (kind == RequestKind::flow) {
     if (!json.contains("flow_input") || !json.contains("flow_target")) {
-      throw PluginError(reply_to(who, id) + ", a flow request (it carries eps and t), without \"flow_input\" and "
+      throw PluginError(reply_to(who, id) +
+                        ", a flow request (it carries eps and t), without \"flow_input\" and "
                         "\"flow_target\"; answer them, or do not declare \"flow\" in the hello");
     }
     reply.flow_input = read_numbers(json["flow_input"], "flow_input", id, who);

@@ -11,7 +11,8 @@ namespace {
 
 constexpr int kShrinkBudget = 1000;
 
-std::vector<RigidTransform> moved_by(const RigidTransform& g, const std::vector<RigidTransform>& chunk) {
+std::vector<RigidTransform> moved_by(const RigidTransform& g,
+                                     const std::vector<RigidTransform>& chunk) {
   std::vector<RigidTransform> out;
   out.reserve(chunk.size());
   for (const RigidTransform& world_T_handk : chunk) out.push_back(g * world_T_handk);
@@ -37,7 +38,8 @@ SeededPolicy::SeededPolicy(std::shared_ptr<const ChunkPolicy> policy) : policy_(
   if (!policy_) throw InvalidArgument("SeededPolicy needs a policy, got null");
 }
 
-std::vector<RigidTransform> SeededPolicy::act(const Scene& observation, const Eigen::VectorXd& noise) const {
+std::vector<RigidTransform> SeededPolicy::act(const Scene& observation,
+                                              const Eigen::VectorXd& noise) const {
   // FNV-1a over the noise's bytes: the same vector, the same seed.
   std::uint64_t seed = 1469598103934665603ULL;
   for (Eigen::Index i = 0; i < noise.size(); ++i) {
@@ -49,7 +51,8 @@ std::vector<RigidTransform> SeededPolicy::act(const Scene& observation, const Ei
   return policy_->act(observation, seed);
 }
 
-Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group, const CheckOptions& options) {
+Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
+                                  const CheckOptions& options) {
   const Eigen::VectorXd noise = fixed_noise(policy.noise_dimension(), options.noise_seed);
   const double relative = options.relative_tolerance;
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
@@ -65,10 +68,12 @@ Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group, const 
     outcome.holds = outcome.witness.error <= outcome.witness.tolerance;  // false for NaN
     return outcome;
   };
-  return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options, options.cases, kShrinkBudget);
+  return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,
+                           options.cases, kShrinkBudget);
 }
 
-Verdict check_policy_distribution(const NoisyPolicy& policy, Group group, const CheckOptions& options,
+Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
+                                  const CheckOptions& options,
                                   const DistributionOptions& distribution) {
   detail::require_distribution_options(distribution);
   detail::LawStatistics statistics;
@@ -78,36 +83,43 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group, const 
     pair.before = [&policy, &scene, g](const Eigen::VectorXd& noise) {
       return flatten_affine(moved_by(g, policy.act(scene, noise)));
     };
-    pair.after = [&policy, &moved](const Eigen::VectorXd& noise) { return flatten_affine(policy.act(moved, noise)); };
+    pair.after = [&policy, &moved](const Eigen::VectorXd& noise) {
+      return flatten_affine(policy.act(moved, noise));
+    };
     pair.noise_dimension = policy.noise_dimension();
     pair.name = policy.name() + ": the chunk";
-    detail::CaseOutcome outcome = detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance),
-                                                       options, distribution, statistics);
+    detail::CaseOutcome outcome =
+        detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance),
+                             options, distribution, statistics);
     outcome.witness.scene = scene;
     outcome.witness.g = g;
     return outcome;
   };
-  Verdict verdict = detail::run_check(run_case, Component::policy, group, Mode::distribution, options, distribution.cases,
-                                      distribution.shrink_budget);
+  Verdict verdict = detail::run_check(run_case, Component::policy, group, Mode::distribution,
+                                      options, distribution.cases, distribution.shrink_budget);
   detail::finish_distribution_verdict(verdict, statistics, distribution);
   return verdict;
 }
 
-Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy, const ClassifierOptions& options) {
+Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
+                               const ClassifierOptions& options) {
   if (!policy) throw InvalidArgument("classify_policy needs a policy, got null");
   Classification out;
   out.name = policy->name();
   for (View view : options.views) {
     const CheckOptions check = with_view(options.check, view);
     for (Group group : options.groups) {
-      out.verdicts.push_back(with_float32_note(check_policy_equivariance(*policy, group, check), options,
-                                               [&](const CheckOptions& o) { return check_policy_equivariance(*policy, group, o); }));
+      out.verdicts.push_back(with_float32_note(
+          check_policy_equivariance(*policy, group, check), options,
+          [&](const CheckOptions& o) { return check_policy_equivariance(*policy, group, o); }));
     }
     if (!options.in_distribution) continue;
     for (Group group : options.groups) {
       out.verdicts.push_back(with_float32_note(
           check_policy_distribution(*policy, group, check, options.distribution), options,
-          [&](const CheckOptions& o) { return check_policy_distribution(*policy, group, o, options.distribution); }));
+          [&](const CheckOptions& o) {
+            return check_policy_distribution(*policy, group, o, options.distribution);
+          }));
     }
   }
   return out;

@@ -15,7 +15,8 @@ RandomMlp::RandomMlp(int inputs, const std::vector<int>& hidden, int outputs, st
   sizes.insert(sizes.end(), hidden.begin(), hidden.end());
   sizes.push_back(outputs);
   for (int size : sizes) {
-    if (size < 1) throw InvalidArgument("RandomMlp layer sizes must be positive, got " + std::to_string(size));
+    if (size < 1)
+      throw InvalidArgument("RandomMlp layer sizes must be positive, got " + std::to_string(size));
   }
   std::mt19937_64 rng(seed);
   for (std::size_t layer = 0; layer + 1 < sizes.size(); ++layer) {
@@ -42,8 +43,9 @@ Eigen::VectorXd RandomMlp::operator()(const Eigen::VectorXd& input) const {
   return x;
 }
 
-RandomOuterPolicy::RandomOuterPolicy(std::shared_ptr<const Representation> representation, int observation_dimension,
-                                     int chunk_length, const std::vector<int>& hidden, std::uint64_t weight_seed)
+RandomOuterPolicy::RandomOuterPolicy(std::shared_ptr<const Representation> representation,
+                                     int observation_dimension, int chunk_length,
+                                     const std::vector<int>& hidden, std::uint64_t weight_seed)
     : representation_(std::move(representation)),
       chunk_length_(chunk_length),
       network_(observation_dimension + 6 * chunk_length, hidden, 6 * chunk_length, weight_seed) {
@@ -51,20 +53,26 @@ RandomOuterPolicy::RandomOuterPolicy(std::shared_ptr<const Representation> repre
     throw InvalidArgument("RandomOuterPolicy needs a representation that decodes actions");
   }
   if (observation_dimension < 0 || chunk_length < 1) {
-    throw InvalidArgument("RandomOuterPolicy needs observation_dimension >= 0 and chunk_length >= 1, got " +
-                          std::to_string(observation_dimension) + " and " + std::to_string(chunk_length));
+    throw InvalidArgument(
+        "RandomOuterPolicy needs observation_dimension >= 0 and chunk_length >= 1, got " +
+        std::to_string(observation_dimension) + " and " + std::to_string(chunk_length));
   }
 }
 
-std::string RandomOuterPolicy::name() const { return "random_outer_policy(" + representation_->name() + ")"; }
+std::string RandomOuterPolicy::name() const {
+  return "random_outer_policy(" + representation_->name() + ")";
+}
 
-std::vector<RigidTransform> RandomOuterPolicy::act(const Scene& observation, std::uint64_t noise_seed) const {
+std::vector<RigidTransform> RandomOuterPolicy::act(const Scene& observation,
+                                                   std::uint64_t noise_seed) const {
   observation.validate_observation();
-  const Eigen::VectorXd o = representation_->encode_observation(observation);  // eq. (3) for hand_centric
+  const Eigen::VectorXd o =
+      representation_->encode_observation(observation);  // eq. (3) for hand_centric
   Eigen::VectorXd input(network_.inputs());
   if (o.size() + 6 * chunk_length_ != network_.inputs()) {
-    throw InvalidArgument("RandomOuterPolicy: the observation encodes to " + std::to_string(o.size()) +
-                          " numbers, the network was built for " + std::to_string(network_.inputs() - 6 * chunk_length_));
+    throw InvalidArgument("RandomOuterPolicy: the observation encodes to " +
+                          std::to_string(o.size()) + " numbers, the network was built for " +
+                          std::to_string(network_.inputs() - 6 * chunk_length_));
   }
   input << o, fixed_noise(6 * chunk_length_, noise_seed);
   // Inverse of eq. (1) for hand_centric: a_k = T_0 ^R a_k (Theorem 1).

@@ -18,8 +18,8 @@ void show_list(std::ostream& os, const char* label, const std::vector<Item>& ite
 }  // namespace
 
 void showValue(const Rotation& rotation, std::ostream& os) {
-  os << "Rotation{r = " << format_matrix(rotation.log()) << ", angle = "
-     << format_number(rotation.angle()) << "}";
+  os << "Rotation{r = " << format_matrix(rotation.log())
+     << ", angle = " << format_number(rotation.angle()) << "}";
 }
 
 void showValue(const RigidTransform& transform, std::ostream& os) {

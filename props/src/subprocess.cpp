@@ -16,15 +16,19 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 Clock::time_point deadline_after(double seconds) {
-  return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  return Clock::now() +
+         std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
 }
 
 int remaining_ms(Clock::time_point deadline) {
-  const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+  const auto left =
+      std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
   return left <= 0 ? 0 : static_cast<int>(std::min<long long>(left, 1 << 30));
 }
 
-void set_nonblocking(int fd) { fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK); }
+void set_nonblocking(int fd) {
+  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) | O_NONBLOCK);
+}
 
 }  // namespace
 
@@ -38,7 +42,8 @@ Subprocess::Subprocess(std::string command, std::size_t max_line_bytes)
     : command_(std::move(command)), max_line_bytes_(max_line_bytes) {
   ::signal(SIGPIPE, SIG_IGN);  // a dead child gives EPIPE, which the caller reports
   int in[2], out[2], err[2];
-  if (pipe2(in, O_CLOEXEC) != 0) throw PluginError("cannot create pipes for '" + command_ + "': " + std::strerror(errno));
+  if (pipe2(in, O_CLOEXEC) != 0)
+    throw PluginError("cannot create pipes for '" + command_ + "': " + std::strerror(errno));
   if (pipe2(out, O_CLOEXEC) != 0 || pipe2(err, O_CLOEXEC) != 0) {
     const std::string reason = std::strerror(errno);
     close(in[0]);
@@ -51,7 +56,8 @@ Subprocess::Subprocess(std::string command, std::size_t max_line_bytes)
     for (int fd : {in[0], in[1], out[0], out[1], err[0], err[1]}) close(fd);
     throw PluginError("cannot start '" + command_ + "': " + reason);
   }
-  if (pid_ == 0) {  // child: its own process group, the pipes as stdin, stdout, stderr, then the shell
+  if (pid_ ==
+      0) {  // child: its own process group, the pipes as stdin, stdout, stderr, then the shell
     setpgid(0, 0);
     dup2(in[0], 0);
     dup2(out[1], 1);
@@ -99,7 +105,8 @@ void Subprocess::drain_stderr(bool until_eof) {
       if (chunk[i] == '\n') {
         stderr_lines_.push_back(std::move(stderr_partial_));
         stderr_partial_.clear();
-        if (stderr_lines_.size() > static_cast<std::size_t>(kStderrLines)) stderr_lines_.pop_front();
+        if (stderr_lines_.size() > static_cast<std::size_t>(kStderrLines))
+          stderr_lines_.pop_front();
       } else if (stderr_partial_.size() < kStderrLineBytes) {
         stderr_partial_ += chunk[i];
       }

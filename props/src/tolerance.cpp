@@ -10,7 +10,8 @@ double length_scale(const Scene& scene) {
   for (const auto& T : scene.world_T_hand_chunk) scale = std::max(scale, T.translation().norm());
   for (const auto& x : scene.world_points) scale = std::max(scale, x.norm());
   for (const auto& x : scene.hand_points) scale = std::max(scale, x.norm());
-  for (const auto& named : scene.extra_poses) scale = std::max(scale, named.second.translation().norm());
+  for (const auto& named : scene.extra_poses)
+    scale = std::max(scale, named.second.translation().norm());
   return scale;
 }
 

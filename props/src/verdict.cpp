@@ -27,24 +27,36 @@ std::string vector_text(const Eigen::VectorXd& v) {
 
 std::string to_string(Component component) {
   switch (component) {
-    case Component::actions: return "actions";
-    case Component::observation: return "observation";
-    case Component::flow_input: return "flow_input";
-    case Component::flow_target: return "flow_target";
-    case Component::policy: return "policy";
+    case Component::actions:
+      return "actions";
+    case Component::observation:
+      return "observation";
+    case Component::flow_input:
+      return "flow_input";
+    case Component::flow_target:
+      return "flow_target";
+    case Component::policy:
+      return "policy";
   }
   return "?";
 }
 
-std::string to_string(Mode mode) { return mode == Mode::pointwise ? "pointwise" : "distribution"; }
+std::string to_string(Mode mode) {
+  return mode == Mode::pointwise ? "pointwise" : "distribution";
+}
 
-std::string to_string(View view) { return view == View::eye_in_hand ? "eye_in_hand" : "third_person"; }
+std::string to_string(View view) {
+  return view == View::eye_in_hand ? "eye_in_hand" : "third_person";
+}
 
 std::string to_string(Method method) {
   switch (method) {
-    case Method::compared: return "compared";
-    case Method::exact_gaussian: return "exact_gaussian";
-    case Method::energy_test: return "energy_test";
+    case Method::compared:
+      return "compared";
+    case Method::exact_gaussian:
+      return "exact_gaussian";
+    case Method::energy_test:
+      return "energy_test";
   }
   return "?";
 }
@@ -56,15 +68,18 @@ std::string format_witness(const Witness& witness) {
       << "scene: H = " << s.history_length() << ", K = " << s.chunk_length() << ", "
       << s.hand_points.size() << " eye-in-hand and " << s.world_points.size() << " world points\n";
   for (std::size_t h = 0; h < s.world_T_hand_history.size(); ++h) {
-    out << "  T_" << (h == 0 ? "" : "-") << h << ": " << pose_text(s.world_T_hand_history[h]) << "\n";
+    out << "  T_" << (h == 0 ? "" : "-") << h << ": " << pose_text(s.world_T_hand_history[h])
+        << "\n";
   }
   for (std::size_t k = 0; k < s.world_T_hand_chunk.size(); ++k) {
     out << "  T_" << k + 1 << ": " << pose_text(s.world_T_hand_chunk[k]) << "\n";
   }
   for (const auto& x : s.hand_points) out << "  eye-in-hand point: " << format_matrix(x) << "\n";
   for (const auto& x : s.world_points) out << "  world point: " << format_matrix(x) << "\n";
-  for (const auto& [name, T] : s.extra_poses) out << "  extra pose '" << name << "': " << pose_text(T) << "\n";
-  for (const auto& [name, value] : s.scalars) out << "  scalar '" << name << "': " << format_number(value) << "\n";
+  for (const auto& [name, T] : s.extra_poses)
+    out << "  extra pose '" << name << "': " << pose_text(T) << "\n";
+  for (const auto& [name, value] : s.scalars)
+    out << "  scalar '" << name << "': " << format_number(value) << "\n";
   const bool law = !witness.detail.empty();
   out << (law ? "mean before: " : "before: ") << vector_text(witness.before) << "\n"
       << (law ? "mean after:  " : "after:  ") << vector_text(witness.after) << "\n";

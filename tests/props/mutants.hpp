@@ -19,14 +19,19 @@ namespace handcentric::test {
 class DecoderForgetsR0 final : public Representation {
  public:
   std::string name() const override { return "mutant_decoder_forgets_R0"; }
-  Eigen::VectorXd encode_actions(const Scene& scene) const override { return HandCentricRepresentation().encode_actions(scene); }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_actions(scene);
+  }
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     return HandCentricRepresentation().encode_observation(scene);
   }
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& world_T_hand0) const override {
-    std::vector<RigidTransform> chunk = HandCentricRepresentation().decode_actions(a, world_T_hand0);
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
+                                             const RigidTransform& world_T_hand0) const override {
+    std::vector<RigidTransform> chunk =
+        HandCentricRepresentation().decode_actions(a, world_T_hand0);
     for (std::size_t k = 0; k < chunk.size(); ++k) {
-      const Eigen::Vector3d p = world_T_hand0.translation() + a.segment<3>(6 * static_cast<Eigen::Index>(k));
+      const Eigen::Vector3d p =
+          world_T_hand0.translation() + a.segment<3>(6 * static_cast<Eigen::Index>(k));
       chunk[k] = RigidTransform(chunk[k].rotation(), p);
     }
     return chunk;
@@ -38,7 +43,9 @@ class DecoderForgetsR0 final : public Representation {
 class BiasedNoiseActionFlow final : public FlowTarget {
  public:
   std::string name() const override { return "mutant_biased_noise_actionflow"; }
-  Eigen::Index noise_dimension(const Scene& scene) const override { return inner_.noise_dimension(scene); }
+  Eigen::Index noise_dimension(const Scene& scene) const override {
+    return inner_.noise_dimension(scene);
+  }
   FlowSample operator()(const Scene& scene, const Eigen::VectorXd& eps, double t) const override {
     Eigen::VectorXd biased = eps;
     for (Eigen::Index k = 0; 3 * k + 2 < biased.size(); ++k) biased(3 * k + 2) += 2.0;
@@ -62,7 +69,9 @@ class WorldDelta final : public Representation {
       const RigidTransform& current = scene.world_T_hand_chunk[static_cast<std::size_t>(k)];
       out.segment<3>(6 * k) = current.translation() - previous.translation();
       out.segment<3>(6 * k + 3) =
-          Rotation::from_matrix_unchecked(current.rotation().matrix() * previous.rotation().matrix().transpose()).log();
+          Rotation::from_matrix_unchecked(current.rotation().matrix() *
+                                          previous.rotation().matrix().transpose())
+              .log();
       previous = current;
     }
     return out;
@@ -70,12 +79,14 @@ class WorldDelta final : public Representation {
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     return HandCentricRepresentation().encode_observation(scene);
   }
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& world_T_hand0) const override {
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
+                                             const RigidTransform& world_T_hand0) const override {
     std::vector<RigidTransform> chunk;
     RigidTransform previous = world_T_hand0;
     for (Eigen::Index k = 0; 6 * k < a.size(); ++k) {
-      previous = RigidTransform::unchecked(Rotation::exp(a.segment<3>(6 * k + 3)).matrix() * previous.rotation().matrix(),
-                                           previous.translation() + a.segment<3>(6 * k));
+      previous = RigidTransform::unchecked(
+          Rotation::exp(a.segment<3>(6 * k + 3)).matrix() * previous.rotation().matrix(),
+          previous.translation() + a.segment<3>(6 * k));
       chunk.push_back(previous);
     }
     return chunk;
@@ -87,7 +98,9 @@ class WorldDelta final : public Representation {
 class RawWorldPoints final : public Representation {
  public:
   std::string name() const override { return "mutant_raw_world_points"; }
-  Eigen::VectorXd encode_actions(const Scene& scene) const override { return HandCentricRepresentation().encode_actions(scene); }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_actions(scene);
+  }
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     Eigen::VectorXd out = HandCentricRepresentation().encode_observation(scene);
     Eigen::Index offset = out.size() - 3 * static_cast<Eigen::Index>(scene.world_points.size());
@@ -97,7 +110,8 @@ class RawWorldPoints final : public Representation {
     }
     return out;
   }
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& world_T_hand0) const override {
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
+                                             const RigidTransform& world_T_hand0) const override {
     return HandCentricRepresentation().decode_actions(a, world_T_hand0);
   }
 };
@@ -106,12 +120,15 @@ class RawWorldPoints final : public Representation {
 class ConstantZeros final : public Representation {
  public:
   std::string name() const override { return "mutant_constant_zeros"; }
-  Eigen::VectorXd encode_actions(const Scene& scene) const override { return Eigen::VectorXd::Zero(6 * scene.chunk_length()); }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    return Eigen::VectorXd::Zero(6 * scene.chunk_length());
+  }
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     return HandCentricRepresentation().encode_observation(scene);
   }
   bool can_decode() const override { return false; }
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd&, const RigidTransform&) const override {
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd&,
+                                             const RigidTransform&) const override {
     throw InvalidArgument("mutant_constant_zeros cannot decode");
   }
 };
@@ -123,14 +140,16 @@ class TranslationsOnly final : public Representation {
   Eigen::VectorXd encode_actions(const Scene& scene) const override {
     const Eigen::VectorXd full = HandCentricRepresentation().encode_actions(scene);
     Eigen::VectorXd out(full.size() / 2);
-    for (Eigen::Index k = 0; 6 * k < full.size(); ++k) out.segment<3>(3 * k) = full.segment<3>(6 * k);
+    for (Eigen::Index k = 0; 6 * k < full.size(); ++k)
+      out.segment<3>(3 * k) = full.segment<3>(6 * k);
     return out;
   }
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     return HandCentricRepresentation().encode_observation(scene);
   }
   bool can_decode() const override { return false; }
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd&, const RigidTransform&) const override {
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd&,
+                                             const RigidTransform&) const override {
     throw InvalidArgument("mutant_translations_only cannot decode");
   }
 };
@@ -146,7 +165,9 @@ class Float32HandCentric final : public Representation {
     const Eigen::Matrix4f hand0_T_world = world_T_hand0.inverse();
     Eigen::VectorXd out(6 * scene.chunk_length());
     for (int k = 0; k < scene.chunk_length(); ++k) {
-      const Eigen::Matrix4f hand0_T_handk = hand0_T_world * scene.world_T_hand_chunk[static_cast<std::size_t>(k)].matrix().cast<float>();
+      const Eigen::Matrix4f hand0_T_handk =
+          hand0_T_world *
+          scene.world_T_hand_chunk[static_cast<std::size_t>(k)].matrix().cast<float>();
       out.segment<3>(6 * k) = hand0_T_handk.block<3, 1>(0, 3).cast<double>();
       // The rotation vector of the float32 matrix, taken in double: the rounding is float32's.
       const Eigen::AngleAxisd angle_axis(hand0_T_handk.block<3, 3>(0, 0).cast<double>());
@@ -157,7 +178,8 @@ class Float32HandCentric final : public Representation {
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     return HandCentricRepresentation().encode_observation(scene).cast<float>().cast<double>();
   }
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& world_T_hand0) const override {
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
+                                             const RigidTransform& world_T_hand0) const override {
     return HandCentricRepresentation().decode_actions(a, world_T_hand0);
   }
 };
@@ -166,9 +188,12 @@ class Float32HandCentric final : public Representation {
 /// decided by the energy test.
 class CubedNoiseFlow final : public FlowTarget {
  public:
-  explicit CubedNoiseFlow(std::shared_ptr<const Representation> representation) : inner_(std::move(representation)) {}
+  explicit CubedNoiseFlow(std::shared_ptr<const Representation> representation)
+      : inner_(std::move(representation)) {}
   std::string name() const override { return "mutant_cubed_noise_flow"; }
-  Eigen::Index noise_dimension(const Scene& scene) const override { return inner_.noise_dimension(scene); }
+  Eigen::Index noise_dimension(const Scene& scene) const override {
+    return inner_.noise_dimension(scene);
+  }
   FlowSample operator()(const Scene& scene, const Eigen::VectorXd& eps, double t) const override {
     FlowSample sample = inner_(scene, Eigen::VectorXd::Zero(eps.size()), t);
     sample.target -= eps.array().cube().matrix();

@@ -26,7 +26,8 @@ inline CommandResult run_command(const std::string& command) {
   if (pipe == nullptr) return result;
   std::array<char, 4096> chunk{};
   std::size_t n = 0;
-  while ((n = std::fread(chunk.data(), 1, chunk.size(), pipe)) > 0) result.out.append(chunk.data(), n);
+  while ((n = std::fread(chunk.data(), 1, chunk.size(), pipe)) > 0)
+    result.out.append(chunk.data(), n);
   const int status = pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   std::ifstream err_file(err_path);
@@ -38,15 +39,22 @@ inline CommandResult run_command(const std::string& command) {
 }
 
 /// The `handcentric` binary, the Python with NumPy, and the plug-ins, from CMake.
-inline std::string cli() { return HANDCENTRIC_CLI; }
-inline std::string python() { return HANDCENTRIC_PYTHON; }
+inline std::string cli() {
+  return HANDCENTRIC_CLI;
+}
+inline std::string python() {
+  return HANDCENTRIC_PYTHON;
+}
 inline std::string python_example() {
   return python() + " " + HANDCENTRIC_SOURCE_DIR + "/examples/python_representation/repr.py";
 }
 /// `python tests/props/plugins/<file> [arguments]`.
 inline std::string test_plugin(const std::string& file, const std::string& arguments = "") {
-  return python() + " " + HANDCENTRIC_SOURCE_DIR + "/tests/props/plugins/" + file + (arguments.empty() ? "" : " " + arguments);
+  return python() + " " + HANDCENTRIC_SOURCE_DIR + "/tests/props/plugins/" + file +
+         (arguments.empty() ? "" : " " + arguments);
 }
-inline std::string faulty_plugin(const std::string& mode) { return test_plugin("faulty.py", mode); }
+inline std::string faulty_plugin(const std::string& mode) {
+  return test_plugin("faulty.py", mode);
+}
 
 }  // namespace handcentric::test

@@ -25,13 +25,15 @@ props::ClassifierOptions fast() {
 
 const std::vector<Group> kNone = {};
 const std::vector<Group> kTranslation = {Group::translation};
-const std::vector<Group> kAll = {Group::translation, Group::rotation, Group::se2, Group::se3, Group::c8};
+const std::vector<Group> kAll = {Group::translation, Group::rotation, Group::se2, Group::se3,
+                                 Group::c8};
 
 }  // namespace
 
 TEST_CASE("builtin_representations_are_classified_as_the_paper_says", "[property]") {
   const auto absolute = props::classify_representation(make_representation("absolute"), fast());
-  for (Component c : {Component::actions, Component::observation, Component::flow_input, Component::flow_target}) {
+  for (Component c : {Component::actions, Component::observation, Component::flow_input,
+                      Component::flow_target}) {
     CHECK(props::invariant_groups(absolute, c, Mode::pointwise) == kNone);
   }
   CHECK(props::invariant_groups(absolute, Component::flow_target, Mode::distribution) == kNone);
@@ -40,11 +42,15 @@ TEST_CASE("builtin_representations_are_classified_as_the_paper_says", "[property
     const auto relative = props::classify_representation(make_representation(name), fast());
     CHECK(props::invariant_groups(relative, Component::actions, Mode::pointwise) == kTranslation);
     CHECK(props::invariant_groups(relative, Component::observation, Mode::pointwise) == kNone);
-    CHECK(props::invariant_groups(relative, Component::flow_target, Mode::pointwise) == kTranslation);
-    CHECK(props::invariant_groups(relative, Component::flow_target, Mode::distribution) == kTranslation);
+    CHECK(props::invariant_groups(relative, Component::flow_target, Mode::pointwise) ==
+          kTranslation);
+    CHECK(props::invariant_groups(relative, Component::flow_target, Mode::distribution) ==
+          kTranslation);
   }
-  const auto hand_centric = props::classify_representation(make_representation("hand_centric"), fast());
-  for (Component c : {Component::actions, Component::observation, Component::flow_input, Component::flow_target}) {
+  const auto hand_centric =
+      props::classify_representation(make_representation("hand_centric"), fast());
+  for (Component c : {Component::actions, Component::observation, Component::flow_input,
+                      Component::flow_target}) {
     CHECK(props::invariant_groups(hand_centric, c, Mode::pointwise) == kAll);
   }
   CHECK(props::invariant_groups(hand_centric, Component::flow_target, Mode::distribution) == kAll);
@@ -53,7 +59,8 @@ TEST_CASE("builtin_representations_are_classified_as_the_paper_says", "[property
   }
 }
 
-TEST_CASE("actionflow_target_is_classified_pointwise_none_in_distribution_rotations", "[property]") {
+TEST_CASE("actionflow_target_is_classified_pointwise_none_in_distribution_rotations",
+          "[property]") {
   const auto actionflow = props::classify_flow_target(std::make_shared<ActionFlowTarget>(), fast());
   CHECK(props::invariant_groups(actionflow, Component::flow_target, Mode::pointwise) == kNone);
   CHECK(props::invariant_groups(actionflow, Component::flow_input, Mode::pointwise) == kNone);
@@ -62,9 +69,10 @@ TEST_CASE("actionflow_target_is_classified_pointwise_none_in_distribution_rotati
   CHECK(props::mismatches_with_paper(actionflow).empty());
 }
 
-TEST_CASE("mutant_encoder_is_classified_translation_only_and_reported_as_a_mismatch", "[property]") {
-  props::Classification mutant =
-      props::classify_representation(std::make_shared<test::ForgetsRotationOnTranslation>(), fast());
+TEST_CASE("mutant_encoder_is_classified_translation_only_and_reported_as_a_mismatch",
+          "[property]") {
+  props::Classification mutant = props::classify_representation(
+      std::make_shared<test::ForgetsRotationOnTranslation>(), fast());
   CHECK(props::invariant_groups(mutant, Component::actions, Mode::pointwise) == kTranslation);
   mutant.name = "hand_centric";  // judged as if it claimed to be hand-centric
   CHECK_FALSE(props::mismatches_with_paper(mutant).empty());
@@ -73,31 +81,40 @@ TEST_CASE("mutant_encoder_is_classified_translation_only_and_reported_as_a_misma
 TEST_CASE("audit_rejects_unknown_names_and_bad_case_counts", "[unit]") {
   props::AuditOptions options;
   options.cases = 10;
-  CHECK_THROWS_WITH(props::audit_builtins({"hand-centric"}, options),
-                    Catch::Matchers::Contains("'hand-centric'") && Catch::Matchers::Contains("hand_centric"));
+  CHECK_THROWS_WITH(
+      props::audit_builtins({"hand-centric"}, options),
+      Catch::Matchers::Contains("'hand-centric'") && Catch::Matchers::Contains("hand_centric"));
   options.cases = 0;
-  CHECK_THROWS_WITH(props::audit_builtins({"absolute"}, options), Catch::Matchers::Contains("--cases"));
+  CHECK_THROWS_WITH(props::audit_builtins({"absolute"}, options),
+                    Catch::Matchers::Contains("--cases"));
 }
 
 TEST_CASE("every_builtin_cell_matches_its_expectation_in_both_views", "[property]") {
   for (const std::string& name : builtin_representation_names()) {
-    const props::Classification c = props::classify_representation(make_representation(name), fast());
+    const props::Classification c =
+        props::classify_representation(make_representation(name), fast());
     INFO(name);
     for (const auto& line : props::mismatches_with_paper(c)) INFO(line);
     CHECK(props::mismatches_with_paper(c).empty());
-    CHECK(props::find_verdict(c, Component::observation, Mode::pointwise, Group::se3, props::View::third_person) != nullptr);
-    const auto expectation = props::paper_expectation(name, Component::observation, Mode::pointwise, props::View::third_person);
+    CHECK(props::find_verdict(c, Component::observation, Mode::pointwise, Group::se3,
+                              props::View::third_person) != nullptr);
+    const auto expectation = props::paper_expectation(name, Component::observation, Mode::pointwise,
+                                                      props::View::third_person);
     REQUIRE(expectation.has_value());
-    CHECK_THAT(expectation->basis, Catch::Matchers::Contains("eye-in-hand"));  // says whose rule it is
+    CHECK_THAT(expectation->basis,
+               Catch::Matchers::Contains("eye-in-hand"));  // says whose rule it is
   }
 }
 
 TEST_CASE("copying_world_points_raw_is_caught_in_the_third_person_view_only", "[property]") {
   const auto raw = std::make_shared<test::RawWorldPoints>();
   const props::Classification c = props::classify_representation(raw, fast());
-  CHECK(props::invariant_groups(c, Component::observation, Mode::pointwise, props::View::eye_in_hand) == kAll);
-  CHECK(props::invariant_groups(c, Component::observation, Mode::pointwise, props::View::third_person) == kNone);
-  const props::Verdict* se3 = props::find_verdict(c, Component::observation, Mode::pointwise, Group::se3, props::View::third_person);
+  CHECK(props::invariant_groups(c, Component::observation, Mode::pointwise,
+                                props::View::eye_in_hand) == kAll);
+  CHECK(props::invariant_groups(c, Component::observation, Mode::pointwise,
+                                props::View::third_person) == kNone);
+  const props::Verdict* se3 = props::find_verdict(c, Component::observation, Mode::pointwise,
+                                                  Group::se3, props::View::third_person);
   REQUIRE(se3 != nullptr);
   REQUIRE(se3->witness.has_value());
   CHECK(se3->witness->scene.world_points.size() >= 1);
@@ -107,12 +124,15 @@ TEST_CASE("copying_world_points_raw_is_caught_in_the_third_person_view_only", "[
   dropping.views = {props::View::third_person};
   props::CheckOptions check = props::with_view(dropping.check, props::View::third_person);
   check.shape.min_world_points = check.shape.max_world_points = 0;
-  CHECK(props::check_invariance(props::observation_of(raw), Component::observation, Group::se3, check).invariant);
+  CHECK(
+      props::check_invariance(props::observation_of(raw), Component::observation, Group::se3, check)
+          .invariant);
 }
 
 TEST_CASE("hand_centric_takes_world_points_into_the_hand_frame", "[unit]") {
   Scene scene;
-  scene.world_T_hand_history = {RigidTransform(Rotation::about_z(1.5707963267948966), Eigen::Vector3d(1, 2, 3))};
+  scene.world_T_hand_history = {
+      RigidTransform(Rotation::about_z(1.5707963267948966), Eigen::Vector3d(1, 2, 3))};
   scene.world_T_hand_chunk = {RigidTransform::identity()};
   scene.world_points = {Eigen::Vector3d(1, 3, 3)};  // one metre along the hand's x axis
   const Eigen::VectorXd hand = HandCentricRepresentation().encode_observation(scene);
@@ -140,15 +160,21 @@ props::CheckOptions pair_options() {
 }  // namespace
 
 TEST_CASE("injectivity_catches_degenerate_maps_and_proves_the_builtins", "[property]") {
-  const InjectivityCheck real = [](std::shared_ptr<const Representation> r) { return props::check_injectivity(r, pair_options()); };
-  const InjectivityCheck blind = [](std::shared_ptr<const Representation>) { return props::Injectivity{}; };
+  const InjectivityCheck real = [](std::shared_ptr<const Representation> r) {
+    return props::check_injectivity(r, pair_options());
+  };
+  const InjectivityCheck blind = [](std::shared_ptr<const Representation>) {
+    return props::Injectivity{};
+  };
   CHECK(catches_constant_map(real));
   CHECK_FALSE(catches_constant_map(blind));
   const props::Injectivity zeros = real(std::make_shared<test::ConstantZeros>());
   REQUIRE(zeros.collision.has_value());
-  CHECK(zeros.collision->first.world_T_hand_history.size() == zeros.collision->second.world_T_hand_history.size());
+  CHECK(zeros.collision->first.world_T_hand_history.size() ==
+        zeros.collision->second.world_T_hand_history.size());
   CHECK(zeros.collision->chunk_distance >= 1e-3);
-  CHECK_THAT(props::format_collision(*zeros.collision), Catch::Matchers::Contains("both encode to"));
+  CHECK_THAT(props::format_collision(*zeros.collision),
+             Catch::Matchers::Contains("both encode to"));
   // Dropping the rotations is caught too (a pair that turns one pose).
   CHECK(real(std::make_shared<test::TranslationsOnly>()).injective == false);
   for (const std::string& name : builtin_representation_names()) {
@@ -190,13 +216,17 @@ TEST_CASE("float32_rounding_gets_a_note_and_passes_at_float32_tolerance", "[prop
     INFO(props::to_string(v.component) << " " << props::to_string(v.group));
     CHECK(v.invariant);
   }
-  const auto ignores_precision = [](const props::AuditOptions&) { return props::kRelativeTolerance; };
+  const auto ignores_precision = [](const props::AuditOptions&) {
+    return props::kRelativeTolerance;
+  };
   bool mutant_fails = false;
-  for (const props::Verdict& v : classify_at(ignores_precision(audit)).verdicts) mutant_fails |= !v.invariant;
+  for (const props::Verdict& v : classify_at(ignores_precision(audit)).verdicts)
+    mutant_fails |= !v.invariant;
   CHECK(mutant_fails);
   audit.relative_tolerance = 3e-6;
   CHECK(props::audit_relative_tolerance(audit) == 3e-6);
   audit.relative_tolerance = -1.0;
-  CHECK_THROWS_WITH(props::audit_relative_tolerance(audit), Catch::Matchers::Contains("--tolerance"));
+  CHECK_THROWS_WITH(props::audit_relative_tolerance(audit),
+                    Catch::Matchers::Contains("--tolerance"));
   CHECK_THROWS_WITH(props::parse_precision("float16"), Catch::Matchers::Contains("float16"));
 }

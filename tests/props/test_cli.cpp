@@ -11,12 +11,14 @@ using namespace handcentric;
 using Catch::Matchers::Contains;
 
 TEST_CASE("audit_json_lists_every_check_of_a_builtin", "[unit]") {
-  const auto result = test::run_command(test::cli() + " audit --repr relative --group rotation --cases 100 --seed 3 --json");
+  const auto result = test::run_command(
+      test::cli() + " audit --repr relative --group rotation --cases 100 --seed 3 --json");
   REQUIRE(result.exit_code == 0);
   const auto json = nlohmann::json::parse(result.out);
   const auto& relative = json.at("representations").at(0);
   CHECK(relative.at("name") == "relative");
-  REQUIRE(relative.at("checks").size() == 12);  // (4 pointwise components + 2 in distribution) x 2 views
+  REQUIRE(relative.at("checks").size() ==
+          12);  // (4 pointwise components + 2 in distribution) x 2 views
   const auto& actions = relative.at("checks").at(0);
   CHECK(actions.at("component") == "actions");
   CHECK(actions.at("group") == "rotation");
@@ -24,8 +26,13 @@ TEST_CASE("audit_json_lists_every_check_of_a_builtin", "[unit]") {
   CHECK(actions.at("view") == "eye_in_hand");
   CHECK(relative.at("checks").at(6).at("view") == "third_person");
   CHECK(relative.at("injective") == true);
-  CHECK(relative.at("summary").at("eye_in_hand").at("flow_target").at("distribution").at("rotation") == false);
-  CHECK(relative.at("summary").at("third_person").at("actions").at("pointwise").at("rotation") == false);
+  CHECK(relative.at("summary")
+            .at("eye_in_hand")
+            .at("flow_target")
+            .at("distribution")
+            .at("rotation") == false);
+  CHECK(relative.at("summary").at("third_person").at("actions").at("pointwise").at("rotation") ==
+        false);
   for (const auto& check : relative.at("checks")) {
     if (check.at("mode") == "distribution") CHECK(check.at("method") == "exact_gaussian");
   }
@@ -37,8 +44,8 @@ TEST_CASE("audit_json_lists_every_check_of_a_builtin", "[unit]") {
 }
 
 TEST_CASE("python_plugin_audit_matches_the_builtin_hand_centric", "[unit]") {
-  const auto result =
-      test::run_command(test::cli() + " audit --exec '" + test::python_example() + "' --cases 100 --json");
+  const auto result = test::run_command(test::cli() + " audit --exec '" + test::python_example() +
+                                        "' --cases 100 --json");
   INFO(result.err);
   REQUIRE(result.exit_code == 0);
   const auto json = nlohmann::json::parse(result.out);
@@ -74,21 +81,24 @@ TEST_CASE("main_report_opens_with_the_audit_summary_and_matches_the_paper", "[un
   const auto result = test::run_command(test::cli() + " report --cases 100 --seed 2");
   INFO(result.out << result.err);
   CHECK(result.exit_code == 0);
-  CHECK_THAT(result.out, Contains("1. Audit of the built-in representations") && Contains("hand_centric") &&
-                             Contains("actionflow") && Contains("Every cell matches App. A"));
+  CHECK_THAT(result.out, Contains("1. Audit of the built-in representations") &&
+                             Contains("hand_centric") && Contains("actionflow") &&
+                             Contains("Every cell matches App. A"));
   CHECK(result.out.find("witness:") == std::string::npos);
-  const auto human = test::run_command(test::cli() + " audit --repr absolute --group c8 --cases 50");
+  const auto human =
+      test::run_command(test::cli() + " audit --repr absolute --group c8 --cases 50");
   CHECK(human.exit_code == 0);
   CHECK_THAT(human.out, Contains("witness: actions under c8") && Contains("g: r = "));
 }
 
 TEST_CASE("a_plugin_without_observation_is_audited_on_actions_and_flow_only", "[unit]") {
-  const auto result = test::run_command(test::cli() + " audit --exec '" + test::faulty_plugin("constant") +
-                                        "' --cases 50 --json");
+  const auto result = test::run_command(test::cli() + " audit --exec '" +
+                                        test::faulty_plugin("constant") + "' --cases 50 --json");
   INFO(result.err);
   REQUIRE(result.exit_code == 0);
   const auto checks = nlohmann::json::parse(result.out).at("representations").at(0).at("checks");
-  CHECK(checks.size() == 50);  // (actions, flow input, flow target x 5 groups + 2 x 5 in distribution) x 2 views
+  CHECK(checks.size() ==
+        50);  // (actions, flow input, flow target x 5 groups + 2 x 5 in distribution) x 2 views
   for (const auto& check : checks) CHECK(check.at("component") != "observation");
   // Six zeros whatever the chunk: invariant under everything, and useless.
   CHECK(nlohmann::json::parse(result.out).at("representations").at(0).at("injective") == false);
@@ -99,14 +109,16 @@ namespace {
 // The audit's JSON for a plug-in command (with extra arguments), parsed; the test fails on a
 // non-zero exit.
 nlohmann::json audit_plugin(const std::string& plugin, const std::string& arguments) {
-  const auto result = test::run_command(test::cli() + " audit --exec '" + plugin + "' " + arguments + " --json");
+  const auto result =
+      test::run_command(test::cli() + " audit --exec '" + plugin + "' " + arguments + " --json");
   INFO(result.err);
   REQUIRE(result.exit_code == 0);
   return nlohmann::json::parse(result.out).at("representations").at(0);
 }
 
-const nlohmann::json& cell(const nlohmann::json& representation, const std::string& view, const std::string& component,
-                           const std::string& mode, const std::string& group) {
+const nlohmann::json& cell(const nlohmann::json& representation, const std::string& view,
+                           const std::string& component, const std::string& mode,
+                           const std::string& group) {
   return representation.at("summary").at(view).at(component).at(mode).at(group);
 }
 
@@ -114,7 +126,7 @@ const nlohmann::json& cell(const nlohmann::json& representation, const std::stri
 
 TEST_CASE("a_plugin_that_copies_world_points_is_not_invariant_in_the_third_person_view", "[unit]") {
   const auto raw = audit_plugin(test::test_plugin("world_points_raw.py"), "--cases 60 --group se3");
-  CHECK(cell(raw, "eye_in_hand", "observation", "pointwise", "se3") == true);   // nothing to copy
+  CHECK(cell(raw, "eye_in_hand", "observation", "pointwise", "se3") == true);  // nothing to copy
   CHECK(cell(raw, "third_person", "observation", "pointwise", "se3") == false);
   CHECK(cell(raw, "third_person", "actions", "pointwise", "se3") == true);
   for (const auto& check : raw.at("checks")) {
@@ -132,7 +144,8 @@ TEST_CASE("float32_rounding_is_named_and_precision_float32_accepts_it", "[unit]"
   for (const auto& check : strict.at("checks")) {
     if (check.at("invariant") == false) {
       INFO(check.dump());
-      CHECK_THAT(check.at("note").get<std::string>(), Contains("float32") && Contains("--precision float32"));
+      CHECK_THAT(check.at("note").get<std::string>(),
+                 Contains("float32") && Contains("--precision float32"));
       noted = true;
     }
   }
@@ -144,16 +157,21 @@ TEST_CASE("float32_rounding_is_named_and_precision_float32_accepts_it", "[unit]"
     CHECK(check.at("relative_tolerance") == 1e-4);
   }
   // The same with the number itself.
-  CHECK(audit_plugin(plugin, "--cases 30 --group rotation --tolerance 1e-4").at("checks").at(0).at("invariant") == true);
+  CHECK(audit_plugin(plugin, "--cases 30 --group rotation --tolerance 1e-4")
+            .at("checks")
+            .at(0)
+            .at("invariant") == true);
   for (const char* bad : {"--tolerance -1", "--tolerance 2", "--precision float16"}) {
-    const auto result = test::run_command(test::cli() + " audit --repr hand_centric --cases 5 " + bad);
+    const auto result =
+        test::run_command(test::cli() + " audit --repr hand_centric --cases 5 " + bad);
     CHECK(result.exit_code == 1);
     CHECK_THAT(result.err, Contains("--tolerance") || Contains("float16"));
   }
 }
 
 TEST_CASE("the_world_delta_mode_is_translation_invariant_only_in_distribution_too", "[unit]") {
-  const auto delta = audit_plugin(test::test_plugin("delta_world.py"), "--cases 60 --view eye_in_hand");
+  const auto delta =
+      audit_plugin(test::test_plugin("delta_world.py"), "--cases 60 --view eye_in_hand");
   for (const char* group : {"rotation", "se2", "se3", "c8"}) {
     CHECK(cell(delta, "eye_in_hand", "flow_target", "distribution", group) == false);
   }
@@ -176,14 +194,16 @@ TEST_CASE("protocol_v2_plugin_gets_its_extras_decodes_and_answers_its_own_flow",
   CHECK(v2.at("injectivity").at("round_trips").get<int>() > 0);
   // --extra-poses adds to the hello's names: both go on the wire.
   const std::string log = "/tmp/handcentric_test_v2_requests.jsonl";
-  audit_plugin("tee " + log + " | " + test::test_plugin("v2_everything.py"),
-               "--cases 5 --group rotation --view eye_in_hand --extra-poses left_hand --scalars width");
+  audit_plugin(
+      "tee " + log + " | " + test::test_plugin("v2_everything.py"),
+      "--cases 5 --group rotation --view eye_in_hand --extra-poses left_hand --scalars width");
   std::ifstream requests(log);
   std::string first, last, line;
   std::getline(requests, first);
   while (std::getline(requests, line)) last = line;
   std::remove(log.c_str());
-  CHECK(first.find("left_hand") != std::string::npos);  // the probe carries the flag's names from the start
+  CHECK(first.find("left_hand") !=
+        std::string::npos);  // the probe carries the flag's names from the start
   const auto request = nlohmann::json::parse(last);
   CHECK(request.at("extra_poses").contains("start"));
   CHECK(request.at("extra_poses").contains("left_hand"));
@@ -191,8 +211,10 @@ TEST_CASE("protocol_v2_plugin_gets_its_extras_decodes_and_answers_its_own_flow",
   CHECK(request.at("scalars").contains("width"));
 }
 
-TEST_CASE("actionflow_through_the_flow_request_is_rotation_invariant_in_distribution_only", "[unit]") {
-  const auto actionflow = audit_plugin(test::test_plugin("actionflow_v2.py"), "--cases 40 --view eye_in_hand");
+TEST_CASE("actionflow_through_the_flow_request_is_rotation_invariant_in_distribution_only",
+          "[unit]") {
+  const auto actionflow =
+      audit_plugin(test::test_plugin("actionflow_v2.py"), "--cases 40 --view eye_in_hand");
   for (const char* group : {"rotation", "c8"}) {
     CHECK(cell(actionflow, "eye_in_hand", "flow_target", "distribution", group) == true);
     CHECK(cell(actionflow, "eye_in_hand", "flow_target", "pointwise", group) == false);
@@ -203,15 +225,16 @@ TEST_CASE("actionflow_through_the_flow_request_is_rotation_invariant_in_distribu
 }
 
 TEST_CASE("a_plugin_that_never_flushes_is_told_about_buffering", "[unit]") {
-  const auto result = test::run_command(test::cli() + " audit --exec '" + test::test_plugin("no_flush.py") +
-                                        "' --timeout 0.5 --cases 5");
+  const auto result =
+      test::run_command(test::cli() + " audit --exec '" + test::test_plugin("no_flush.py") +
+                        "' --timeout 0.5 --cases 5");
   CHECK(result.exit_code == 1);
   CHECK_THAT(result.err, Contains("flush") && Contains("python3 -u"));
 }
 
 TEST_CASE("a_plugin_traceback_keeps_its_last_lines", "[unit]") {
-  const auto result = test::run_command(test::cli() + " audit --exec '" + test::test_plugin("stderr_long.py") +
-                                        "' --cases 5");
+  const auto result = test::run_command(test::cli() + " audit --exec '" +
+                                        test::test_plugin("stderr_long.py") + "' --cases 5");
   CHECK(result.exit_code == 1);
   INFO(result.err);
   CHECK_THAT(result.err, Contains("exited with status 1") && Contains("line 40 of 40") &&
@@ -221,8 +244,9 @@ TEST_CASE("a_plugin_traceback_keeps_its_last_lines", "[unit]") {
 }
 
 TEST_CASE("the_text_audit_warns_loudly_about_a_map_that_is_not_injective", "[unit]") {
-  const auto result = test::run_command(test::cli() + " audit --exec '" + test::test_plugin("constant_zeros.py") +
-                                        "' --cases 30 --group se3");
+  const auto result =
+      test::run_command(test::cli() + " audit --exec '" + test::test_plugin("constant_zeros.py") +
+                        "' --cases 30 --group se3");
   CHECK(result.exit_code == 0);
   CHECK_THAT(result.out, Contains("NOT INJECTIVE") && Contains("both encode to"));
 }
@@ -250,31 +274,40 @@ TEST_CASE("policy_exec_audits_a_whole_policy_and_finds_each_planted_fault", "[un
 }
 
 TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[unit]") {
-  const auto pass = test::run_command(test::cli() + " audit --repr hand_centric --cases 30 --expect se3,actions:c8");
+  const auto pass = test::run_command(
+      test::cli() + " audit --repr hand_centric --cases 30 --expect se3,actions:c8");
   CHECK(pass.exit_code == 0);
-  const auto fail = test::run_command(test::cli() + " audit --repr relative --cases 30 --expect actions:rotation");
+  const auto fail = test::run_command(
+      test::cli() + " audit --repr relative --cases 30 --expect actions:rotation");
   CHECK(fail.exit_code == 1);
   CHECK_THAT(fail.err, Contains("expected invariance does not hold") && Contains("g: r = "));
-  const auto policy = test::run_command(test::cli() + " audit --policy-exec '" +
-                                        test::test_plugin("policy_hand_centric.py", "world_noise") +
-                                        "' --cases 20 --group rotation --view eye_in_hand --expect rotation --json");
+  const auto policy = test::run_command(
+      test::cli() + " audit --policy-exec '" +
+      test::test_plugin("policy_hand_centric.py", "world_noise") +
+      "' --cases 20 --group rotation --view eye_in_hand --expect rotation --json");
   CHECK(policy.exit_code == 1);
   CHECK_THAT(policy.err, Contains("expected equivariance does not hold"));
-  const auto empty = test::run_command(test::cli() + " audit --repr hand_centric --group se3 --cases 5 --expect c8");
+  const auto empty = test::run_command(
+      test::cli() + " audit --repr hand_centric --group se3 --cases 5 --expect c8");
   CHECK(empty.exit_code == 1);
   CHECK_THAT(empty.err, Contains("matches no check"));
-  const auto bad = test::run_command(test::cli() + " audit --repr hand_centric --cases 5 --expect hands:se3");
+  const auto bad =
+      test::run_command(test::cli() + " audit --repr hand_centric --cases 5 --expect hands:se3");
   CHECK(bad.exit_code == 1);
   CHECK_THAT(bad.err, Contains("'hands'"));
 }
 
-TEST_CASE("audit_model_finds_a_trained_hand_centric_policy_equivariant_and_an_absolute_one_not", "[unit]") {
+TEST_CASE("audit_model_finds_a_trained_hand_centric_policy_equivariant_and_an_absolute_one_not",
+          "[unit]") {
   const std::string dir = "/tmp/handcentric_test_audit_model";
   REQUIRE(test::run_command("rm -rf " + dir + " && mkdir -p " + dir).exit_code == 0);
-  REQUIRE(test::run_command(test::cli() + " demos --n 5 --dist train --seed 1 --out " + dir + "/d.jsonl").exit_code == 0);
+  REQUIRE(test::run_command(test::cli() + " demos --n 5 --dist train --seed 1 --out " + dir +
+                            "/d.jsonl")
+              .exit_code == 0);
   for (const char* repr : {"hand_centric", "absolute"}) {
-    const auto trained = test::run_command(test::cli() + " train --demos " + dir + "/d.jsonl --repr " + repr +
-                                           " --steps 50 --seed 1 --out " + dir + "/" + repr + ".model");
+    const auto trained =
+        test::run_command(test::cli() + " train --demos " + dir + "/d.jsonl --repr " + repr +
+                          " --steps 50 --seed 1 --out " + dir + "/" + repr + ".model");
     INFO(trained.err);
     REQUIRE(trained.exit_code == 0);
   }
@@ -301,9 +334,9 @@ TEST_CASE("audit_model_finds_a_trained_hand_centric_policy_equivariant_and_an_ab
 TEST_CASE("an_endless_plugin_line_is_refused_in_bounded_memory", "[unit]") {
   // 200 MB on one line: refused at 64 MiB, the audit's peak memory (GNU time's %M, KiB) far below
   // 512 MB.
-  const auto result = test::run_command("/usr/bin/time -f 'peak %M' " + test::cli() + " audit --exec \"" +
-                                        test::python() + " -c 'import sys; sys.stdout.write(\\\"x\\\" * 200000000)'\"" +
-                                        " --cases 5");
+  const auto result = test::run_command(
+      "/usr/bin/time -f 'peak %M' " + test::cli() + " audit --exec \"" + test::python() +
+      " -c 'import sys; sys.stdout.write(\\\"x\\\" * 200000000)'\"" + " --cases 5");
   CHECK(result.exit_code == 1);
   CHECK_THAT(result.err, Contains("longer than 64 MiB"));
   const std::size_t at = result.err.rfind("peak ");

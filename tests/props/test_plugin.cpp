@@ -40,11 +40,13 @@ TEST_CASE("python_example_plugin_encodes_like_the_builtin_hand_centric", "[unit]
   CHECK(plugin.provides_observation());
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
     std::mt19937_64 rng(seed);
-    const Scene scene = random_scene(rng, static_cast<int>(seed % 4), 1 + static_cast<int>(seed % 7), 2, 0, 1e3);
+    const Scene scene =
+        random_scene(rng, static_cast<int>(seed % 4), 1 + static_cast<int>(seed % 7), 2, 0, 1e3);
     const Eigen::VectorXd actions = plugin.encode_actions(scene);
     REQUIRE(actions.size() == builtin.encode_actions(scene).size());
     CHECK((actions - builtin.encode_actions(scene)).lpNorm<Eigen::Infinity>() < 1e-9);
-    CHECK((plugin.encode_observation(scene) - builtin.encode_observation(scene)).lpNorm<Eigen::Infinity>() < 1e-9);
+    CHECK((plugin.encode_observation(scene) - builtin.encode_observation(scene))
+              .lpNorm<Eigen::Infinity>() < 1e-9);
   }
   const int sent = plugin.requests_sent();
   plugin.encode_actions(small_scene(1));
@@ -52,23 +54,26 @@ TEST_CASE("python_example_plugin_encodes_like_the_builtin_hand_centric", "[unit]
   CHECK(plugin.requests_sent() <= sent + 1);
   CHECK_FALSE(plugin.can_decode());
   CHECK(plugin.capabilities().protocol == 1);  // no hello
-  CHECK_THROWS_AS(plugin.decode_actions(Eigen::VectorXd::Zero(6), RigidTransform()), InvalidArgument);
+  CHECK_THROWS_AS(plugin.decode_actions(Eigen::VectorXd::Zero(6), RigidTransform()),
+                  InvalidArgument);
 }
 
 TEST_CASE("bad_plugins_give_errors_whose_first_line_says_what_happened", "[unit]") {
   const std::string not_found = plugin_error("handcentric_no_such_plugin_xyz --flag");
-  CHECK_THAT(not_found, Contains("command not found") && Contains("handcentric_no_such_plugin_xyz"));
+  CHECK_THAT(not_found,
+             Contains("command not found") && Contains("handcentric_no_such_plugin_xyz"));
   CHECK_THAT(plugin_error("echo 'plug-in crashed' >&2; exit 3"),
              Contains("exited with status 3") && Contains("plug-in crashed"));
   CHECK_THAT(plugin_error(test::faulty_plugin("exit_early")),
              Contains("exited with status 3") && Contains("giving up on request 1"));
-  CHECK_THAT(plugin_error(test::faulty_plugin("not_json")), Contains("not JSON") && Contains("actions: 1 2 3"));
+  CHECK_THAT(plugin_error(test::faulty_plugin("not_json")),
+             Contains("not JSON") && Contains("actions: 1 2 3"));
   CHECK_THAT(plugin_error(test::faulty_plugin("wrong_id")), Contains("request 0 with id 1"));
   CHECK_THAT(plugin_error(test::faulty_plugin("nan")), Contains("NaN"));
   CHECK_THAT(plugin_error(test::faulty_plugin("big")), Contains("non-finite") && Contains("inf"));
   // The handshake's probe is request 0, so the seventh number comes with the first real scene.
-  CHECK_THAT(plugin_error(test::faulty_plugin("length")), Contains("changed its vector lengths") &&
-                                                              Contains("actions 7 then 6"));
+  CHECK_THAT(plugin_error(test::faulty_plugin("length")),
+             Contains("changed its vector lengths") && Contains("actions 7 then 6"));
   // Without stderr the message is one line; with stderr, its lines follow, indented.
   for (const char* mode : {"not_json", "wrong_id", "nan", "length"}) {
     CHECK(plugin_error(test::faulty_plugin(mode)).find('\n') == std::string::npos);
@@ -81,7 +86,8 @@ TEST_CASE("bad_plugins_give_errors_whose_first_line_says_what_happened", "[unit]
 TEST_CASE("subprocess_keeps_the_last_20_lines_of_stderr_and_reaps_once", "[unit]") {
   // The first-lines reader is the planted fault: a traceback's last line is what matters.
   auto keeps_the_end = [](const std::string& tail) {
-    return tail.find("line 40\n") != std::string::npos && tail.find("line 21\n") != std::string::npos &&
+    return tail.find("line 40\n") != std::string::npos &&
+           tail.find("line 21\n") != std::string::npos &&
            tail.find("line 20\n") == std::string::npos;
   };
   std::string tail;
@@ -118,26 +124,32 @@ TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
   using props::RequestKind;
   const std::string who = "plug-in 'x'";
   const auto hello = props::parse_reply(
-      R"({"id": 0, "hello": {"protocol": 2, "extra_poses": ["start"], "scalars": ["gripper"], "decode": true}})", 0,
-      RequestKind::encode, who, true);
+      R"({"id": 0, "hello": {"protocol": 2, "extra_poses": ["start"], "scalars": ["gripper"], "decode": true}})",
+      0, RequestKind::encode, who, true);
   REQUIRE(hello.hello.has_value());
   CHECK(hello.hello->extra_pose_names == std::vector<std::string>{"start"});
   CHECK(hello.hello->scalar_names == std::vector<std::string>{"gripper"});
   CHECK(hello.hello->decode);
   CHECK_FALSE(hello.hello->flow);
-  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 3, "hello": {}})", 3, RequestKind::encode, who, false),
-                    Contains("only answer the first request"));
-  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"protocol": 9}})", 0, RequestKind::encode, who, true),
+  CHECK_THROWS_WITH(
+      props::parse_reply(R"({"id": 3, "hello": {}})", 3, RequestKind::encode, who, false),
+      Contains("only answer the first request"));
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"protocol": 9}})", 0,
+                                       RequestKind::encode, who, true),
                     Contains("protocol 9"));
-  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"scalars": [1]}})", 0, RequestKind::encode, who, true),
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"scalars": [1]}})", 0,
+                                       RequestKind::encode, who, true),
                     Contains("not a name"));
-  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 1, "actions": [1]})", 1, RequestKind::flow, who, false),
-                    Contains("flow_input"));
-  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 1, "chunk": [[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 2]]})", 1,
-                                       RequestKind::decode, who, false),
+  CHECK_THROWS_WITH(
+      props::parse_reply(R"({"id": 1, "actions": [1]})", 1, RequestKind::flow, who, false),
+      Contains("flow_input"));
+  CHECK_THROWS_WITH(props::parse_reply(
+                        R"({"id": 1, "chunk": [[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 2]]})",
+                        1, RequestKind::decode, who, false),
                     Contains("last row 0 0 0 1"));
-  const auto decoded = props::parse_reply(R"({"id": 1, "chunk": [[1, 0, 0, 5, 0, 1, 0, 6, 0, 0, 1, 7, 0, 0, 0, 1]]})",
-                                          1, RequestKind::decode, who, false);
+  const auto decoded = props::parse_reply(
+      R"({"id": 1, "chunk": [[1, 0, 0, 5, 0, 1, 0, 6, 0, 0, 1, 7, 0, 0, 0, 1]]})", 1,
+      RequestKind::decode, who, false);
   REQUIRE(decoded.chunk.size() == 1);
   CHECK(decoded.chunk[0].translation() == Eigen::Vector3d(5, 6, 7));
   // Requests: the extras and the flow query go on the wire.
@@ -145,7 +157,8 @@ TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
   scene.extra_poses = {{"start", RigidTransform::identity()}};
   scene.scalars = {{"gripper", 0.25}};
   const Eigen::VectorXd eps = Eigen::VectorXd::Ones(2);
-  const std::string line = props::request_line(7, props::encode_request_body(scene, props::FlowQuery{&eps, 0.5}));
+  const std::string line =
+      props::request_line(7, props::encode_request_body(scene, props::FlowQuery{&eps, 0.5}));
   const auto json = nlohmann::json::parse(line);
   CHECK(json.at("id") == 7);
   CHECK(json.at("protocol") == 2);
@@ -153,12 +166,15 @@ TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
   CHECK(json.at("scalars").at("gripper") == 0.25);
   CHECK(json.at("eps").size() == 2);
   CHECK(json.at("t") == 0.5);
-  CHECK(nlohmann::json::parse(props::request_line(8, props::decode_request_body(eps, scene))).at("decode").size() == 2);
+  CHECK(nlohmann::json::parse(props::request_line(8, props::decode_request_body(eps, scene)))
+            .at("decode")
+            .size() == 2);
 }
 
 TEST_CASE("a_silent_plugin_times_out_instead_of_hanging", "[unit]") {
   const auto start = std::chrono::steady_clock::now();
-  CHECK_THAT(plugin_error(test::faulty_plugin("silent"), 0.3), Contains("no answer to request 0 within 0.3"));
+  CHECK_THAT(plugin_error(test::faulty_plugin("silent"), 0.3),
+             Contains("no answer to request 0 within 0.3"));
   CHECK_THAT(plugin_error("sleep 30", 0.3), Contains("no answer"));
   CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(5));
 }
@@ -174,11 +190,12 @@ TEST_CASE("plugin_replies_are_bounded_in_length_and_nesting", "[unit]") {
   props::Subprocess endless("head -c 5000 /dev/zero | tr '\\0' x", 1024);
   std::string line;
   CHECK(endless.read_line(line, 5.0) == props::Subprocess::Outcome::too_long);
-  const std::string deep = "{\"id\": 0, \"actions\": " + std::string(1000, '[') + std::string(1000, ']') + "}";
+  const std::string deep =
+      "{\"id\": 0, \"actions\": " + std::string(1000, '[') + std::string(1000, ']') + "}";
   CHECK_THROWS_WITH(props::parse_reply(deep, 0, props::RequestKind::encode, "plug-in 'x'", false),
                     Contains("nested deeper than"));
   // Brackets inside strings do not count.
-  CHECK_THROWS_WITH(props::parse_reply("{\"id\": 0, \"note\": \"" + std::string(100, '[') + "\"}", 0,
-                                       props::RequestKind::encode, "plug-in 'x'", false),
+  CHECK_THROWS_WITH(props::parse_reply("{\"id\": 0, \"note\": \"" + std::string(100, '[') + "\"}",
+                                       0, props::RequestKind::encode, "plug-in 'x'", false),
                     Contains("without \"actions\""));
 }

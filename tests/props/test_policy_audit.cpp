@@ -31,7 +31,8 @@ class NoisyStraightPolicy final : public props::NoisyPolicy {
     for (int k = 0; k < kChunk; ++k) {
       T = T * RigidTransform::exp(step);
       const Eigen::Vector3d n = 0.1 * noise.segment<3>(3 * k);
-      const Eigen::Vector3d shift = world_ ? n : Eigen::Vector3d(o.world_T_hand0().rotation().matrix() * n);
+      const Eigen::Vector3d shift =
+          world_ ? n : Eigen::Vector3d(o.world_T_hand0().rotation().matrix() * n);
       chunk.push_back(RigidTransform::unchecked(T.rotation().matrix(), T.translation() + shift));
     }
     return chunk;
@@ -50,23 +51,28 @@ props::ClassifierOptions fast() {
 
 }  // namespace
 
-TEST_CASE("any_network_inside_the_hand_centric_outer_policy_is_equivariant_pointwise_and_in_law", "[property]") {
-  const auto inner = std::make_shared<props::RandomOuterPolicy>(std::make_shared<HandCentricRepresentation>(), 6, kChunk,
-                                                                std::vector<int>{16}, 3);
+TEST_CASE("any_network_inside_the_hand_centric_outer_policy_is_equivariant_pointwise_and_in_law",
+          "[property]") {
+  const auto inner = std::make_shared<props::RandomOuterPolicy>(
+      std::make_shared<HandCentricRepresentation>(), 6, kChunk, std::vector<int>{16}, 3);
   props::ClassifierOptions options = fast();
   options.views = {props::View::eye_in_hand};
   options.check.shape.min_history = options.check.shape.max_history = 0;
   options.check.shape.max_hand_points = 0;
-  const props::Classification c = props::classify_policy(std::make_shared<props::SeededPolicy>(inner), options);
+  const props::Classification c =
+      props::classify_policy(std::make_shared<props::SeededPolicy>(inner), options);
   REQUIRE(c.verdicts.size() == 10);
   for (const props::Verdict& v : c.verdicts) {
     INFO(props::to_string(v.mode) << " " << props::to_string(v.group));
     CHECK(v.invariant);
-    if (v.mode == props::Mode::distribution) CHECK(v.method == props::Method::energy_test);  // seeded: not affine
+    if (v.mode == props::Mode::distribution)
+      CHECK(v.method == props::Method::energy_test);  // seeded: not affine
   }
 }
 
-TEST_CASE("noise_in_the_world_frame_is_equivariant_in_law_under_rotations_only_and_is_decided_exactly", "[property]") {
+TEST_CASE(
+    "noise_in_the_world_frame_is_equivariant_in_law_under_rotations_only_and_is_decided_exactly",
+    "[property]") {
   const NoisyStraightPolicy world(true), hand(false);
   const props::CheckOptions options = props::options_for(props::View::third_person);
   for (Group group : {Group::rotation, Group::c8, Group::se3}) {
@@ -83,16 +89,18 @@ TEST_CASE("noise_in_the_world_frame_is_equivariant_in_law_under_rotations_only_a
 }
 
 TEST_CASE("a_policy_whose_decoder_forgets_R0_is_not_rotation_equivariant", "[property]") {
-  const auto forgets = std::make_shared<props::RandomOuterPolicy>(std::make_shared<test::DecoderForgetsR0>(), 6, kChunk,
-                                                                  std::vector<int>{16}, 4);
+  const auto forgets = std::make_shared<props::RandomOuterPolicy>(
+      std::make_shared<test::DecoderForgetsR0>(), 6, kChunk, std::vector<int>{16}, 4);
   props::CheckOptions options = props::eye_in_hand_options();
   options.shape.min_history = options.shape.max_history = 0;
   options.shape.max_hand_points = 0;
   const props::SeededPolicy seeded(forgets);
-  const props::Verdict pointwise = props::check_policy_equivariance(seeded, Group::rotation, options);
+  const props::Verdict pointwise =
+      props::check_policy_equivariance(seeded, Group::rotation, options);
   CHECK_FALSE(pointwise.invariant);
   REQUIRE(pointwise.witness.has_value());
-  CHECK(props::check_policy_distribution(seeded, Group::translation, options).invariant);  // R_0 untouched
+  CHECK(props::check_policy_distribution(seeded, Group::translation, options)
+            .invariant);  // R_0 untouched
 }
 
 TEST_CASE("a_mean_moved_by_a_frame_mix_up_is_caught_in_law_by_the_paired_mean_test", "[property]") {
@@ -125,12 +133,14 @@ TEST_CASE("a_mean_moved_by_a_frame_mix_up_is_caught_in_law_by_the_paired_mean_te
 
 TEST_CASE("student_t_and_the_paired_mean_test", "[unit]") {
   CHECK(props::student_t_two_sided_p(0.0, 10.0) == Approx(1.0));
-  CHECK(props::student_t_two_sided_p(2.228, 10.0) == Approx(0.05).epsilon(0.01));  // the 97.5% quantile, 10 df
+  CHECK(props::student_t_two_sided_p(2.228, 10.0) ==
+        Approx(0.05).epsilon(0.01));  // the 97.5% quantile, 10 df
   CHECK(props::student_t_two_sided_p(12.706, 1.0) == Approx(0.05).epsilon(0.01));
   Eigen::MatrixXd zero_mean(6, 2), shifted(6, 2);
   zero_mean << 1, -1, -1, 1, 1, -1, -1, 1, 0.5, -0.5, -0.5, 0.5;
   shifted = zero_mean.array() + 3.0;
   CHECK(props::paired_mean_test(zero_mean, 1e-12) > 0.5);
   CHECK(props::paired_mean_test(shifted, 1e-12) < 0.01);
-  CHECK(props::paired_mean_test(Eigen::MatrixXd::Constant(4, 3, 0.2), 1e-12) == 0.0);  // a constant offset
+  CHECK(props::paired_mean_test(Eigen::MatrixXd::Constant(4, 3, 0.2), 1e-12) ==
+        0.0);  // a constant offset
 }

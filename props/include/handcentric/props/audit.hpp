@@ -21,7 +21,7 @@ Precision parse_precision(const std::string& name);
 struct AuditOptions {
   std::vector<Group> groups = all_groups();
   std::vector<View> views = {View::eye_in_hand, View::third_person};
-  int cases = kDefaultCases;       ///< pointwise cases per cell
+  int cases = kDefaultCases;  ///< pointwise cases per cell
   std::uint64_t seed = 1;
   Precision precision = Precision::float64;
   /// REL of the tolerance REL * (1 + L); 0 = from `precision` (kRelativeTolerance for float64,
@@ -43,7 +43,8 @@ ClassifierOptions classifier_options(const AuditOptions& options);
 
 /// Audits the named built-ins (empty = all of auditable_names()). Throws InvalidArgument
 /// naming an unknown name and the valid ones.
-std::vector<Classification> audit_builtins(const std::vector<std::string>& names, const AuditOptions& options);
+std::vector<Classification> audit_builtins(const std::vector<std::string>& names,
+                                           const AuditOptions& options);
 
 /// Human output: per classification, one table per view, then notes, injectivity (a loud
 /// warning when a map is not injective) and, with `witnesses`, the failing cells' witnesses.

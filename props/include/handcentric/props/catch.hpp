@@ -24,8 +24,8 @@ void require_property(const std::string& description, Testable&& testable) {
 /// Returns the outcome, so the test can check the witness it found.
 template <typename Testable>
 PropertyOutcome require_falsified(const std::string& description, Testable&& testable) {
-  const PropertyOutcome outcome =
-      run_property(description, std::forward<Testable>(testable), property_params(), Expect::failure);
+  const PropertyOutcome outcome = run_property(description, std::forward<Testable>(testable),
+                                               property_params(), Expect::failure);
   INFO(description << " was expected to FAIL (planted fault), but held on " << outcome.cases
                    << " cases; seed " << outcome.seed);
   REQUIRE_FALSE(outcome.passed);

@@ -64,13 +64,16 @@ SceneFunction observation_of(std::shared_ptr<const Representation> representatio
 /// The flow target's network input (or regression target) at time t and a fixed eps: the
 /// first noise_dimension(scene) standard normals of mt19937_64(noise_seed). The same eps is
 /// used for s and g * s, so this is the pointwise question of App. A (eqs. 11, 16, 23, 29).
-SceneFunction flow_input_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed, double t);
-SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed, double t);
+SceneFunction flow_input_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed,
+                            double t);
+SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed,
+                             double t);
 
 /// The first `n` standard normals of mt19937_64(seed) (core/sampling.hpp).
 Eigen::VectorXd fixed_noise(Eigen::Index n, std::uint64_t seed);
 
-/// f(g * s) = f(s) within pointwise_tolerance for g in `group`. `component` only labels the verdict.
+/// f(g * s) = f(s) within pointwise_tolerance for g in `group`. `component` only labels the
+/// verdict.
 Verdict check_invariance(const SceneFunction& f, Component component, Group group,
                          const CheckOptions& options = {});
 
@@ -80,7 +83,8 @@ double recompute_error(const SceneFunction& f, const Witness& witness);
 /// eq. (4): policy.act(g * o, s) = g * policy.act(o, s) within pointwise_tolerance, for the
 /// observations generated with options.shape and the noise seed options.noise_seed. The
 /// witness's before/after are g * a(o) and a(g * o), each pose flattened to [p, r(R)].
-Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOptions& options = {});
+Verdict check_equivariance(const ChunkPolicy& policy, Group group,
+                           const CheckOptions& options = {});
 
 /// max_k distance(a(g * o)_k, (g * a(o))_k) recomputed from a witness.
 double recompute_equivariance_error(const ChunkPolicy& policy, const Witness& witness,

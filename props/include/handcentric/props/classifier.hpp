@@ -29,10 +29,10 @@ struct ClassifierOptions {
   DistributionOptions distribution = {};
   std::vector<Group> groups = all_groups();
   std::vector<View> views = {View::eye_in_hand, View::third_person};
-  bool observation = true;   ///< check the observation (off for a plug-in that sends none)
-  bool flow = true;          ///< check the flow of a representation
+  bool observation = true;  ///< check the observation (off for a plug-in that sends none)
+  bool flow = true;         ///< check the flow of a representation
   bool in_distribution = true;
-  bool injectivity = true;   ///< run check_injectivity on a representation
+  bool injectivity = true;      ///< run check_injectivity on a representation
   int injectivity_cases = 200;  ///< chunk pairs it tries (on third-person scenes)
   /// When a cell fails at a tolerance below float32 rounding, re-check it at
   /// kFloat32RelativeTolerance and say in the verdict's note if it would pass there.
@@ -41,8 +41,8 @@ struct ClassifierOptions {
 
 struct Classification {
   std::string name;
-  std::vector<Verdict> verdicts;            ///< one per (view, component, mode, group) checked
-  std::optional<Injectivity> injectivity;   ///< representations only
+  std::vector<Verdict> verdicts;           ///< one per (view, component, mode, group) checked
+  std::optional<Injectivity> injectivity;  ///< representations only
 };
 
 /// `flow`: the flow to audit; null = the rectified flow of `representation` (eq. 5).
@@ -64,12 +64,12 @@ Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
 CheckOptions with_view(CheckOptions check, View view);
 
 /// The groups whose verdict for (component, mode, view) held, in all_groups() order.
-std::vector<Group> invariant_groups(const Classification& classification, Component component, Mode mode,
-                                    View view = View::eye_in_hand);
+std::vector<Group> invariant_groups(const Classification& classification, Component component,
+                                    Mode mode, View view = View::eye_in_hand);
 
 /// The verdict for (component, mode, group, view), or null when it was not checked.
-const Verdict* find_verdict(const Classification& classification, Component component, Mode mode, Group group,
-                            View view = View::eye_in_hand);
+const Verdict* find_verdict(const Classification& classification, Component component, Mode mode,
+                            Group group, View view = View::eye_in_hand);
 
 /// What we assert for a built-in, and on what authority.
 struct Expectation {
@@ -87,8 +87,8 @@ struct Expectation {
 ///     assumes eye-in-hand views): world points are copied raw by absolute, relative,
 ///     relative_diff and ActionFlow's input (never invariant), and taken into the hand frame,
 ///     T_0^{-1} q, by hand_centric (invariant under all five).
-std::optional<Expectation> paper_expectation(const std::string& name, Component component, Mode mode,
-                                             View view = View::eye_in_hand);
+std::optional<Expectation> paper_expectation(const std::string& name, Component component,
+                                             Mode mode, View view = View::eye_in_hand);
 
 /// The cells of `classification` that differ from paper_expectation, one line each.
 std::vector<std::string> mismatches_with_paper(const Classification& classification);

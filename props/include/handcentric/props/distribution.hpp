@@ -47,11 +47,11 @@ TwoSampleResult energy_test(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, 
                             std::uint64_t seed, double stop_above = 0.0);
 
 struct DistributionOptions {
-  int cases = 10;               ///< (scene, g) pairs tested
-  int samples = 32;             ///< energy test: eps draws per scene (each sample has this many rows)
-  double family_alpha = 0.01;   ///< energy test: per check, split evenly over the cases (Bonferroni)
-  int shrink_budget = 20;       ///< evaluations spent shrinking a witness
-  int affinity_checks = 2;      ///< random eps at which an affine law is verified, per scene
+  int cases = 10;    ///< (scene, g) pairs tested
+  int samples = 32;  ///< energy test: eps draws per scene (each sample has this many rows)
+  double family_alpha = 0.01;  ///< energy test: per check, split evenly over the cases (Bonferroni)
+  int shrink_budget = 20;      ///< evaluations spent shrinking a witness
+  int affinity_checks = 2;     ///< random eps at which an affine law is verified, per scene
 };
 
 /// Permutations used for a per-case level alpha: enough that p can fall below it twice over.
@@ -76,8 +76,9 @@ struct GaussianLaw {
 /// f(eps) = mean + J eps within `tolerance` (inf-norm) at `checks` standard normal eps drawn
 /// from mt19937_64(seed). Returns nullopt when a verification fails or f changes length: f is
 /// not affine in eps (as far as the checks see).
-std::optional<GaussianLaw> affine_law(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
-                                      Eigen::Index n, double tolerance, std::uint64_t seed, int checks = 2);
+std::optional<GaussianLaw> affine_law(
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, Eigen::Index n,
+    double tolerance, std::uint64_t seed, int checks = 2);
 
 /// How far apart two Gaussian laws are: |mean_a - mean_b|_inf and |J_a J_a^T - J_b J_b^T|_inf
 /// (infinite when their dimensions differ). Both zero iff the laws are equal.

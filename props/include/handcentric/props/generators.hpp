@@ -19,7 +19,8 @@ namespace handcentric::props {
 /// A Haar-uniform rotation (no edge cases).
 rc::Gen<Rotation> haar_rotation();
 
-/// Haar-uniform rotations mixed with edge cases (identity, 1e-12, pi - 1e-9, pi): 1 in 5 is an edge case.
+/// Haar-uniform rotations mixed with edge cases (identity, 1e-12, pi - 1e-9, pi): 1 in 5 is an edge
+/// case.
 rc::Gen<Rotation> rotation();
 
 /// A rotation whose angle is within 1e-10 of pi (about a Haar-random axis).
@@ -42,7 +43,8 @@ struct SceneShape {
   int min_chunk = 1, max_chunk = 32;     ///< K
   int max_world_points = 3;
   int max_hand_points = 3;
-  int min_world_points = 0;  ///< above 0, the count is drawn in [min, max] (a fixed count: min = max)
+  int min_world_points =
+      0;  ///< above 0, the count is drawn in [min, max] (a fixed count: min = max)
   int min_hand_points = 0;
   /// Named world-frame poses to generate (e.g. "start"): random poses that move with g.
   std::vector<std::string> extra_pose_names;

@@ -40,18 +40,19 @@ struct RoundTripFailure {
 };
 
 struct Injectivity {
-  std::optional<bool> injective;  ///< see the top of this file
-  std::string how;                ///< one sentence: how it was decided
-  int cases = 0;                  ///< pairs tried
-  int round_trips = 0;            ///< decode(encode(s)) checked (0 without a decoder)
-  std::optional<Collision> collision;                    ///< when injective is false
-  std::optional<RoundTripFailure> round_trip_failure;    ///< a decoder that does not invert
+  std::optional<bool> injective;       ///< see the top of this file
+  std::string how;                     ///< one sentence: how it was decided
+  int cases = 0;                       ///< pairs tried
+  int round_trips = 0;                 ///< decode(encode(s)) checked (0 without a decoder)
+  std::optional<Collision> collision;  ///< when injective is false
+  std::optional<RoundTripFailure> round_trip_failure;  ///< a decoder that does not invert
 };
 
 /// Runs options.cases pairs from options.seed on options.shape's scenes, with
 /// options.relative_tolerance. Throws InvalidArgument for a null representation; rethrows a
 /// handcentric::Error of the representation (a plug-in that stops answering).
-Injectivity check_injectivity(std::shared_ptr<const Representation> representation, const CheckOptions& options);
+Injectivity check_injectivity(std::shared_ptr<const Representation> representation,
+                              const CheckOptions& options);
 
 /// A multi-line rendering of a collision (17 digits) for the text report.
 std::string format_collision(const Collision& collision);

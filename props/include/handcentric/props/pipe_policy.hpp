@@ -17,13 +17,15 @@ class PipePolicy final : public NoisyPolicy {
  public:
   /// Starts `command`; names as PipeRepresentation's. Throws InvalidArgument for an empty
   /// command, a timeout <= 0 or a repeated name; PluginError if it cannot start.
-  PipePolicy(std::string command, double timeout_seconds, std::vector<std::string> extra_pose_names = {},
+  PipePolicy(std::string command, double timeout_seconds,
+             std::vector<std::string> extra_pose_names = {},
              std::vector<std::string> scalar_names = {});
 
   std::string name() const override { return "policy-exec: " + connection_.command(); }
   Eigen::Index noise_dimension() const override;
   /// Throws PluginError for a chunk whose length changes between observations.
-  std::vector<RigidTransform> act(const Scene& observation, const Eigen::VectorXd& noise) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  const Eigen::VectorXd& noise) const override;
 
   /// The handshake's result (runs it if it has not run).
   const PluginCapabilities& capabilities() const;

@@ -36,7 +36,8 @@ class PipeRepresentation final : public Representation {
   /// empty or repeated name; PluginError if the process cannot be started. Nothing is sent
   /// until the first question.
   PipeRepresentation(std::string command, double timeout_seconds,
-                     std::vector<std::string> extra_pose_names = {}, std::vector<std::string> scalar_names = {});
+                     std::vector<std::string> extra_pose_names = {},
+                     std::vector<std::string> scalar_names = {});
   ~PipeRepresentation() override;
   PipeRepresentation(const PipeRepresentation&) = delete;
   PipeRepresentation& operator=(const PipeRepresentation&) = delete;
@@ -51,7 +52,8 @@ class PipeRepresentation final : public Representation {
   std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& actions,
                                              const RigidTransform& world_T_hand0) const override;
   /// The plug-in's decode answer. Throws InvalidArgument when it does not decode.
-  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions, const Scene& observation) const override;
+  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
+                                              const Scene& observation) const override;
 
   /// The handshake's result (runs it if it has not run): protocol, names, decode, flow.
   const PluginCapabilities& capabilities() const;
@@ -80,7 +82,8 @@ class PipeRepresentation final : public Representation {
   mutable bool has_observation_ = false;
   mutable std::unordered_map<std::string, PluginReply> cache_;
   /// (H, K, #hand points, #world points) -> (actions length, observation length, has observation)
-  mutable std::map<std::tuple<int, int, int, int>, std::tuple<Eigen::Index, Eigen::Index, bool>> lengths_;
+  mutable std::map<std::tuple<int, int, int, int>, std::tuple<Eigen::Index, Eigen::Index, bool>>
+      lengths_;
 };
 
 /// A plug-in's own flow (declared "flow" in its hello) as a FlowTarget: eps has the length of

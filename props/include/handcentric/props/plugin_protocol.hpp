@@ -49,7 +49,8 @@ struct FlowQuery {
 };
 
 /// The body of an encode request (everything after the id; also the cache key).
-std::string encode_request_body(const Scene& scene, const std::optional<FlowQuery>& flow = std::nullopt);
+std::string encode_request_body(const Scene& scene,
+                                const std::optional<FlowQuery>& flow = std::nullopt);
 /// The body of a decode request: the observation (no chunk) and the actions to decode.
 std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& observation);
 /// The body of a policy request: the observation (no chunk) and the noise.
@@ -77,7 +78,8 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
 /// Throws InvalidArgument naming `flag` for an empty or repeated name.
 void require_distinct_names(const std::vector<std::string>& names, const std::string& flag);
 /// `first` followed by the names of `second` it lacks (a hello's names, then a flag's).
-std::vector<std::string> merged_names(std::vector<std::string> first, const std::vector<std::string>& second);
+std::vector<std::string> merged_names(std::vector<std::string> first,
+                                      const std::vector<std::string>& second);
 
 /// A scene with an identity pose and a zero for each name it lacks (the handshake's probe).
 Scene with_named_extras(Scene scene, const std::vector<std::string>& pose_names,

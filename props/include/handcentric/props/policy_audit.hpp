@@ -33,7 +33,8 @@ class NoisyPolicy {
   /// The length of the noise vector act() reads.
   virtual Eigen::Index noise_dimension() const = 0;
   /// T_1..T_K for `observation` (its history, points, extras; its chunk is ignored).
-  virtual std::vector<RigidTransform> act(const Scene& observation, const Eigen::VectorXd& noise) const = 0;
+  virtual std::vector<RigidTransform> act(const Scene& observation,
+                                          const Eigen::VectorXd& noise) const = 0;
 };
 
 /// A ChunkPolicy, whose noise comes from a seed, as a NoisyPolicy: the noise vector's bits are
@@ -46,7 +47,8 @@ class SeededPolicy final : public NoisyPolicy {
   explicit SeededPolicy(std::shared_ptr<const ChunkPolicy> policy);
   std::string name() const override { return policy_->name(); }
   Eigen::Index noise_dimension() const override { return 4; }
-  std::vector<RigidTransform> act(const Scene& observation, const Eigen::VectorXd& noise) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  const Eigen::VectorXd& noise) const override;
 
  private:
   std::shared_ptr<const ChunkPolicy> policy_;
@@ -55,16 +57,19 @@ class SeededPolicy final : public NoisyPolicy {
 /// eq. (4) pointwise: a(g o, n) = g a(o, n) with n the first noise_dimension() normals of
 /// mt19937_64(options.noise_seed). The witness's before/after are g a(o) and a(g o), each pose
 /// flattened to [p, r(R)].
-Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group, const CheckOptions& options = {});
+Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
+                                  const CheckOptions& options = {});
 
 /// eq. (4) in distribution (see the top of this file). The witness's before/after are the
 /// laws' means (exact) or first samples (energy test), each pose flattened to [p, R row-major].
-Verdict check_policy_distribution(const NoisyPolicy& policy, Group group, const CheckOptions& options = {},
+Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
+                                  const CheckOptions& options = {},
                                   const DistributionOptions& distribution = {});
 
 /// Both modes, options.views and options.groups (component Component::policy; the verdict's
 /// `invariant` means equivariant), with the float32 note of classifier.hpp.
-Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy, const ClassifierOptions& options = {});
+Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
+                               const ClassifierOptions& options = {});
 
 /// {"policies": [{"name", "summary": {view: {mode: {group: bool}}}, "checks": [{"group",
 /// "mode", "view", "method", "equivariant", "max_error", "cases", "seed", "witness", ...}]}]}

@@ -40,7 +40,8 @@ class RandomOuterPolicy final : public ChunkPolicy {
   RandomOuterPolicy(std::shared_ptr<const Representation> representation, int observation_dimension,
                     int chunk_length, const std::vector<int>& hidden, std::uint64_t weight_seed);
   std::string name() const override;
-  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  std::uint64_t noise_seed) const override;
 
  private:
   std::shared_ptr<const Representation> representation_;

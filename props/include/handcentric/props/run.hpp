@@ -25,7 +25,7 @@ constexpr int kDefaultCases = 1000;
 struct PropertyOutcome {
   bool passed = false;
   std::uint64_t seed = 0;
-  int cases = 0;              ///< test cases run (up to the first failure)
+  int cases = 0;               ///< test cases run (up to the first failure)
   std::string counterexample;  ///< shrunk, printed; empty when passed
   std::string message;         ///< RapidCheck's full message plus how to replay
 };
@@ -44,8 +44,10 @@ PropertyParams property_params();
 enum class Expect { pass, failure };
 
 /// Runs a property of no arguments (it draws its values with *gen and fails with RC_ASSERT).
-PropertyOutcome run_nullary_property(const std::string& description, const std::function<void()>& property,
-                                     const PropertyParams& params = property_params(), Expect expect = Expect::pass);
+PropertyOutcome run_nullary_property(const std::string& description,
+                                     const std::function<void()>& property,
+                                     const PropertyParams& params = property_params(),
+                                     Expect expect = Expect::pass);
 
 namespace detail {
 
@@ -81,10 +83,12 @@ void call_with_arbitrary(Testable& testable, std::tuple<A...>*) {
 /// it may return bool or assert with RC_ASSERT) under `params`.
 template <typename Testable>
 PropertyOutcome run_property(const std::string& description, Testable&& testable,
-                             const PropertyParams& params = property_params(), Expect expect = Expect::pass) {
+                             const PropertyParams& params = property_params(),
+                             Expect expect = Expect::pass) {
   using Tuple = typename detail::Arguments<Testable>::Tuple;
   return run_nullary_property(
-      description, [&testable] { detail::call_with_arbitrary(testable, static_cast<Tuple*>(nullptr)); }, params,
+      description,
+      [&testable] { detail::call_with_arbitrary(testable, static_cast<Tuple*>(nullptr)); }, params,
       expect);
 }
 

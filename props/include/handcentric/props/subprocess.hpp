@@ -26,16 +26,16 @@ class Subprocess {
  public:
   /// How a child ended.
   struct Exit {
-    bool reaped = false;      ///< false: still running after the grace period, then killed
-    bool exited = false;      ///< exited normally, with `status`
+    bool reaped = false;  ///< false: still running after the grace period, then killed
+    bool exited = false;  ///< exited normally, with `status`
     int status = 0;
-    bool signaled = false;    ///< killed by `signal`
+    bool signaled = false;  ///< killed by `signal`
     int signal = 0;
     std::string describe() const;  ///< "exited with status 3", "was killed by signal 9", ...
   };
   enum class Outcome { done, timed_out, closed, too_long };
 
-  static constexpr int kStderrLines = 20;          ///< stderr lines kept
+  static constexpr int kStderrLines = 20;                ///< stderr lines kept
   static constexpr std::size_t kStderrLineBytes = 1000;  ///< longer lines are cut there
   /// The longest stdout line read_line accepts by default: 64 MiB, far above any answer (a
   /// chunk of 10^4 poses is ~3 MB), far below what would strain memory.
@@ -73,8 +73,8 @@ class Subprocess {
   std::size_t max_line_bytes_;
   int pid_ = -1;
   int stdin_ = -1, stdout_ = -1, stderr_ = -1;
-  std::string stdout_buffer_;    ///< bytes read past the last newline
-  std::string stderr_partial_;   ///< the stderr line being written
+  std::string stdout_buffer_;   ///< bytes read past the last newline
+  std::string stderr_partial_;  ///< the stderr line being written
   std::deque<std::string> stderr_lines_;
   std::optional<Exit> exit_;
 };

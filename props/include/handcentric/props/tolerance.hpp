@@ -32,7 +32,8 @@ double length_scale(const Scene& scene);
 
 /// relative * (1 + max(L(s), L(g * s))); relative = kRelativeTolerance unless a check's
 /// options say otherwise (e.g. 1e-4 for a network computed in float).
-double pointwise_tolerance(const Scene& scene, const Scene& moved, double relative = kRelativeTolerance);
+double pointwise_tolerance(const Scene& scene, const Scene& moved,
+                           double relative = kRelativeTolerance);
 
 /// angle(R~) + |p~| / (1 + L(s)): how far g is from the identity, relative to the scene.
 double distance_from_identity(const RigidTransform& g, const Scene& scene);

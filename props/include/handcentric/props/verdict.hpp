@@ -49,10 +49,12 @@ std::string to_string(Method method);
 struct Witness {
   Scene scene;
   RigidTransform g;
-  Eigen::VectorXd before;  ///< f(scene)            (policy: g * a(o), flattened; exact law: its mean)
-  Eigen::VectorXd after;   ///< f(g * scene)        (policy: a(g * o), flattened; exact law: its mean)
-  double error = 0.0;      ///< |after - before|_inf; exact law: max(mean, covariance difference);
-                           ///< energy test: the energy distance
+  Eigen::VectorXd
+      before;  ///< f(scene)            (policy: g * a(o), flattened; exact law: its mean)
+  Eigen::VectorXd
+      after;           ///< f(g * scene)        (policy: a(g * o), flattened; exact law: its mean)
+  double error = 0.0;  ///< |after - before|_inf; exact law: max(mean, covariance difference);
+                       ///< energy test: the energy distance
   double tolerance = 0.0;  ///< what error had to stay below (energy test: the level alpha)
   double p_value = 1.0;    ///< energy test: the permutation p-value (else 1)
   std::string detail;      ///< exact law: which moment differs and by how much
@@ -64,10 +66,10 @@ struct Verdict {
   Mode mode = Mode::pointwise;
   View view = View::eye_in_hand;
   Method method = Method::compared;
-  bool invariant = false;    ///< the check held on every case (and on at least one far case)
-  double max_error = 0.0;    ///< largest error seen (before shrinking)
-  double min_p_value = 1.0;  ///< distribution mode: smallest p-value seen
-  int cases = 0;             ///< cases run with g far from the identity (tolerance.hpp)
+  bool invariant = false;       ///< the check held on every case (and on at least one far case)
+  double max_error = 0.0;       ///< largest error seen (before shrinking)
+  double min_p_value = 1.0;     ///< distribution mode: smallest p-value seen
+  int cases = 0;                ///< cases run with g far from the identity (tolerance.hpp)
   int near_identity_cases = 0;  ///< cases run with g near the identity (run, not counted)
   std::uint64_t seed = 0;
   double relative_tolerance = 0.0;  ///< the REL of the pointwise tolerance REL * (1 + L)
