@@ -7,12 +7,12 @@
 #include <limits>
 #include <iostream>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
 
 #include "commands.hpp"
 #include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/results.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/expert_check.hpp"
 #include "handcentric/sim/policies.hpp"
@@ -50,12 +50,7 @@ int run_eval(const EvalOptions& options) {
   const sim::CollisionChecker checker;
   const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed, loaded.rollout_options);
   if (options.json) {
-    const double n = summary.trials;
-    const nlohmann::json out = {{"trials", summary.trials},     {"success", summary.success / n},
-                                {"collision", summary.collision / n}, {"timeout", summary.timeout / n},
-                                {"clipped", summary.clipped},   {"policy", policy->name()},
-                                {"dist", distribution.name},    {"seed", options.seed}};
-    std::cout << out.dump() << "\n";
+    std::cout << experiments::eval_json(summary, policy->name(), distribution.name, options.seed) << "\n";
   } else {
     std::cout << "policy " << policy->name() << " on " << summary.trials << " '" << distribution.name
               << "' scenes (seed " << options.seed << "): success " << summary.success << ", collision "
