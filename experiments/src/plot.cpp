@@ -33,12 +33,14 @@ void text(cv::Mat& canvas, const std::string& s, cv::Point at, double scale = 0.
 sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
   if (rows.empty()) throw InvalidArgument("draw_table1: no rows to draw (no cell has a result yet)");
   cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const int left = 70, right = width - 300, top = 50, bottom = height - 60;
+  const int left = 70, right = width - 300, top = 70, bottom = height - 60;
   int max_demos = 0;
   for (const Row& r : rows) max_demos = std::max(max_demos, r.demos);
   const double x_max = std::max(10, static_cast<int>(std::ceil(max_demos / 10.0)) * 10);
-  const auto px = [&](double demos, double success) {
-    return cv::Point(static_cast<int>(std::lround(left + (right - left) * demos / x_max)),
+  // `shift`: a horizontal offset in pixels, so that series and their OOD markers at one demo
+  // count stay apart whatever the axis' scale.
+  const auto px = [&](double demos, double success, int shift = 0) {
+    return cv::Point(static_cast<int>(std::lround(left + (right - left) * demos / x_max)) + shift,
                      static_cast<int>(std::lround(bottom - (bottom - top) * success)));
   };
   // Axes, grid and ticks.
@@ -56,7 +58,7 @@ sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
   cv::rectangle(canvas, px(0, 1), px(x_max, 0), rgb(20, 20, 20), 1);
   text(canvas, "number of demos", cv::Point((left + right) / 2 - 60, height - 15), 0.55);
   text(canvas, "success", cv::Point(8, top - 15), 0.55);
-  text(canvas, "Table 1: closed-loop success (bars: Wilson 95%)", cv::Point(left, 30), 0.65);
+  text(canvas, "Table 1: closed-loop success (bars: Wilson 95%)", cv::Point(left, 28), 0.65);
 
   std::vector<std::pair<std::string, std::string>> series;
   for (const Row& r : rows) {
@@ -72,25 +74,28 @@ sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
       if (r.method == series[s].first && r.head == series[s].second && r.train_seed == seed) points.push_back(&r);
     }
     std::sort(points.begin(), points.end(), [](const Row* a, const Row* b) { return a->demos < b->demos; });
-    // A small horizontal offset per series keeps overlapping bars apart.
-    const double dx = (static_cast<double>(s) - 0.5 * (series.size() - 1)) * 0.5;
+    const int shift = static_cast<int>(std::lround((static_cast<double>(s) - 0.5 * (series.size() - 1)) * 5.0));
+    const int ood_shift = shift + 7;
     const Row* previous = nullptr;
     for (const Row* r : points) {
-      const double x = r->demos + dx;
+      const double x = r->demos;
       if (r->id_success) {
-        if (r->id_ci) cv::line(canvas, px(x, r->id_ci->lo), px(x, r->id_ci->hi), colour, 1, cv::LINE_AA);
+        if (r->id_ci) cv::line(canvas, px(x, r->id_ci->lo, shift), px(x, r->id_ci->hi, shift), colour, 1, cv::LINE_AA);
         if (previous && previous->id_success) {
-          cv::line(canvas, px(previous->demos + dx, *previous->id_success), px(x, *r->id_success), colour, 2, cv::LINE_AA);
+          cv::line(canvas, px(previous->demos, *previous->id_success, shift), px(x, *r->id_success, shift), colour, 2,
+                   cv::LINE_AA);
         }
-        cv::circle(canvas, px(x, *r->id_success), 5, colour, cv::FILLED, cv::LINE_AA);
+        cv::circle(canvas, px(x, *r->id_success, shift), 5, colour, cv::FILLED, cv::LINE_AA);
       }
       if (r->ood_success) {
-        const double xo = x + 0.8;
-        if (r->ood_ci) cv::line(canvas, px(xo, r->ood_ci->lo), px(xo, r->ood_ci->hi), colour, 1, cv::LINE_AA);
-        if (previous && previous->ood_success) {
-          dashed(canvas, px(previous->demos + dx + 0.8, *previous->ood_success), px(xo, *r->ood_success), colour);
+        if (r->ood_ci) {
+          cv::line(canvas, px(x, r->ood_ci->lo, ood_shift), px(x, r->ood_ci->hi, ood_shift), colour, 1, cv::LINE_AA);
         }
-        const cv::Point c = px(xo, *r->ood_success);
+        if (previous && previous->ood_success) {
+          dashed(canvas, px(previous->demos, *previous->ood_success, ood_shift), px(x, *r->ood_success, ood_shift),
+                 colour);
+        }
+        const cv::Point c = px(x, *r->ood_success, ood_shift);
         cv::rectangle(canvas, c - cv::Point(5, 5), c + cv::Point(5, 5), rgb(255, 255, 255), cv::FILLED);
         cv::rectangle(canvas, c - cv::Point(5, 5), c + cv::Point(5, 5), colour, 2, cv::LINE_AA);
       }
