@@ -3,17 +3,19 @@
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/sim/policies.hpp"
+#include "handcentric/sim/rollout.hpp"
 
 namespace handcentric::apps {
 
-LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string& scripted_name) {
+LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string& scripted_name,
+                               const policy::SamplingOverrides& overrides) {
   LoadedPolicy loaded;
   if (model_path.empty()) {
     loaded.policy = sim::make_scripted_policy(scripted_name);
     return loaded;
   }
-  auto model = std::make_unique<policy::LearnedPolicy>(policy::load_model(model_path));
-  loaded.rollout_options.history = model->config().history_length;
+  auto model = std::make_unique<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
+  loaded.rollout_options = sim::RolloutOptions::for_policy(model->config().history_length, model->config().execute);
   loaded.policy = std::move(model);
   return loaded;
 }

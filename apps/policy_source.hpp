@@ -5,6 +5,7 @@
 #include <string>
 
 #include "handcentric/core/chunk_policy.hpp"
+#include "handcentric/policy/model_file.hpp"
 #include "handcentric/sim/rollout.hpp"
 
 namespace handcentric::apps {
@@ -12,13 +13,16 @@ namespace handcentric::apps {
 /// A policy and the rollout settings it needs.
 struct LoadedPolicy {
   std::unique_ptr<ChunkPolicy> policy;
-  /// The rollout's observation history: the H a model was trained with (a rollout with another
-  /// H would hand it observations of the wrong shape), the sim's default for scripted policies.
+  /// The rollout's observation history and executed poses: the H a model was trained with (a
+  /// rollout with another H would hand it observations of the wrong shape) and its execute, the
+  /// sim's defaults for scripted policies.
   sim::RolloutOptions rollout_options;
 };
 
 /// The model in `model_path` when it is not empty, else the scripted policy `scripted_name`.
 /// Throws a typed error naming the file or the name when neither can be had.
-LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string& scripted_name);
+/// `overrides` apply to a model only.
+LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string& scripted_name,
+                               const policy::SamplingOverrides& overrides = {});
 
 }  // namespace handcentric::apps

@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev catch2 librapidcheck-dev libbox2d-dev libopencv-dev libginac-dev
   libcli11-dev nlohmann-json3-dev libbenchmark-dev
   python3-numpy python3-pytest time
+  parallel
 )
 
 missing=()

@@ -109,7 +109,7 @@ class C8FlowHead final : public FlowHead {
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
     Eigen::MatrixXf x0(config_.action_dimension, observations.cols());
     fill_standard_normal(rng, x0);
-    x0.array().colwise() *= action_normalizer_.active_float().array();
+    x0.array().colwise() *= action_normalizer_.active_float().array() * static_cast<float>(config_.noise_scale);
     action_normalizer_.denormalize(x0);
     Eigen::MatrixXf out(x0.rows(), x0.cols());
     const int steps = config_.euler_steps;

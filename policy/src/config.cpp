@@ -108,7 +108,8 @@ const std::vector<Field>& fields() {
             [](PolicyConfig& c, const std::string& v) { c.lr_schedule = parse_schedule(v); }},
       HC_DOUBLE_FIELD(weight_decay), HC_DOUBLE_FIELD(gradient_clip), HC_DOUBLE_FIELD(ema_decay),
       HC_INT_FIELD(euler_steps), HC_INT_FIELD(ddpm_train_steps), HC_INT_FIELD(ddim_steps),
-      HC_INT_FIELD(cvae_latent), HC_DOUBLE_FIELD(cvae_kl_weight),
+      HC_INT_FIELD(cvae_latent), HC_DOUBLE_FIELD(cvae_kl_weight), HC_DOUBLE_FIELD(noise_scale),
+      HC_INT_FIELD(execute),
   };
   return all;
 }
@@ -136,6 +137,8 @@ void PolicyConfig::validate() const {
   require(weight_decay >= 0.0 && weight_decay < 1.0, "weight_decay", format_number(weight_decay), "[0, 1)");
   require(gradient_clip >= 0.0, "gradient_clip", format_number(gradient_clip), ">= 0 (0 disables)");
   require(ema_decay >= 0.0 && ema_decay < 1.0, "ema_decay", format_number(ema_decay), "[0, 1) (0 disables)");
+  require(noise_scale >= 0.0 && noise_scale <= 10.0, "noise_scale", format_number(noise_scale), "[0, 10]");
+  require(execute >= 1 && execute <= 1024, "execute", s(execute), "1..1024 (a rollout runs at most the K poses it has)");
   require(euler_steps >= 1 && euler_steps <= 10000, "euler_steps", s(euler_steps), "1..10000");
   require(ddpm_train_steps >= 2 && ddpm_train_steps <= 10000, "ddpm_train_steps", s(ddpm_train_steps), "2..10000");
   require(ddim_steps >= 1 && ddim_steps <= ddpm_train_steps, "ddim_steps", s(ddim_steps),

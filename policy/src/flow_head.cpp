@@ -51,7 +51,7 @@ Eigen::MatrixXf FlowHead::sample(const Eigen::MatrixXf& observations, std::mt199
   Eigen::MatrixXf x(config_.action_dimension, batch);
   fill_standard_normal(rng, x);
   const Eigen::VectorXf& active = action_normalizer_.active_float();
-  x.array().colwise() *= active.array();
+  x.array().colwise() *= active.array() * static_cast<float>(config_.noise_scale);
   Eigen::MatrixXf input, velocity, scratch[2];
   const Eigen::VectorXd t0 = Eigen::VectorXd::Zero(batch);
   assemble(x, t0, o, input);  // sizes the input once; per step only x and the time rows change

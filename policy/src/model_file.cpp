@@ -34,7 +34,8 @@ std::string serialize_model(const LearnedPolicy& policy) {
   return file.bytes();
 }
 
-LearnedPolicy deserialize_model(const std::string& bytes, const std::string& source) {
+LearnedPolicy deserialize_model(const std::string& bytes, const std::string& source,
+                                const SamplingOverrides& overrides) {
   ByteReader header(bytes, source);
   if (bytes.size() < sizeof kMagic || bytes.compare(0, sizeof kMagic, kMagic, sizeof kMagic) != 0) {
     throw InvalidModelFile(source + ": not a handcentric model file (it does not start with HCPOLICY): give a "
@@ -63,6 +64,10 @@ LearnedPolicy deserialize_model(const std::string& bytes, const std::string& sou
   } catch (const InvalidArgument& error) {
     in.fail(std::string("bad config: ") + error.what());
   }
+  if (overrides.noise_scale) config.noise_scale = *overrides.noise_scale;
+  if (overrides.execute) config.execute = *overrides.execute;
+  if (overrides.euler_steps) config.euler_steps = *overrides.euler_steps;
+  config.validate();
   const std::string representation_name = in.string(256);
   const std::string head_name = in.string(256);
   if (representation_name != config.representation || head_name != to_string(config.head)) {
@@ -86,7 +91,7 @@ void save_model(const LearnedPolicy& policy, const std::string& path) {
   write_file_atomically(path, serialize_model(policy));
 }
 
-LearnedPolicy load_model(const std::string& path) {
+LearnedPolicy load_model(const std::string& path, const SamplingOverrides& overrides) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) {
     throw InvalidModelFile(path + ": no such model file: give the path written by `handcentric train --out`");
@@ -95,7 +100,7 @@ LearnedPolicy load_model(const std::string& path) {
   std::ostringstream bytes;
   bytes << in.rdbuf();
   if (!in && !in.eof()) throw InvalidModelFile(path + ": cannot read the file: check its permissions");
-  return deserialize_model(bytes.str(), path);
+  return deserialize_model(bytes.str(), path, overrides);
 }
 
 }  // namespace handcentric::policy

@@ -1,5 +1,6 @@
 #include "handcentric/policy/trainer.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -10,6 +11,13 @@
 #include "handcentric/core/representations.hpp"
 
 namespace handcentric::policy {
+
+int training_budget(long long samples) {
+  if (samples < 1) throw InvalidArgument("training_budget: no training samples (got " + std::to_string(samples) + ")");
+  const double steps = kBudgetStepsPerSample * static_cast<double>(samples);
+  return static_cast<int>(std::clamp(std::llround(steps), static_cast<long long>(kBudgetMinSteps),
+                                     static_cast<long long>(kBudgetMaxSteps)));
+}
 
 double learning_rate_at(const PolicyConfig& config, int step) {
   if (step < 1 || step > config.steps) {
@@ -39,6 +47,7 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
   config.validate();
   std::shared_ptr<const Representation> representation = make_representation(config.representation);
   if (data.size() == 0) throw InvalidScene("no training samples: give at least one demonstration step");
+  if (config.steps == 0) config.steps = training_budget(data.size());
   config.action_dimension = static_cast<int>(data.actions.rows());
   config.observation_dimension = static_cast<int>(data.observations.rows());
   config.hand_points = data.hand_points;

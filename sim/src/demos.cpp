@@ -184,4 +184,21 @@ std::vector<Scene> training_scenes(const Demo& demo, int H, int K, const PegHole
   return scenes;
 }
 
+std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K, int max_demos,
+                                   const PegHoleGeometry& geometry) {
+  if (max_demos < 0) {
+    throw InvalidArgument("the number of demos to train on must be >= 0 (0 = all), got " + std::to_string(max_demos));
+  }
+  if (max_demos > static_cast<int>(demos.size())) {
+    throw InvalidArgument("asked to train on " + std::to_string(max_demos) + " demos but only " +
+                          std::to_string(demos.size()) + " are given: ask for at most that many");
+  }
+  const std::size_t used = max_demos == 0 ? demos.size() : static_cast<std::size_t>(max_demos);
+  std::vector<Scene> scenes;
+  for (std::size_t i = 0; i < used; ++i) {
+    for (Scene& scene : training_scenes(demos[i], H, K, geometry)) scenes.push_back(std::move(scene));
+  }
+  return scenes;
+}
+
 }  // namespace handcentric::sim

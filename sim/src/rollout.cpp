@@ -30,6 +30,15 @@ void RolloutOptions::validate() const {
   }
 }
 
+RolloutOptions RolloutOptions::for_policy(int history, int execute) {
+  RolloutOptions options;
+  options.history = history;
+  options.execute = execute;
+  options.max_replans = execute >= 1 ? (kStepBudget + execute - 1) / execute : 1;
+  options.validate();
+  return options;
+}
+
 std::string outcome_name(Outcome outcome) {
   switch (outcome) {
     case Outcome::success: return "success";

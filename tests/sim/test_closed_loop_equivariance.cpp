@@ -27,13 +27,8 @@ policy::LearnedPolicy trained_policy(const std::string& representation) {
   config.hidden_layers = 2;
   config.steps = 300;
   config.batch_size = 64;
-  std::vector<Scene> data;
-  for (const sim::Demo& demo : run.demos) {
-    for (Scene& scene : sim::training_scenes(demo, config.history_length, config.chunk_length)) {
-      data.push_back(std::move(scene));
-    }
-  }
-  return policy::train_policy(config, data, 5);
+  config.history_length = 2;  // what sim::rollout observes by default (RolloutOptions::history)
+  return policy::train_policy(config, sim::training_scenes(run.demos, config.history_length, config.chunk_length), 5);
 }
 
 // Largest |g T_t - T'_t| over the two rollouts' common steps (cm + Frobenius of the rotation).

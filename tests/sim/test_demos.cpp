@@ -11,6 +11,7 @@
 #include "handcentric/sim/demos.hpp"
 #include "handcentric/sim/expert.hpp"
 #include "handcentric/sim/scenes.hpp"
+#include "throws.hpp"
 
 using namespace handcentric;
 using namespace handcentric::sim;
@@ -132,4 +133,18 @@ TEST_CASE("training_scenes_pad_history_and_chunk_and_observe_the_opening_from_th
   CHECK_THROWS_AS(training_scenes(demo, -1, 16), InvalidArgument);
   CHECK_THROWS_AS(training_scenes(demo, 2, 0), InvalidArgument);
   CHECK_THROWS_AS(training_scenes(Demo{}, 2, 16), InvalidArgument);
+}
+
+TEST_CASE("training_scenes_of_the_first_n_demos_are_theirs_in_demo_order", "[unit]") {
+  const std::vector<Demo> demos = some_demos(3);
+  const auto all = training_scenes(demos, 0, 4);
+  const auto first_two = training_scenes(demos, 0, 4, 2);
+  const std::size_t n0 = demos[0].world_T_hand.size(), n1 = demos[1].world_T_hand.size();
+  REQUIRE(first_two.size() == n0 + n1);
+  REQUIRE(all.size() == n0 + n1 + demos[2].world_T_hand.size());
+  // Scene n0 is the start of demo 1 (a loader that skipped or repeated a demo would differ).
+  CHECK(same_bits(first_two[n0].world_T_hand_history[0], demos[1].world_T_hand[0]));
+  CHECK(same_bits(all.back().world_T_hand_history[0], demos[2].world_T_hand.back()));
+  HC_CHECK_THROWS(training_scenes(demos, 0, 4, 4), InvalidArgument, Contains("4 demos") && Contains("only 3"));
+  HC_CHECK_THROWS(training_scenes(demos, 0, 4, -1), InvalidArgument, Contains("-1"));
 }

@@ -10,6 +10,7 @@
 //
 // Little-endian; written to "<path>.tmp.<pid>" and renamed over `path` (atomic on POSIX).
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "handcentric/policy/learned_policy.hpp"
@@ -21,14 +22,24 @@ constexpr std::uint32_t kModelFormatVersion = 1;
 /// The file's bytes (for tests that damage them).
 std::string serialize_model(const LearnedPolicy& policy);
 
+/// Settings that change how a trained model samples and acts, not its weights; a set one
+/// replaces the stored value (PolicyConfig::noise_scale, execute, euler_steps).
+struct SamplingOverrides {
+  std::optional<double> noise_scale;
+  std::optional<int> execute;
+  std::optional<int> euler_steps;
+};
+
 /// Throws InvalidModelFile naming `source` for any damage: truncated, wrong magic, wrong version,
-/// bad checksum, a config or lengths that do not fit, trailing bytes.
-LearnedPolicy deserialize_model(const std::string& bytes, const std::string& source);
+/// bad checksum, a config or lengths that do not fit, trailing bytes; InvalidArgument for an
+/// override out of its range (PolicyConfig::validate).
+LearnedPolicy deserialize_model(const std::string& bytes, const std::string& source,
+                                const SamplingOverrides& overrides = {});
 
 /// Writes atomically. Throws InvalidArgument naming the path when it cannot be written.
 void save_model(const LearnedPolicy& policy, const std::string& path);
 
 /// Throws InvalidModelFile naming the path (missing, unreadable or damaged).
-LearnedPolicy load_model(const std::string& path);
+LearnedPolicy load_model(const std::string& path, const SamplingOverrides& overrides = {});
 
 }  // namespace handcentric::policy

@@ -23,13 +23,24 @@ struct TrainingProgress {
 
 using ProgressCallback = std::function<void(const TrainingProgress&)>;
 
+/// The automatic training budget (PolicyConfig::steps = 0) for `samples` training samples:
+/// kBudgetStepsPerSample steps per sample, at least kBudgetMinSteps and at most
+/// kBudgetMaxSteps. Measured on the peg-in-hole task (docs/EXPERIMENTS.md): a few demos are
+/// learned (or overfit) in a few thousand steps, while 100 demos keep improving with steps.
+/// Throws InvalidArgument for samples < 1.
+int training_budget(long long samples);
+inline constexpr double kBudgetStepsPerSample = 6.0;
+inline constexpr int kBudgetMinSteps = 3000;
+inline constexpr int kBudgetMaxSteps = 30000;
+
 /// The learning rate of Adam step `step` (1..config.steps) under config.lr_schedule:
 /// constant: learning_rate; cosine: learning_rate * (1 + cos(pi (step - 1) / steps)) / 2, so the
 /// first step uses learning_rate and the last one learning_rate * O(1/steps^2), never 0.
 /// Throws InvalidArgument for a step outside 1..steps.
 double learning_rate_at(const PolicyConfig& config, int step);
 
-/// Trains `config.head` on `scenes` with `config.representation`. Dimensions and point counts
+/// Trains `config.head` on `scenes` with `config.representation` (config.steps = 0: the
+/// automatic budget for scenes.size() samples). Dimensions and point counts
 /// in the returned policy's config come from the data. `progress` (optional) is called about
 /// every `report_every` steps and after the last step. Throws InvalidArgument for a bad config
 /// or a non-finite loss (diverged training), InvalidScene for bad scenes (dataset.hpp).

@@ -51,4 +51,10 @@ std::vector<Eigen::Vector3d> eye_in_hand_points(const RigidTransform& world_T_ho
 std::vector<Scene> training_scenes(const Demo& demo, int H, int K,
                                    const PegHoleGeometry& geometry = PegHoleGeometry());
 
+/// The training scenes of the first `max_demos` demos (0: all of them), demo after demo: what a
+/// behavior-cloning policy with history H and chunk K learns from. Throws InvalidArgument for
+/// max_demos < 0 or more than demos.size() (naming both and the fix), and as above.
+std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K, int max_demos = 0,
+                                   const PegHoleGeometry& geometry = PegHoleGeometry());
+
 }  // namespace handcentric::sim

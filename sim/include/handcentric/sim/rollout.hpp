@@ -22,15 +22,22 @@
 
 namespace handcentric::sim {
 
+/// Control steps a rollout may take (25 replans of 8 executed poses): the time limit of the task.
+constexpr int kStepBudget = 200;
+
 struct RolloutOptions {
   int history = 2;         ///< H past poses in the observation
   int execute = 8;         ///< poses executed per chunk
-  int max_replans = 25;
+  int max_replans = 25;    ///< kStepBudget / execute
   double max_step_cm = kMaxStepCm;
   double max_step_deg = kMaxStepDeg;
 
   /// Throws InvalidArgument naming the field for a non-positive value (history may be 0).
   void validate() const;
+
+  /// Options for a policy that observes `history` past poses and executes `execute` poses per
+  /// chunk, with replans enough for kStepBudget steps (the same time limit for every execute).
+  static RolloutOptions for_policy(int history, int execute);
 };
 
 enum class Outcome { success, collision, timeout };

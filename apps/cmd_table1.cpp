@@ -1,0 +1,88 @@
+// `handcentric table1`: the paper's Table 1 (Sec. 4.2) on this library. A thin handler: the
+// grid, the cache, the plan and the table live in experiments/ (table1.hpp).
+//
+//   handcentric table1 --out t1                 # all 28 cells, both cores, then the table
+//   handcentric table1 --out t1 --resume        # after a kill: only what is missing
+//   handcentric table1 --out t1 --plan          # t1/jobs.txt, one shell line per cell
+//   handcentric table1 --collect t1             # the table from whatever results t1 holds
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+
+#include "commands.hpp"
+#include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/table1.hpp"
+
+namespace handcentric::apps {
+namespace {
+
+struct Table1CommandOptions {
+  std::string demos = "5,10,20,40,60,80,100";
+  std::string methods = "hand_centric,relative,absolute,c8flow";
+  std::string heads = "flow";
+  std::string train_seeds = "1";
+  experiments::Table1Options table;
+  bool plan = false;
+  std::string collect;
+};
+
+std::string this_executable() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::string("handcentric") : self.string();
+}
+
+int run_table1_command(Table1CommandOptions options) {
+  if (!options.collect.empty()) {
+    std::cout << experiments::collect_table1(options.collect);
+    return 0;
+  }
+  experiments::Table1Options& table = options.table;
+  table.demo_counts = experiments::parse_int_list(options.demos, "--demos");
+  table.methods = experiments::parse_methods(options.methods);
+  table.heads = experiments::parse_heads(options.heads);
+  table.train_seeds = experiments::parse_seed_list(options.train_seeds, "--train-seeds");
+  const experiments::Table1Grid grid = experiments::prepare_table1(table);
+  if (options.plan) {
+    const int jobs = experiments::write_plan(grid, table.eval, this_executable());
+    std::cout << "wrote " << jobs << " jobs to " << grid.dir << "/jobs.txt; run them (e.g. parallel -j 2 < "
+              << grid.dir << "/jobs.txt), then: handcentric table1 --collect " << grid.dir << "\n";
+    return 0;
+  }
+  experiments::run_table1(table, grid);
+  std::cout << experiments::collect_table1(grid.dir);
+  std::cout << "\nwrote " << grid.dir << "/table1.json, table1.md, table1.png\n";
+  return 0;
+}
+
+void add_table1_command(CLI::App& app, int& exit_code) {
+  auto options = std::make_shared<Table1CommandOptions>();
+  experiments::Table1Options& t = options->table;
+  CLI::App* cmd = app.add_subcommand("table1", "the paper's Table 1: train and score every cell, print the table");
+  cmd->add_option("--demos", options->demos, "numbers of demos (nested: the first N of one demo file)")
+      ->capture_default_str();
+  cmd->add_option("--trials", t.eval.trials, "rollouts per cell and scene set")->capture_default_str();
+  cmd->add_option("--methods", options->methods, "hand_centric, relative, absolute, c8flow")->capture_default_str();
+  cmd->add_option("--heads", options->heads, "flow, ddpm, cvae (c8flow has its own)")->capture_default_str();
+  cmd->add_option("--seed", t.demo_seed, "seed of the demos")->capture_default_str();
+  cmd->add_option("--train-seeds", options->train_seeds, "training seeds, one row each")->capture_default_str();
+  cmd->add_option("--eval-seed", t.eval.eval_seed, "seed of the train-distribution and paired OOD scenes")
+      ->capture_default_str();
+  cmd->add_option("--ood-seed", t.eval.ood_seed, "seed of the independent OOD scenes")->capture_default_str();
+  cmd->add_option("--steps", t.steps, "Adam steps per cell (0: the library's automatic budget)")->capture_default_str();
+  cmd->add_option("--jobs", t.jobs, "trainings at once (0: one per hardware thread)")->capture_default_str();
+  auto* out = cmd->add_option("--out", t.out, "output directory")->capture_default_str();
+  cmd->add_flag("--resume", t.resume, "reuse the models and results already in --out");
+  auto* plan = cmd->add_flag("--plan", options->plan, "write --out/jobs.txt (one shell line per cell) and stop");
+  auto* collect = cmd->add_option("--collect", options->collect, "build the table from the results in DIR");
+  cmd->add_flag("--quiet", t.quiet, "no progress display");
+  collect->excludes(plan);
+  collect->excludes(out);
+  cmd->callback([options, &exit_code] { exit_code = run_table1_command(*options); });
+}
+
+const CommandRegistration table1_command("table1", add_table1_command);
+
+}  // namespace
+}  // namespace handcentric::apps

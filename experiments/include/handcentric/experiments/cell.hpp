@@ -1,0 +1,60 @@
+#pragma once
+// One cell of Table 1: a method with a head, trained on the first `demos` demos with one
+// training seed, then scored on three scene sets. Its files are named by a hash of everything
+// that determines the trained model, so a rerun (--resume, or another machine running the plan)
+// finds finished work by name and redoes only what is missing.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "handcentric/policy/config.hpp"
+
+namespace handcentric::experiments {
+
+/// The three scene sets a cell is scored on.
+///   id     : train-distribution scenes of the evaluation seed;
+///   ood    : OOD (bottom-up) scenes of their own seed, independent of the id set;
+///   paired : OOD scenes of the evaluation seed: scene i is a global transform of id scene i
+///            with the same policy noise, so an SE(3)-equivariant policy scores exactly its id
+///            success there (the equivariance result, not a generalization estimate).
+enum class SceneSet { id, ood, paired };
+inline constexpr SceneSet kSceneSets[] = {SceneSet::id, SceneSet::ood, SceneSet::paired};
+std::string to_string(SceneSet set);
+
+struct EvalSettings {
+  int trials = 100;
+  std::uint64_t eval_seed = 100;  ///< id and paired scenes, and the policy noise there
+  std::uint64_t ood_seed = 101;   ///< the independent OOD scenes
+  /// The scene seed of `set` ("train" or "ood" distribution is implied by the set).
+  std::uint64_t seed(SceneSet set) const { return set == SceneSet::ood ? ood_seed : eval_seed; }
+};
+
+struct Cell {
+  std::string method;           ///< methods.hpp name
+  std::string head;             ///< flow, ddpm, cvae, c8flow
+  int demos = 0;                ///< the first `demos` demos of the demo file
+  std::uint64_t train_seed = 1;
+  policy::PolicyConfig config;  ///< representation, head and the resolved step budget set
+  std::string demo_digest;      ///< FNV-1a 64 (hex) of the demo file's bytes
+  std::string hash;             ///< cell_hash(*this), set by make_cell
+
+  /// "hand_centric/flow, 40 demos, train seed 1".
+  std::string describe() const;
+  std::string model_path() const;                                        ///< "models/<hash>.hcm"
+  std::string result_path(SceneSet set, const EvalSettings& eval) const;  ///< "results/<hash>.<set>-s<seed>-n<trials>.json"
+};
+
+/// FNV-1a 64 of `bytes`, as 16 hex digits.
+std::string digest(const std::string& bytes);
+
+/// The cell's hash: digest of a canonical text of its demo digest, demo count, training seed,
+/// the model file format and the full PolicyConfig (policy/config.hpp to_text).
+std::string cell_hash(const Cell& cell);
+
+/// A cell with its config from the library defaults (PolicyConfig{}), the method's
+/// representation and the head, and `steps` Adam steps (0: the automatic budget for
+/// `training_samples`, trainer.hpp training_budget); hash set.
+Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
+               std::uint64_t train_seed, long long training_samples, const std::string& demo_digest, int steps = 0);
+
+}  // namespace handcentric::experiments

@@ -1,0 +1,81 @@
+#pragma once
+// Table 1 (Sec. 4.2) end to end: nested demo sets made once, one cell per (method, head, demo
+// count, training seed), each trained and scored on three scene sets (cell.hpp), then the table,
+// its JSON and its figure. The same directory layout serves three ways of running:
+//   run_table1      : every cell in this process, on `jobs` threads (one training per thread);
+//   write_plan      : every unfinished cell as one shell line of `handcentric train` and
+//                     `handcentric eval` in DIR/jobs.txt, for GNU parallel or a Slurm array;
+//   collect_table1  : the table from whatever result files DIR holds.
+//
+//   DIR/demos-seed<S>.jsonl   the demos (the first N of them train an N-demo cell)
+//   DIR/cells.json            the grid and the evaluation settings (what collect reads)
+//   DIR/models/<hash>.hcm     trained models, named by cell_hash
+//   DIR/results/<hash>.<set>-s<seed>-n<trials>.json   `handcentric eval --json` of each set
+//   DIR/table1.json, table1.md, table1.png
+// Every file is written to a temporary file and renamed, so a killed run leaves no half file
+// and `resume` redoes only the missing models and results.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "handcentric/experiments/cell.hpp"
+#include "handcentric/experiments/methods.hpp"
+#include "handcentric/experiments/results.hpp"
+
+namespace handcentric::experiments {
+
+struct Table1Options {
+  std::vector<int> demo_counts = {kPaperDemoCounts.begin(), kPaperDemoCounts.end()};
+  std::vector<Method> methods = table1_methods();
+  std::vector<std::string> heads = {"flow"};
+  std::uint64_t demo_seed = 1;
+  std::vector<std::uint64_t> train_seeds = {1};
+  EvalSettings eval;
+  int steps = 0;  ///< Adam steps per cell; 0: the library's automatic budget (PolicyConfig)
+  int jobs = 0;  ///< trainings at once; 0: one per hardware thread
+  std::string out = "table1";
+  bool resume = false;
+  bool quiet = false;
+
+  /// Throws InvalidArgument naming the first bad value and the fix (a demo count outside
+  /// 1..1000 or repeated, steps < 0, no method, no training seed, trials < 1, jobs < 0, ood_seed equal to
+  /// eval_seed: the OOD set would be the paired one).
+  void validate() const;
+};
+
+/// Comma-separated positive integers ("5,10,20"); throws InvalidArgument naming `option` and
+/// the text.
+std::vector<int> parse_int_list(const std::string& text, const std::string& option);
+std::vector<std::uint64_t> parse_seed_list(const std::string& text, const std::string& option);
+
+struct Table1Grid {
+  std::string dir;        ///< options.out, absolute
+  std::string demo_file;  ///< relative to dir
+  std::vector<Cell> cells;
+};
+
+/// Creates DIR, its demos (or reuses them when present) and DIR/cells.json. Without
+/// options.resume a DIR that already holds cells.json is an error (pass --resume or another
+/// --out). Throws InvalidArgument when the expert leaves too few demos.
+Table1Grid prepare_table1(const Table1Options& options);
+
+/// Trains and scores every cell whose files are missing, options.jobs at a time, with a progress
+/// display on stderr. A failed cell stops the run (the running cells finish) and is rethrown
+/// naming the cell.
+void run_table1(const Table1Options& options, const Table1Grid& grid);
+
+/// Writes DIR/jobs.txt: one line per cell with a missing result, `cli` train (unless its model
+/// exists) then eval of each missing set, outputs renamed into place. Returns the line count.
+int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::string& cli);
+
+/// The rows from DIR/cells.json and whatever result files exist; writes DIR/table1.json,
+/// table1.md and table1.png; returns the markdown (our table beside the paper's). Throws
+/// InvalidArgument when DIR has no cells.json.
+std::string collect_table1(const std::string& dir);
+
+/// The markdown of `rows`: per method and head, the id success (mean over training seeds) at
+/// each demo count and the OOD success (independent, and paired) at each count, with the
+/// paper's row beside it.
+std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval, std::uint64_t demo_seed);
+
+}  // namespace handcentric::experiments

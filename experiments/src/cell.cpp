@@ -1,0 +1,66 @@
+#include "handcentric/experiments/cell.hpp"
+
+#include <cstdio>
+
+#include "handcentric/policy/model_file.hpp"
+#include "handcentric/policy/trainer.hpp"
+
+namespace handcentric::experiments {
+
+std::string to_string(SceneSet set) {
+  switch (set) {
+    case SceneSet::id: return "id";
+    case SceneSet::ood: return "ood";
+    case SceneSet::paired: return "paired";
+  }
+  return "?";
+}
+
+std::string Cell::describe() const {
+  return method + "/" + head + ", " + std::to_string(demos) + " demos, train seed " + std::to_string(train_seed);
+}
+
+std::string Cell::model_path() const { return "models/" + hash + ".hcm"; }
+
+std::string Cell::result_path(SceneSet set, const EvalSettings& eval) const {
+  return "results/" + hash + "." + to_string(set) + "-s" + std::to_string(eval.seed(set)) + "-n" +
+         std::to_string(eval.trials) + ".json";
+}
+
+std::string digest(const std::string& bytes) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const unsigned char c : bytes) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
+std::string cell_hash(const Cell& cell) {
+  const std::string text = "handcentric table1 cell\ndemo_digest=" + cell.demo_digest +
+                           "\ndemos=" + std::to_string(cell.demos) + "\ntrain_seed=" + std::to_string(cell.train_seed) +
+                           "\nmodel_format=" + std::to_string(policy::kModelFormatVersion) + "\n" +
+                           cell.config.to_text();
+  return digest(text);
+}
+
+Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
+               std::uint64_t train_seed, long long training_samples, const std::string& demo_digest, int steps) {
+  Cell cell;
+  cell.method = method;
+  cell.head = head;
+  cell.demos = demos;
+  cell.train_seed = train_seed;
+  cell.demo_digest = demo_digest;
+  cell.config.representation = representation;
+  cell.config.head = policy::parse_head(head);
+  if (steps > 0) cell.config.steps = steps;
+  if (cell.config.steps == 0) cell.config.steps = policy::training_budget(training_samples);
+  cell.config.validate();
+  cell.hash = cell_hash(cell);
+  return cell;
+}
+
+}  // namespace handcentric::experiments

@@ -1,0 +1,79 @@
+#include "handcentric/experiments/methods.hpp"
+
+#include <algorithm>
+#include <sstream>
+
+#include "handcentric/core/errors.hpp"
+
+namespace handcentric::experiments {
+namespace {
+
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> items;
+  std::stringstream in(list);
+  std::string item;
+  while (std::getline(in, item, ',')) items.push_back(item);
+  return items;
+}
+
+}  // namespace
+
+const std::vector<Method>& table1_methods() {
+  static const std::vector<Method> methods = {
+      {"hand_centric", "hand_centric", "", "Hand-Centric"},
+      {"relative", "relative", "", "Relative-Action"},
+      {"absolute", "absolute", "", "Absolute-Action"},
+      {"c8flow", "absolute", "c8flow", "C8-symmetrized flow (analogue of Equivariant-DiffPo [7])"},
+  };
+  return methods;
+}
+
+std::vector<Method> parse_methods(const std::string& list) {
+  std::vector<Method> chosen;
+  for (const std::string& name : split(list)) {
+    const auto& all = table1_methods();
+    const auto it = std::find_if(all.begin(), all.end(), [&](const Method& m) { return m.name == name; });
+    if (it == all.end()) {
+      throw InvalidArgument("--methods: unknown method '" + name + "': use hand_centric, relative, absolute, c8flow");
+    }
+    if (std::any_of(chosen.begin(), chosen.end(), [&](const Method& m) { return m.name == name; })) {
+      throw InvalidArgument("--methods: '" + name + "' is listed twice: name each method once");
+    }
+    chosen.push_back(*it);
+  }
+  if (chosen.empty()) throw InvalidArgument("--methods is empty: name at least one of hand_centric, relative, absolute, c8flow");
+  return chosen;
+}
+
+std::vector<std::string> parse_heads(const std::string& list) {
+  std::vector<std::string> heads;
+  for (const std::string& head : split(list)) {
+    if (head != "flow" && head != "ddpm" && head != "cvae") {
+      throw InvalidArgument("--heads: unknown head '" + head + "': use flow, ddpm, cvae");
+    }
+    if (std::find(heads.begin(), heads.end(), head) != heads.end()) {
+      throw InvalidArgument("--heads: '" + head + "' is listed twice: name each head once");
+    }
+    heads.push_back(head);
+  }
+  if (heads.empty()) throw InvalidArgument("--heads is empty: name at least one of flow, ddpm, cvae");
+  return heads;
+}
+
+std::optional<PaperRow> paper_row(const std::string& method, const std::string& head) {
+  if (method == "hand_centric" && head == "flow") {
+    return PaperRow{"Hand-Centric-Flow", {0.01, 0.25, 0.56, 0.79, 0.90, 0.94, 0.98}, 0.96};
+  }
+  if (method == "relative" && head == "flow") {
+    return PaperRow{"Relative-Action-Flow", {0.00, 0.00, 0.05, 0.16, 0.42, 0.48, 0.58}, 0.01};
+  }
+  if (method == "absolute" && head == "flow") {
+    return PaperRow{"Absolute-Action-Flow", {0.00, 0.00, 0.01, 0.06, 0.08, 0.12, 0.14}, 0.02};
+  }
+  if (method == "c8flow") {
+    return PaperRow{"Equivariant-DiffPo [7]", {0.00, 0.01, 0.03, 0.07, 0.12, 0.18, 0.27}, 0.12};
+  }
+  return std::nullopt;
+}
+
+}  // namespace handcentric::experiments

@@ -1,0 +1,412 @@
+#include "handcentric/experiments/table1.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <thread>
+
+#include "handcentric/core/atomic_file.hpp"
+#include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/plot.hpp"
+#include "handcentric/experiments/progress.hpp"
+#include "handcentric/policy/model_file.hpp"
+#include "handcentric/policy/trainer.hpp"
+#include "handcentric/sim/collision.hpp"
+#include "handcentric/sim/demos.hpp"
+#include "handcentric/sim/expert.hpp"
+#include "handcentric/sim/rollout.hpp"
+#include "handcentric/sim/scenes.hpp"
+
+namespace handcentric::experiments {
+namespace fs = std::filesystem;
+namespace {
+
+std::vector<std::string> split(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) items.push_back(item);
+  return items;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError("cannot open '" + path.string() + "': check the path");
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// A rollout costs about as much as this many training steps (measured: 300 rollouts in ~3 s,
+// 1000 steps of a 256-wide network in ~3 s on one core); only the ETA uses it.
+constexpr double kStepsPerRollout = 10.0;
+
+double cell_work(const Cell& cell, const EvalSettings& eval) {
+  return cell.config.steps + 3.0 * eval.trials * kStepsPerRollout;
+}
+
+sim::SceneDistribution distribution_of(SceneSet set) {
+  return set == SceneSet::id ? sim::SceneDistribution::train() : sim::SceneDistribution::ood();
+}
+
+bool cell_done(const Cell& cell, const EvalSettings& eval, const fs::path& dir) {
+  for (const SceneSet set : kSceneSets) {
+    if (!fs::exists(dir / cell.result_path(set, eval))) return false;
+  }
+  return true;
+}
+
+// Trains (or loads) the cell's model and writes each missing result file.
+void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir, const std::vector<sim::Demo>& demos) {
+  const fs::path model_path = dir / cell.model_path();
+  const policy::LearnedPolicy trained = [&] {
+    if (fs::exists(model_path)) return policy::load_model(model_path.string());
+    const auto scenes =
+        sim::training_scenes(demos, cell.config.history_length, cell.config.chunk_length, cell.demos);
+    policy::LearnedPolicy model = policy::train_policy(cell.config, scenes, cell.train_seed);
+    policy::save_model(model, model_path.string());
+    return model;
+  }();
+  const sim::RolloutOptions rollout_options =
+      sim::RolloutOptions::for_policy(trained.config().history_length, trained.config().execute);
+  const sim::CollisionChecker checker;  // one per thread: it counts its queries
+  for (const SceneSet set : kSceneSets) {
+    const fs::path result = dir / cell.result_path(set, eval);
+    if (fs::exists(result)) continue;
+    const sim::SceneDistribution distribution = distribution_of(set);
+    const std::uint64_t seed = eval.seed(set);
+    const auto scenes = sim::sample_scenes(distribution, eval.trials, seed);
+    const sim::RolloutSummary summary = sim::evaluate(trained, scenes, checker, seed, rollout_options);
+    write_file_atomically(result.string(), eval_json(summary, trained.name(), distribution.name, seed) + "\n");
+  }
+}
+
+std::string shell_quote(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval, std::uint64_t demo_seed) {
+  nlohmann::json cells = nlohmann::json::array();
+  for (const Cell& c : grid.cells) {
+    cells.push_back({{"method", c.method},
+                     {"head", c.head},
+                     {"representation", c.config.representation},
+                     {"demos", c.demos},
+                     {"train_seed", c.train_seed},
+                     {"steps", c.config.steps},
+                     {"hash", c.hash}});
+  }
+  return {{"format", "handcentric-table1-cells"},
+          {"version", 1},
+          {"demo_file", grid.demo_file},
+          {"demo_seed", demo_seed},
+          {"eval", {{"trials", eval.trials}, {"eval_seed", eval.eval_seed}, {"ood_seed", eval.ood_seed}}},
+          {"cells", cells}};
+}
+
+// " value |": appends only (GCC 12 warns, falsely, on `" " + std::string&&`, -Wrestrict).
+std::string cell_text(const std::string& value) {
+  std::string text = " ";
+  text += value;
+  text += " |";
+  return text;
+}
+
+std::string rate(const std::optional<double>& value) {
+  if (!value) return "-";
+  char text[16];
+  std::snprintf(text, sizeof text, "%.2f", *value);
+  return text;
+}
+
+}  // namespace
+
+void Table1Options::validate() const {
+  if (demo_counts.empty()) throw InvalidArgument("--demos is empty: give numbers of demos, e.g. 5,10,100");
+  std::set<int> seen;
+  for (const int n : demo_counts) {
+    if (n < 1 || n > 1000) throw InvalidArgument("--demos: " + std::to_string(n) + " is outside 1..1000");
+    if (!seen.insert(n).second) throw InvalidArgument("--demos: " + std::to_string(n) + " is listed twice");
+  }
+  if (steps < 0) throw InvalidArgument("--steps must be >= 0 (0: the automatic budget), got " + std::to_string(steps));
+  if (methods.empty()) throw InvalidArgument("--methods is empty: name at least one method");
+  if (heads.empty()) throw InvalidArgument("--heads is empty: name at least one head");
+  if (train_seeds.empty()) throw InvalidArgument("--train-seeds is empty: give at least one seed");
+  if (eval.trials < 1) throw InvalidArgument("--trials must be at least 1, got " + std::to_string(eval.trials));
+  if (jobs < 0) throw InvalidArgument("--jobs must be >= 0 (0: one per hardware thread), got " + std::to_string(jobs));
+  if (eval.ood_seed == eval.eval_seed) {
+    throw InvalidArgument("--ood-seed " + std::to_string(eval.ood_seed) +
+                          " equals --eval-seed: the independent OOD scenes would be the paired ones; choose another");
+  }
+}
+
+std::vector<int> parse_int_list(const std::string& text, const std::string& option) {
+  std::vector<int> values;
+  for (const std::string& item : split(text)) {
+    std::size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || value < 1) {
+      throw InvalidArgument(option + " '" + text + "': '" + item + "' is not a positive integer; give e.g. 5,10,100");
+    }
+    values.push_back(value);
+  }
+  if (values.empty()) throw InvalidArgument(option + " is empty: give e.g. 5,10,100");
+  return values;
+}
+
+std::vector<std::uint64_t> parse_seed_list(const std::string& text, const std::string& option) {
+  std::vector<std::uint64_t> values;
+  for (const std::string& item : split(text)) {
+    std::size_t used = 0;
+    unsigned long long value = 0;
+    try {
+      value = std::stoull(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size() || item.front() == '-') {
+      throw InvalidArgument(option + " '" + text + "': '" + item + "' is not a non-negative integer; give e.g. 1,2,3");
+    }
+    values.push_back(value);
+  }
+  if (values.empty()) throw InvalidArgument(option + " is empty: give e.g. 1,2,3");
+  return values;
+}
+
+Table1Grid prepare_table1(const Table1Options& options) {
+  options.validate();
+  Table1Grid grid;
+  const fs::path dir = fs::absolute(options.out);
+  grid.dir = dir.string();
+  if (fs::exists(dir / "cells.json") && !options.resume) {
+    throw InvalidArgument("--out '" + options.out +
+                          "' already holds a Table 1 run (cells.json): pass --resume to finish it, or choose another --out");
+  }
+  std::error_code error;
+  fs::create_directories(dir / "models", error);
+  fs::create_directories(dir / "results", error);
+  if (error || !fs::is_directory(dir / "results")) {
+    throw FileError("cannot create the directory '" + dir.string() + "' (" + error.message() + "): check --out");
+  }
+  const int largest = *std::max_element(options.demo_counts.begin(), options.demo_counts.end());
+  grid.demo_file = "demos-seed" + std::to_string(options.demo_seed) + "-n" + std::to_string(largest) + ".jsonl";
+  const fs::path demo_path = dir / grid.demo_file;
+  if (!fs::exists(demo_path)) {
+    const sim::CollisionChecker checker;
+    const auto scenes = sim::sample_scenes(sim::SceneDistribution::train(), largest, options.demo_seed);
+    const sim::ExpertRun run = sim::expert_demos(scenes, options.demo_seed, checker);
+    if (static_cast<int>(run.demos.size()) < largest) {
+      throw InvalidArgument("the expert solved " + std::to_string(run.demos.size()) + " of " +
+                            std::to_string(largest) + " scenes of demo seed " + std::to_string(options.demo_seed) +
+                            ": choose another --seed");
+    }
+    sim::save_demos(demo_path.string(), run.demos, checker.geometry());
+  }
+  const std::string demo_bytes = read_text(demo_path);
+  const std::string demo_digest = digest(demo_bytes);
+  const std::vector<sim::Demo> demos = sim::load_demos(demo_path.string());
+  std::vector<long long> samples_upto(demos.size() + 1, 0);  // training samples of the first n demos
+  for (std::size_t i = 0; i < demos.size(); ++i) {
+    samples_upto[i + 1] = samples_upto[i] + static_cast<long long>(demos[i].world_T_hand.size());
+  }
+  for (const Method& method : options.methods) {
+    const std::vector<std::string> heads =
+        method.fixed_head.empty() ? options.heads : std::vector<std::string>{method.fixed_head};
+    for (const std::string& head : heads) {
+      for (const std::uint64_t seed : options.train_seeds) {
+        for (const int n : options.demo_counts) {
+          grid.cells.push_back(make_cell(method.name, method.representation, head, n, seed,
+                                         samples_upto[static_cast<std::size_t>(n)], demo_digest, options.steps));
+        }
+      }
+    }
+  }
+  write_file_atomically((dir / "cells.json").string(),
+                        cells_json(grid, options.eval, options.demo_seed).dump(2) + "\n");
+  return grid;
+}
+
+void run_table1(const Table1Options& options, const Table1Grid& grid) {
+  const fs::path dir = grid.dir;
+  const std::vector<sim::Demo> demos = sim::load_demos((dir / grid.demo_file).string());
+  // Largest cells first, so the last ones to finish are short and both cores stay busy.
+  std::vector<const Cell*> order;
+  double total_work = 0.0;
+  for (const Cell& cell : grid.cells) {
+    order.push_back(&cell);
+    total_work += cell_work(cell, options.eval);
+  }
+  std::stable_sort(order.begin(), order.end(),
+                   [](const Cell* a, const Cell* b) { return a->config.steps > b->config.steps; });
+  const int jobs = options.jobs > 0 ? options.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  Progress progress(static_cast<int>(order.size()), total_work, stderr, options.quiet);
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  std::mutex error_mutex;
+  std::string error;
+  const auto worker = [&](int id) {
+    while (!failed) {
+      const std::size_t i = next++;
+      if (i >= order.size()) return;
+      const Cell& cell = *order[i];
+      progress.start(id, cell.describe());
+      const bool skipped = cell_done(cell, options.eval, dir);
+      try {
+        if (!skipped) run_cell(cell, options.eval, dir, demos);
+      } catch (const std::exception& e) {
+        const std::lock_guard lock(error_mutex);
+        if (!failed.exchange(true)) error = "Table 1 cell " + cell.describe() + " failed: " + e.what();
+        return;
+      }
+      progress.finish(id, cell_work(cell, options.eval), skipped);
+    }
+  };
+  std::vector<std::thread> threads;
+  for (int id = 0; id < std::min<int>(jobs, static_cast<int>(order.size())); ++id) threads.emplace_back(worker, id);
+  for (std::thread& thread : threads) thread.join();
+  if (failed) throw Error(error + " (finished cells are kept: rerun with --resume)");
+}
+
+int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::string& cli) {
+  const fs::path dir = grid.dir;
+  std::string lines;
+  int count = 0;
+  for (const Cell& cell : grid.cells) {
+    if (cell_done(cell, eval, dir)) continue;
+    std::string line = "cd " + shell_quote(grid.dir) + " && { test -f " + cell.model_path() + " || " +
+                       shell_quote(cli) + " train --demos " + grid.demo_file + " --max-demos " +
+                       std::to_string(cell.demos) + " --repr " + cell.config.representation + " --head " + cell.head +
+                       " --steps " + std::to_string(cell.config.steps) + " --seed " + std::to_string(cell.train_seed) +
+                       " --quiet --out " + cell.model_path() + " >/dev/null; }";
+    for (const SceneSet set : kSceneSets) {
+      const std::string result = cell.result_path(set, eval);
+      line += " && { test -f " + result + " || { " + shell_quote(cli) + " eval --model " + cell.model_path() +
+              " --dist " + (set == SceneSet::id ? "train" : "ood") + " --trials " + std::to_string(eval.trials) +
+              " --seed " + std::to_string(eval.seed(set)) + " --json > " + result + ".tmp && mv " + result + ".tmp " +
+              result + "; }; }";
+    }
+    lines += line + "\n";
+    ++count;
+  }
+  write_file_atomically((dir / "jobs.txt").string(), lines);
+  return count;
+}
+
+std::string collect_table1(const std::string& dir_text) {
+  const fs::path dir = fs::absolute(dir_text);
+  const fs::path cells_path = dir / "cells.json";
+  if (!fs::exists(cells_path)) {
+    throw InvalidArgument("'" + dir_text + "' holds no cells.json: give the --out of a `handcentric table1` or --plan run");
+  }
+  EvalSettings eval;
+  std::uint64_t demo_seed = 0;
+  std::vector<Row> rows;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(read_text(cells_path));
+    eval.trials = j.at("eval").at("trials").get<int>();
+    eval.eval_seed = j.at("eval").at("eval_seed").get<std::uint64_t>();
+    eval.ood_seed = j.at("eval").at("ood_seed").get<std::uint64_t>();
+    demo_seed = j.at("demo_seed").get<std::uint64_t>();
+    for (const auto& c : j.at("cells")) {
+      Cell cell;
+      cell.method = c.at("method").get<std::string>();
+      cell.head = c.at("head").get<std::string>();
+      cell.demos = c.at("demos").get<int>();
+      cell.train_seed = c.at("train_seed").get<std::uint64_t>();
+      cell.config.steps = c.at("steps").get<int>();
+      cell.hash = c.at("hash").get<std::string>();
+      rows.push_back(collect_row(cell, eval, dir.string()));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InvalidArgument("'" + cells_path.string() + "' is damaged (" + e.what() + "): run --plan or table1 again");
+  }
+  const std::string markdown = table1_markdown(rows, eval, demo_seed);
+  write_file_atomically((dir / "table1.json").string(), rows_json(rows));
+  write_file_atomically((dir / "table1.md").string(), markdown);
+  write_table1_png((dir / "table1.png").string(), rows);
+  return markdown;
+}
+
+std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval, std::uint64_t demo_seed) {
+  std::vector<int> counts;
+  std::vector<std::pair<std::string, std::string>> series;  // (method, head) in row order
+  std::set<std::uint64_t> seeds;
+  for (const Row& r : rows) {
+    if (std::find(counts.begin(), counts.end(), r.demos) == counts.end()) counts.push_back(r.demos);
+    if (std::find(series.begin(), series.end(), std::make_pair(r.method, r.head)) == series.end()) {
+      series.emplace_back(r.method, r.head);
+    }
+    seeds.insert(r.train_seed);
+  }
+  std::sort(counts.begin(), counts.end());
+  // Mean over the training seeds that have the value.
+  const auto mean = [&](const std::string& m, const std::string& h, int n, auto field) -> std::optional<double> {
+    double sum = 0.0;
+    int k = 0;
+    for (const Row& r : rows) {
+      const std::optional<double> v = r.*field;
+      if (r.method == m && r.head == h && r.demos == n && v) {
+        sum += *v;
+        ++k;
+      }
+    }
+    return k == 0 ? std::nullopt : std::optional<double>(sum / k);
+  };
+  std::string header = "| policy | scenes |";
+  std::string rule = "|---|---|";
+  for (const int n : counts) {
+    header += cell_text(std::to_string(n));
+    rule += "---|";
+  }
+  std::string text = "# Table 1 on this library\n\n";
+  char line[512];
+  std::snprintf(line, sizeof line,
+                "Success over %d closed-loop rollouts per cell (mean over %zu training seed%s). Scenes: `id` = "
+                "train distribution, eval seed %llu; `ood` = bottom-up holes, their own seed %llu; `ood paired` = "
+                "the global transforms of the id scenes (same seed, same noise: equal to id exactly when the policy "
+                "is equivariant). Demos: the first N of `demos --n 100 --dist train --seed %llu`.\n\n",
+                eval.trials, seeds.size(), seeds.size() == 1 ? "" : "s",
+                static_cast<unsigned long long>(eval.eval_seed), static_cast<unsigned long long>(eval.ood_seed),
+                static_cast<unsigned long long>(demo_seed));
+  text += line;
+  text += header + "\n" + rule + "\n";
+  for (const auto& [m, h] : series) {
+    const auto paper = paper_row(m, h);
+    const std::string label = m + "/" + h;
+    std::string id = "| " + label + " | id |", ood = "| " + label + " | ood |", paired = "| " + label + " | ood paired |";
+    std::string paper_line = "| " + (paper ? paper->label : std::string("-")) + " (paper) | id |";
+    for (const int n : counts) {
+      id += cell_text(rate(mean(m, h, n, &Row::id_success)));
+      ood += cell_text(rate(mean(m, h, n, &Row::ood_success)));
+      paired += cell_text(rate(mean(m, h, n, &Row::ood_paired_success)));
+      const auto* at = std::find(kPaperDemoCounts.begin(), kPaperDemoCounts.end(), n);
+      paper_line += cell_text(paper && at != kPaperDemoCounts.end()
+                                  ? rate(paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())])
+                                  : std::string("-"));
+    }
+    text += id + "\n" + ood + "\n" + paired + "\n";
+    if (paper) {
+      std::string paper_ood = "| " + paper->label + " (paper) | ood |";
+      for (const int n : counts) paper_ood += cell_text(n == 100 ? rate(paper->ood_at_100) : std::string("-"));
+      text += paper_line + "\n" + paper_ood + "\n";
+    }
+  }
+  return text;
+}
+
+}  // namespace handcentric::experiments

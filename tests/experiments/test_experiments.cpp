@@ -1,0 +1,180 @@
+// The experiments library: Wilson intervals, cell hashes, the grid's options, result files,
+// the table's markdown and figure. The end-to-end runs (in process, plan + GNU parallel +
+// collect, resume) are CLI tests in CMakeLists.txt.
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/cell.hpp"
+#include "handcentric/experiments/methods.hpp"
+#include "handcentric/experiments/plot.hpp"
+#include "handcentric/experiments/results.hpp"
+#include "handcentric/experiments/table1.hpp"
+#include "handcentric/experiments/wilson.hpp"
+#include "handcentric/policy/trainer.hpp"
+#include "throws.hpp"
+
+using namespace handcentric;
+using namespace handcentric::experiments;
+using Catch::Matchers::Contains;
+
+TEST_CASE("wilson_intervals_match_published_values_and_stay_in_0_1", "[unit]") {
+  // Reference values: Newcombe (1998), Table I (Wilson score, no continuity correction).
+  const Interval a = wilson_interval(81, 263);
+  CHECK(a.lo == Approx(0.2553).margin(5e-4));
+  CHECK(a.hi == Approx(0.3662).margin(5e-4));
+  const Interval b = wilson_interval(15, 148);
+  CHECK(b.lo == Approx(0.0624).margin(5e-4));
+  CHECK(b.hi == Approx(0.1605).margin(5e-4));
+  // At 0 and n successes a Wald interval collapses to a point; Wilson's does not.
+  const Interval zero = wilson_interval(0, 100);
+  CHECK(zero.lo == 0.0);
+  CHECK(zero.hi == Approx(0.0370).margin(5e-4));
+  const Interval all = wilson_interval(100, 100);
+  CHECK(all.hi == 1.0);
+  CHECK(all.lo == Approx(0.9630).margin(5e-4));
+  HC_CHECK_THROWS(wilson_interval(3, 2), InvalidArgument, Contains("3 successes in 2 trials"));
+  HC_CHECK_THROWS(wilson_interval(0, 0), InvalidArgument, Contains("trials >= 1"));
+}
+
+TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them", "[unit]") {
+  const Cell base = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff");
+  CHECK(base.hash == make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff").hash);
+  CHECK(base.hash.size() == 16);
+  CHECK(base.config.steps == policy::training_budget(320));  // the library's automatic budget
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 20, 1, 320, "00ff").hash);
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 2, 320, "00ff").hash);
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00fe").hash);
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "ddpm", 10, 1, 320, "00ff").hash);
+  CHECK(base.hash != make_cell("relative", "relative", "flow", 10, 1, 320, "00ff").hash);
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 77).hash);
+  // The method's name is a label; two methods with one representation and head share models.
+  CHECK(base.hash == make_cell("renamed", "hand_centric", "flow", 10, 1, 320, "00ff").hash);
+  // Any config field changes it (the whole PolicyConfig text is hashed).
+  Cell wider = base;
+  wider.config.hidden_width = 128;
+  CHECK(cell_hash(wider) != base.hash);
+  CHECK(base.model_path() == "models/" + base.hash + ".hcm");
+  const EvalSettings eval;
+  CHECK(base.result_path(SceneSet::ood, eval) == "results/" + base.hash + ".ood-s101-n100.json");
+  CHECK(base.result_path(SceneSet::paired, eval) == "results/" + base.hash + ".paired-s100-n100.json");
+}
+
+TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
+  HC_CHECK_THROWS(parse_int_list("5,x,10", "--demos"), InvalidArgument, Contains("'x'") && Contains("--demos"));
+  HC_CHECK_THROWS(parse_int_list("5,-1", "--demos"), InvalidArgument, Contains("'-1'"));
+  HC_CHECK_THROWS(parse_int_list("", "--demos"), InvalidArgument, Contains("empty"));
+  CHECK(parse_int_list("5,10,100", "--demos") == std::vector<int>{5, 10, 100});
+  HC_CHECK_THROWS(parse_seed_list("1,-2", "--train-seeds"), InvalidArgument, Contains("'-2'"));
+  HC_CHECK_THROWS(parse_methods("hand_centric,diffusion"), InvalidArgument, Contains("'diffusion'"));
+  HC_CHECK_THROWS(parse_methods("absolute,absolute"), InvalidArgument, Contains("twice"));
+  HC_CHECK_THROWS(parse_heads("flow,gan"), InvalidArgument, Contains("'gan'"));
+  Table1Options options;
+  options.validate();
+  options.eval.ood_seed = options.eval.eval_seed;
+  HC_CHECK_THROWS(options.validate(), InvalidArgument, Contains("--ood-seed") && Contains("paired"));
+  options = Table1Options();
+  options.demo_counts = {5, 5};
+  HC_CHECK_THROWS(options.validate(), InvalidArgument, Contains("5 is listed twice"));
+  options = Table1Options();
+  options.eval.trials = 0;
+  HC_CHECK_THROWS(options.validate(), InvalidArgument, Contains("--trials"));
+}
+
+TEST_CASE("eval_json_round_trips_its_counts_and_rejects_foreign_files", "[unit]") {
+  sim::RolloutSummary summary;
+  summary.trials = 7;
+  summary.success = 3;
+  summary.collision = 4;
+  summary.clipped = 11;
+  const sim::RolloutSummary back = parse_eval_json(eval_json(summary, "flow/hand_centric", "ood", 5), "x.json");
+  CHECK(back.trials == 7);
+  CHECK(back.success == 3);
+  CHECK(back.collision == 4);
+  CHECK(back.timeout == 0);
+  CHECK(back.clipped == 11);
+  HC_CHECK_THROWS(parse_eval_json("{\"trials\": 7", "cut.json"), InvalidArgument, Contains("cut.json"));
+  HC_CHECK_THROWS(parse_eval_json("{\"trials\": 7, \"success\": 1.5, \"collision\": 0, \"timeout\": 0, \"clipped\": 0}",
+                                  "rate.json"),
+                  InvalidArgument, Contains("rate.json") && Contains("success"));
+}
+
+namespace {
+
+Row row(const std::string& method, int demos, double id, double ood) {
+  Row r;
+  r.method = method;
+  r.head = method == "c8flow" ? "c8flow" : "flow";
+  r.demos = demos;
+  r.trials = 100;
+  r.train_seed = 1;
+  r.id_success = id;
+  r.ood_success = ood;
+  r.ood_paired_success = id;
+  r.id_ci = wilson_interval(static_cast<int>(id * 100 + 0.5), 100);
+  r.ood_ci = wilson_interval(static_cast<int>(ood * 100 + 0.5), 100);
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
+  const std::vector<Row> rows = {row("hand_centric", 10, 0.5, 0.48), row("hand_centric", 100, 0.97, 0.95),
+                                 row("absolute", 10, 0.0, 0.0), row("absolute", 100, 0.12, 0.01)};
+  const std::string md = table1_markdown(rows, EvalSettings(), 1);
+  CHECK_THAT(md, Contains("| policy | scenes | 10 | 100 |"));
+  CHECK_THAT(md, Contains("| hand_centric/flow | id | 0.50 | 0.97 |"));
+  CHECK_THAT(md, Contains("| hand_centric/flow | ood | 0.48 | 0.95 |"));
+  CHECK_THAT(md, Contains("| Hand-Centric-Flow (paper) | id | 0.25 | 0.98 |"));
+  CHECK_THAT(md, Contains("| Hand-Centric-Flow (paper) | ood | - | 0.96 |"));
+  CHECK_THAT(md, Contains("| Absolute-Action-Flow (paper) | id | 0.00 | 0.14 |"));
+  // A missing result is a dash, not a zero.
+  Row partial = row("relative", 10, 0.1, 0.0);
+  partial.ood_success.reset();
+  CHECK_THAT(table1_markdown({partial}, EvalSettings(), 1), Contains("| relative/flow | ood | - |"));
+}
+
+TEST_CASE("the_figure_draws_one_colour_per_method_with_id_dots_and_ood_squares", "[unit]") {
+  const std::vector<Row> rows = {row("hand_centric", 10, 0.5, 0.48), row("hand_centric", 100, 0.97, 0.95),
+                                 row("absolute", 10, 0.0, 0.0), row("absolute", 100, 0.12, 0.01)};
+  const sim::Image image = draw_table1(rows);
+  CHECK(image.width == 960);
+  CHECK(image.height == 600);
+  // Okabe-Ito blue (hand_centric) and vermillion (absolute) are both drawn.
+  CHECK(image.count_pixels(0, 114, 178, 10) > 200);
+  CHECK(image.count_pixels(213, 94, 0, 10) > 200);
+  HC_CHECK_THROWS(draw_table1({}), InvalidArgument, Contains("no rows"));
+}
+
+TEST_CASE("collect_builds_the_table_from_whatever_results_exist", "[unit]") {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("handcentric_test_collect_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  HC_CHECK_THROWS(collect_table1(dir.string()), InvalidArgument, Contains("no cells.json"));
+  std::filesystem::create_directories(dir / "results");
+  const Cell cell = make_cell("hand_centric", "hand_centric", "flow", 5, 1, 100, "aa");
+  const EvalSettings eval;
+  std::ofstream(dir / "cells.json")
+      << R"({"format": "handcentric-table1-cells", "version": 1, "demo_file": "d.jsonl", "demo_seed": 1,
+             "eval": {"trials": 100, "eval_seed": 100, "ood_seed": 101},
+             "cells": [{"method": "hand_centric", "head": "flow", "representation": "hand_centric", "demos": 5,
+                        "train_seed": 1, "steps": )"
+      << cell.config.steps << R"(, "hash": ")" << cell.hash << "\"}]}";
+  sim::RolloutSummary summary;
+  summary.trials = 100;
+  summary.success = 40;
+  summary.collision = 60;
+  std::ofstream(dir / cell.result_path(SceneSet::id, eval)) << eval_json(summary, "flow/hand_centric", "train", 100);
+  const std::string md = collect_table1(dir.string());
+  CHECK_THAT(md, Contains("| hand_centric/flow | id | 0.40 |"));
+  CHECK_THAT(md, Contains("| hand_centric/flow | ood | - |"));
+  std::ifstream json(dir / "table1.json");
+  const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
+  CHECK_THAT(text, Contains("\"id_success\": 0.4"));
+  CHECK_THAT(text, Contains("\"ood_success\": null"));
+  CHECK(std::filesystem::exists(dir / "table1.png"));
+  std::filesystem::remove_all(dir);
+}
