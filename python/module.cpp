@@ -469,11 +469,11 @@ std::string describe(const props::Verdict& v, const std::string& name, bool poli
   std::ostringstream out;
   out << name << ": " << (policy ? "not equivariant" : to_string(v.component) + " not invariant") << " under "
       << props::to_string(v.group) << " (" << props::to_string(v.mode) << ", " << props::to_string(v.view)
-      << ", " << props::to_string(v.method) << "); largest error " << v.max_error << " over " << v.cases
-      << " cases, seed " << v.seed << ", tolerance " << v.relative_tolerance << " (1 + L)\n";
+      << ", " << props::to_string(v.method) << "); largest error " << v.max_error << ", failed on far case "
+      << v.cases << ", seed " << v.seed << ", tolerance " << v.relative_tolerance << " (1 + L)\n";
   if (!v.note.empty()) out << "  note: " << v.note << "\n";
   if (v.witness) {
-    out << "  shrunk witness (g and the scene are world_T_hand, row-major; before/after = "
+    out << "  shrunk witness (poses as rotation vector r and translation p; before/after = "
         << (policy ? "g a(o) and a(g o), each pose [p, r(R)]" : "f(s) and f(g s)") << "):\n";
     std::istringstream lines(props::format_witness(*v.witness));
     for (std::string line; std::getline(lines, line);) out << "    " << line << "\n";
