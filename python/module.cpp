@@ -510,8 +510,8 @@ props::Component component_of(const std::string& name) {
 // ---------------------------------------------------------------------------------------------
 // The module's functions
 
-py::dict audit(py::object actions, py::object observation, py::object decode, py::handle groups, py::handle views,
-               int cases, std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
+py::dict audit(py::object actions, py::object observation, py::handle groups, py::handle views, int cases,
+               std::uint64_t seed, std::optional<double> tolerance, const std::string& precision, py::object decode,
                py::handle extra_poses, py::handle scalars) {
   if (!PyCallable_Check(actions.ptr())) throw DtypeError("actions must be callable, got a " + type_name(actions));
   const CommonOptions o = common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
@@ -649,10 +649,10 @@ PYBIND11_MODULE(handcentric, m) {
   m.attr("VIEWS") = both_views;
   m.attr("REPRESENTATIONS") = py::cast(builtin_representation_names());
 
-  m.def("audit", &audit, py::arg("actions"), py::arg("observation") = py::none(), py::kw_only(),
-        py::arg("decode") = py::none(), py::arg("groups") = all_groups, py::arg("views") = both_views,
-        py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1, py::arg("tolerance") = py::none(),
-        py::arg("precision") = "float64", py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
+  m.def("audit", &audit, py::arg("actions"), py::arg("observation") = py::none(), py::arg("groups") = all_groups,
+        py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+        py::arg("tolerance") = py::none(), py::arg("precision") = "float64", py::kw_only(),
+        py::arg("decode") = py::none(), py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
         R"doc(Audit a representation written in Python; returns one representation of `handcentric audit --json`.
 
 actions(history, chunk, hand_points, world_points) -> 1-D array, with history (H+1, 4, 4) (index 0 = T_0,
@@ -662,10 +662,10 @@ world_points) -> 1-D array (optional). decode(actions, history, hand_points, wor
 (optional: lets the audit prove the map injective). The flow components are the rectified flow's (eq. 5).
 With extra_poses / scalars (names), every callable also gets extra_poses={name: (4, 4)}, scalars={name: x}.)doc");
 
-  m.def("audit_policy", &audit_policy, py::arg("policy"), py::kw_only(), py::arg("groups") = all_groups,
+  m.def("audit_policy", &audit_policy, py::arg("policy"), py::arg("groups") = all_groups,
         py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
         py::arg("tolerance") = py::none(), py::arg("precision") = "float64", py::arg("noise") = props::kPolicyNoise,
-        py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
+        py::kw_only(), py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
         R"doc(Audit a whole policy (eq. 4) pointwise and in distribution; returns one policy of `audit --json`.
 
 policy(history, hand_points, world_points, noise) -> (K, 4, 4), the world-frame chunk T_1..T_K; noise is a

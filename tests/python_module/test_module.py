@@ -286,3 +286,10 @@ def test_demo_files_load_as_numpy(tmp_path):
     np.testing.assert_array_equal(scenes["history"][0, 0], demos[0]["world_T_hand"][0])
     with pytest.raises(handcentric.Error, match="missing.jsonl"):
         handcentric.load_demos(str(tmp_path / "missing.jsonl"))
+
+
+def test_options_may_be_given_by_position_as_documented():
+    result = handcentric.audit(policies.hand_centric_actions, None, "se3", "eye_in_hand", 20, 2)
+    assert result["checks"][0]["seed"] == 2 and {c["group"] for c in result["checks"]} == {"se3"}
+    policy = handcentric.audit_policy(make_policy(), "c8", "third_person", 20, 3, None, "float32", 64)
+    assert {(c["group"], c["view"]) for c in policy["checks"]} == {("c8", "third_person")}
