@@ -514,6 +514,11 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
                std::uint64_t seed, std::optional<double> tolerance, const std::string& precision, py::object decode,
                py::handle extra_poses, py::handle scalars) {
   if (!PyCallable_Check(actions.ptr())) throw DtypeError("actions must be callable, got a " + type_name(actions));
+  for (const auto& [what, fn] : {std::pair<const char*, py::handle>{"observation", observation}, {"decode", decode}}) {
+    if (!fn.is_none() && !PyCallable_Check(fn.ptr())) {
+      throw DtypeError(std::string(what) + " must be callable or None, got a " + type_name(fn));
+    }
+  }
   const CommonOptions o = common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
   auto representation = std::make_shared<PythonRepresentation>(actions, observation, decode, extras);

@@ -220,6 +220,8 @@ def test_wrong_dtypes_and_non_numbers_are_type_errors():
 
     with pytest.raises(TypeError, match="callable"):
         handcentric.audit_policy("not a function")
+    with pytest.raises(TypeError, match="observation must be callable or None, got a ndarray"):
+        handcentric.audit(policies.hand_centric_actions, np.zeros(3))
 
 
 def test_bad_options_name_the_value_and_the_choices():
