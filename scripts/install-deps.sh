@@ -10,6 +10,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libbenchmark-dev
   python3-numpy python3-pytest time
   parallel
+  python3-dev pybind11-dev python3-torch
 )
 
 missing=()
