@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Quick start, command 2: installs what is missing, builds (Release, every core), runs every
 # ctest suite, then installs the package into a staging prefix and builds and tests
-# examples/downstream against it with find_package(handcentric).
+# examples/downstream against it with find_package(handcentric); last, the sanitizer run
+# (scripts/sanitize.sh: a second tree with ASan + UBSan, labels unit, property, proofs).
+# SANITIZE=0 skips the sanitizer run (CI never does).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
@@ -21,3 +23,8 @@ cmake -S "$root/examples/downstream" -B "$build_dir/downstream" -DCMAKE_BUILD_TY
       -DCMAKE_PREFIX_PATH="$stage" >/dev/null
 cmake --build "$build_dir/downstream" -j "$jobs"
 (cd "$build_dir/downstream" && ctest --output-on-failure -j "$jobs")
+
+if [ "${SANITIZE:-1}" != 0 ]; then
+  echo "== sanitizers: AddressSanitizer + LeakSanitizer + UndefinedBehaviorSanitizer"
+  bash "$root/scripts/sanitize.sh"
+fi
