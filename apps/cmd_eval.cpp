@@ -1,5 +1,8 @@
 // `handcentric eval`: closed-loop rollouts (sim/rollout.hpp) of a policy on N seeded scenes of
-// the 2D insertion task, counted as success / collision / timeout (Sec. 4.2, Table 1).
+// the 2D insertion task, counted as success / collision / timeout (Sec. 4.2, Table 1), and
+// invalid: a trial whose policy returned a non-finite pose is a failure with its own count and a
+// one-line warning on stderr naming the first such scene, so one diverging scene does not throw
+// away a long evaluation; --strict stops at it with an error instead.
 // Policies: --policy expert|straight|hold (no file needed), or --model FILE: a trained model
 // (policy/model_file.hpp), when this build has the policy module.
 #include <cstdio>
@@ -30,6 +33,7 @@ struct EvalOptions {
   std::uint64_t seed = 1;
   std::string transform;
   bool json = false;
+  bool strict = false;
 };
 
 int run_eval(const EvalOptions& options) {
@@ -41,19 +45,27 @@ int run_eval(const EvalOptions& options) {
   auto scenes = sim::sample_scenes(distribution, options.trials, options.seed);
   if (!options.transform.empty()) scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
   const sim::CollisionChecker checker;
-  const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed, loaded.rollout_options);
+  sim::RolloutOptions rollout_options = loaded.rollout_options;
+  rollout_options.stop_on_invalid = options.strict;
+  const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed, rollout_options);
   const double n = summary.trials;
+  if (summary.invalid > 0) {
+    std::cerr << "handcentric: warning: " << summary.invalid << " of " << summary.trials
+              << " trials invalid (counted as failures): the first is scene " << summary.first_invalid_scene << ", "
+              << summary.first_invalid_reason << "; --strict stops at the first instead\n";
+  }
   if (options.json) {
     const nlohmann::json out = {{"trials", summary.trials},     {"success", summary.success / n},
                                 {"collision", summary.collision / n}, {"timeout", summary.timeout / n},
-                                {"clipped", summary.clipped},   {"policy", policy->name()},
-                                {"dist", distribution.name},    {"seed", options.seed}};
+                                {"invalid", summary.invalid},   {"clipped", summary.clipped},
+                                {"policy", policy->name()},     {"dist", distribution.name},
+                                {"seed", options.seed}};
     std::cout << out.dump() << "\n";
   } else {
     std::cout << "policy " << policy->name() << " on " << summary.trials << " '" << distribution.name
               << "' scenes (seed " << options.seed << "): success " << summary.success << ", collision "
-              << summary.collision << ", timeout " << summary.timeout << "; " << summary.clipped
-              << " commands clipped to the step limits\n";
+              << summary.collision << ", timeout " << summary.timeout << ", invalid " << summary.invalid << "; "
+              << summary.clipped << " commands clipped to the step limits\n";
   }
   return 0;
 }
@@ -75,7 +87,10 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--transform", options->transform,
                   "apply the global planar transform DEG,X,Y (degrees about z, then cm) to every scene");
   cmd->add_option("--seed", options->seed, "seed of the scenes and of the policy's noise")->capture_default_str();
-  cmd->add_flag("--json", options->json, "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, ...}");
+  cmd->add_flag("--json", options->json,
+                "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, \"invalid\": count, ...}");
+  cmd->add_flag("--strict", options->strict,
+                "stop with an error at the first non-finite pose from the policy (default: count the trial as invalid)");
   cmd->callback([options, &exit_code] {
     if (options->dist.empty() && options->hole_angle_deg.empty()) throw CLI::RequiredError("--dist or --hole-angle-deg");
     if (options->model.empty() && options->policy.empty()) throw CLI::RequiredError("--model or --policy");
