@@ -6,9 +6,10 @@
 //      at pi and within 1e-12 of both;
 //   3. validating constructors reject every non-finite, non-orthonormal or reflecting input with
 //      a typed error whose message names the value.
-// Each property runs on kNumericCases inputs (RC_PARAMS="max_success=N" overrides; the long run
-// in docs/RELIABILITY.md uses 1e7), and each is run on a planted fault that must fail it
-// (the mutant_* cases; faults in mutants.hpp).
+// Each property runs on kNumericCases inputs (RC_PARAMS="max_success=N" overrides, and so does
+// HANDCENTRIC_NUMERIC_CASES=N, which scripts/sanitize.sh uses; the long run in
+// docs/RELIABILITY.md uses 1e7), and each is run on a planted fault that must fail it (the
+// mutant_* cases; faults in mutants.hpp).
 #include <catch2/catch.hpp>
 
 #include <Eigen/LU>  // determinant
@@ -47,7 +48,13 @@ constexpr int kNumericCases = 100'000;
 rc::detail::TestParams numeric_params() {
   rc::detail::TestParams params = props::test_params();
   const char* rc_params = std::getenv("RC_PARAMS");
-  if (rc_params == nullptr || std::strstr(rc_params, "max_success=") == nullptr) params.maxSuccess = kNumericCases;
+  if (rc_params != nullptr && std::strstr(rc_params, "max_success=") != nullptr) return params;
+  params.maxSuccess = kNumericCases;
+  if (const char* cases = std::getenv("HANDCENTRIC_NUMERIC_CASES")) {
+    const int n = std::atoi(cases);
+    if (n < 1) throw InvalidArgument(std::string("HANDCENTRIC_NUMERIC_CASES='") + cases + "': give a positive number of cases");
+    params.maxSuccess = n;
+  }
   return params;
 }
 
