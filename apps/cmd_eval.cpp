@@ -1,5 +1,8 @@
 // `handcentric eval`: closed-loop rollouts (sim/rollout.hpp) of a policy on N seeded scenes of
-// the 2D insertion task, counted as success / collision / timeout (Sec. 4.2, Table 1).
+// the 2D insertion task, counted as success / collision / timeout (Sec. 4.2, Table 1), and
+// invalid: a trial whose policy returned a non-finite pose is a failure with its own count and a
+// one-line warning on stderr naming the first such scene, so one diverging scene does not throw
+// away a long evaluation; --strict stops at it with an error instead.
 // Policies: --policy expert|straight|hold (no file needed), or --model FILE: a trained model
 // (policy/model_file.hpp), when this build has the policy module.
 #include <cmath>
@@ -33,6 +36,7 @@ struct EvalOptions {
   bool json = false;
   double noise_scale = std::numeric_limits<double>::quiet_NaN();  // NaN: the model's own
   int execute = 0;            // 0: the model's own
+  bool strict = false;
 };
 
 int run_eval(const EvalOptions& options) {
@@ -48,14 +52,21 @@ int run_eval(const EvalOptions& options) {
   auto scenes = sim::sample_scenes(distribution, options.trials, options.seed);
   if (!options.transform.empty()) scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
   const sim::CollisionChecker checker;
-  const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed, loaded.rollout_options);
+  sim::RolloutOptions rollout_options = loaded.rollout_options;
+  rollout_options.stop_on_invalid = options.strict;
+  const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed, rollout_options);
+  if (summary.invalid > 0) {
+    std::cerr << "handcentric: warning: " << summary.invalid << " of " << summary.trials
+              << " trials invalid (counted as failures): the first is scene " << summary.first_invalid_scene << ", "
+              << summary.first_invalid_reason << "; --strict stops at the first instead\n";
+  }
   if (options.json) {
     std::cout << experiments::eval_json(summary, policy->name(), distribution.name, options.seed) << "\n";
   } else {
     std::cout << "policy " << policy->name() << " on " << summary.trials << " '" << distribution.name
               << "' scenes (seed " << options.seed << "): success " << summary.success << ", collision "
-              << summary.collision << ", timeout " << summary.timeout << "; " << summary.clipped
-              << " commands clipped to the step limits\n";
+              << summary.collision << ", timeout " << summary.timeout << ", invalid " << summary.invalid << "; "
+              << summary.clipped << " commands clipped to the step limits\n";
   }
   return 0;
 }
@@ -80,7 +91,10 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--noise-scale", options->noise_scale,
                   "a model's sampler noise instead of its own (0: the most likely chunk, eq. 6)");
   cmd->add_option("--execute", options->execute, "poses of each chunk a model executes instead of its own");
-  cmd->add_flag("--json", options->json, "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, ...}");
+  cmd->add_flag("--json", options->json,
+                "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, \"invalid\": count, ...}");
+  cmd->add_flag("--strict", options->strict,
+                "stop with an error at the first non-finite pose from the policy (default: count the trial as invalid)");
   cmd->callback([options, &exit_code] {
     if (options->dist.empty() && options->hole_angle_deg.empty()) throw CLI::RequiredError("--dist or --hole-angle-deg");
     if (options->model.empty() && options->policy.empty()) throw CLI::RequiredError("--model or --policy");

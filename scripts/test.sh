@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Quick start, command 2: installs what is missing, builds (Release, every core), runs every
 # ctest suite, then installs the package into a staging prefix and builds and tests
-# examples/downstream against it with find_package(handcentric).
+# examples/downstream against it with find_package(handcentric); last, the sanitizer run
+# (scripts/sanitize.sh: a second tree with ASan + UBSan, labels unit, property, proofs).
+# SANITIZE=1 adds the sanitizer run. It is off by default: with it, CI on two cores would take
+# about 30 minutes (docs/RELIABILITY.md), over its 25-minute budget.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
@@ -31,3 +34,8 @@ cmake -S "$root/examples/policy_downstream" -B "$build_dir/policy_downstream" -D
       -DCMAKE_DISABLE_FIND_PACKAGE_box2d=TRUE >/dev/null
 cmake --build "$build_dir/policy_downstream" -j "$jobs"
 (cd "$build_dir/policy_downstream" && ctest --output-on-failure)
+
+if [ "${SANITIZE:-0}" != 0 ]; then
+  echo "== sanitizers: AddressSanitizer + LeakSanitizer + UndefinedBehaviorSanitizer"
+  bash "$root/scripts/sanitize.sh"
+fi

@@ -11,11 +11,25 @@ namespace {
 
 // Below this angle the SE(3) V-matrix coefficients use their Taylor series (cf. so3.cpp).
 constexpr double kSeriesAngle = 1e-4;
+// Above this squared angle (|omega| > 1e150) exp() works from the unit axis (as so3::exp does).
+constexpr double kLargestSquaredAngle = 1e300;
 
 // V = I + b [w]x + c [w]x^2 maps rho to the translation: p = V rho.
 // b = (1 - cos phi) / phi^2, c = (phi - sin phi) / phi^3.
 Eigen::Matrix3d left_jacobian(const Eigen::Vector3d& omega) {
   const double phi2 = omega.squaredNorm();
+  if (phi2 > kLargestSquaredAngle) {
+    // |omega| > 1e150: [w]x^2 would overflow. With the unit axis u, b [w]x = (1 - cos phi) / phi
+    // [u]x and c [w]x^2 = (1 - sin(phi) / phi) [u]x^2; phi = 2 * half may be inf (then both
+    // quotients are 0), never nan.
+    double half = 0.0;
+    const Eigen::Vector3d u = so3::unit_axis_and_half_angle(omega, half);
+    double s, c;
+    ::sincos(half, &s, &c);
+    const double phi = 2.0 * half;
+    const Eigen::Matrix3d U = so3::hat(u);
+    return Eigen::Matrix3d::Identity() + (2.0 * s * s / phi) * U + (1.0 - 2.0 * s * c / phi) * U * U;
+  }
   const double phi = std::sqrt(phi2);
   double b, c;
   if (phi < kSeriesAngle) {

@@ -15,15 +15,17 @@ Rotation Rotation::from_matrix(const Eigen::Matrix3d& R) {
     throw InvalidRotation("rotation matrix has a non-finite entry: " + format_matrix(R) +
                           "; pass a finite 3x3 rotation matrix");
   }
+  // Written so that nan fails: R^T R of a finite matrix with entries near 1e300 sums +inf and
+  // -inf into nan, and "nan > tolerance" is false.
   const double orthonormality_error = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
-  if (orthonormality_error > kOrthonormalityTolerance) {
+  if (!(orthonormality_error <= kOrthonormalityTolerance)) {
     throw InvalidRotation("matrix is not orthonormal: |R^T R - I|_F = " +
                           format_number(orthonormality_error) + " > " +
                           format_number(kOrthonormalityTolerance) + " for R = " + format_matrix(R) +
                           "; project it with Rotation::nearest(R) if it is a rounded rotation");
   }
   const double determinant = R.determinant();
-  if (determinant < 0.0) {
+  if (!(determinant > 0.0)) {
     throw InvalidRotation("matrix is a reflection, det(R) = " + format_number(determinant) +
                           " for R = " + format_matrix(R) +
                           "; a rotation has det +1 (flip one axis to fix the handedness)");
@@ -37,7 +39,8 @@ Rotation Rotation::nearest(const Eigen::Matrix3d& M) {
   }
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
   const Eigen::Vector3d singular = svd.singularValues();
-  if (!(singular(2) > 1e-12 * std::max(1.0, singular(0)))) {
+  // Relative, so that a scaled rotation (1e-20 R or 1e20 R) projects to R like R itself.
+  if (!(singular(2) > 1e-12 * singular(0))) {
     throw InvalidRotation("cannot project a rank-deficient matrix onto SO(3): singular values " +
                           format_matrix(singular) + " of " + format_matrix(M));
   }
@@ -47,15 +50,25 @@ Rotation Rotation::nearest(const Eigen::Matrix3d& M) {
 }
 
 Rotation Rotation::from_quaternion(double w, double x, double y, double z) {
-  const Eigen::Vector4d q(w, x, y, z);
-  if (!q.allFinite()) {
-    throw InvalidRotation("quaternion has a non-finite entry: (w, x, y, z) = " + format_matrix(q));
+  const Eigen::Vector4d given(w, x, y, z);
+  if (!given.allFinite()) {
+    throw InvalidRotation("quaternion has a non-finite entry: (w, x, y, z) = " + format_matrix(given));
   }
-  const double norm2 = q.squaredNorm();
-  if (!(norm2 > 0.0) || !std::isfinite(norm2)) {
-    throw InvalidRotation("quaternion (w, x, y, z) = " + format_matrix(q) +
-                          " has zero (or overflowing) norm; a rotation needs a nonzero quaternion");
+  Eigen::Vector4d q = given;
+  double norm2 = q.squaredNorm();
+  if (!(norm2 >= 1e-200 && norm2 <= 1e200)) {
+    // |q|^2 would overflow (|q| > ~1e154) or lose digits to underflow: R(q) = R(q / c) for any
+    // c > 0, so divide by the largest component first. Only here, so other quaternions keep
+    // their bits.
+    const double largest = q.cwiseAbs().maxCoeff();
+    if (!(largest > 0.0)) {
+      throw InvalidRotation("quaternion (w, x, y, z) = " + format_matrix(given) +
+                            " is zero; a rotation needs a nonzero quaternion");
+    }
+    q /= largest;
+    norm2 = q.squaredNorm();
   }
+  w = q[0], x = q[1], y = q[2], z = q[3];
   // R(q) = M(q) / |q|^2 with M quadratic in q: orthonormal for any nonzero q.
   const double s = 2.0 / norm2;
   Eigen::Matrix3d R;

@@ -15,6 +15,9 @@ constexpr double kLogSeriesSine = 1e-4;
 // sin(phi) < 0.6 and dividing the skew part by it would amplify its rounding error.
 constexpr double kNearPiCosine = -0.8;
 constexpr double kPi = 3.141592653589793238462643383279502884;
+// Above this squared angle (|r| > 1e150) exp() works from the unit axis: phi^2 and the products
+// b x y of the closed form overflow near |r| ~ 1e154.
+constexpr double kLargestSquaredAngle = 1e300;
 
 // phi in [0, pi] from sin(phi) >= 0 and cos(phi), each through a well-conditioned function:
 // asin where |cos| >= 0.8 (d asin / ds = 1 / |cos| <= 1.25), acos in between (d acos / dc =
@@ -33,7 +36,37 @@ Eigen::Vector3d skew_vector(const Eigen::Matrix3d& R) {
   return 0.5 * Eigen::Vector3d(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
 }
 
+// R = I + sin(phi) [u]x + (1 - cos(phi)) [u]x^2 for the unit axis u, with sin(phi) = 2 s c and
+// 1 - cos(phi) = 2 s^2 of the half angle. Takes s = sin(phi / 2), c = cos(phi / 2).
+Eigen::Matrix3d rodrigues_unit_axis(const Eigen::Vector3d& u, double s, double c) {
+  const double sine = 2.0 * s * c, versine = 2.0 * s * s;
+  Eigen::Matrix3d R = versine * (u * u.transpose());
+  R.diagonal().array() += 1.0 - versine;
+  R(0, 1) -= sine * u.z();
+  R(1, 0) += sine * u.z();
+  R(0, 2) += sine * u.y();
+  R(2, 0) -= sine * u.y();
+  R(1, 2) -= sine * u.x();
+  R(2, 1) += sine * u.x();
+  return R;
+}
+
 }  // namespace
+
+Eigen::Vector3d unit_axis_and_half_angle(const Eigen::Vector3d& r, double& half_angle) {
+  // Scaled by the largest component first: |r|^2 overflows above ~1.3e154 and underflows below
+  // ~1.5e-154, and |r| itself exceeds DBL_MAX when every component is near it, but r / max|r_i|
+  // has norm in [1, sqrt(3)] and half the angle, max|r_i| / 2 * that norm, is always finite.
+  const double largest = r.cwiseAbs().maxCoeff();
+  if (!(largest > 0.0)) {
+    half_angle = 0.0;
+    return Eigen::Vector3d::UnitX();
+  }
+  const Eigen::Vector3d scaled = r / largest;
+  const double norm = scaled.norm();
+  half_angle = (0.5 * largest) * norm;
+  return scaled / norm;
+}
 
 Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
   Eigen::Matrix3d W;
@@ -45,6 +78,15 @@ Eigen::Matrix3d hat(const Eigen::Vector3d& w) {
 
 Eigen::Matrix3d exp(const Eigen::Vector3d& r) {
   const double phi2 = r.squaredNorm();
+  if (phi2 > kLargestSquaredAngle) {
+    // |r| > 1e150: phi^2 is near overflow (or past it) and the products below would be inf.
+    // The angle wraps modulo 2 pi; half of it is finite for every finite r.
+    double half = 0.0;
+    const Eigen::Vector3d u = unit_axis_and_half_angle(r, half);
+    double s, c;
+    ::sincos(half, &s, &c);
+    return rodrigues_unit_axis(u, s, c);
+  }
   double a;  // sin(phi) / phi
   double b;  // (1 - cos(phi)) / phi^2
   if (phi2 < kExpSeriesAngle * kExpSeriesAngle) {

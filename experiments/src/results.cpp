@@ -26,7 +26,8 @@ std::string eval_json(const sim::RolloutSummary& summary, const std::string& pol
   const double n = summary.trials;
   const nlohmann::json out = {{"trials", summary.trials},          {"success", summary.success / n},
                               {"collision", summary.collision / n}, {"timeout", summary.timeout / n},
-                              {"clipped", summary.clipped},        {"policy", policy},
+                              {"invalid", summary.invalid},        {"clipped", summary.clipped},
+                              {"policy", policy},
                               {"dist", dist},                      {"seed", seed}};
   return out.dump();
 }

@@ -119,14 +119,23 @@ const std::vector<Field>& fields() {
 
 }  // namespace
 
+namespace {
+constexpr int kMaxPoints = 1 << 16;
+constexpr int kMaxDimension = 1 << 20;
+}  // namespace
+
 void PolicyConfig::validate() const {
   const auto s = [](auto v) { return std::to_string(v); };
   require(chunk_length >= 1 && chunk_length <= 1024, "chunk_length", s(chunk_length), "1..1024");
   require(history_length >= 0 && history_length <= 1024, "history_length", s(history_length), "0..1024");
-  require(hand_points >= 0, "hand_points", s(hand_points), ">= 0");
-  require(world_points >= 0, "world_points", s(world_points), ">= 0");
-  require(action_dimension >= 0, "action_dimension", s(action_dimension), ">= 0");
-  require(observation_dimension >= 0, "observation_dimension", s(observation_dimension), ">= 0");
+  // Upper bounds keep every size a network is built from (sums and products of these) far from
+  // int overflow, and a model file's config from describing an absurd network.
+  require(hand_points >= 0 && hand_points <= kMaxPoints, "hand_points", s(hand_points), "0..65536");
+  require(world_points >= 0 && world_points <= kMaxPoints, "world_points", s(world_points), "0..65536");
+  require(action_dimension >= 0 && action_dimension <= kMaxDimension, "action_dimension", s(action_dimension),
+          "0..1048576");
+  require(observation_dimension >= 0 && observation_dimension <= kMaxDimension, "observation_dimension",
+          s(observation_dimension), "0..1048576");
   require(hidden_width >= 1 && hidden_width <= 65536, "hidden_width", s(hidden_width), "1..65536");
   require(hidden_layers >= 1 && hidden_layers <= 64, "hidden_layers", s(hidden_layers), "1..64");
   require(time_embedding == 0 || (time_embedding >= 2 && time_embedding % 2 == 0 && time_embedding <= 1024),

@@ -30,6 +30,38 @@ std::unique_ptr<Head> make_head(const PolicyConfig& config) {
 }
 
 namespace {
+// Weights of an MLP input -> hidden_layers x hidden_width -> output (W and b of every layer).
+std::uint64_t mlp_parameter_count(std::uint64_t input, const PolicyConfig& config, std::uint64_t output) {
+  const auto width = static_cast<std::uint64_t>(config.hidden_width);
+  std::uint64_t total = 0, fan_in = input;
+  for (int l = 0; l < config.hidden_layers; ++l) {
+    total += (fan_in + 1) * width;
+    fan_in = width;
+  }
+  return total + (fan_in + 1) * output;
+}
+}  // namespace
+
+std::uint64_t parameter_count(const PolicyConfig& config) {
+  // The same checks as make_head; validate() bounds every size, so nothing below overflows.
+  config.validate();
+  if (config.action_dimension < 1 || config.observation_dimension < 1) {
+    throw InvalidArgument("parameter_count: action_dimension " + std::to_string(config.action_dimension) +
+                          " and observation_dimension " + std::to_string(config.observation_dimension) +
+                          " must be set (>= 1) from the training data first");
+  }
+  const auto actions = static_cast<std::uint64_t>(config.action_dimension);
+  const auto observations = static_cast<std::uint64_t>(config.observation_dimension);
+  const auto latent = static_cast<std::uint64_t>(config.cvae_latent);
+  const auto time = static_cast<std::uint64_t>(time_feature_count(config.time_embedding));
+  if (config.head == HeadKind::cvae) {
+    return mlp_parameter_count(actions + observations, config, 2 * latent) +
+           mlp_parameter_count(latent + observations, config, actions);
+  }
+  return mlp_parameter_count(actions + time + observations, config, actions);
+}
+
+namespace {
 std::vector<int> network_widths(const PolicyConfig& config, int output) {
   std::vector<int> widths{config.action_dimension + time_feature_count(config.time_embedding) +
                           config.observation_dimension};

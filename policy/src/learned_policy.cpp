@@ -36,7 +36,7 @@ Eigen::VectorXd LearnedPolicy::action_vector(const Scene& observation, std::uint
   std::mt19937_64 rng(noise_seed);
   const Eigen::VectorXd a = head_->sample(o, rng).col(0).cast<double>();
   if (!a.allFinite()) {
-    throw InvalidScene(name() + " produced a non-finite action for this observation: is it far outside the "
+    throw NonFiniteAction(name() + " produced a non-finite action for this observation: is it far outside the "
                        "training data (units, frames)?");
   }
   return a;

@@ -37,6 +37,11 @@ std::string serialize_model(const LearnedPolicy& policy) {
 LearnedPolicy deserialize_model(const std::string& bytes, const std::string& source,
                                 const SamplingOverrides& overrides) {
   ByteReader header(bytes, source);
+  if (bytes.size() > kMaxModelFileBytes) {
+    throw InvalidModelFile(source + ": " + std::to_string(bytes.size()) + " bytes, more than the " +
+                           std::to_string(kMaxModelFileBytes) + " a model file may have: give a file written by "
+                           "`handcentric train --out`");
+  }
   if (bytes.size() < sizeof kMagic || bytes.compare(0, sizeof kMagic, kMagic, sizeof kMagic) != 0) {
     throw InvalidModelFile(source + ": not a handcentric model file (it does not start with HCPOLICY): give a "
                            "file written by `handcentric train --out`");
@@ -74,6 +79,20 @@ LearnedPolicy deserialize_model(const std::string& bytes, const std::string& sou
     in.fail("the config says " + to_string(config.head) + "/" + config.representation + " but the file stores " +
             head_name + "/" + representation_name);
   }
+  // Before make_head allocates the network (and Adam's state beside it): the weights it
+  // describes must be in this file, so a damaged or hostile config cannot ask for more memory
+  // than a few times the file's size.
+  std::uint64_t parameters = 0;
+  try {
+    parameters = parameter_count(config);
+  } catch (const InvalidArgument& error) {
+    in.fail(error.what());
+  }
+  if (parameters > in.remaining() / sizeof(float)) {
+    in.fail("the config describes a network of " + std::to_string(parameters) + " parameters (" +
+            std::to_string(parameters * sizeof(float)) + " bytes of weights) but only " +
+            std::to_string(in.remaining()) + " bytes follow");
+  }
   std::shared_ptr<const Representation> representation;
   std::shared_ptr<Head> head;
   try {
@@ -96,11 +115,21 @@ LearnedPolicy load_model(const std::string& path, const SamplingOverrides& overr
   if (!std::filesystem::is_regular_file(path, error)) {
     throw InvalidModelFile(path + ": no such model file: give the path written by `handcentric train --out`");
   }
+  const std::uintmax_t size = std::filesystem::file_size(path, error);
+  if (error) throw InvalidModelFile(path + ": cannot read the file's size (" + error.message() + "): check its permissions");
+  if (size > kMaxModelFileBytes) {
+    throw InvalidModelFile(path + ": " + std::to_string(size) + " bytes, more than the " +
+                           std::to_string(kMaxModelFileBytes) + " a model file may have (checked before reading): "
+                           "give a file written by `handcentric train --out`");
+  }
   std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in && !in.eof()) throw InvalidModelFile(path + ": cannot read the file: check its permissions");
-  return deserialize_model(bytes.str(), path, overrides);
+  if (!in) throw InvalidModelFile(path + ": cannot open the file: check its permissions");
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  in.read(bytes.data(), static_cast<std::streamsize>(size));
+  if (static_cast<std::uintmax_t>(in.gcount()) != size || in.peek() != std::char_traits<char>::eof()) {
+    throw InvalidModelFile(path + ": the file changed while it was read: load it again");
+  }
+  return deserialize_model(bytes, path, overrides);
 }
 
 }  // namespace handcentric::policy

@@ -2,7 +2,9 @@
 #include "handcentric/sim/demos.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <istream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -81,6 +83,45 @@ void check_demo(const Demo& demo, std::size_t index) {
   }
 }
 
+// One line of `in` into `line`, without its newline; `newline` says whether it ended in one.
+// False at the end of the file with nothing read. Stops with InvalidDemoFile once the line passes
+// limits.max_line_bytes, having read (and kept) no more than that.
+bool read_line(std::istream& in, std::string& line, bool& newline, const DemoFileLimits& limits,
+               const std::string& path, const std::string& where) {
+  line.clear();
+  newline = false;
+  std::streambuf& buffer = *in.rdbuf();
+  for (;;) {
+    const int c = buffer.sbumpc();
+    if (c == std::char_traits<char>::eof()) return !line.empty();
+    if (c == '\n') {
+      newline = true;
+      return true;
+    }
+    if (line.size() == limits.max_line_bytes) {
+      fail(path, where, "the line is longer than " + std::to_string(limits.max_line_bytes) +
+                            " bytes, the limit for one demo: this is not a demo file of this task, or it is damaged");
+    }
+    line.push_back(static_cast<char>(c));
+  }
+}
+
+// json::parse with a bound on nesting, checked as each container opens (nlohmann's parser keeps
+// its own stack, so this is about memory and the size of the tree, not the call stack).
+json parse_line(const std::string& line, const DemoFileLimits& limits, const std::string& path,
+                const std::string& where) {
+  const json::parser_callback_t depth_guard = [&](int depth, json::parse_event_t event, json&) {
+    // `depth` counts the containers around the one that opens
+    if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+        depth >= limits.max_json_depth) {
+      fail(path, where, "JSON nested deeper than " + std::to_string(limits.max_json_depth) +
+                            " levels (a demo record has 4): this is not a demo file of this task");
+    }
+    return true;
+  };
+  return json::parse(line, depth_guard);
+}
+
 }  // namespace
 
 void save_demos(const std::string& path, const std::vector<Demo>& demos, const PegHoleGeometry& geometry) {
@@ -101,39 +142,48 @@ void save_demos(const std::string& path, const std::vector<Demo>& demos, const P
   write_file_atomically(path, out.str());
 }
 
-std::vector<Demo> load_demos(const std::string& path) {
+std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InvalidDemoFile("cannot open demo file '" + path + "'; check the path (make one with `handcentric demos`)");
   std::string line;
-  if (!std::getline(in, line)) fail(path, "line 1", "the file is empty; expected a header line");
+  bool newline = false;
+  if (!read_line(in, line, newline, limits, path, "line 1 (header)")) {
+    fail(path, "line 1", "the file is empty; expected a header line");
+  }
   json header;
   try {
-    header = json::parse(line);
+    header = parse_line(line, limits, path, "line 1 (header)");
   } catch (const json::exception&) {
     fail(path, "line 1 (header)", "not valid JSON");
   }
-  if (!header.is_object() || header.value("format", "") != kFormat) {
+  // Types first: json::value("format", "") throws a json::type_error on a non-string format.
+  if (!header.is_object() || !header.contains("format") || header["format"] != kFormat) {
     fail(path, "line 1 (header)", std::string("expected {\"format\": \"") + kFormat + "\", ...}");
   }
-  if (header.value("version", -1) != kVersion) {
-    fail(path, "line 1 (header)", "unsupported version " + header.value("version", json()).dump() +
+  if (!header.contains("version") || !header["version"].is_number_integer() || header["version"] != kVersion) {
+    fail(path, "line 1 (header)", "unsupported version " + (header.contains("version") ? header["version"].dump() : "(none)") +
                                       "; this build reads version " + std::to_string(kVersion));
   }
   if (!header.contains("count") || !header["count"].is_number_unsigned()) {
     fail(path, "line 1 (header)", "\"count\" must be a non-negative integer");
   }
-  const auto count = header["count"].get<std::size_t>();
+  const auto count = header["count"].get<std::uint64_t>();
+  if (count > limits.max_demos) {
+    fail(path, "line 1 (header)", "the header announces " + std::to_string(count) + " demos, more than the limit of " +
+                                      std::to_string(limits.max_demos) + ": split the data set, or fix the count");
+  }
   std::vector<Demo> demos;
+  std::size_t poses = 0;
   for (std::size_t record = 1; record <= count; ++record) {
     const std::string where = "record " + std::to_string(record) + " (line " + std::to_string(record + 1) + ")";
-    if (!std::getline(in, line)) {
+    if (!read_line(in, line, newline, limits, path, where)) {
       fail(path, where, "missing: the header promises " + std::to_string(count) + " demos but the file ends after " +
                             std::to_string(record - 1) + " (truncated file?)");
     }
-    if (in.eof()) fail(path, where, "the line has no final newline (truncated file?)");
+    if (!newline) fail(path, where, "the line has no final newline (truncated file?)");
     json value;
     try {
-      value = json::parse(line);
+      value = parse_line(line, limits, path, where);
     } catch (const json::exception&) {
       fail(path, where, "not valid JSON (truncated or corrupted line)");
     }
@@ -144,13 +194,23 @@ std::vector<Demo> load_demos(const std::string& path) {
     demo.world_T_hole = pose_from_json(value["world_T_hole"], path, where + ", world_T_hole");
     const json& hands = value["world_T_hand"];
     if (!hands.is_array() || hands.empty()) fail(path, where, "world_T_hand must be a non-empty array of poses");
+    if (hands.size() > limits.max_poses_per_demo) {
+      fail(path, where, "a demo of " + std::to_string(hands.size()) + " poses, more than the limit of " +
+                            std::to_string(limits.max_poses_per_demo) + " for one demo");
+    }
+    poses += hands.size();
+    if (poses > limits.max_poses) {
+      fail(path, where, "the demos so far hold " + std::to_string(poses) + " poses, more than the limit of " +
+                            std::to_string(limits.max_poses) + " for one file: split the data set");
+    }
+    demo.world_T_hand.reserve(hands.size());
     for (std::size_t t = 0; t < hands.size(); ++t) {
       demo.world_T_hand.push_back(
           pose_from_json(hands[t], path, where + ", world_T_hand[" + std::to_string(t) + "]"));
     }
     demos.push_back(std::move(demo));
   }
-  if (std::getline(in, line) && !line.empty()) {
+  if (read_line(in, line, newline, limits, path, "line " + std::to_string(count + 2)) && !line.empty()) {
     fail(path, "line " + std::to_string(count + 2), "extra data after the " + std::to_string(count) +
                                                          " demos the header promises");
   }

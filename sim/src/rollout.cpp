@@ -44,6 +44,7 @@ std::string outcome_name(Outcome outcome) {
     case Outcome::success: return "success";
     case Outcome::collision: return "collision";
     case Outcome::timeout: return "timeout";
+    case Outcome::invalid: return "invalid";
   }
   return "unknown";
 }
@@ -75,9 +76,22 @@ Rollout rollout(const ChunkPolicy& policy, const TaskScene& scene, const Collisi
     result.outcome = Outcome::collision;
     return result;
   }
+  // Ends the rollout as invalid, or throws with stop_on_invalid.
+  const auto invalid = [&](const std::string& reason) {
+    if (options.stop_on_invalid) throw NonFiniteAction(reason);
+    result.outcome = Outcome::invalid;
+    result.invalid_reason = reason;
+    return result;
+  };
   for (int replan = 0; replan < options.max_replans; ++replan) {
     const Scene observed = observation(scene.world_T_hole, result.world_T_hand, options.history, checker.geometry());
-    const std::vector<RigidTransform> chunk = policy.act(observed, stream_seed(seed, static_cast<std::uint64_t>(replan)));
+    std::vector<RigidTransform> chunk;
+    try {
+      chunk = policy.act(observed, stream_seed(seed, static_cast<std::uint64_t>(replan)));
+    } catch (const NonFiniteAction& error) {
+      ++result.replans;
+      return invalid("policy '" + policy.name() + "' at replan " + std::to_string(replan) + ": " + error.what());
+    }
     ++result.replans;
     if (chunk.empty()) {
       throw InvalidArgument("policy '" + policy.name() + "' returned an empty chunk at replan " + std::to_string(replan));
@@ -86,8 +100,8 @@ Rollout rollout(const ChunkPolicy& policy, const TaskScene& scene, const Collisi
     for (int k = 0; k < n; ++k) {
       const RigidTransform& world_T_command = chunk[static_cast<std::size_t>(k)];
       if (!finite(world_T_command)) {
-        throw InvalidArgument("policy '" + policy.name() + "' returned a non-finite pose (chunk entry " +
-                              std::to_string(k) + " at replan " + std::to_string(replan) + ")");
+        return invalid("policy '" + policy.name() + "' returned a non-finite pose (chunk entry " + std::to_string(k) +
+                       " at replan " + std::to_string(replan) + ")");
       }
       // the commanded pose in the hole frame, projected onto the plane
       const Eigen::Vector3d q = planar_coordinates(scene.world_T_hole.inverse_compose(world_T_command));
@@ -121,13 +135,24 @@ RolloutSummary evaluate(const ChunkPolicy& policy, const std::vector<TaskScene>&
                         const CollisionChecker& checker, std::uint64_t seed, const RolloutOptions& options) {
   RolloutSummary summary;
   for (std::size_t i = 0; i < scenes.size(); ++i) {
-    const Rollout r = rollout(policy, scenes[i], checker, stream_seed(seed, i), options);
+    Rollout r;
+    try {
+      r = rollout(policy, scenes[i], checker, stream_seed(seed, i), options);
+    } catch (const NonFiniteAction& error) {
+      throw NonFiniteAction("scene " + std::to_string(i) + ": " + error.what());
+    }
     ++summary.trials;
     summary.clipped += r.clipped;
     switch (r.outcome) {
       case Outcome::success: ++summary.success; break;
       case Outcome::collision: ++summary.collision; break;
       case Outcome::timeout: ++summary.timeout; break;
+      case Outcome::invalid:
+        if (summary.invalid++ == 0) {
+          summary.first_invalid_scene = static_cast<int>(i);
+          summary.first_invalid_reason = r.invalid_reason;
+        }
+        break;
     }
   }
   return summary;

@@ -2,10 +2,16 @@
 // Planted faults for the core suite: each property below is also run on one of these and must
 // fail there, so that a property that cannot fail is caught.
 #include <Eigen/Core>
+#include <Eigen/LU>  // determinant
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/core/rigid_transform.hpp"
+#include "handcentric/core/rotation.hpp"
 #include "handcentric/core/so3.hpp"
 
 namespace handcentric::test {
@@ -18,6 +24,39 @@ inline Eigen::Vector3d naive_log(const Eigen::Matrix3d& R) {
   if (phi == 0.0) return Eigen::Vector3d::Zero();
   const Eigen::Vector3d v(R(2, 1) - R(1, 2), R(0, 2) - R(2, 0), R(1, 0) - R(0, 1));
   return phi / (2.0 * std::sin(phi)) * v;
+}
+
+/// The textbook exp: phi = |r|, R = I + sin(phi)/phi [r]x + (1 - cos(phi))/phi^2 [r]x^2.
+/// phi^2 underflows to 0 below |r| ~ 1e-154 (0/0) and [r]x^2 overflows above ~1e154 (sin of inf,
+/// 0 * inf): nan on valid rotation vectors.
+inline Eigen::Matrix3d textbook_exp(const Eigen::Vector3d& r) {
+  const double phi = r.norm();
+  if (phi == 0.0) return Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d W = so3::hat(r);
+  return Eigen::Matrix3d::Identity() + std::sin(phi) / phi * W + (1.0 - std::cos(phi)) / (phi * phi) * W * W;
+}
+
+/// SE(3) exp whose V = I + (1 - cos phi)/phi^2 [w]x + (phi - sin phi)/phi^3 [w]x^2 is the
+/// textbook one: nan for huge and for tiny (nonzero) omega.
+inline RigidTransform textbook_se3_exp(const Twist& twist) {
+  const Eigen::Vector3d rho = twist.head<3>(), omega = twist.tail<3>();
+  const double phi = omega.norm();
+  if (phi == 0.0) return RigidTransform::unchecked(Eigen::Matrix3d::Identity(), rho);
+  const Eigen::Matrix3d W = so3::hat(omega);
+  const Eigen::Matrix3d V = Eigen::Matrix3d::Identity() + (1.0 - std::cos(phi)) / (phi * phi) * W +
+                            (phi - std::sin(phi)) / (phi * phi * phi) * W * W;
+  return RigidTransform::unchecked(so3::exp(omega), V * rho);
+}
+
+/// Rotation::from_matrix without its finiteness check and with its comparisons written so that
+/// nan passes them ("nan > tolerance" is false): accepts a matrix with a nan entry.
+inline Rotation lenient_from_matrix(const Eigen::Matrix3d& R) {
+  const double error = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
+  if (error > Rotation::kOrthonormalityTolerance) {
+    throw InvalidRotation("matrix is not orthonormal: R = " + format_matrix(R) + "; project it");
+  }
+  if (R.determinant() < 0.0) throw InvalidRotation("matrix is a reflection: R = " + format_matrix(R) + "; flip an axis");
+  return Rotation::from_matrix_unchecked(R);
 }
 
 /// A log whose canonical sign at pi is the opposite of the documented one.

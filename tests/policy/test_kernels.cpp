@@ -4,6 +4,7 @@
 // (partial tiles, k beyond one k block, n beyond one column block, strides, k = 0), the narrow
 // products of sampling (n <= 16) with unaligned columns, the SiLU kernels, the squared norm
 // and Adam. Then the whole Mlp per kernel set against MlpT<double>. The checks are seen failing on planted faults.
+// Under ASan, the masked accesses ASan cannot see are checked lane by lane (kernels/asan_lanes.hpp).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -18,6 +19,7 @@
 #include "handcentric/policy/adam.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/mlp.hpp"
+#include "kernels/asan_lanes.hpp"
 #include "kernels/kernel_set.hpp"
 #include "throws.hpp"
 
@@ -417,4 +419,21 @@ TEST_CASE("training_is_bit_for_bit_repeatable_on_each_kernel_set", "[unit]") {
     INFO(to_string(isa));
     CHECK(first.cwiseEqual(second).all());
   }
+}
+
+TEST_CASE("masked_kernel_accesses_are_checked_lane_by_lane_under_asan", "[unit]") {
+  // ASan does not see masked loads, stores and gathers (builtins); the kernels check their
+  // enabled lanes through poisoned_lane (kernels/asan_lanes.hpp). Off ASan it finds nothing.
+#if defined(__SANITIZE_ADDRESS__)
+  std::vector<float> five(5, 1.0f);
+  const float* x = five.data();
+  CHECK(kernels::poisoned_lane(x, 0x1F, sizeof(float)) == nullptr);       // lanes 0..4: the buffer
+  CHECK(kernels::poisoned_lane(x, 0x3F, sizeof(float)) == x + 5);         // a tail one lane too long
+  CHECK(kernels::poisoned_lane(x - 1, 0x3E, sizeof(float)) == nullptr);   // a shifted head: lane 0 is off
+  CHECK(kernels::poisoned_lane(x - 1, 0x3F, sizeof(float)) == x - 1);     // ... unless it is on
+  CHECK(kernels::poisoned_lane(x, 0x21, sizeof(float)) == x + 5);         // lanes between are skipped, not the last
+#else
+  std::vector<float> five(5, 1.0f);
+  CHECK(kernels::poisoned_lane(five.data(), 0xFFFF, sizeof(float)) == nullptr);
+#endif
 }

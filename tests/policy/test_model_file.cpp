@@ -75,13 +75,17 @@ TEST_CASE("damaged_model_files_are_typed_errors", "[unit]") {
   version[8] = 7;
   HC_CHECK_THROWS(deserialize_model(with_valid_checksum(version), "v7.model"), InvalidModelFile,
                   Catch::Contains("version 7"));
-  // A consistent checksum over an edited config: the weights no longer fit the network.
+  // A consistent checksum over an edited config: the weights no longer fit the network. A
+  // narrower one (12) is found at the weight array, a wider one (42) before anything is built.
   std::string edited = bytes;
   const std::size_t at = edited.find("hidden_width=32");
   REQUIRE(at != std::string::npos);
-  edited[at + std::strlen("hidden_width=")] = '4';
+  edited[at + std::strlen("hidden_width=")] = '1';
   HC_CHECK_THROWS(deserialize_model(with_valid_checksum(edited), "edited.model"), InvalidModelFile,
                   Catch::Contains("numbers where"));
+  edited[at + std::strlen("hidden_width=")] = '4';
+  HC_CHECK_THROWS(deserialize_model(with_valid_checksum(edited), "edited.model"), InvalidModelFile,
+                  Catch::Contains("the config describes a network of 5232 parameters"));
 }
 
 TEST_CASE("missing_or_unwritable_model_paths_are_typed_errors", "[unit]") {

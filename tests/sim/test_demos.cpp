@@ -97,6 +97,11 @@ TEST_CASE("bad_demo_files_give_an_error_naming_the_record", "[unit]") {
   // header
   rejects(with_line(good, 0, "{\"format\":\"something-else\"}"), "header", "handcentric-demos");
   rejects(with_line(good, 0, "{\"format\":\"handcentric-demos\",\"version\":9,\"count\":2}"), "header", "version 9");
+  // mistyped fields are the same typed error, not a JSON library exception
+  rejects(with_line(good, 0, "{\"format\":5,\"version\":1,\"count\":2}"), "header", "handcentric-demos");
+  rejects(with_line(good, 0, "{\"format\":\"handcentric-demos\",\"version\":\"1\",\"count\":2}"), "header",
+          "version \"1\"");
+  rejects(with_line(good, 0, "[1,2]"), "header", "handcentric-demos");
   rejects("", "line 1", "empty");
   rejects(good + hand_ok + "\n", "line 4", "extra data");
   std::filesystem::remove(path);

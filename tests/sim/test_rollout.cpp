@@ -141,9 +141,18 @@ TEST_CASE("a_policy_returning_garbage_is_a_typed_error_naming_it", "[unit]") {
   const TaskScene scene = scene_at(0.0, 0.0, 15.0);
   CHECK_THROWS_WITH(rollout(BrokenPolicy({}), scene, checker, 1), Catch::Matchers::Contains("broken") &&
                                                                      Catch::Matchers::Contains("empty chunk"));
+  // a non-finite pose ends the rollout as invalid, or is an error with stop_on_invalid
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const RigidTransform bad = RigidTransform::unchecked(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0));
-  CHECK_THROWS_WITH(rollout(BrokenPolicy({bad}), scene, checker, 1), Catch::Matchers::Contains("non-finite"));
+  const Rollout r = rollout(BrokenPolicy({bad}), scene, checker, 1);
+  CHECK(r.outcome == Outcome::invalid);
+  CHECK(outcome_name(r.outcome) == "invalid");
+  CHECK_THAT(r.invalid_reason, Catch::Matchers::Contains("broken") && Catch::Matchers::Contains("non-finite") &&
+                                   Catch::Matchers::Contains("replan 0"));
+  RolloutOptions strict;
+  strict.stop_on_invalid = true;
+  CHECK_THROWS_AS(rollout(BrokenPolicy({bad}), scene, checker, 1, strict), NonFiniteAction);
+  CHECK_THROWS_WITH(rollout(BrokenPolicy({bad}), scene, checker, 1, strict), Catch::Matchers::Contains("non-finite"));
   RolloutOptions options;
   options.execute = 0;
   CHECK_THROWS_AS(rollout(HoldPolicy(), scene, checker, 1, options), InvalidArgument);

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "asan_lanes.hpp"
 #include "kernel_set.hpp"
 #include "pack.hpp"
 
@@ -16,6 +17,17 @@
 
 namespace handcentric::policy::kernels {
 namespace {
+
+// The masked accesses, through asan_lanes.hpp's check (empty without ASan); lane i is enabled
+// when the sign bit of lane i of `mask` is set.
+HC_AVX2 inline __attribute__((always_inline)) __m256 maskload(const float* p, __m256i mask) {
+  check_lanes(p, static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(mask))), sizeof(float), false);
+  return _mm256_maskload_ps(p, mask);
+}
+HC_AVX2 inline __attribute__((always_inline)) void maskstore(float* p, __m256i mask, __m256 value) {
+  check_lanes(p, static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(mask))), sizeof(float), true);
+  _mm256_maskstore_ps(p, mask, value);
+}
 
 HC_AVX2 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
 HC_AVX2 void silu(std::ptrdiff_t n, float* x);
@@ -38,7 +50,7 @@ HC_AVX2 void narrow_product(int shift, int rows, int k, const float* a, long lda
   c -= shift;
   if (bias != nullptr) bias -= shift;
   const auto load = [&](const float* p, int v) HC_AVX2 {
-    return v == 0 ? _mm256_maskload_ps(p, head) : v + 1 == V ? _mm256_maskload_ps(p, tail) : _mm256_loadu_ps(p);
+    return v == 0 ? maskload(p, head) : v + 1 == V ? maskload(p, tail) : _mm256_loadu_ps(p);
   };
   __m256 acc[N][V];
   #pragma GCC unroll 16
@@ -63,9 +75,9 @@ HC_AVX2 void narrow_product(int shift, int rows, int k, const float* a, long lda
     #pragma GCC unroll 16
     for (int v = 0; v < V; ++v) {
       if (v == 0) {
-        _mm256_maskstore_ps(cj, head, acc[j][0]);
+        maskstore(cj, head, acc[j][0]);
       } else if (v + 1 == V) {
-        _mm256_maskstore_ps(cj + 8 * v, tail, acc[j][v]);
+        maskstore(cj + 8 * v, tail, acc[j][v]);
       } else {
         _mm256_storeu_ps(cj + 8 * v, acc[j][v]);
       }

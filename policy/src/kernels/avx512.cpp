@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "asan_lanes.hpp"
 #include "kernel_set.hpp"
 #include "pack.hpp"
 
@@ -17,6 +18,31 @@
 
 namespace handcentric::policy::kernels {
 namespace {
+
+// The masked accesses, through asan_lanes.hpp's check (empty without ASan).
+HC_AVX512 inline __attribute__((always_inline)) __m512 maskz_loadu(__mmask16 mask, const float* p) {
+  check_lanes(p, mask, sizeof(float), false);
+  return _mm512_maskz_loadu_ps(mask, p);
+}
+HC_AVX512 inline __attribute__((always_inline)) void mask_storeu(float* p, __mmask16 mask, __m512 value) {
+  check_lanes(p, mask, sizeof(float), true);
+  _mm512_mask_storeu_ps(p, mask, value);
+}
+HC_AVX512 inline __attribute__((always_inline)) __m512i maskz_loadu_epi64(__mmask8 mask, const std::uint64_t* p) {
+  check_lanes(p, mask, sizeof(std::uint64_t), false);
+  return _mm512_maskz_loadu_epi64(mask, p);
+}
+// Lane i reads base[index[i]] when `mask` enables it, else 0.
+HC_AVX512 inline __attribute__((always_inline)) __m512 mask_gather(__mmask16 mask, __m512i index, const float* base) {
+#if defined(__SANITIZE_ADDRESS__)
+  alignas(64) int offsets[16];
+  _mm512_store_si512(offsets, index);
+  for (int i = 0; i < 16; ++i) {
+    if ((mask >> i) & 1) check_lanes(base + offsets[i], 1, sizeof(float), false);
+  }
+#endif
+  return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), mask, index, base, 4);
+}
 
 HC_AVX512 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a);
 HC_AVX512 void silu(std::ptrdiff_t n, float* x);
@@ -39,7 +65,7 @@ HC_AVX512 void narrow_product(int shift, int rows, int k, const float* a, long l
   __m512 acc[N][V];
   #pragma GCC unroll 32
   for (int v = 0; v < V; ++v) {
-    const __m512 start = bias != nullptr ? _mm512_maskz_loadu_ps(mask(v), bias + 16 * v) : _mm512_setzero_ps();
+    const __m512 start = bias != nullptr ? maskz_loadu(mask(v), bias + 16 * v) : _mm512_setzero_ps();
     #pragma GCC unroll 16
     for (int j = 0; j < N; ++j) acc[j][v] = start;
   }
@@ -49,7 +75,7 @@ HC_AVX512 void narrow_product(int shift, int rows, int k, const float* a, long l
     // No software prefetch: measured (n = 1), prefetching 2, 4 or 8 columns ahead changed nothing.
     #pragma GCC unroll 32
     for (int v = 0; v < V; ++v) {
-      const __m512 a_v = v == 0 || v + 1 == V ? _mm512_maskz_loadu_ps(mask(v), column + 16 * v)
+      const __m512 a_v = v == 0 || v + 1 == V ? maskz_loadu(mask(v), column + 16 * v)
                                                : _mm512_loadu_ps(column + 16 * v);
       #pragma GCC unroll 16
       for (int j = 0; j < N; ++j) acc[j][v] = _mm512_fmadd_ps(a_v, _mm512_set1_ps(b_row[j * b_stride]), acc[j][v]);
@@ -58,7 +84,7 @@ HC_AVX512 void narrow_product(int shift, int rows, int k, const float* a, long l
   #pragma GCC unroll 16
   for (int j = 0; j < N; ++j) {
     #pragma GCC unroll 32
-    for (int v = 0; v < V; ++v) _mm512_mask_storeu_ps(c + j * ldc + 16 * v, mask(v), acc[j][v]);
+    for (int v = 0; v < V; ++v) mask_storeu(c + j * ldc + 16 * v, mask(v), acc[j][v]);
   }
 }
 
@@ -86,16 +112,16 @@ struct Avx512Kernel {
       if (op == Op::none) {
         const float* column = a + (i0 + panel) + static_cast<long>(p0) * lda;
         for (int p = 0; p < kc; ++p, column += lda) {
-          _mm512_store_ps(out + p * MR, _mm512_maskz_loadu_ps(mask0, column));
-          _mm512_store_ps(out + p * MR + 16, _mm512_maskz_loadu_ps(mask1, column + 16));
+          _mm512_store_ps(out + p * MR, maskz_loadu(mask0, column));
+          _mm512_store_ps(out + p * MR + 16, maskz_loadu(mask1, column + 16));
         }
       } else {
         const float* row0 = a + p0 + static_cast<long>(i0 + panel) * lda;  // op(A)(i, p) = a[p + i lda]
         const float* row16 = rows > 16 ? row0 + 16L * lda : row0;  // unused (mask 0) when rows <= 16
         for (int p = 0; p < kc; ++p) {
-          _mm512_store_ps(out + p * MR, _mm512_mask_i32gather_ps(_mm512_setzero_ps(), mask0, rows_apart, row0 + p, 4));
+          _mm512_store_ps(out + p * MR, mask_gather(mask0, rows_apart, row0 + p));
           _mm512_store_ps(out + p * MR + 16,
-                          _mm512_mask_i32gather_ps(_mm512_setzero_ps(), mask1, rows_apart, row16 + p, 4));
+                          mask_gather(mask1, rows_apart, row16 + p));
         }
       }
       out += static_cast<long>(kc) * MR;
@@ -177,10 +203,10 @@ HC_AVX512 __mmask16 tail_mask(std::ptrdiff_t remaining) {
 HC_AVX512 void silu_forward(std::ptrdiff_t n, const float* z, float* s, float* a) {
   for (std::ptrdiff_t i = 0; i < n; i += 16) {
     const __mmask16 mask = tail_mask(n - i);
-    const __m512 zi = _mm512_maskz_loadu_ps(mask, z + i);
+    const __m512 zi = maskz_loadu(mask, z + i);
     const __m512 si = sigmoid_ps(zi);
-    _mm512_mask_storeu_ps(s + i, mask, si);
-    _mm512_mask_storeu_ps(a + i, mask, _mm512_mul_ps(zi, si));
+    mask_storeu(s + i, mask, si);
+    mask_storeu(a + i, mask, _mm512_mul_ps(zi, si));
   }
 }
 
@@ -188,24 +214,24 @@ HC_AVX512 void silu_backward(std::ptrdiff_t n, const float* a, const float* s, f
   const __m512 one = _mm512_set1_ps(1.0f);
   for (std::ptrdiff_t i = 0; i < n; i += 16) {
     const __mmask16 mask = tail_mask(n - i);
-    const __m512 ai = _mm512_maskz_loadu_ps(mask, a + i), si = _mm512_maskz_loadu_ps(mask, s + i);
+    const __m512 ai = maskz_loadu(mask, a + i), si = maskz_loadu(mask, s + i);
     const __m512 derivative = _mm512_fmadd_ps(ai, _mm512_sub_ps(one, si), si);  // s + a (1 - s)
-    _mm512_mask_storeu_ps(delta + i, mask, _mm512_mul_ps(_mm512_maskz_loadu_ps(mask, delta + i), derivative));
+    mask_storeu(delta + i, mask, _mm512_mul_ps(maskz_loadu(mask, delta + i), derivative));
   }
 }
 
 HC_AVX512 void silu(std::ptrdiff_t n, float* x) {
   for (std::ptrdiff_t i = 0; i < n; i += 16) {
     const __mmask16 mask = tail_mask(n - i);
-    const __m512 xi = _mm512_maskz_loadu_ps(mask, x + i);
-    _mm512_mask_storeu_ps(x + i, mask, _mm512_mul_ps(xi, sigmoid_ps(xi)));
+    const __m512 xi = maskz_loadu(mask, x + i);
+    mask_storeu(x + i, mask, _mm512_mul_ps(xi, sigmoid_ps(xi)));
   }
 }
 
 HC_AVX512 double squared_norm(std::ptrdiff_t n, const float* g) {
   __m512d sum0 = _mm512_setzero_pd(), sum1 = _mm512_setzero_pd();
   for (std::ptrdiff_t i = 0; i < n; i += 16) {
-    const __m512 gi = _mm512_maskz_loadu_ps(tail_mask(n - i), g + i);
+    const __m512 gi = maskz_loadu(tail_mask(n - i), g + i);
     const __m512d lo = _mm512_cvtps_pd(_mm512_castps512_ps256(gi));
     const __m512d hi = _mm512_cvtps_pd(_mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(gi), 1)));
     sum0 = _mm512_fmadd_pd(lo, lo, sum0);
@@ -222,15 +248,15 @@ HC_AVX512 void adam(const AdamUpdate& u) {
   const __m512 gradient_scale = _mm512_set1_ps(u.gradient_scale);
   for (std::ptrdiff_t i = 0; i < u.n; i += 16) {
     const __mmask16 mask = tail_mask(u.n - i);
-    const __m512 g = _mm512_mul_ps(_mm512_maskz_loadu_ps(mask, u.gradient + i), gradient_scale);
-    const __m512 m = _mm512_fmadd_ps(b1, _mm512_maskz_loadu_ps(mask, u.m + i), _mm512_mul_ps(c1, g));
-    const __m512 v = _mm512_fmadd_ps(b2, _mm512_maskz_loadu_ps(mask, u.v + i), _mm512_mul_ps(c2, _mm512_mul_ps(g, g)));
-    __m512 p = _mm512_maskz_loadu_ps(mask, u.parameters + i);
+    const __m512 g = _mm512_mul_ps(maskz_loadu(mask, u.gradient + i), gradient_scale);
+    const __m512 m = _mm512_fmadd_ps(b1, maskz_loadu(mask, u.m + i), _mm512_mul_ps(c1, g));
+    const __m512 v = _mm512_fmadd_ps(b2, maskz_loadu(mask, u.v + i), _mm512_mul_ps(c2, _mm512_mul_ps(g, g)));
+    __m512 p = maskz_loadu(mask, u.parameters + i);
     if (u.decay != 1.0f) p = _mm512_mul_ps(p, decay);
     p = _mm512_fnmadd_ps(_mm512_mul_ps(step, m), reciprocal_ps(_mm512_fmadd_ps(_mm512_sqrt_ps(v), scale, eps)), p);
-    _mm512_mask_storeu_ps(u.m + i, mask, m);
-    _mm512_mask_storeu_ps(u.v + i, mask, v);
-    _mm512_mask_storeu_ps(u.parameters + i, mask, p);
+    mask_storeu(u.m + i, mask, m);
+    mask_storeu(u.v + i, mask, v);
+    mask_storeu(u.parameters + i, mask, p);
   }
 }
 
@@ -282,7 +308,7 @@ HC_AVX512 void normal_pairs(std::ptrdiff_t pairs, const std::uint64_t* bits, flo
     const std::ptrdiff_t count = std::min<std::ptrdiff_t>(16, pairs - i);
     const __mmask8 first = static_cast<__mmask8>(count >= 8 ? 0xFF : (1u << count) - 1u);
     const __mmask8 second = static_cast<__mmask8>(count >= 16 ? 0xFF : count <= 8 ? 0 : (1u << (count - 8)) - 1u);
-    const __m512i b0 = _mm512_maskz_loadu_epi64(first, bits + i), b1 = _mm512_maskz_loadu_epi64(second, bits + i + 8);
+    const __m512i b0 = maskz_loadu_epi64(first, bits + i), b1 = maskz_loadu_epi64(second, bits + i + 8);
     // High and low 24-bit fields of each draw (BoxMuller::high24 / low24), 16 lanes each.
     const __m512i high = _mm512_inserti64x4(_mm512_castsi256_si512(_mm512_cvtepi64_epi32(_mm512_srli_epi64(b0, 40))),
                                             _mm512_cvtepi64_epi32(_mm512_srli_epi64(b1, 40)), 1);
@@ -298,8 +324,8 @@ HC_AVX512 void normal_pairs(std::ptrdiff_t pairs, const std::uint64_t* bits, flo
     c = _mm512_mul_ps(radius, c);
     s = _mm512_mul_ps(radius, s);
     const __mmask16 lanes = tail_mask(2 * count), lanes_high = tail_mask(2 * count - 16 > 0 ? 2 * count - 16 : 0);
-    _mm512_mask_storeu_ps(out + 2 * i, lanes, _mm512_permutex2var_ps(c, interleave_low, s));
-    _mm512_mask_storeu_ps(out + 2 * i + 16, lanes_high, _mm512_permutex2var_ps(c, interleave_high, s));
+    mask_storeu(out + 2 * i, lanes, _mm512_permutex2var_ps(c, interleave_low, s));
+    mask_storeu(out + 2 * i + 16, lanes_high, _mm512_permutex2var_ps(c, interleave_high, s));
   }
 }
 

@@ -30,6 +30,15 @@ class InvalidScene : public Error {
   using Error::Error;
 };
 
+/// A policy produced a non-finite action or pose (nan or infinity): its network diverged on this
+/// observation, or the observation is far outside its training data. A ChunkPolicy throws it
+/// rather than return such a chunk; sim's rollouts count the trial as invalid instead of stopping
+/// (`handcentric eval --strict` stops).
+class NonFiniteAction : public InvalidScene {
+ public:
+  using InvalidScene::InvalidScene;
+};
+
 /// A file that cannot be read or written: names the path, the reason and the fix.
 class FileError : public Error {
  public:

@@ -8,6 +8,13 @@
 // Validating constructors throw InvalidTransform (non-finite translation, bad homogeneous row)
 // or InvalidRotation (bad rotation block); unchecked() is the fast path for inner loops whose
 // inputs are rigid by construction.
+//
+// Valid input, on which every function here returns finite values (tests/core/test_numerics.cpp):
+// rotations that pass Rotation::from_matrix, translations (and twists' rho) with coordinates up
+// to 1e150 in magnitude, so that sums and products of two stay far from overflow, and any finite
+// rotation vector omega (exp wraps it). Accuracy, with so3.hpp's constants:
+//   - |exp(log(T)) - T| (distance below) <= so3::kRoundTripError * (1 + |p|);
+//   - |log(exp(xi)) - xi| <= so3::kRoundTripError * (1 + |rho|) when |omega| <= pi - so3::kSignAmbiguity.
 #include <Eigen/Core>
 
 #include "handcentric/core/rotation.hpp"

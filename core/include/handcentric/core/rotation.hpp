@@ -25,11 +25,13 @@ class Rotation {
   /// Unchecked fast path for inner loops: R must already be a rotation matrix.
   static Rotation from_matrix_unchecked(const Eigen::Matrix3d& R) noexcept { return Rotation(R); }
 
-  /// The rotation nearest to M in the Frobenius norm (SVD projection, det fixed to +1).
-  /// Throws InvalidRotation for non-finite or rank-deficient M.
+  /// The rotation nearest to M in the Frobenius norm (SVD projection, det fixed to +1), for M of
+  /// any scale. Throws InvalidRotation for non-finite or rank-deficient M (smallest singular
+  /// value at most 1e-12 times the largest).
   static Rotation nearest(const Eigen::Matrix3d& M);
 
-  /// From a quaternion w + xi + yj + zk of any nonzero norm (normalized here).
+  /// From a quaternion w + xi + yj + zk of any nonzero finite norm, 1e-300 or 1e300 alike
+  /// (normalized here).
   /// Throws InvalidRotation for a zero or non-finite quaternion.
   static Rotation from_quaternion(double w, double x, double y, double z);
 

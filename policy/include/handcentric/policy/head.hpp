@@ -10,6 +10,7 @@
 //            z through the origin, f(x) = 1/8 sum_g g_* f(g^-1 x), on ABSOLUTE actions: the
 //            analogue of Equivariant Diffusion Policy [7] (not [7] itself; see c8_action.hpp)
 #include <Eigen/Core>
+#include <cstdint>
 #include <memory>
 #include <random>
 
@@ -52,5 +53,9 @@ class Head {
 /// observation_dimension must be set). Throws InvalidArgument for a bad config, and for c8flow
 /// with a representation other than "absolute".
 std::unique_ptr<Head> make_head(const PolicyConfig& config);
+
+/// The number of float32 weights make_head(config) holds (and a model file stores), computed
+/// without allocating anything. Throws InvalidArgument for a config make_head refuses.
+std::uint64_t parameter_count(const PolicyConfig& config);
 
 }  // namespace handcentric::policy

@@ -29,8 +29,9 @@ class LearnedPolicy final : public ChunkPolicy {
   /// "<head>/<representation>", e.g. "flow/hand_centric".
   std::string name() const override;
 
-  /// Throws InvalidScene for an invalid observation, one whose H or point counts differ from
-  /// training, or a non-finite output (an observation far outside the training data).
+  /// Throws InvalidScene for an invalid observation or one whose H or point counts differ from
+  /// training, and NonFiniteAction (an InvalidScene) for a non-finite output (an observation far
+  /// outside the training data, or diverged weights).
   std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
 
   /// The head's raw action vector for `observation` (before decoding).

@@ -8,6 +8,12 @@
 //   {"world_T_hole": P, "world_T_hand": [P, P, ...]}
 // where each pose P is a 3x4 matrix [[r00, r01, r02, x], [r10, r11, r12, y], [r20, r21, r22, z]]
 // (row-major, shortest round-trip decimal, so a load gives back the same bits).
+//
+// Bounded input: load_demos refuses a file that passes one of the limits below with
+// InvalidDemoFile, before it allocates for what is over the limit. Its memory is at most one line
+// (and that line's JSON tree, ~20 bytes per byte of the line) plus the poses it keeps, so a
+// hostile or broken file costs at most a few hundred MB (tests/sim/test_demo_limits.cpp measures it).
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -25,13 +31,30 @@ class InvalidDemoFile : public Error {
   using Error::Error;
 };
 
+/// What load_demos accepts. An expert demo of the task has ~50-300 poses (~250 bytes each), a
+/// data set of Table 1 at most 100 demos: the defaults are far above real files. Tests pass
+/// smaller limits to reach each one cheaply.
+struct DemoFileLimits {
+  /// Bytes of one line, without its newline: 4 MiB, ~16000 poses.
+  std::size_t max_line_bytes = std::size_t{4} << 20;
+  /// Containers nested in one line: a record is 4 deep (record, pose list, pose, row).
+  int max_json_depth = 8;
+  /// Demos the header may announce.
+  std::size_t max_demos = 100'000;
+  /// Poses in one demo.
+  std::size_t max_poses_per_demo = 10'000;
+  /// Poses in the whole file (~200 MB once loaded).
+  std::size_t max_poses = 2'000'000;
+};
+
 struct Demo {
   RigidTransform world_T_hole;               ///< the hole (planar)
   std::vector<RigidTransform> world_T_hand;  ///< the hand at each control step; [0] = start
 };
 
-/// Reads and validates a demo file (format above). Throws InvalidDemoFile naming the record.
-std::vector<Demo> load_demos(const std::string& path);
+/// Reads and validates a demo file (format above). Throws InvalidDemoFile naming the record, also
+/// for a file over one of the DemoFileLimits (naming the limit).
+std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits = DemoFileLimits());
 
 /// Writes `demos` atomically (a temporary file beside `path`, then rename). Throws
 /// InvalidArgument for an empty or non-planar demo, Error when the file cannot be written.

@@ -9,7 +9,10 @@
 // a command beyond the per-step limits is clipped to them along the straight (theta, x, y) line,
 // and counted. Every motion is checked continuously (collision.hpp) in the hole frame.
 // Outcome: success as soon as the tip is kSuccessDepth deep inside the opening; collision at the
-// first contact; timeout when the replans run out.
+// first contact; timeout when the replans run out; invalid when the policy returns a non-finite
+// pose or throws NonFiniteAction (core/errors.hpp), which ends the rollout there. An invalid
+// trial is a failure with its own count, so one diverging scene in a long evaluation is reported
+// rather than fatal; RolloutOptions::stop_on_invalid makes it an error instead.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,6 +34,9 @@ struct RolloutOptions {
   int max_replans = 25;    ///< kStepBudget / execute
   double max_step_cm = kMaxStepCm;
   double max_step_deg = kMaxStepDeg;
+  /// A non-finite pose from the policy: false ends the rollout as Outcome::invalid, true throws
+  /// NonFiniteAction naming the policy, the replan and the chunk entry (`eval --strict`).
+  bool stop_on_invalid = false;
 
   /// Throws InvalidArgument naming the field for a non-positive value (history may be 0).
   void validate() const;
@@ -40,9 +46,9 @@ struct RolloutOptions {
   static RolloutOptions for_policy(int history, int execute);
 };
 
-enum class Outcome { success, collision, timeout };
+enum class Outcome { success, collision, timeout, invalid };
 
-/// "success", "collision", "timeout".
+/// "success", "collision", "timeout", "invalid".
 std::string outcome_name(Outcome outcome);
 
 struct Rollout {
@@ -52,6 +58,7 @@ struct Rollout {
   int clipped = 0;                           ///< commands clipped to the step limits
   std::vector<RigidTransform> world_T_hand;  ///< [0] = start, then one pose per step (the last
                                              ///< one is the colliding pose after a collision)
+  std::string invalid_reason;                ///< Outcome::invalid: what the policy returned, where
 };
 
 /// The observation at the end of `world_T_hand` (history of `history` past poses, eye-in-hand
@@ -63,15 +70,20 @@ Scene observation(const RigidTransform& world_T_hole, const std::vector<RigidTra
 bool is_inserted(const RigidTransform& hole_T_hand, const PegHoleGeometry& geometry = PegHoleGeometry());
 
 /// One rollout; act() call r gets the noise seed stream_seed(seed, r). Throws InvalidArgument
-/// when the policy returns an empty chunk or a non-finite pose (naming the policy and the replan).
+/// when the policy returns an empty chunk (naming the policy and the replan); a non-finite pose
+/// is Outcome::invalid, or NonFiniteAction with options.stop_on_invalid.
 Rollout rollout(const ChunkPolicy& policy, const TaskScene& scene, const CollisionChecker& checker,
                 std::uint64_t seed, const RolloutOptions& options = RolloutOptions());
 
 struct RolloutSummary {
   int trials = 0, success = 0, collision = 0, timeout = 0, clipped = 0;
+  int invalid = 0;                   ///< trials whose policy returned a non-finite pose
+  int first_invalid_scene = -1;      ///< index of the first such scene, -1 when none
+  std::string first_invalid_reason;  ///< its Rollout::invalid_reason
 };
 
-/// Rollouts on every scene (scene i uses seed stream_seed(seed, i)), counted.
+/// Rollouts on every scene (scene i uses seed stream_seed(seed, i)), counted. With
+/// options.stop_on_invalid the first invalid trial throws NonFiniteAction naming its scene.
 RolloutSummary evaluate(const ChunkPolicy& policy, const std::vector<TaskScene>& scenes,
                         const CollisionChecker& checker, std::uint64_t seed,
                         const RolloutOptions& options = RolloutOptions());
