@@ -4,29 +4,19 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 
+#include "drawing.hpp"
 #include "handcentric/core/errors.hpp"
 
 namespace handcentric::experiments {
 namespace {
 
-cv::Scalar rgb(int r, int g, int b) { return cv::Scalar(b, g, r); }  // OpenCV stores BGR
+using drawing::dashed;
+using drawing::rgb;
+using drawing::text;
 
 // Colour-blind-safe (Okabe-Ito) colours, one per series in row order.
 const cv::Scalar kColours[] = {rgb(0, 114, 178), rgb(213, 94, 0), rgb(0, 158, 115), rgb(204, 121, 167),
                                rgb(230, 159, 0), rgb(86, 180, 233), rgb(0, 0, 0)};
-
-void dashed(cv::Mat& canvas, cv::Point a, cv::Point b, const cv::Scalar& colour) {
-  const double length = std::hypot(b.x - a.x, b.y - a.y);
-  const int pieces = std::max(1, static_cast<int>(length / 8.0));
-  for (int i = 0; i < pieces; i += 2) {
-    const double s0 = static_cast<double>(i) / pieces, s1 = std::min(1.0, static_cast<double>(i + 1) / pieces);
-    cv::line(canvas, a + (b - a) * s0, a + (b - a) * s1, colour, 2, cv::LINE_AA);
-  }
-}
-
-void text(cv::Mat& canvas, const std::string& s, cv::Point at, double scale = 0.5) {
-  cv::putText(canvas, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, rgb(20, 20, 20), 1, cv::LINE_AA);
-}
 
 }  // namespace
 
@@ -116,13 +106,7 @@ sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
   std::snprintf(seed_text, sizeof seed_text, "training seed %llu", static_cast<unsigned long long>(seed));
   text(canvas, seed_text, key + cv::Point(40, 61));
 
-  cv::Mat rgb_mat;
-  cv::cvtColor(canvas, rgb_mat, cv::COLOR_BGR2RGB);
-  sim::Image image;
-  image.width = rgb_mat.cols;
-  image.height = rgb_mat.rows;
-  image.rgb.assign(rgb_mat.data, rgb_mat.data + rgb_mat.total() * 3);
-  return image;
+  return drawing::to_image(canvas);
 }
 
 void write_table1_png(const std::string& path, const std::vector<Row>& rows) {
