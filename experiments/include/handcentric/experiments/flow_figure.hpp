@@ -1,7 +1,7 @@
 #pragma once
-// Figure 3 of "Hand-Centric Action Representations ..." (Sec. 3 and App. A): what a global rigid
-// transform does to the rectified-flow problem of the first action a_1, for absolute, relative
-// and hand-centric actions.
+// Figure 3 of "Guaranteed SE(3)-Equivariant Control via Hand-Centric Behavior Cloning" (Sec. 3,
+// App. A): what a global rigid transform does to the rectified-flow problem of the first action
+// a_1, for absolute, relative and hand-centric actions.
 //
 // For each representation, on the 2D peg-in-hole task:
 //   - the training samples of a_1's 2D position (x, y of its translation) over all training
