@@ -261,4 +261,30 @@ std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K,
   return scenes;
 }
 
+Demo mirrored_about_hole_axis(const Demo& demo) {
+  if (demo.world_T_hand.empty()) throw InvalidArgument("mirrored_about_hole_axis: the demo has no hand pose");
+  Demo mirrored;
+  mirrored.world_T_hole = demo.world_T_hole;
+  mirrored.world_T_hand.reserve(demo.world_T_hand.size());
+  for (const RigidTransform& world_T_hand : demo.world_T_hand) {
+    const RigidTransform hole_T_hand = demo.world_T_hole.inverse_compose(world_T_hand);
+    const Eigen::Matrix3d& R = hole_T_hand.rotation().matrix();
+    const Eigen::Vector3d& p = hole_T_hand.translation();
+    if (std::abs(p.z()) > 1e-9 || std::abs(R(2, 2) - 1.0) > 1e-9) {
+      throw InvalidArgument("mirrored_about_hole_axis: a hand pose is not planar in its hole's frame (z = " +
+                            std::to_string(p.z()) + "): only planar demos can be mirrored");
+    }
+    const double theta = std::atan2(R(1, 0), R(0, 0));
+    mirrored.world_T_hand.push_back(demo.world_T_hole * RigidTransform::planar(-theta, -p.x(), p.y()));
+  }
+  return mirrored;
+}
+
+std::vector<Demo> with_mirrored_demos(const std::vector<Demo>& demos) {
+  std::vector<Demo> all = demos;
+  all.reserve(2 * demos.size());
+  for (const Demo& demo : demos) all.push_back(mirrored_about_hole_axis(demo));
+  return all;
+}
+
 }  // namespace handcentric::sim

@@ -153,3 +153,68 @@ TEST_CASE("training_scenes_of_the_first_n_demos_are_theirs_in_demo_order", "[uni
   HC_CHECK_THROWS(training_scenes(demos, 0, 4, 4), InvalidArgument, Contains("4 demos") && Contains("only 3"));
   HC_CHECK_THROWS(training_scenes(demos, 0, 4, -1), InvalidArgument, Contains("-1"));
 }
+
+namespace {
+
+// What a mirror image of a demo must be: every pose and every motion free of collision, the peg
+// inserted at the end, each eye-in-hand observation the reflection (x -> -x, left and right
+// corners swapped) of the original's, and the mirror of the mirror the original. Returns the
+// first violation, empty when there is none.
+std::string mirror_violation(const Demo& demo, const Demo& mirrored) {
+  const CollisionChecker checker;
+  if (mirrored.world_T_hand.size() != demo.world_T_hand.size()) return "a different number of poses";
+  for (std::size_t t = 0; t < demo.world_T_hand.size(); ++t) {
+    const RigidTransform hole_T_hand = mirrored.world_T_hole.inverse_compose(mirrored.world_T_hand[t]);
+    if (checker.collides(hole_T_hand)) return "pose " + std::to_string(t) + " collides";
+    if (t > 0 &&
+        checker.motion_collides(mirrored.world_T_hole.inverse_compose(mirrored.world_T_hand[t - 1]), hole_T_hand)) {
+      return "the motion into pose " + std::to_string(t) + " collides";
+    }
+    const auto seen = eye_in_hand_points(demo.world_T_hole, demo.world_T_hand[t]);
+    const auto seen_mirrored = eye_in_hand_points(mirrored.world_T_hole, mirrored.world_T_hand[t]);
+    for (int i = 0; i < 2; ++i) {
+      const Eigen::Vector3d reflected(-seen[1 - i].x(), seen[1 - i].y(), seen[1 - i].z());
+      if ((seen_mirrored[i] - reflected).norm() > 1e-9) return "observation " + std::to_string(t) + " is not reflected";
+    }
+  }
+  const RigidTransform hole_T_end = mirrored.world_T_hole.inverse_compose(mirrored.world_T_hand.back());
+  if ((hole_T_end * Eigen::Vector3d(0, -kPegLength, 0)).y() > -kSuccessDepth) return "the peg is not inserted";
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("a_demo_mirrored_about_its_hole_axis_is_another_valid_insertion", "[unit]") {
+  const std::vector<Demo> demos = some_demos(6);
+  REQUIRE(demos.size() == 6);
+  const std::vector<Demo> all = with_mirrored_demos(demos);
+  REQUIRE(all.size() == 12);
+  for (std::size_t i = 0; i < demos.size(); ++i) {
+    INFO("demo " << i);
+    CHECK(mirror_violation(demos[i], all[6 + i]).empty());
+    CHECK(same_bits(all[i].world_T_hand.back(), demos[i].world_T_hand.back()));
+    const Demo twice = mirrored_about_hole_axis(all[6 + i]);
+    for (std::size_t t = 0; t < twice.world_T_hand.size(); ++t) {
+      CHECK((twice.world_T_hand[t].matrix() - demos[i].world_T_hand[t].matrix()).norm() < 1e-9);
+    }
+  }
+  HC_CHECK_THROWS(mirrored_about_hole_axis(Demo()), InvalidArgument, Contains("no hand pose"));
+}
+
+TEST_CASE("mutant_a_mirror_that_keeps_the_angle_is_caught", "[unit]") {
+  // Planted fault: x negated but the angle kept, a pose no reflection gives.
+  const std::vector<Demo> demos = some_demos(3);
+  int caught = 0;
+  for (const Demo& demo : demos) {
+    Demo wrong = demo;
+    for (RigidTransform& world_T_hand : wrong.world_T_hand) {
+      const RigidTransform hole_T_hand = demo.world_T_hole.inverse_compose(world_T_hand);
+      const Eigen::Matrix3d& R = hole_T_hand.rotation().matrix();
+      world_T_hand = demo.world_T_hole * RigidTransform::planar(std::atan2(R(1, 0), R(0, 0)),
+                                                                -hole_T_hand.translation().x(),
+                                                                hole_T_hand.translation().y());
+    }
+    if (!mirror_violation(demo, wrong).empty()) ++caught;
+  }
+  CHECK(caught == 3);
+}

@@ -80,4 +80,14 @@ std::vector<Scene> training_scenes(const Demo& demo, int H, int K,
 std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K, int max_demos = 0,
                                    const PegHoleGeometry& geometry = PegHoleGeometry());
 
+/// The demo reflected about its hole's axis (the hole frame's y axis): every hand pose
+/// hole_T_hand = planar(theta, x, y) becomes planar(-theta, -x, y). The peg, the hole and the
+/// start-pose range are symmetric about that axis (docs/SIM.md), so the result is another
+/// collision-free insertion from a start pose of the same distribution: training data the
+/// task's own symmetry gives for free. Throws InvalidArgument for an empty or non-planar demo.
+Demo mirrored_about_hole_axis(const Demo& demo);
+
+/// `demos` followed by mirrored_about_hole_axis of each.
+std::vector<Demo> with_mirrored_demos(const std::vector<Demo>& demos);
+
 }  // namespace handcentric::sim
