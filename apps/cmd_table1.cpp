@@ -73,6 +73,8 @@ void add_table1_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--steps", t.steps, "Adam steps per cell (0: the library's automatic budget)")->capture_default_str();
   cmd->add_option("--jobs", t.jobs, "trainings at once (0: one per hardware thread)")->capture_default_str();
   auto* out = cmd->add_option("--out", t.out, "output directory")->capture_default_str();
+  cmd->add_flag("--no-mirror{false}", t.data.mirror,
+                "train every cell on its demos only, not also on their mirror images about the hole axis");
   cmd->add_flag("--resume", t.resume, "reuse the models and results already in --out");
   auto* plan = cmd->add_flag("--plan", options->plan, "write --out/jobs.txt (one shell line per cell) and stop");
   auto* collect = cmd->add_option("--collect", options->collect, "build the table from the results in DIR");

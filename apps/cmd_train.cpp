@@ -33,7 +33,7 @@ struct TrainOptions {
   std::string lr_schedule = policy::to_string(config.lr_schedule);
   std::uint64_t seed = 1;
   int max_demos = 0;
-  bool mirror = false;
+  sim::TrainingData data;
   bool quiet = false;
 };
 
@@ -65,9 +65,8 @@ int run_train(const TrainOptions& options) {
                           std::to_string(demos.size()) + " demos: give 0 (all) up to " + std::to_string(demos.size()));
   }
   const std::size_t used = options.max_demos == 0 ? demos.size() : static_cast<std::size_t>(options.max_demos);
-  std::vector<sim::Demo> training_demos(demos.begin(), demos.begin() + static_cast<std::ptrdiff_t>(used));
-  if (options.mirror) training_demos = sim::with_mirrored_demos(training_demos);
-  const std::vector<Scene> scenes = sim::training_scenes(training_demos, config.history_length, config.chunk_length);
+  const std::vector<Scene> scenes =
+      sim::training_scenes(demos, config.history_length, config.chunk_length, options.max_demos, options.data);
   if (config.steps == 0) config.steps = policy::training_budget(static_cast<long long>(scenes.size()));
 
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
@@ -85,7 +84,8 @@ int run_train(const TrainOptions& options) {
   const policy::LearnedPolicy trained = policy::train_policy(config, scenes, options.seed, progress, report_every);
   policy::save_model(trained, options.out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << "trained " << trained.name() << " on " << scenes.size() << " scenes from " << used << " demos: "
+  std::cout << "trained " << trained.name() << " on " << scenes.size() << " scenes from " << used << " demos"
+            << (options.data.mirror ? " and their mirror images" : "") << ": "
             << config.steps << " steps, final loss " << last_loss << ", " << static_cast<long>(last_rate)
             << " samples/s (" << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
             << " -> " << options.out << "\n";
@@ -105,7 +105,8 @@ void add_train_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--steps", config.steps, "Adam steps (0: the automatic budget for the number of training samples)")
       ->capture_default_str();
   cmd->add_option("--seed", options->seed, "seed of initialization, minibatches and noise")->capture_default_str();
-  cmd->add_flag("--mirror", options->mirror, "also train on each demo reflected about its hole's axis");
+  cmd->add_flag("--no-mirror{false}", options->data.mirror,
+                "train on the demos only, not also on their mirror images about the hole axis");
   cmd->add_option("--max-demos", options->max_demos, "train on the first N demos only (0 = all)")
       ->capture_default_str();
   cmd->add_option("--chunk", config.chunk_length, "K, actions per chunk")->capture_default_str();

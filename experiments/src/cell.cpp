@@ -41,23 +41,26 @@ std::string digest(const std::string& bytes) {
 std::string cell_hash(const Cell& cell) {
   const std::string text = "handcentric table1 cell\ndemo_digest=" + cell.demo_digest +
                            "\ndemos=" + std::to_string(cell.demos) + "\ntrain_seed=" + std::to_string(cell.train_seed) +
+                           "\nmirror=" + (cell.data.mirror ? "1" : "0") +
                            "\nmodel_format=" + std::to_string(policy::kModelFormatVersion) + "\n" +
                            cell.config.to_text();
   return digest(text);
 }
 
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
-               std::uint64_t train_seed, long long training_samples, const std::string& demo_digest, int steps) {
+               std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps,
+               const sim::TrainingData& data) {
   Cell cell;
   cell.method = method;
   cell.head = head;
   cell.demos = demos;
   cell.train_seed = train_seed;
   cell.demo_digest = demo_digest;
+  cell.data = data;
   cell.config.representation = representation;
   cell.config.head = policy::parse_head(head);
   if (steps > 0) cell.config.steps = steps;
-  if (cell.config.steps == 0) cell.config.steps = policy::training_budget(training_samples);
+  if (cell.config.steps == 0) cell.config.steps = policy::training_budget(data.samples(demo_samples));
   cell.config.validate();
   cell.hash = cell_hash(cell);
   return cell;

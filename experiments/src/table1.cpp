@@ -70,7 +70,7 @@ void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir, c
   const policy::LearnedPolicy trained = [&] {
     if (fs::exists(model_path)) return policy::load_model(model_path.string());
     const auto scenes =
-        sim::training_scenes(demos, cell.config.history_length, cell.config.chunk_length, cell.demos);
+        sim::training_scenes(demos, cell.config.history_length, cell.config.chunk_length, cell.demos, cell.data);
     policy::LearnedPolicy model = policy::train_policy(cell.config, scenes, cell.train_seed);
     policy::save_model(model, model_path.string());
     return model;
@@ -104,6 +104,7 @@ nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval, std:
                      {"demos", c.demos},
                      {"train_seed", c.train_seed},
                      {"steps", c.config.steps},
+                     {"mirror", c.data.mirror},
                      {"hash", c.hash}});
   }
   return {{"format", "handcentric-table1-cells"},
@@ -231,7 +232,8 @@ Table1Grid prepare_table1(const Table1Options& options) {
       for (const std::uint64_t seed : options.train_seeds) {
         for (const int n : options.demo_counts) {
           grid.cells.push_back(make_cell(method.name, method.representation, head, n, seed,
-                                         samples_upto[static_cast<std::size_t>(n)], demo_digest, options.steps));
+                                         samples_upto[static_cast<std::size_t>(n)], demo_digest, options.steps,
+                                         options.data));
         }
       }
     }
@@ -291,7 +293,8 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
     std::string line = "cd " + shell_quote(grid.dir) + " && { test -f " + cell.model_path() + " || " +
                        shell_quote(cli) + " train --demos " + grid.demo_file + " --max-demos " +
                        std::to_string(cell.demos) + " --repr " + cell.config.representation + " --head " + cell.head +
-                       " --steps " + std::to_string(cell.config.steps) + " --seed " + std::to_string(cell.train_seed) +
+                       " --steps " + std::to_string(cell.config.steps) + (cell.data.mirror ? "" : " --no-mirror") +
+                       " --seed " + std::to_string(cell.train_seed) +
                        " --quiet --out " + cell.model_path() + " >/dev/null; }";
     for (const SceneSet set : kSceneSets) {
       const std::string result = cell.result_path(set, eval);
@@ -329,6 +332,8 @@ std::string collect_table1(const std::string& dir_text) {
       cell.demos = c.at("demos").get<int>();
       cell.train_seed = c.at("train_seed").get<std::uint64_t>();
       cell.config.steps = c.at("steps").get<int>();
+      // Runs written before the mirror images existed trained on the demos only.
+      cell.data.mirror = c.contains("mirror") && c.at("mirror").get<bool>();
       cell.hash = c.at("hash").get<std::string>();
       rows.push_back(collect_row(cell, eval, dir.string()));
     }

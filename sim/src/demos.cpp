@@ -287,4 +287,17 @@ std::vector<Demo> with_mirrored_demos(const std::vector<Demo>& demos) {
   return all;
 }
 
+std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K, int max_demos,
+                                   const TrainingData& data, const PegHoleGeometry& geometry) {
+  std::vector<Scene> scenes = training_scenes(demos, H, K, max_demos, geometry);
+  if (!data.mirror) return scenes;
+  const std::size_t used = max_demos == 0 ? demos.size() : static_cast<std::size_t>(max_demos);
+  for (std::size_t i = 0; i < used; ++i) {
+    for (Scene& scene : training_scenes(mirrored_about_hole_axis(demos[i]), H, K, geometry)) {
+      scenes.push_back(std::move(scene));
+    }
+  }
+  return scenes;
+}
+
 }  // namespace handcentric::sim

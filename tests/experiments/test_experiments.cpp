@@ -44,7 +44,14 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   const Cell base = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff");
   CHECK(base.hash == make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff").hash);
   CHECK(base.hash.size() == 16);
-  CHECK(base.config.steps == policy::training_budget(320));  // the library's automatic budget
+  // The library's automatic budget, for the 320 demo scenes and their 320 mirror images.
+  CHECK(base.config.steps == policy::training_budget(640));
+  sim::TrainingData demos_only;
+  demos_only.mirror = false;
+  const Cell unmirrored = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 0, demos_only);
+  CHECK(unmirrored.config.steps == policy::training_budget(320));
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", base.config.steps,
+                               demos_only).hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 20, 1, 320, "00ff").hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 2, 320, "00ff").hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00fe").hash);

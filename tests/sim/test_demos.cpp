@@ -218,3 +218,20 @@ TEST_CASE("mutant_a_mirror_that_keeps_the_angle_is_caught", "[unit]") {
   }
   CHECK(caught == 3);
 }
+
+TEST_CASE("training_data_adds_the_mirror_images_after_the_demos_by_default", "[unit]") {
+  const std::vector<Demo> demos = some_demos(3);
+  const std::vector<Scene> plain = training_scenes(demos, 0, 4, 2);
+  const std::vector<Scene> mirrored = training_scenes(demos, 0, 4, 2, TrainingData());
+  REQUIRE(TrainingData().mirror);
+  REQUIRE(mirrored.size() == 2 * plain.size());
+  CHECK(TrainingData().samples(static_cast<long long>(plain.size())) == static_cast<long long>(mirrored.size()));
+  for (std::size_t i = 0; i < plain.size(); ++i) CHECK(same_bits(mirrored[i].world_T_hand0(), plain[i].world_T_hand0()));
+  const std::vector<Scene> of_mirrors = training_scenes(with_mirrored_demos({demos[0], demos[1]}), 0, 4, 0);
+  for (std::size_t i = plain.size(); i < mirrored.size(); ++i) {
+    CHECK(same_bits(mirrored[i].world_T_hand0(), of_mirrors[i].world_T_hand0()));
+  }
+  TrainingData off;
+  off.mirror = false;
+  CHECK(training_scenes(demos, 0, 4, 2, off).size() == plain.size());
+}

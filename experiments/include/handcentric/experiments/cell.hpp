@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "handcentric/policy/config.hpp"
+#include "handcentric/sim/demos.hpp"
 
 namespace handcentric::experiments {
 
@@ -34,6 +35,7 @@ struct Cell {
   std::string head;             ///< flow, ddpm, cvae, c8flow
   int demos = 0;                ///< the first `demos` demos of the demo file
   std::uint64_t train_seed = 1;
+  sim::TrainingData data;       ///< the demos' mirror images too, or not
   policy::PolicyConfig config;  ///< representation, head and the resolved step budget set
   std::string demo_digest;      ///< FNV-1a 64 (hex) of the demo file's bytes
   std::string hash;             ///< cell_hash(*this), set by make_cell
@@ -52,9 +54,11 @@ std::string digest(const std::string& bytes);
 std::string cell_hash(const Cell& cell);
 
 /// A cell with its config from the library defaults (PolicyConfig{}), the method's
-/// representation and the head, and `steps` Adam steps (0: the automatic budget for
-/// `training_samples`, trainer.hpp training_budget); hash set.
+/// representation and the head, and `steps` Adam steps (0: the automatic budget for the
+/// training samples that `data` makes of `demo_samples` demo scenes, trainer.hpp
+/// training_budget); hash set.
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
-               std::uint64_t train_seed, long long training_samples, const std::string& demo_digest, int steps = 0);
+               std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps = 0,
+               const sim::TrainingData& data = sim::TrainingData());
 
 }  // namespace handcentric::experiments

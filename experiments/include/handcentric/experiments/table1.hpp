@@ -32,6 +32,7 @@ struct Table1Options {
   std::vector<std::uint64_t> train_seeds = {1};
   EvalSettings eval;
   int steps = 0;  ///< Adam steps per cell; 0: the library's automatic budget (PolicyConfig)
+  sim::TrainingData data;  ///< every cell's training data recipe (the demos' mirror images too)
   int jobs = 0;  ///< trainings at once; 0: one per hardware thread
   std::string out = "table1";
   bool resume = false;
