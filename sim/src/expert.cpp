@@ -9,6 +9,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "scene_helpers.hpp"
 
 namespace handcentric::sim {
 namespace {
@@ -101,7 +102,7 @@ Vec3 to_u(const RigidTransform& pose) {
 
 RigidTransform from_u(const Vec3& u) { return RigidTransform::planar(u(0) / kAngleScale, u(1), u(2)); }
 
-double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
+using detail::uniform;
 
 bool is_planar(const RigidTransform& pose) {
   const Eigen::Matrix4d M = pose.matrix();
