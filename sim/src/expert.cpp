@@ -251,14 +251,7 @@ ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t 
 ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed, const CollisionChecker& checker,
                        const ExpertOptions& options) {
   ExpertRun total;
-  for (std::size_t i = 0; i < scenes.size(); ++i) {
-    ExpertRun one = expert_demo(scenes[i], seed, i, checker, options);
-    total.scenes += one.scenes;
-    total.unsolved += one.unsolved;
-    total.solutions += one.solutions;
-    total.discarded += one.discarded;
-    for (Demo& demo : one.demos) total.demos.push_back(std::move(demo));
-  }
+  for (std::size_t i = 0; i < scenes.size(); ++i) total.append(expert_demo(scenes[i], seed, i, checker, options));
   return total;
 }
 
