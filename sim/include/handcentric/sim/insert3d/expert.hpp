@@ -30,6 +30,7 @@
 
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/sim/insert3d/collision.hpp"
+#include "handcentric/sim/insert3d/demos.hpp"
 #include "handcentric/sim/insert3d/scenes.hpp"
 #include "handcentric/sim/expert_run.hpp"
 
@@ -63,11 +64,6 @@ struct ExpertPlan {
 /// One plan from slot_T_hand_start (one random via point drawn from rng), then validated.
 ExpertPlan plan_in_slot_frame(const RigidTransform& slot_T_hand_start, std::mt19937_64& rng,
                               const CollisionChecker& checker, const ExpertOptions& options = ExpertOptions());
-
-struct Demo {
-  RigidTransform world_T_slot;
-  std::vector<RigidTransform> world_T_hand;  ///< the hand at each control step; [0] = start
-};
 
 using ExpertRun = BasicExpertRun<Demo>;
 
