@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "insert3d_options.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
@@ -50,13 +51,8 @@ int report(const DemosOptions& options, const std::string& dist, const Run& run)
 
 // The 3D blade insertion (sim/insert3d): --dist train, ood or random-se3, or --rotate-deg.
 int run_insert3d_demos(const DemosOptions& options) {
-  if (!options.hole_angle_deg.empty() || !options.transform.empty()) {
-    throw InvalidArgument("--hole-angle-deg and --transform are options of the 2D task; with --task insert3d use "
-                          "--dist train|ood|random-se3 or --rotate-deg RX,RY,RZ");
-  }
   const sim::insert3d::SceneDistribution distribution =
-      options.rotate_deg.empty() ? sim::insert3d::SceneDistribution::parse(options.dist)
-                                 : sim::insert3d::SceneDistribution::parse_rotate_deg(options.rotate_deg);
+      insert3d_distribution(options.dist, options.rotate_deg, options.hole_angle_deg, options.transform);
   const sim::insert3d::CollisionChecker checker;
   const sim::insert3d::ExpertRun run =
       sim::insert3d::expert_demos(sim::insert3d::sample_scenes(distribution, options.n, options.seed), options.seed, checker);
@@ -67,9 +63,7 @@ int run_insert3d_demos(const DemosOptions& options) {
 int run_demos(const DemosOptions& options) {
   if (options.n < 1) throw InvalidArgument("--n must be at least 1, got " + std::to_string(options.n));
   if (options.task == "insert3d") return run_insert3d_demos(options);
-  if (!options.rotate_deg.empty() || options.dist == "random-se3") {
-    throw InvalidArgument("--rotate-deg and --dist random-se3 are options of the 3D task: add --task insert3d");
-  }
+  refuse_3d_options(options.dist, options.rotate_deg);
   const sim::SceneDistribution distribution =
       sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist);
   auto scenes = sim::sample_scenes(distribution, options.n, options.seed);
