@@ -4,20 +4,24 @@
 // one-line warning on stderr naming the first such scene, so one diverging scene does not throw
 // away a long evaluation; --strict stops at it with an error instead.
 // Policies: --policy expert|straight|hold (no file needed), or --model FILE: a trained model
-// (policy/model_file.hpp), when this build has the policy module.
+// (policy/model_file.hpp), when this build has the policy module. With --task insert3d: the 3D
+// blade insertion (sim/insert3d/rollout.hpp), for now with --policy expert only.
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <iostream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "commands.hpp"
+#include "insert3d_options.hpp"
 #include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/experiments/results.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/expert_check.hpp"
+#include "handcentric/sim/insert3d/rollout.hpp"
 #include "handcentric/sim/policies.hpp"
 #include "handcentric/sim/rollout.hpp"
 #include "handcentric/sim/scenes.hpp"
@@ -26,6 +30,7 @@ namespace handcentric::apps {
 namespace {
 
 struct EvalOptions {
+  std::string task = "peg2d";
   std::string model;
   std::string policy;
   std::string dist;
@@ -37,10 +42,50 @@ struct EvalOptions {
   double noise_scale = std::numeric_limits<double>::quiet_NaN();  // NaN: the model's own
   int execute = 0;            // 0: the model's own
   bool strict = false;
+  std::string rotate_deg;
 };
+
+// The 3D blade insertion: closed-loop expert rollouts on --dist train|ood|random-se3 or
+// --rotate-deg scenes, counted as in 2D.
+int run_insert3d_eval(const EvalOptions& options) {
+  if (!options.model.empty() || (!options.policy.empty() && options.policy != "expert")) {
+    throw InvalidArgument("--task insert3d evaluates --policy expert only so far; learned and scripted policies "
+                          "run on the 2D task (--task peg2d)");
+  }
+  const sim::insert3d::SceneDistribution distribution =
+      insert3d_distribution(options.dist, options.rotate_deg, options.hole_angle_deg, options.transform);
+  const sim::insert3d::CollisionChecker checker;
+  const sim::insert3d::ClosedLoopExpert expert;
+  int counts[4] = {0, 0, 0, 0};
+  int clipped = 0;
+  const auto scenes = sim::insert3d::sample_scenes(distribution, options.trials, options.seed);
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const sim::insert3d::Rollout result =
+        sim::insert3d::rollout(expert, scenes[i], sim::stream_seed(options.seed, i), checker);
+    ++counts[static_cast<int>(result.outcome)];
+    clipped += result.clipped;
+  }
+  const double n = options.trials;
+  const nlohmann::json summary = {{"task", "insert3d"},  {"trials", options.trials},
+                                  {"success", counts[0] / n},  {"collision", counts[1] / n},
+                                  {"timeout", counts[2] / n},  {"invalid", counts[3]},
+                                  {"clipped", clipped},        {"policy", expert.name()},
+                                  {"dist", distribution.name()}, {"seed", options.seed}};
+  if (options.json) {
+    std::cout << summary.dump() << "\n";
+  } else {
+    std::cout << "policy " << expert.name() << " on " << options.trials << " insert3d '" << distribution.name()
+              << "' scenes (seed " << options.seed << "): success " << counts[0] / n << ", collision " << counts[1] / n
+              << ", timeout " << counts[2] / n << ", invalid " << counts[3] << "; " << clipped
+              << " commands clipped to the step limits\n";
+  }
+  return 0;
+}
 
 int run_eval(const EvalOptions& options) {
   if (options.trials < 1) throw InvalidArgument("--trials must be at least 1, got " + std::to_string(options.trials));
+  if (options.task == "insert3d") return run_insert3d_eval(options);
+  refuse_3d_options(options.dist, options.rotate_deg);
   const sim::SceneDistribution distribution =
       sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist);
   policy::SamplingOverrides overrides;
@@ -73,17 +118,24 @@ int run_eval(const EvalOptions& options) {
 
 void add_eval_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<EvalOptions>();
-  CLI::App* cmd = app.add_subcommand("eval", "closed-loop rollouts of a policy on the 2D peg-in-hole task");
+  CLI::App* cmd = app.add_subcommand("eval", "closed-loop rollouts of a policy on the 2D peg-in-hole task or the 3D blade insertion");
+  cmd->add_option("--task", options->task, "peg2d (the 2D task) or insert3d (the 3D blade insertion, --policy expert)")
+      ->check(CLI::IsMember({"peg2d", "insert3d"}))
+      ->capture_default_str();
   auto* model = cmd->add_option("--model", options->model, "a trained model file (from `handcentric train`)");
   auto* policy = cmd->add_option("--policy", options->policy, "a policy without a file: expert, straight, hold")
                      ->check(CLI::IsMember(sim::scripted_policy_names()));
   model->excludes(policy);
   policy->excludes(model);
-  auto* dist = cmd->add_option("--dist", options->dist, "scene distribution: train or ood")
-                   ->check(CLI::IsMember({"train", "ood"}));
+  auto* dist = cmd->add_option("--dist", options->dist, "scene distribution: train or ood (insert3d: also random-se3)")
+                   ->check(CLI::IsMember({"train", "ood", "random-se3"}));
   auto* angle = cmd->add_option("--hole-angle-deg", options->hole_angle_deg, "hole angles A:B in degrees, instead of --dist");
   dist->excludes(angle);
   angle->excludes(dist);
+  auto* rotate = cmd->add_option("--rotate-deg", options->rotate_deg,
+                                 "insert3d: train scenes under the global rotation RX,RY,RZ (XYZ Euler, degrees)");
+  rotate->excludes(dist);
+  rotate->excludes(angle);
   cmd->add_option("--trials", options->trials, "number of scenes (one rollout each)")->capture_default_str();
   cmd->add_option("--transform", options->transform,
                   "apply the global planar transform DEG,X,Y (degrees about z, then cm) to every scene");
@@ -96,7 +148,9 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--strict", options->strict,
                 "stop with an error at the first non-finite pose from the policy (default: count the trial as invalid)");
   cmd->callback([options, &exit_code] {
-    if (options->dist.empty() && options->hole_angle_deg.empty()) throw CLI::RequiredError("--dist or --hole-angle-deg");
+    if (options->dist.empty() && options->hole_angle_deg.empty() && options->rotate_deg.empty()) {
+      throw CLI::RequiredError("--dist, --hole-angle-deg or --rotate-deg");
+    }
     if (options->model.empty() && options->policy.empty()) throw CLI::RequiredError("--model or --policy");
     exit_code = run_eval(*options);
   });

@@ -9,6 +9,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "scene_helpers.hpp"
 
 namespace handcentric::sim {
 namespace {
@@ -101,7 +102,7 @@ Vec3 to_u(const RigidTransform& pose) {
 
 RigidTransform from_u(const Vec3& u) { return RigidTransform::planar(u(0) / kAngleScale, u(1), u(2)); }
 
-double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
+using detail::uniform;
 
 bool is_planar(const RigidTransform& pose) {
   const Eigen::Matrix4d M = pose.matrix();
@@ -250,14 +251,7 @@ ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t 
 ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed, const CollisionChecker& checker,
                        const ExpertOptions& options) {
   ExpertRun total;
-  for (std::size_t i = 0; i < scenes.size(); ++i) {
-    ExpertRun one = expert_demo(scenes[i], seed, i, checker, options);
-    total.scenes += one.scenes;
-    total.unsolved += one.unsolved;
-    total.solutions += one.solutions;
-    total.discarded += one.discarded;
-    for (Demo& demo : one.demos) total.demos.push_back(std::move(demo));
-  }
+  for (std::size_t i = 0; i < scenes.size(); ++i) total.append(expert_demo(scenes[i], seed, i, checker, options));
   return total;
 }
 

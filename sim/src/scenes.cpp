@@ -8,21 +8,12 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "scene_helpers.hpp"
 
 namespace handcentric::sim {
-namespace {
-
-double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
-
-double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
-
-bool parse_double(const std::string& text, double& value) {
-  const char* end = text.data() + text.size();
-  const auto result = std::from_chars(text.data(), end, value);
-  return result.ec == std::errc() && result.ptr == end;
-}
-
-}  // namespace
+using detail::parse_double;
+using detail::radians;
+using detail::uniform;
 
 TaskScene operator*(const RigidTransform& g, const TaskScene& scene) {
   return TaskScene{g * scene.world_T_hole, g * scene.world_T_hand_start};
@@ -57,17 +48,12 @@ SceneDistribution SceneDistribution::parse(const std::string& text) {
 }
 
 RigidTransform parse_planar_transform(const std::string& text) {
-  double values[3] = {0.0, 0.0, 0.0};
-  std::size_t begin = 0;
-  for (int i = 0; i < 3; ++i) {
-    const std::size_t end = i < 2 ? text.find(',', begin) : text.size();
-    if (end == std::string::npos || !parse_double(text.substr(begin, end - begin), values[i]) || !std::isfinite(values[i])) {
-      throw InvalidArgument("bad planar transform '" + text +
-                            "'; expected DEG,X,Y (three finite numbers: degrees about z, then cm), e.g. 90,10,-5");
-    }
-    begin = end + 1;
+  Eigen::Vector3d values;
+  if (!detail::parse_finite_triple(text, values)) {
+    throw InvalidArgument("bad planar transform '" + text +
+                          "'; expected DEG,X,Y (three finite numbers: degrees about z, then cm), e.g. 90,10,-5");
   }
-  return RigidTransform::planar(radians(values[0]), values[1], values[2]);
+  return RigidTransform::planar(radians(values(0)), values(1), values(2));
 }
 
 std::vector<TaskScene> transform_scenes(const RigidTransform& g, const std::vector<TaskScene>& scenes) {
@@ -104,11 +90,7 @@ TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed
 }
 
 std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n, std::uint64_t seed) {
-  if (n < 0) throw InvalidArgument("number of scenes must be >= 0, got " + std::to_string(n));
-  std::vector<TaskScene> scenes;
-  scenes.reserve(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) scenes.push_back(sample_scene(distribution, seed, static_cast<std::uint64_t>(i)));
-  return scenes;
+  return detail::sample_n(sample_scene, distribution, n, seed);
 }
 
 }  // namespace handcentric::sim

@@ -8,6 +8,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
+#include "motion_check_faults.hpp"
 
 using namespace handcentric;
 using namespace handcentric::sim;
@@ -18,19 +19,6 @@ using MotionCheck = bool (*)(const CollisionChecker&, const RigidTransform&, con
 
 bool continuous(const CollisionChecker& checker, const RigidTransform& a, const RigidTransform& b) {
   return checker.motion_collides(a, b);
-}
-
-// A planted fault: checks the two end poses only.
-bool endpoints_only(const CollisionChecker& checker, const RigidTransform& a, const RigidTransform& b) {
-  return checker.collides(a) || checker.collides(b);
-}
-
-// A planted fault: fixed subdivision into 4 pieces, whatever the motion's length.
-bool four_samples(const CollisionChecker& checker, const RigidTransform& a, const RigidTransform& b) {
-  for (int i = 0; i <= 4; ++i) {
-    if (checker.collides(interpolate_planar(a, b, i / 4.0))) return true;
-  }
-  return false;
 }
 
 // Claim: motions that pass through a wall (or clip a wall's corner) between two collision-free
@@ -100,11 +88,11 @@ TEST_CASE("motions_through_walls_between_free_poses_are_caught", "[unit]") {
 }
 
 TEST_CASE("mutant_endpoint_only_motion_check_is_caught", "[unit]") {
-  CHECK_FALSE(catches_motions_through_walls(endpoints_only));
+  CHECK_FALSE(catches_motions_through_walls(testing::endpoints_only<CollisionChecker>));
 }
 
 TEST_CASE("mutant_fixed_four_sample_motion_check_is_caught", "[unit]") {
-  CHECK_FALSE(catches_motions_through_walls(four_samples));
+  CHECK_FALSE(catches_motions_through_walls(testing::four_samples<CollisionChecker, interpolate_planar>));
 }
 
 TEST_CASE("continuous_check_steps_by_the_clearance_and_never_coarser_than_c_over_4_near_walls", "[unit]") {

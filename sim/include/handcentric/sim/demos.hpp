@@ -3,7 +3,9 @@
 // training scenes a behavior-cloning policy learns from (Sec. 4.2).
 //
 // File format (docs/SIM.md): JSON Lines. Line 1 is a header
-//   {"format": "handcentric-demos", "version": 1, "count": N, "clearance": c}
+//   {"format": "handcentric-demos", "version": 1, "task": "peg2d", "count": N, "clearance": c}
+// (a header without "task" is peg2d; a file of another task, such as insert3d/demos.hpp's, is
+// refused with a message naming both tasks)
 // then one line per demo (record 1..N):
 //   {"world_T_hole": P, "world_T_hand": [P, P, ...]}
 // where each pose P is a 3x4 matrix [[r00, r01, r02, x], [r10, r11, r12, y], [r20, r21, r22, z]]

@@ -28,6 +28,7 @@
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
 #include "handcentric/sim/scenes.hpp"
+#include "handcentric/sim/expert_run.hpp"
 
 namespace handcentric::sim {
 
@@ -59,15 +60,7 @@ struct ExpertPlan {
 ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19937_64& rng,
                               const CollisionChecker& checker, const ExpertOptions& options = ExpertOptions());
 
-struct ExpertRun {
-  std::vector<Demo> demos;  ///< one per solved scene, in scene order
-  int scenes = 0;
-  int unsolved = 0;         ///< scenes where every attempt was invalid
-  int solutions = 0;        ///< optimizations run
-  int discarded = 0;        ///< invalid solutions among them
-  double discard_rate() const { return solutions == 0 ? 0.0 : static_cast<double>(discarded) / solutions; }
-  double solved_rate() const { return scenes == 0 ? 0.0 : 1.0 - static_cast<double>(unsolved) / scenes; }
-};
+using ExpertRun = BasicExpertRun<Demo>;
 
 /// The expert on one scene: up to options.attempts optimizations from the stream (seed, index),
 /// the first valid one mapped to the world (world_T_hand = world_T_hole hole_T_hand).
