@@ -1,4 +1,5 @@
 // Kernel selection (kernels.hpp).
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <mutex>
@@ -30,14 +31,14 @@ KernelIsa parse_kernel_isa(const std::string& name) {
 namespace {
 
 // The Highway target behind a name: avx512 is HWY_AVX3, avx2 HWY_AVX2, and generic the best
-// target below AVX2 this CPU runs (SSE4, or the portable code), or the build's only target when
-// it was compiled for one instruction set (-march). 0: none.
+// target below AVX2 this CPU runs (SSE4, or the portable code); in a build whose baseline is
+// AVX2 or AVX-512 (-march), which has no such target, the lowest one it has. 0: none.
 std::int64_t target_of(KernelIsa isa) {
   const std::vector<std::int64_t> targets = kernels::available_targets();  // best first
   for (std::int64_t target : targets) {
     const bool vector = target == HWY_AVX3 || target == HWY_AVX2;
-    if ((isa == KernelIsa::avx512 && target == HWY_AVX3) || (isa == KernelIsa::avx2 && target == HWY_AVX2) ||
-        (isa == KernelIsa::generic && !vector)) {
+    if ((isa == KernelIsa::avx512 && target == HWY_AVX3) ||
+        (isa == KernelIsa::avx2 && target == HWY_AVX2) || (isa == KernelIsa::generic && !vector)) {
       return target;
     }
   }
@@ -119,10 +120,16 @@ void apply_epilogue(const Gemm& g, int i0, int rows, int j0, int cols, const Sil
 }
 
 const KernelSet& kernels_for(KernelIsa isa) {
-  static const KernelSet* const sets[] = {&kernels_of_target(target_of(KernelIsa::generic)),
-                                          kernel_isa_supported(KernelIsa::avx2) ? &kernels_of_target(target_of(KernelIsa::avx2)) : nullptr,
-                                          kernel_isa_supported(KernelIsa::avx512) ? &kernels_of_target(target_of(KernelIsa::avx512)) : nullptr};
-  return *sets[static_cast<int>(isa)];
+  static const auto sets = [] {  // the targets are fixed for the process: looked up once
+    std::array<const KernelSet*, 3> table{};
+    for (KernelIsa each : {KernelIsa::generic, KernelIsa::avx2, KernelIsa::avx512}) {
+      if (const std::int64_t target = target_of(each); target != 0) {
+        table[static_cast<std::size_t>(each)] = &kernels_of_target(target);
+      }
+    }
+    return table;
+  }();
+  return *sets[static_cast<std::size_t>(isa)];
 }
 
 const KernelSet& active() { return kernels_for(kernel_isa()); }
