@@ -78,6 +78,9 @@ struct GemmKernel {
   static constexpr int MR = 2 * kLanes, NR = kRegisters == 32 ? 12 : 6;
   static constexpr int kNarrowLanes = kLanes, kNarrowAccumulators = kRegisters == 32 ? 24 : 12;
   static constexpr int kNarrowGroup = kRegisters == 32 ? 8 : 4;
+  /// Whether the narrow products start a shifted, masked head at a vector boundary: only where
+  /// a masked load is one instruction; elsewhere the head would go through a buffer every k.
+  static constexpr bool kAlignedHeads = kMaskedLoadInstructions;
   template <int N, int V>
   static constexpr auto narrow_block = &NarrowProduct<N, V>;
   static constexpr SiluFunctions kSilu{SiluForward, SiluInPlace, SiluBackward};

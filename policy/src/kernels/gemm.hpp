@@ -188,7 +188,7 @@ void blocked_gemm(const Gemm& g) {
 // a cache line: the first vector masks off its first `shift` lanes and the last one the lanes
 // past the end (masked lanes are neither read nor written). Needs shift + rows <= lanes V.
 // Kernel provides kNarrowLanes (floats per vector), kNarrowAccumulators (N V <= it),
-// kNarrowGroup (columns per pass) and
+// kNarrowGroup (columns per pass), kAlignedHeads (whether to shift the heads at all) and
 //   template <int N, int V> narrow_block(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc).
 constexpr int kNarrowMax = 16;
 
@@ -207,7 +207,9 @@ void narrow_columns(const Gemm& g, int j0) {
   const long b_step = g.op_b == Op::none ? 1 : g.ldb, b_stride = g.op_b == Op::none ? g.ldb : 1;
   // Columns share their offset from a vector boundary when lda is a multiple of the lanes.
   const auto address = reinterpret_cast<std::uintptr_t>(g.a);
-  const int shift = (g.lda % kLanes == 0 && address % 4 == 0) ? static_cast<int>(address % (4 * kLanes) / 4) : 0;
+  const int shift = (Kernel::kAlignedHeads && g.lda % kLanes == 0 && address % 4 == 0)
+                        ? static_cast<int>(address % (4 * kLanes) / 4)
+                        : 0;
   const int block_rows = kLanes * kVectors - shift;
   for (int i0 = 0; i0 < g.m; i0 += block_rows) {
     const int rows = std::min(block_rows, g.m - i0);

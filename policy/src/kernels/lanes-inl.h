@@ -16,6 +16,9 @@ namespace handcentric::policy::kernels::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
 /// Lanes [begin, end) of one vector of D: the mask, and the same lanes as bits for the ASan check.
+/// Whether masked loads are instructions on this target (cheap enough for every k of a product).
+constexpr bool kMaskedLoadInstructions = HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL;
+
 template <class D>
 struct LaneSpan {
   hn::Mask<D> mask;
@@ -38,15 +41,17 @@ HWY_INLINE LaneSpan<D> FirstLanes(D d, std::size_t count) {
 
 /// p[i] for the lanes of `lanes`, 0 elsewhere; nothing outside them is read. Highway's
 /// MaskedLoad is a masked instruction on AVX2 and AVX-512 only: on the other targets it loads the
-/// whole vector and then clears lanes, so there the lanes are copied through a buffer instead.
+/// whole vector and then clears lanes, so there a partial vector is copied through a buffer.
 template <class D, typename T = hn::TFromD<D>>
 HWY_INLINE hn::Vec<D> LoadLanes(D d, const LaneSpan<D>& lanes, const T* p) {
   check_lanes(p, lanes.bits, sizeof(T), false);
-#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL  // kMaskedLoadInstructions
   return hn::MaskedLoad(lanes.mask, d, p);
 #else
-  alignas(64) T buffer[hn::MaxLanes(D())] = {};
-  for (std::size_t i = 0; i < hn::MaxLanes(D()); ++i) {
+  constexpr std::size_t kLanes = hn::MaxLanes(D());
+  if (lanes.bits == (kLanes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << kLanes) - 1)) return hn::LoadU(d, p);
+  alignas(64) T buffer[kLanes] = {};
+  for (std::size_t i = 0; i < kLanes; ++i) {
     if ((lanes.bits >> i) & 1) buffer[i] = p[i];
   }
   return hn::Load(d, buffer);
