@@ -1,8 +1,8 @@
-// Private, per target: the named lane masks and tail accesses every kernel uses. A vector may cover lanes that lie
-// outside a buffer (a tail of n mod Lanes values; a head that starts before a column to keep
-// loads inside cache lines); those lanes are masked, and a masked lane is neither read nor
-// written. The masked accesses are instructions AddressSanitizer does not see, so under ASan
-// each one first checks its enabled lanes (asan_lanes.hpp).
+// Private, per target: the named lane masks and tail accesses every kernel uses. A vector may
+// cover lanes that lie outside a buffer (a tail of n mod Lanes values; a head that starts before
+// a column to keep loads inside cache lines); those lanes are masked, and a masked lane is
+// neither read nor written. The masked accesses are instructions AddressSanitizer does not see,
+// so under ASan each one first checks its enabled lanes (asan_lanes.hpp).
 
 #include <cstddef>
 #include <cstdint>
