@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   ca-certificates cmake g++ make pkg-config python3
   libeigen3-dev catch2 librapidcheck-dev libbox2d-dev libfcl-dev libopencv-dev libginac-dev
-  libcli11-dev nlohmann-json3-dev libbenchmark-dev
+  libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev
   python3-numpy python3-pytest time
   parallel
   python3-dev pybind11-dev python3-torch

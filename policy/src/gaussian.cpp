@@ -3,19 +3,19 @@
 #include <cstdint>
 #include <vector>
 
-#include "kernels/kernel_set.hpp"
+#include "box_muller.hpp"
 
 namespace handcentric::policy {
 
 void fill_standard_normal(std::mt19937_64& rng, Eigen::Ref<Eigen::MatrixXf> out) {
-  // One 64-bit draw per pair of normals (kernels::BoxMuller), transformed by the kernel set.
+  // One 64-bit draw per pair of normals (box_muller.hpp).
   thread_local std::vector<std::uint64_t> bits;
   thread_local std::vector<float> values;
   const Eigen::Index n = out.size(), pairs = (n + 1) / 2;
   bits.resize(static_cast<std::size_t>(pairs));
   values.resize(static_cast<std::size_t>(2 * pairs));
   for (std::uint64_t& b : bits) b = rng();
-  kernels::active().normal_pairs(pairs, bits.data(), values.data());
+  box_muller_pairs(pairs, bits.data(), values.data());
   // Ref<MatrixXf> has an inner stride of 1 but may have an outer stride: walk column by column.
   Eigen::Index k = 0;
   for (Eigen::Index j = 0; j < out.cols(); ++j) {

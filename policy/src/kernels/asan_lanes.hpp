@@ -2,7 +2,7 @@
 // AddressSanitizer checks the kernels' plain vector loads and stores (GCC's intrinsics for them
 // are ordinary memory accesses), but not masked loads, masked stores and gathers: those are
 // builtins it does not see, and they are exactly the tails where a mask one lane too long would
-// read or write past a buffer. Under ASan the wrappers in avx2.cpp and avx512.cpp check each
+// read or write past a buffer. Under ASan the wrappers in lanes-inl.h check each
 // enabled lane here first, so such a mask is reported like any overflow. Without ASan these
 // functions are empty and the wrappers compile to the bare intrinsic.
 #include <cstddef>
@@ -16,7 +16,7 @@ namespace handcentric::policy::kernels {
 
 /// The first poisoned byte among the lanes that `mask` enables (bit i: lane i, `lane_bytes`
 /// each, from `base`), or nullptr. Disabled lanes are not looked at: a shifted head mask
-/// (pack.hpp's narrow products) starts before the buffer on purpose. Always nullptr without ASan.
+/// (gemm-inl.h's narrow products) starts before the buffer on purpose. Always nullptr without ASan.
 inline const void* poisoned_lane(const void* base, std::uint64_t mask, std::size_t lane_bytes) {
 #if defined(__SANITIZE_ADDRESS__)
   for (int i = 0; mask != 0; ++i, mask >>= 1) {

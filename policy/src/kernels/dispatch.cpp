@@ -1,7 +1,11 @@
 // Kernel selection (kernels.hpp).
+#include <array>
 #include <atomic>
 #include <cstdlib>
 #include <mutex>
+#include <vector>
+
+#include <hwy/targets.h>
 
 #include "kernel_set.hpp"
 #include "handcentric/core/errors.hpp"
@@ -24,25 +28,30 @@ KernelIsa parse_kernel_isa(const std::string& name) {
   throw InvalidArgument("unknown kernel set '" + name + "': use generic, avx2 or avx512");
 }
 
-bool kernel_isa_supported(KernelIsa isa) {
-  switch (isa) {
-    case KernelIsa::generic: return true;
-#if defined(HANDCENTRIC_X86_KERNELS)
-    // __builtin_cpu_supports also checks that the OS saves the ymm / zmm state (XGETBV).
-    case KernelIsa::avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-    case KernelIsa::avx512: return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("fma");
-#else
-    case KernelIsa::avx2:
-    case KernelIsa::avx512: return false;
-#endif
+namespace {
+
+// The Highway target behind a name: avx512 is HWY_AVX3, avx2 HWY_AVX2, and generic the best
+// target below AVX2 this CPU runs (SSE4, or the portable code); in a build whose baseline is
+// AVX2 or AVX-512 (-march), which has no such target, the lowest one it has. 0: none.
+std::int64_t target_of(KernelIsa isa) {
+  const std::vector<std::int64_t> targets = kernels::available_targets();  // best first
+  for (std::int64_t target : targets) {
+    const bool vector = target == HWY_AVX3 || target == HWY_AVX2;
+    if ((isa == KernelIsa::avx512 && target == HWY_AVX3) ||
+        (isa == KernelIsa::avx2 && target == HWY_AVX2) || (isa == KernelIsa::generic && !vector)) {
+      return target;
+    }
   }
-  return false;
+  return isa == KernelIsa::generic ? targets.back() : 0;
 }
 
+}  // namespace
+
+bool kernel_isa_supported(KernelIsa isa) { return target_of(isa) != 0; }
+
 KernelIsa best_kernel_isa() {
-  if (kernel_isa_supported(KernelIsa::avx512)) return KernelIsa::avx512;
-  if (kernel_isa_supported(KernelIsa::avx2)) return KernelIsa::avx2;
-  return KernelIsa::generic;
+  const std::int64_t best = kernels::best_kernels().target;
+  return best == HWY_AVX3 ? KernelIsa::avx512 : best == HWY_AVX2 ? KernelIsa::avx2 : KernelIsa::generic;
 }
 
 namespace {
@@ -111,13 +120,16 @@ void apply_epilogue(const Gemm& g, int i0, int rows, int j0, int cols, const Sil
 }
 
 const KernelSet& kernels_for(KernelIsa isa) {
-  switch (isa) {
-#if defined(HANDCENTRIC_X86_KERNELS)
-    case KernelIsa::avx512: return avx512_kernels();
-    case KernelIsa::avx2: return avx2_kernels();
-#endif
-    default: return generic_kernels();
-  }
+  static const auto sets = [] {  // the targets are fixed for the process: looked up once
+    std::array<const KernelSet*, 3> table{};
+    for (KernelIsa each : {KernelIsa::generic, KernelIsa::avx2, KernelIsa::avx512}) {
+      if (const std::int64_t target = target_of(each); target != 0) {
+        table[static_cast<std::size_t>(each)] = &kernels_of_target(target);
+      }
+    }
+    return table;
+  }();
+  return *sets[static_cast<std::size_t>(isa)];
 }
 
 const KernelSet& active() { return kernels_for(kernel_isa()); }

@@ -1,12 +1,14 @@
 #pragma once
-// Private: the float32 kernels behind Mlp and Adam, one implementation per instruction set
-// (generic.cpp: Eigen for the build's target; avx2.cpp; avx512.cpp), chosen at run time by
-// the functions at the bottom (dispatch.cpp, kernels.hpp).
+// Private: the float32 kernels behind Mlp and Adam, written once on Google Highway and compiled
+// for several targets (kernels.cpp), one KernelSet per target, chosen at run time by the
+// functions at the bottom (dispatch.cpp, kernels.hpp).
 //
 // Storage is column-major throughout, as in Eigen: element (i, j) of an r x c matrix with
 // leading dimension ld is data[i + j * ld]. op(X) is X or X^T as stored.
 #include <cstddef>
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "handcentric/policy/kernels.hpp"
 
@@ -70,7 +72,7 @@ struct AdamUpdate {
   float beta1 = 0, beta2 = 0, step_size = 0, inv_sqrt_bias2 = 0, epsilon = 0, decay = 1;
 };
 
-/// exp(x) in the vector sets (Cephes' expf): x = n ln2 + r with n = round(x log2 e) and
+/// exp(x) in the kernels (silu-inl.h; Cephes' expf): x = n ln2 + r with n = round(x log2 e) and
 /// ln2 = kLn2High + kLn2Low (r exact to float rounding), then
 /// exp(r) = 1 + r + r^2 (c0 r^5 + c1 r^4 + ... + c5), relative error ~1e-7, times 2^n.
 struct ExpPolynomial {
@@ -80,28 +82,7 @@ struct ExpPolynomial {
                                   4.1665795894e-2f, 1.6666665459e-1f, 5.0000001201e-1f};
 };
 
-/// Box-Muller from one 64-bit draw per pair of normals (gaussian.hpp): with the top 24 bits
-/// of each 32-bit half, u1 = (hi + 1) 2^-24 in (0, 1] and u2 = lo 2^-24 in [0, 1), both exact
-/// in float; r = sqrt(-2 ln u1) (at most sqrt(48 ln 2) = 5.77: the tails beyond 5.77 sigma,
-/// probability 8e-9, are cut), and the pair is (r cos 2 pi u2, r sin 2 pi u2).
-struct BoxMuller {
-  static std::uint32_t high24(std::uint64_t bits) { return static_cast<std::uint32_t>(bits >> 40); }
-  static std::uint32_t low24(std::uint64_t bits) { return static_cast<std::uint32_t>(bits >> 8) & 0xFFFFFFu; }
-  static constexpr float kTwoPow24Inverse = 0x1.0p-24f;
-};
-
-/// The polynomials of the vector Box-Muller (avx2.cpp, avx512.cpp), coefficients highest first.
-/// ln m for m in [sqrt(1/2), sqrt(2)): 2 s (1 + s^2/3 + ... + s^8/9), s = (m - 1) / (m + 1).
-/// sin t and cos t for |t| <= pi/4 by Taylor: t + t^3 (kSin...), 1 + t^2 (kCos...).
-struct BoxMullerPolynomials {
-  static constexpr float kLn2 = 0.693147180559945f, kSqrt2 = 1.41421356f;
-  static constexpr float kTwoPi = 6.28318530717958648f;
-  static constexpr float kLog[4] = {1.0f / 9.0f, 1.0f / 7.0f, 1.0f / 5.0f, 1.0f / 3.0f};
-  static constexpr float kSin[4] = {1.0f / 362880.0f, -1.0f / 5040.0f, 1.0f / 120.0f, -1.0f / 6.0f};
-  static constexpr float kCos[4] = {1.0f / 40320.0f, -1.0f / 720.0f, 1.0f / 24.0f, -0.5f};
-};
-
-/// One instruction set's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
+/// One target's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
 struct KernelSet {
   void (*gemm)(const Gemm& problem);
   /// s = sigmoid(z), a = z s over n values (training: s is kept for the backward pass); a may be z.
@@ -114,13 +95,19 @@ struct KernelSet {
   /// sum of g_i^2, in double.
   double (*squared_norm)(std::ptrdiff_t n, const float* g);
   void (*adam)(const AdamUpdate& update);
-  /// out[2 i], out[2 i + 1] = the BoxMuller pair of bits[i], i < pairs.
-  void (*normal_pairs)(std::ptrdiff_t pairs, const std::uint64_t* bits, float* out);
+  /// The Highway target (HWY_AVX3, HWY_AVX2, ...) the functions are compiled for.
+  std::int64_t target;
 };
 
-const KernelSet& generic_kernels();
-const KernelSet& avx2_kernels();    ///< only where HANDCENTRIC_X86_KERNELS is defined
-const KernelSet& avx512_kernels();  ///< only where HANDCENTRIC_X86_KERNELS is defined
+/// The Highway targets this build compiled and this CPU runs, best first
+/// (hwy::SupportedAndGeneratedTargets(); hwy::TargetName names them).
+std::vector<std::int64_t> available_targets();
+/// Highway's name of a target ("AVX3", "AVX2", "SSE4", "EMU128", "SCALAR", ...).
+std::string target_name(std::int64_t target);
+/// The kernels compiled for `target`, one of available_targets().
+const KernelSet& kernels_of_target(std::int64_t target);
+/// The set Highway's dynamic dispatch picks: the best of available_targets().
+const KernelSet& best_kernels();
 
 /// The set for `isa` (which must be supported), and the one in use (kernel_isa()).
 const KernelSet& kernels_for(KernelIsa isa);

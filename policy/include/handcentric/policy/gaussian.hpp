@@ -1,8 +1,8 @@
 #pragma once
 // Seeded standard normals for noise (flow, DDPM, CVAE): Box-Muller from one 64-bit draw of the
 // generator per pair (24-bit uniforms, so tails beyond 5.77 sigma, probability 8e-9, are cut),
-// both outputs used, vectorized by the kernel set (kernels.hpp). Same generator state and kernel
-// set, same bits (no std::normal_distribution).
+// both outputs used. Same generator state, same bits on every kernel set (no
+// std::normal_distribution).
 #include <Eigen/Core>
 #include <random>
 

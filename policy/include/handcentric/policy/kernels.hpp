@@ -1,11 +1,12 @@
 #pragma once
 // Which float32 kernels the policy networks run on. Mlp<float> multiplies its matrices with
-// hand-written kernels for the instruction set of the CPU it runs on, chosen at run time, so
-// one portable build (no -march) trains at AVX-512 speed where the CPU has AVX-512:
+// kernels written once on Google Highway and compiled for several instruction sets; the one for
+// the CPU it runs on is chosen at run time, so one portable build (no -march) trains at AVX-512
+// speed where the CPU has AVX-512:
 //
-//   generic  Eigen, compiled for the build's target (SSE2 on plain x86-64); every CPU
+//   generic  the best below AVX2: SSE4 on most x86 CPUs, else the portable code; every CPU
 //   avx2     AVX2 + FMA (Haswell and later, Zen)
-//   avx512   AVX-512 F (Skylake-SP and later, Zen 4)
+//   avx512   AVX-512 F, BW, DQ, VL (Skylake-SP and later, Zen 4)
 //
 // The default is the best the CPU supports; the environment variable HANDCENTRIC_KERNELS
 // (generic | avx2 | avx512) or set_kernel_isa() picks another. Results are bit-for-bit

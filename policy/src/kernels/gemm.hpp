@@ -1,11 +1,13 @@
 #pragma once
-// Private: the loop nests of the GEMM in avx2.cpp and avx512.cpp: packing and the blocked nest
-// (the BLIS scheme), the narrow products of n <= 16 columns, and vector_gemm that picks one.
-// For the blocked nest, a block of op(A) is copied into panels of MR rows, each panel k-major
-// (panel[k * MR + i]); a block of op(B) into panels of NR columns (panel[k * NR + j]). Rows and
-// columns past the matrix are zero, so the micro-kernel always runs on full MR x NR tiles.
-// Compiled for the build's baseline target (no target attributes): packing is O(mk + kn)
-// against the O(mnk) products, so it does not need vector code.
+// Private: the GEMM driver, the loop nests around a target's micro-kernels (gemm-inl.h): packing
+// and the blocked nest (the BLIS scheme), the narrow products of n <= 16 columns, and
+// vector_gemm that picks one. For the blocked nest, a block of op(A) is copied into panels of MR
+// rows, each panel k-major (panel[k * MR + i]); a block of op(B) into panels of NR columns
+// (panel[k * NR + j]). Rows and columns past the matrix are zero, so the micro-kernel always runs
+// on full MR x NR tiles.
+// These templates are defined outside Highway's per-target regions, so they compile for the
+// build's baseline target whatever kernel they are instantiated with, and call the kernel's
+// functions: packing is O(mk + kn) against the O(mnk) products and does not need vector code.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -16,11 +18,6 @@
 #include "kernel_set.hpp"
 
 namespace handcentric::policy::kernels {
-
-/// op(A)(i, p) for A stored column-major with leading dimension lda.
-inline float element(Op op, const float* a, int lda, int i, int p) {
-  return op == Op::none ? a[i + static_cast<long>(p) * lda] : a[p + static_cast<long>(i) * lda];
-}
 
 /// Panels of MR rows of op(A)(i0 : i0 + mc, p0 : p0 + kc) into `out` (ceil(mc / MR) * kc * MR floats).
 template <int MR>
@@ -48,30 +45,11 @@ void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, floa
   }
 }
 
-/// Panels of NR columns of op(B)(p0 : p0 + kc, j0 : j0 + nc) into `out` (ceil(nc / NR) * kc * NR floats).
+/// Panels of NR columns of op(B)(p0 : p0 + kc, j0 : j0 + nc) into `out` (ceil(nc / NR) * kc * NR
+/// floats): the panels of NR rows of op(B)^T, whose op is the other one.
 template <int NR>
 void pack_b(Op op, const float* b, int ldb, int p0, int kc, int j0, int nc, float* out) {
-  for (int panel = 0; panel < nc; panel += NR) {
-    const int cols = std::min(NR, nc - panel);
-    if (op == Op::none) {
-      for (int j = 0; j < NR; ++j) {
-        if (j < cols) {
-          const float* column = b + p0 + static_cast<long>(j0 + panel + j) * ldb;  // contiguous in p
-          for (int p = 0; p < kc; ++p) out[p * NR + j] = column[p];
-        } else {
-          for (int p = 0; p < kc; ++p) out[p * NR + j] = 0.0f;
-        }
-      }
-    } else {
-      for (int p = 0; p < kc; ++p) {
-        const float* row = b + (j0 + panel) + static_cast<long>(p0 + p) * ldb;  // op(B)(p, .) is contiguous
-        float* dst = out + p * NR;
-        for (int j = 0; j < cols; ++j) dst[j] = row[j];
-        for (int j = cols; j < NR; ++j) dst[j] = 0.0f;
-      }
-    }
-    out += static_cast<long>(kc) * NR;
-  }
+  pack_a<NR>(op == Op::none ? Op::transpose : Op::none, b, ldb, j0, nc, p0, kc, out);
 }
 
 /// A float buffer on a 64-byte boundary (a cache line; the micro-kernels load it aligned).
@@ -108,10 +86,26 @@ struct PackBuffers {
 /// b[p + j * ldb]).
 enum class BLayout { packed, rows, columns };
 
-/// The blocked loop nest shared by the instruction sets (the BLIS order: columns of C, then k,
-/// then rows). A block of MC x KC of op(A) is packed (it stays in L2 and streams through the
-/// micro-kernel); op(B) is read in place, NR columns at a time (a k x NR block is reused from
-/// L1 by every row panel), except a last partial panel, which is packed with zero padding.
+/// The block sizes of the blocked nest, for the caches they assume (the smallest of the x86 cores
+/// the kernels target: 32 KB L1d, 1 MB L2 per core):
+/// - KC = 256: a micro-kernel streams an MR x KC panel of packed op(A) against a KC x NR block of
+///   op(B) that every row panel reuses; both together (at most 32 x 256 + 256 x 12 floats, 44 KB
+///   at MR = 32, NR = 12; 22 KB at 16 x 6) fit the L1d with the tile of C, or nearly: the A panel
+///   is read once per tile, in order, which the prefetchers cover.
+/// - MC = 256: the packed MC x KC block of op(A), 256 KB, stays in L2 while the nest walks the
+///   columns of C.
+/// - NC = 384: the KC x NC block of op(B) read in place, 384 KB, stays in L2 beside it
+///   (640 KB of the 1 MB).
+struct Blocking {
+  static constexpr std::size_t kL1Bytes = 32 * 1024, kL2Bytes = 1024 * 1024;
+  static constexpr int KC = 256, MC = 256, NC = 384;
+  static_assert((MC + NC) * KC * sizeof(float) <= kL2Bytes, "the A block and the B block share L2");
+};
+
+/// The blocked loop nest shared by the targets (the BLIS order: columns of C, then k, then rows).
+/// A block of MC x KC of op(A) is packed (it stays in L2 and streams through the micro-kernel);
+/// op(B) is read in place, NR columns at a time (a k x NR block is reused from L1 by every row
+/// panel), except a last partial panel, which is packed with zero padding.
 /// Kernel::kSilu (SiluFunctions) applies Gemm::epilogue to each finished block.
 /// Kernel::pack_a has pack_a<MR>'s contract (it may be a faster vector version).
 /// Kernel::tile<BLayout>(kc, a_panel, b, ldb, c, ldc, accumulate, bias) writes a full MR x NR
@@ -120,7 +114,9 @@ enum class BLayout { packed, rows, columns };
 template <typename Kernel>
 void blocked_gemm(const Gemm& g) {
   constexpr int MR = Kernel::MR, NR = Kernel::NR;
-  constexpr int KC = 256, MC = 256, NC = 384;
+  constexpr int KC = Blocking::KC, MC = Blocking::MC, NC = Blocking::NC;
+  static_assert(static_cast<std::size_t>(KC) * (MR + NR) * sizeof(float) <= 2 * Blocking::kL1Bytes,
+                "an A panel and a B block of one k block (nearly) fit L1d");
   PackBuffers& buffers = PackBuffers::local();
   buffers.a.resize(static_cast<std::size_t>((MC + MR - 1) / MR * MR) * KC);
   buffers.b.resize(static_cast<std::size_t>(NR) * KC);
@@ -192,7 +188,7 @@ void blocked_gemm(const Gemm& g) {
 // a cache line: the first vector masks off its first `shift` lanes and the last one the lanes
 // past the end (masked lanes are neither read nor written). Needs shift + rows <= lanes V.
 // Kernel provides kNarrowLanes (floats per vector), kNarrowAccumulators (N V <= it),
-// kNarrowGroup (columns per pass) and
+// kNarrowGroup (columns per pass), kAlignedHeads (whether to shift the heads at all) and
 //   template <int N, int V> narrow_block(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc).
 constexpr int kNarrowMax = 16;
 
@@ -211,7 +207,9 @@ void narrow_columns(const Gemm& g, int j0) {
   const long b_step = g.op_b == Op::none ? 1 : g.ldb, b_stride = g.op_b == Op::none ? g.ldb : 1;
   // Columns share their offset from a vector boundary when lda is a multiple of the lanes.
   const auto address = reinterpret_cast<std::uintptr_t>(g.a);
-  const int shift = (g.lda % kLanes == 0 && address % 4 == 0) ? static_cast<int>(address % (4 * kLanes) / 4) : 0;
+  const int shift = (Kernel::kAlignedHeads && g.lda % kLanes == 0 && address % 4 == 0)
+                        ? static_cast<int>(address % (4 * kLanes) / 4)
+                        : 0;
   const int block_rows = kLanes * kVectors - shift;
   for (int i0 = 0; i0 < g.m; i0 += block_rows) {
     const int rows = std::min(block_rows, g.m - i0);
