@@ -142,9 +142,10 @@ void save_demos(const std::string& path, const std::vector<Demo>& demos, const P
   write_file_atomically(path, out.str());
 }
 
-std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidDemoFile("cannot open demo file '" + path + "'; check the path (make one with `handcentric demos`)");
+namespace {
+
+// The one reader of demo files, from a file or from memory; `path` names the source in errors.
+std::vector<Demo> read_demos(std::istream& in, const std::string& path, const DemoFileLimits& limits) {
   std::string line;
   bool newline = false;
   if (!read_line(in, line, newline, limits, path, "line 1 (header)")) {
@@ -215,6 +216,19 @@ std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limi
                                                          " demos the header promises");
   }
   return demos;
+}
+
+}  // namespace
+
+std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InvalidDemoFile("cannot open demo file '" + path + "'; check the path (make one with `handcentric demos`)");
+  return read_demos(in, path, limits);
+}
+
+std::vector<Demo> parse_demos(const std::string& bytes, const std::string& source, const DemoFileLimits& limits) {
+  std::istringstream in(bytes);
+  return read_demos(in, source, limits);
 }
 
 std::vector<Eigen::Vector3d> eye_in_hand_points(const RigidTransform& world_T_hole,
