@@ -83,7 +83,14 @@ BENCHMARK(BM_c8flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond)
 // The host's speed probe: AVX-512 FMAs on 24 independent registers, no memory traffic. Its
 // GFLOP/s (items/s x 1e-9) is the ceiling of the training kernels at that moment; on a shared
 // host it drifts (docs/BENCHMARKS.md), so it is run beside the numbers it qualifies.
-__attribute__((target("avx512f"), noipa)) float fma_probe(long iterations) {
+// noipa keeps GCC from folding the loop into the caller's constants; clang has no noipa, and
+// noinline does that there.
+#if defined(__clang__)
+#define HANDCENTRIC_NO_INTERPROCEDURAL noinline
+#else
+#define HANDCENTRIC_NO_INTERPROCEDURAL noipa
+#endif
+__attribute__((target("avx512f"), HANDCENTRIC_NO_INTERPROCEDURAL)) float fma_probe(long iterations) {
   __m512 acc[24];
   for (int i = 0; i < 24; ++i) acc[i] = _mm512_set1_ps(0.001f * static_cast<float>(i));
   const __m512 x = _mm512_set1_ps(0.999f), y = _mm512_set1_ps(1e-4f);

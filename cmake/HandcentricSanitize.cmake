@@ -29,6 +29,6 @@ if(HANDCENTRIC_SANITIZE)
   add_link_options(-fsanitize=${handcentric_sanitize_flag} -fno-sanitize-recover=all)
   # GCC 12 warns "may be used uninitialized" inside Eigen's fixed-size assignments once the
   # sanitizers' checks are inlined (a known false positive); the Release build keeps the warning.
-  add_compile_options(-Wno-maybe-uninitialized)
+  add_compile_options($<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>)
   message(STATUS "handcentric: sanitizers ${handcentric_sanitize_flag} on every project target")
 endif()

@@ -11,6 +11,9 @@ packages=(
   python3-numpy python3-pytest time
   parallel
   python3-dev pybind11-dev python3-torch
+  # scripts/fuzz.sh: clang, libFuzzer, and the sanitizer and fuzzer runtimes clang links (only
+  # recommended by clang, so not installed under --no-install-recommends without this name)
+  clang libfuzzer-14-dev libclang-rt-14-dev
 )
 
 missing=()

@@ -83,7 +83,10 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
         {Component::actions, actions_of(representation)}};
     if (options.observation)
       parts.emplace_back(Component::observation, observation_of(representation));
-    for (const auto& [component, f] : parts) {
+    // Named members, not a structured binding: clang 14 cannot capture bindings in a lambda.
+    for (const auto& part : parts) {
+      const Component component = part.first;
+      const SceneFunction& f = part.second;
       for (Group group : options.groups) {
         out.verdicts.push_back(with_float32_note(
             check_invariance(f, component, group, check), options,

@@ -298,14 +298,16 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     if (!hello.is_object())
       throw PluginError(reply_to(who, id) + " with a hello that is not an object");
     PluginCapabilities capabilities;
-    capabilities.protocol = hello.contains("protocol") && hello["protocol"].is_number_integer()
-                                ? hello["protocol"].get<int>()
-                                : 2;
-    if (capabilities.protocol < 2 || capabilities.protocol > kProtocolVersion) {
+    // Compared as the integer JSON holds: converted to int first, 2^32 + 2 would pass for 2.
+    const long long protocol = hello.contains("protocol") && hello["protocol"].is_number_integer()
+                                   ? hello["protocol"].get<long long>()
+                                   : 2;
+    if (protocol < 2 || protocol > kProtocolVersion) {
       throw PluginError(reply_to(who, id) + " with a hello for protocol " +
-                        std::to_string(capabilities.protocol) +
+                        one_line(hello["protocol"].dump(), 40) +
                         "; this audit speaks protocols 1 and " + std::to_string(kProtocolVersion));
     }
+    capabilities.protocol = static_cast<int>(protocol);
     capabilities.extra_pose_names = read_names(hello, "extra_poses", id, who);
     capabilities.scalar_names = read_names(hello, "scalars", id, who);
     capabilities.decode = read_flag(hello, "decode", id, who);

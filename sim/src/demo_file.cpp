@@ -143,10 +143,11 @@ void save_demo_records(const std::string& path, const DemoFileTask& task, double
   write_file_atomically(path, out.str());
 }
 
-std::vector<DemoRecord> load_demo_records(const std::string& path, const DemoFileTask& task,
+namespace {
+
+// The one reader of demo files, from a file or from memory; `path` names the source in errors.
+std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& path, const DemoFileTask& task,
                                           const DemoFileLimits& limits) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidDemoFile("cannot open demo file '" + path + "'; check the path (make one with `handcentric demos`)");
   std::string line;
   bool newline = false;
   if (!read_line(in, line, newline, limits, path, "line 1 (header)")) {
@@ -224,6 +225,21 @@ std::vector<DemoRecord> load_demo_records(const std::string& path, const DemoFil
                                                          " demos the header promises");
   }
   return demos;
+}
+
+}  // namespace
+
+std::vector<DemoRecord> load_demo_records(const std::string& path, const DemoFileTask& task,
+                                          const DemoFileLimits& limits) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InvalidDemoFile("cannot open demo file '" + path + "'; check the path (make one with `handcentric demos`)");
+  return read_demo_records(in, path, task, limits);
+}
+
+std::vector<DemoRecord> parse_demo_records(const std::string& bytes, const std::string& source,
+                                           const DemoFileTask& task, const DemoFileLimits& limits) {
+  std::istringstream in(bytes);
+  return read_demo_records(in, source, task, limits);
 }
 
 }  // namespace handcentric::sim::detail

@@ -38,6 +38,10 @@ void save_demo_records(const std::string& path, const DemoFileTask& task, double
 std::vector<DemoRecord> load_demo_records(const std::string& path, const DemoFileTask& task,
                                           const DemoFileLimits& limits);
 
+/// load_demo_records on a file's bytes in memory; `source` names them in errors as a path would.
+std::vector<DemoRecord> parse_demo_records(const std::string& bytes, const std::string& source,
+                                           const DemoFileTask& task, const DemoFileLimits& limits);
+
 /// One Scene per control step t of a demo: history T_t..T_{t-H} (the first pose repeated before
 /// the start), chunk T_{t+1}..T_{t+K} (the last pose repeated after the end), hand_points =
 /// points_at(T_t). Throws InvalidArgument for H < 0, K < 1 or an empty demo.

@@ -18,12 +18,23 @@ void save_demos(const std::string& path, const std::vector<Demo>& demos, const P
   detail::save_demo_records(path, kPeg2d, geometry.clearance, records);
 }
 
-std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits) {
+namespace {
+
+std::vector<Demo> to_demos(std::vector<detail::DemoRecord> records) {
   std::vector<Demo> demos;
-  for (detail::DemoRecord& record : detail::load_demo_records(path, kPeg2d, limits)) {
-    demos.push_back({record.world_T_object, std::move(record.world_T_hand)});
-  }
+  demos.reserve(records.size());
+  for (detail::DemoRecord& record : records) demos.push_back({record.world_T_object, std::move(record.world_T_hand)});
   return demos;
+}
+
+}  // namespace
+
+std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits) {
+  return to_demos(detail::load_demo_records(path, kPeg2d, limits));
+}
+
+std::vector<Demo> parse_demos(const std::string& bytes, const std::string& source, const DemoFileLimits& limits) {
+  return to_demos(detail::parse_demo_records(bytes, source, kPeg2d, limits));
 }
 
 std::vector<Eigen::Vector3d> eye_in_hand_points(const RigidTransform& world_T_hole,

@@ -186,8 +186,13 @@ ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19
   if (options.random_via) {
     const int m = free / 2;
     const double fraction = uniform(rng, kViaMinFraction, kViaMaxFraction);
-    const Vec3 offset(kAngleScale * uniform(rng, -kViaMaxAbsDegrees, kViaMaxAbsDegrees) * std::numbers::pi / 180.0,
-                      uniform(rng, -kViaMaxAbsDx, kViaMaxAbsDx), uniform(rng, kViaMinDy, kViaMaxDy));
+    // One draw per statement: the arguments of one call are evaluated in an unspecified order
+    // (GCC right to left, clang left to right), which made the demos depend on the compiler.
+    // This is GCC's order, so the demo files GCC builds made stay the same.
+    const double dy = uniform(rng, kViaMinDy, kViaMaxDy);
+    const double dx = uniform(rng, -kViaMaxAbsDx, kViaMaxAbsDx);
+    const double degrees = uniform(rng, -kViaMaxAbsDegrees, kViaMaxAbsDegrees);
+    const Vec3 offset(kAngleScale * degrees * std::numbers::pi / 180.0, dx, dy);
     const Vec3 via = start + fraction * (pre - start) + offset;
     A(m, m) += kViaWeight;
     b.row(m) += kViaWeight * via.transpose();

@@ -137,6 +137,10 @@ TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
   CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"protocol": 9}})", 0,
                                        RequestKind::encode, who, true),
                     Contains("protocol 9"));
+  // Not wrapped into range by a conversion to int.
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"protocol": 4294967298}})", 0,
+                                       RequestKind::encode, who, true),
+                    Contains("protocol 4294967298"));
   CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"scalars": [1]}})", 0,
                                        RequestKind::encode, who, true),
                     Contains("not a name"));

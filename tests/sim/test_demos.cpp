@@ -235,3 +235,24 @@ TEST_CASE("training_data_adds_the_mirror_images_after_the_demos_by_default", "[u
   off.mirror = false;
   CHECK(training_scenes(demos, 0, 4, 2, off).size() == plain.size());
 }
+
+TEST_CASE("demo_bytes_in_memory_parse_like_the_file_they_came_from", "[unit]") {
+  const std::string path = temp_path("in_memory.jsonl");
+  save_demos(path, some_demos(3));
+  const std::string bytes = read(path);
+  const std::vector<Demo> from_file = load_demos(path);
+  const std::vector<Demo> from_memory = parse_demos(bytes, "received demos");
+  REQUIRE(from_memory.size() == from_file.size());
+  for (std::size_t i = 0; i < from_file.size(); ++i) {
+    CHECK(same_bits(from_memory[i].world_T_hole, from_file[i].world_T_hole));
+    REQUIRE(from_memory[i].world_T_hand.size() == from_file[i].world_T_hand.size());
+    for (std::size_t t = 0; t < from_file[i].world_T_hand.size(); ++t)
+      CHECK(same_bits(from_memory[i].world_T_hand[t], from_file[i].world_T_hand[t]));
+  }
+  // The same checks, the source named as the path would be.
+  const std::string truncated = bytes.substr(0, bytes.size() - 1);
+  CHECK_THROWS_AS(parse_demos(truncated, "received demos"), InvalidDemoFile);
+  CHECK_THROWS_WITH(parse_demos(truncated, "received demos"),
+                    Contains("'received demos'") && Contains("record 3") && Contains("final newline"));
+  std::filesystem::remove(path);
+}

@@ -1,6 +1,10 @@
 #pragma once
 // Atomic file writes: the bytes go to a temporary file beside the target, which is then renamed
-// over it, so a reader never sees a half-written demo file, model, report or image.
+// over it, so a reader never sees a half-written demo file, model, report or image, even when
+// the writer is killed (SIGKILL, out of memory): the target holds the old file or the new one.
+// A killed writer may leave its "<path>.tmp.<pid>" behind; no reader looks at those names.
+// For tests only: HANDCENTRIC_FAULT_WRITE_IN_PLACE_MS=<ms> plants the naive writer (in place,
+// with a pause halfway) that tests/reliability/kill_writers.sh must catch.
 #include <string>
 
 namespace handcentric {

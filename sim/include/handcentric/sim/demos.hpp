@@ -58,6 +58,11 @@ struct Demo {
 /// for a file over one of the DemoFileLimits (naming the limit).
 std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits = DemoFileLimits());
 
+/// load_demos on a file's bytes already in memory (received, embedded, or a fuzzer's input);
+/// `source` names them in errors as the path would. Same checks, limits and errors.
+std::vector<Demo> parse_demos(const std::string& bytes, const std::string& source,
+                              const DemoFileLimits& limits = DemoFileLimits());
+
 /// Writes `demos` atomically (a temporary file beside `path`, then rename). Throws
 /// InvalidArgument for an empty or non-planar demo, Error when the file cannot be written.
 void save_demos(const std::string& path, const std::vector<Demo>& demos,
