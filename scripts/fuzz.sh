@@ -18,10 +18,13 @@ command -v "$cxx" >/dev/null || { echo "fuzz.sh: $cxx not found: bash scripts/in
 targets=(fuzz_demo_file fuzz_model_file fuzz_plugin_reply fuzz_geometry)
 
 start=$(date +%s)
-CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DHANDCENTRIC_FUZZ=ON \
-      -DHANDCENTRIC_SANITIZE=address,undefined -DHANDCENTRIC_BUILD_TESTS=OFF \
-      -DHANDCENTRIC_BUILD_BENCH=OFF >/dev/null
+# A tree configured for fuzzing already (scripts/sanitize.sh's, with the tests) is used as it is.
+if ! grep -q '^HANDCENTRIC_FUZZ:BOOL=ON' "$build_dir/CMakeCache.txt" 2>/dev/null; then
+  CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+        -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DHANDCENTRIC_FUZZ=ON \
+        -DHANDCENTRIC_SANITIZE=address,undefined -DHANDCENTRIC_BUILD_TESTS=OFF \
+        -DHANDCENTRIC_BUILD_BENCH=OFF >/dev/null
+fi
 cmake --build "$build_dir" -j 2 --target "${targets[@]}"
 built=$(date +%s)
 

@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# The sanitizer run of CI (issue 14): builds handcentric with AddressSanitizer (with
+# The sanitizer run of CI: builds handcentric with clang 14, AddressSanitizer (with
 # LeakSanitizer) and UndefinedBehaviorSanitizer into ${ASAN_BUILD_DIR:-build-asan} (-O1 with line
-# tables, no benchmarks) and runs the ctest labels unit, property and proofs there. A report
-# aborts the test that caused it, so any report fails this script and CI. Prints the build and
-# test times last. docs/RELIABILITY.md has the measured figures.
+# tables, no benchmarks, the libFuzzer targets too), runs the ctest labels unit, property and
+# proofs there, then every fuzz target for ${FUZZ_SECONDS:-60} s (scripts/fuzz.sh, same tree).
+# A report aborts the test or fuzz run that caused it, so any report fails this script and CI.
+# Prints the build, test and fuzz times last. docs/RELIABILITY.md has the measured figures.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${ASAN_BUILD_DIR:-$root/build-asan}"
 jobs="$(nproc 2>/dev/null || echo 2)"
+cxx="${SANITIZE_CXX:-clang++}"
+command -v "$cxx" >/dev/null || { echo "sanitize.sh: $cxx not found: bash scripts/install-deps.sh (clang, libfuzzer-14-dev)" >&2; exit 2; }
 
 # exitcode=23: a report must not pass for the exit status 1 that the command-line tests expect
 # of a refused input (the sanitizers exit with 1 by default).
@@ -18,9 +21,10 @@ export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:exitcode=23
 # that the command-line tests check.
 export LSAN_OPTIONS="suppressions=$root/tests/support/lsan.supp:print_suppressions=0"
 
+# Clang: libFuzzer needs it, and one tree then serves the tests and the fuzz targets.
 start=$(date +%s)
-cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
-      -DHANDCENTRIC_SANITIZE=address,undefined -DHANDCENTRIC_BUILD_BENCH=OFF >/dev/null
+CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+      -DHANDCENTRIC_SANITIZE=address,undefined -DHANDCENTRIC_FUZZ=ON -DHANDCENTRIC_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build_dir" -j "$jobs"
 built=$(date +%s)
 
@@ -28,8 +32,12 @@ built=$(date +%s)
 #  - the numerics properties run 1e4 cases each instead of 1e5 (RapidCheck's allocations under
 #    ASan make a case ~100 times slower; the Release tree of CI runs the 1e5);
 #  - policy_unit_suite_on_{generic,avx2}_kernels, the whole policy unit suite again on the other
-#    kernel sets (4 min here): test_kernels runs every kernel set and the whole Mlp on each.
+#    kernel sets: test_kernels runs every kernel target and the whole Mlp on each.
 export HANDCENTRIC_NUMERIC_CASES=10000
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E '^policy_unit_suite_on_')
 tested=$(date +%s)
-echo "sanitize: build $((built - start)) s, tests $((tested - built)) s (labels unit, property, proofs)"
+
+FUZZ_BUILD_DIR="$build_dir" FUZZ_CXX="$cxx" bash "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-60}"
+fuzzed=$(date +%s)
+echo "sanitize: build $((built - start)) s, tests $((tested - built)) s (labels unit, property, proofs)," \
+     "fuzzing $((fuzzed - tested)) s"

@@ -2,18 +2,21 @@
 # Quick start, command 2: installs what is missing, builds (Release, every core), runs every
 # ctest suite, then installs the package into a staging prefix and builds and tests
 # examples/downstream against it with find_package(handcentric); last, the sanitizer run
-# (scripts/sanitize.sh: a second tree with ASan + UBSan, labels unit, property, proofs).
-# SANITIZE=1 adds the sanitizer run. It is off by default: with it, CI on two cores would take
-# about 30 minutes (docs/RELIABILITY.md), over its 25-minute budget.
+# (scripts/sanitize.sh: a second tree built by clang with ASan + UBSan, labels unit, property,
+# proofs, then each libFuzzer target for 60 s). SANITIZE=0 skips the sanitizer run (CI never
+# does). Each phase prints its wall time.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 
+t0=$(date +%s)
+phase() { echo "== $1 (at $(( $(date +%s) - t0 )) s)"; }
 bash "$root/scripts/install-deps.sh"
+phase "build"
 bash "$root/scripts/build.sh"
 
-echo "== ctest"
+phase "ctest"
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs")
 
 echo "== downstream project against the installed package"
@@ -35,7 +38,9 @@ cmake -S "$root/examples/policy_downstream" -B "$build_dir/policy_downstream" -D
 cmake --build "$build_dir/policy_downstream" -j "$jobs"
 (cd "$build_dir/policy_downstream" && ctest --output-on-failure)
 
-if [ "${SANITIZE:-0}" != 0 ]; then
+if [ "${SANITIZE:-1}" != 0 ]; then
+  phase "sanitizers"
   echo "== sanitizers: AddressSanitizer + LeakSanitizer + UndefinedBehaviorSanitizer"
   bash "$root/scripts/sanitize.sh"
 fi
+phase "done"
