@@ -27,6 +27,12 @@ if(HANDCENTRIC_SANITIZE)
   add_compile_options(-fsanitize=${handcentric_sanitize_flag} -fno-omit-frame-pointer
                       -fno-sanitize-recover=all)
   add_link_options(-fsanitize=${handcentric_sanitize_flag} -fno-sanitize-recover=all)
+  # GCC says __SANITIZE_ADDRESS__ under ASan, clang 14 only __has_feature(address_sanitizer),
+  # which GCC's preprocessor cannot parse: one macro of our own for the code that must know
+  # (the kernels' lane checks, the tests that cap a child's address space).
+  if("address" IN_LIST handcentric_sanitizers)
+    add_compile_definitions(HANDCENTRIC_ASAN=1)
+  endif()
   # GCC 12 warns "may be used uninitialized" inside Eigen's fixed-size assignments once the
   # sanitizers' checks are inlined (a known false positive); the Release build keeps the warning.
   add_compile_options($<$<CXX_COMPILER_ID:GNU>:-Wno-maybe-uninitialized>)

@@ -16,7 +16,7 @@ TEST_CASE("box_muller_pairs_match_the_formula_in_double", "[unit]") {
   // Including the extremes of both 24-bit fields; `skip` plants a fault in the reference (the
   // pair taken from the next draw), which the check must catch.
   std::mt19937_64 rng(17);
-  std::vector<std::uint64_t> bits(70);
+  std::vector<std::uint64_t> bits(71);  // one more than the most pairs: the shifted reference reads i + 1
   for (std::uint64_t& b : bits) b = rng();
   bits[0] = 0;                             // u1 = 2^-24 (the largest radius), u2 = 0
   bits[1] = ~std::uint64_t{0};             // u1 = 1 (radius 0), u2 = 1 - 2^-24

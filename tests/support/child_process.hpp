@@ -62,7 +62,7 @@ inline std::string slurp_and_remove(const std::string& path) {
 // of filling the machine's memory. ASan reserves terabytes of shadow memory, so it gets no cap;
 // its allocator refuses sizes above max_allocation_size instead (a report, which fails the test).
 inline void cap_memory() {
-#if !defined(__SANITIZE_ADDRESS__)
+#if !defined(__SANITIZE_ADDRESS__) && !defined(HANDCENTRIC_ASAN)
   const rlimit limit{rlim_t{4} << 30, rlim_t{4} << 30};
   ::setrlimit(RLIMIT_AS, &limit);
 #endif

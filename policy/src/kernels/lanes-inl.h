@@ -99,7 +99,7 @@ HWY_INLINE hn::Vec<D> GatherRows(D d, const float* rows, hn::Vec<hn::RebindToSig
                                  const LaneSpan<D>& lanes) {
   const hn::RebindToSigned<D> di;
   const auto offsets = hn::IfThenElseZero(hn::RebindMask(di, lanes.mask), row_offsets);
-#if defined(__SANITIZE_ADDRESS__)
+#if defined(__SANITIZE_ADDRESS__) || defined(HANDCENTRIC_ASAN)
   alignas(64) std::int32_t each[hn::MaxLanes(D())];
   hn::Store(offsets, di, each);
   for (std::size_t i = 0; i < hn::Lanes(d); ++i) check_lanes(rows + each[i], 1, sizeof(float), false);
