@@ -5,7 +5,7 @@
 # (scripts/sanitize.sh: a second tree built by clang with ASan + UBSan, labels unit, property,
 # proofs, then each libFuzzer target for 60 s) when SANITIZE=1. It is off by default: on two
 # cores it adds ~20 minutes (clang build ~10, tests ~8, fuzzing ~2.5; docs/RELIABILITY.md) to the
-# ~16 of the rest, over CI's 25-minute budget. Each phase prints its start time.
+# ~12 of the rest, over CI's 25-minute budget. Each phase prints its start time.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
