@@ -231,33 +231,26 @@ ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19
 
 ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t index,
                       const CollisionChecker& checker, const ExpertOptions& options) {
-  ExpertRun run;
-  run.scenes = 1;
   std::mt19937_64 rng(stream_seed(seed, index));
   const RigidTransform hole_T_hand_start = scene.world_T_hole.inverse_compose(scene.world_T_hand_start);
-  for (int attempt = 0; attempt < std::max(1, options.attempts); ++attempt) {
-    const ExpertPlan plan = plan_in_hole_frame(hole_T_hand_start, rng, checker, options);
-    ++run.solutions;
-    if (!plan.valid) {
-      ++run.discarded;
-      continue;
-    }
-    Demo demo;
-    demo.world_T_hole = scene.world_T_hole;
-    demo.world_T_hand.push_back(scene.world_T_hand_start);  // exactly, not rounded through the hole frame
-    for (std::size_t t = 1; t < plan.hole_T_hand.size(); ++t) demo.world_T_hand.push_back(scene.world_T_hole * plan.hole_T_hand[t]);
-    run.demos.push_back(std::move(demo));
-    return run;
-  }
-  run.unsolved = 1;
-  return run;
+  return first_valid_plan<Demo>(
+      std::max(1, options.attempts), [&] { return plan_in_hole_frame(hole_T_hand_start, rng, checker, options); },
+      [&](const ExpertPlan& plan) {
+        Demo demo;
+        demo.world_T_hole = scene.world_T_hole;
+        demo.world_T_hand.push_back(scene.world_T_hand_start);  // exactly, not rounded through the hole frame
+        for (std::size_t t = 1; t < plan.hole_T_hand.size(); ++t) {
+          demo.world_T_hand.push_back(scene.world_T_hole * plan.hole_T_hand[t]);
+        }
+        return demo;
+      });
 }
 
 ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed, const CollisionChecker& checker,
                        const ExpertOptions& options) {
-  ExpertRun total;
-  for (std::size_t i = 0; i < scenes.size(); ++i) total.append(expert_demo(scenes[i], seed, i, checker, options));
-  return total;
+  return on_every_scene<Demo>(scenes, [&](const TaskScene& scene, std::size_t i) {
+    return expert_demo(scene, seed, i, checker, options);
+  });
 }
 
 }  // namespace handcentric::sim

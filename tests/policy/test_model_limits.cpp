@@ -13,6 +13,7 @@
 #include <string>
 
 #include "child_process.hpp"  // tests/support
+#include "cli_refusal.hpp"    // tests/support
 #include "fixtures.hpp"
 #include "handcentric/policy/binary_io.hpp"
 #include "handcentric/policy/errors.hpp"
@@ -74,12 +75,7 @@ test::ChildRun load_in_child(const std::string& path) {
 // `handcentric eval --model path` must exit 1 with one line on stderr matching `what`, within
 // the memory limit.
 void check_cli_refuses(const std::string& path, const std::string& what) {
-  const test::ChildRun run = test::run_program({HANDCENTRIC_CLI, "eval", "--model", path, "--dist", "train", "--trials", "1"});
-  INFO("stderr: " << run.err << "peak " << run.peak_bytes / (1 << 20) << " MB");
-  CHECK(run.exit_code == 1);
-  CHECK(std::count(run.err.begin(), run.err.end(), '\n') == 1);
-  CHECK_THAT(run.err, Contains("handcentric: error: ") && Contains(path) && Contains(what));
-  CHECK(run.peak_bytes < test::kPeakMemoryLimitBytes);
+  test::check_cli_refuses({HANDCENTRIC_CLI, "eval", "--model", path, "--dist", "train", "--trials", "1"}, path, what);
 }
 
 }  // namespace

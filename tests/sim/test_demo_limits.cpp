@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "child_process.hpp"  // tests/support
+#include "cli_refusal.hpp"    // tests/support
 #include "handcentric/sim/demos.hpp"
 
 using namespace handcentric;
@@ -56,13 +57,7 @@ void check_refused(const test::ChildRun& run, const std::string& where, const st
 // `handcentric render --demos path` exits 1 with one line on stderr naming `what`, within the
 // memory limit.
 void check_cli_refuses(const std::string& path, const std::string& what) {
-  const test::ChildRun run =
-      test::run_program({HANDCENTRIC_CLI, "render", "--demos", path, "--out", test::limits_temp_path("never.png")});
-  INFO("stderr: " << run.err << "peak " << run.peak_bytes / (1 << 20) << " MB");
-  CHECK(run.exit_code == 1);
-  CHECK(std::count(run.err.begin(), run.err.end(), '\n') == 1);
-  CHECK_THAT(run.err, Contains("handcentric: error: ") && Contains(path) && Contains(what));
-  CHECK(run.peak_bytes < test::kPeakMemoryLimitBytes);
+  test::check_cli_refuses({HANDCENTRIC_CLI, "render", "--demos", path, "--out", test::limits_temp_path("never.png")}, path, what);
 }
 
 }  // namespace

@@ -117,30 +117,23 @@ ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t 
   options.validate();
   std::mt19937_64 rng(stream_seed(seed, index));
   const RigidTransform slot_T_hand_start = scene.world_T_slot.inverse_compose(scene.world_T_hand_start);
-  ExpertRun run;
-  run.scenes = 1;
-  for (int attempt = 0; attempt < options.attempts; ++attempt) {
-    const ExpertPlan plan = plan_in_slot_frame(slot_T_hand_start, rng, checker, options);
-    ++run.solutions;
-    if (!plan.valid) {
-      ++run.discarded;
-      continue;
-    }
-    Demo demo{scene.world_T_slot, {scene.world_T_hand_start}};  // the start exactly, not rounded through the slot
-    demo.world_T_hand.reserve(plan.slot_T_hand.size());
-    for (std::size_t t = 1; t < plan.slot_T_hand.size(); ++t) demo.world_T_hand.push_back(scene.world_T_slot * plan.slot_T_hand[t]);
-    run.demos.push_back(std::move(demo));
-    return run;
-  }
-  run.unsolved = 1;
-  return run;
+  return first_valid_plan<Demo>(
+      options.attempts, [&] { return plan_in_slot_frame(slot_T_hand_start, rng, checker, options); },
+      [&](const ExpertPlan& plan) {
+        Demo demo{scene.world_T_slot, {scene.world_T_hand_start}};  // the start exactly, not rounded through the slot
+        demo.world_T_hand.reserve(plan.slot_T_hand.size());
+        for (std::size_t t = 1; t < plan.slot_T_hand.size(); ++t) {
+          demo.world_T_hand.push_back(scene.world_T_slot * plan.slot_T_hand[t]);
+        }
+        return demo;
+      });
 }
 
 ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed, const CollisionChecker& checker,
                        const ExpertOptions& options) {
-  ExpertRun total;
-  for (std::size_t i = 0; i < scenes.size(); ++i) total.append(expert_demo(scenes[i], seed, i, checker, options));
-  return total;
+  return on_every_scene<Demo>(scenes, [&](const TaskScene& scene, std::size_t i) {
+    return expert_demo(scene, seed, i, checker, options);
+  });
 }
 
 }  // namespace handcentric::sim::insert3d

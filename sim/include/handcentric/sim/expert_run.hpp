@@ -26,4 +26,33 @@ struct BasicExpertRun {
   }
 };
 
+/// The expert on one scene: up to `attempts` plans, each made by `plan_once()`, the first valid
+/// one (`plan.valid`) turned into a demo by `to_demo(plan)`. Every plan is counted, an invalid
+/// one as discarded; a scene whose plans are all invalid is unsolved.
+template <typename DemoType, typename PlanOnce, typename ToDemo>
+BasicExpertRun<DemoType> first_valid_plan(int attempts, PlanOnce&& plan_once, ToDemo&& to_demo) {
+  BasicExpertRun<DemoType> run;
+  run.scenes = 1;
+  for (int attempt = 0; attempt < attempts; ++attempt) {
+    const auto plan = plan_once();
+    ++run.solutions;
+    if (!plan.valid) {
+      ++run.discarded;
+      continue;
+    }
+    run.demos.push_back(to_demo(plan));
+    return run;
+  }
+  run.unsolved = 1;
+  return run;
+}
+
+/// `one_scene(scene, i)` on every scene, in order, tallied into one run.
+template <typename DemoType, typename Scene, typename OneScene>
+BasicExpertRun<DemoType> on_every_scene(const std::vector<Scene>& scenes, OneScene&& one_scene) {
+  BasicExpertRun<DemoType> total;
+  for (std::size_t i = 0; i < scenes.size(); ++i) total.append(one_scene(scenes[i], i));
+  return total;
+}
+
 }  // namespace handcentric::sim
