@@ -82,7 +82,11 @@ kill_and_rerun() {
   done
   "$@" >/dev/null
   cmp -s "$output" "$reference" || fail "a re-run of $name differs from an uninterrupted run"
-  echo "$name: $kills kills within $ms ms, every file whole"
+  # The killed runs' "<output>.tmp.<pid>" files: the complete run's write removes them.
+  local leftovers
+  leftovers="$(find "$(dirname "$output")" -name "$(basename "$output").tmp.*")"
+  [ -z "$leftovers" ] || fail "the re-run of $name left the killed runs' temporary files: $leftovers"
+  echo "$name: $kills kills within $ms ms, every file whole, no temporary file left"
 }
 
 # demos and train: the previous file is another seed's.
@@ -118,6 +122,8 @@ done
 diff <(files_of "$dir/table") <(files_of "$dir/table-reference") >&2 ||
   fail "the resumed table1 folder lists other files than an uninterrupted run's"
 check_tree
+leftovers="$(find "$dir/table" -name '*.tmp.*')"
+[ -z "$leftovers" ] || fail "the resumed table1 left the killed runs' temporary files: $leftovers"
 echo "table1: $kills kills within ${table_ms} ms, each resumed; every file whole, the same bytes at the end"
 
 [ "$mode" = --expect-partial ] && { echo "kill_writers: the planted in-place writer was not caught" >&2; exit 1; }

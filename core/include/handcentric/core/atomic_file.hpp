@@ -2,7 +2,9 @@
 // Atomic file writes: the bytes go to a temporary file beside the target, which is then renamed
 // over it, so a reader never sees a half-written demo file, model, report or image, even when
 // the writer is killed (SIGKILL, out of memory): the target holds the old file or the new one.
-// A killed writer may leave its "<path>.tmp.<pid>" behind; no reader looks at those names.
+// The data and then the folder entry are fsync'ed, so the new file also survives a power cut
+// once the call returns. A killed writer leaves its "<path>.tmp.<pid>" behind (no reader looks
+// at those names); the next write of the same path removes those whose process is gone.
 // For tests only: HANDCENTRIC_FAULT_WRITE_IN_PLACE_MS=<ms> plants the naive writer (in place,
 // with a pause halfway) that tests/reliability/kill_writers.sh must catch.
 #include <string>
