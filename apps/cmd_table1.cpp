@@ -75,6 +75,9 @@ void add_table1_command(CLI::App& app, int& exit_code) {
   auto* out = cmd->add_option("--out", t.out, "output directory")->capture_default_str();
   cmd->add_flag("--no-mirror{false}", t.data.mirror,
                 "train every cell on its demos only, not also on their mirror images about the hole axis");
+  cmd->add_option("--perturbed-copies", t.data.perturbed_copies,
+                  "relabelled recovery copies of each training sample (0: none)")
+      ->capture_default_str();
   cmd->add_flag("--resume", t.resume, "reuse the models and results already in --out");
   auto* plan = cmd->add_flag("--plan", options->plan, "write --out/jobs.txt (one shell line per cell) and stop");
   auto* collect = cmd->add_option("--collect", options->collect, "build the table from the results in DIR");

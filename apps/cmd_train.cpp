@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/experiments/cell.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -65,9 +66,13 @@ int run_train(const TrainOptions& options) {
                           std::to_string(demos.size()) + " demos: give 0 (all) up to " + std::to_string(demos.size()));
   }
   const std::size_t used = options.max_demos == 0 ? demos.size() : static_cast<std::size_t>(options.max_demos);
+  sim::TrainingData data = options.data;
+  data.perturbation_seed = options.seed;  // one seed names the whole training run
   const std::vector<Scene> scenes =
-      sim::training_scenes(demos, config.history_length, config.chunk_length, options.max_demos, options.data);
-  if (config.steps == 0) config.steps = policy::training_budget(static_cast<long long>(scenes.size()));
+      sim::training_scenes(demos, config.history_length, config.chunk_length, options.max_demos, data);
+  long long demo_samples = 0;  // one scene per pose of each demo trained on
+  for (std::size_t i = 0; i < used; ++i) demo_samples += static_cast<long long>(demos[i].world_T_hand.size());
+  if (config.steps == 0) config.steps = experiments::automatic_steps(data, demo_samples);
 
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   const int report_every = terminal ? 50 : std::max(1, config.steps / 10);
@@ -85,7 +90,9 @@ int run_train(const TrainOptions& options) {
   policy::save_model(trained, options.out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "trained " << trained.name() << " on " << scenes.size() << " scenes from " << used << " demos"
-            << (options.data.mirror ? " and their mirror images" : "") << ": "
+            << (data.mirror ? " and their mirror images" : "")
+            << (data.perturbed_copies > 0 ? " (" + std::to_string(data.perturbed_copies) + " perturbed copies each)" : "")
+            << ": "
             << config.steps << " steps, final loss " << last_loss << ", " << static_cast<long>(last_rate)
             << " samples/s (" << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
             << " -> " << options.out << "\n";
@@ -104,9 +111,19 @@ void add_train_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--steps", config.steps, "Adam steps (0: the automatic budget for the number of training samples)")
       ->capture_default_str();
-  cmd->add_option("--seed", options->seed, "seed of initialization, minibatches and noise")->capture_default_str();
+  cmd->add_option("--seed", options->seed, "seed of initialization, minibatches, noise and the perturbed copies")->capture_default_str();
   cmd->add_flag("--no-mirror{false}", options->data.mirror,
                 "train on the demos only, not also on their mirror images about the hole axis");
+  cmd->add_option("--perturbed-copies", options->data.perturbed_copies,
+                  "relabelled recovery copies of each training sample, the hand moved off the demo (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--offset-cm", options->data.offset_cm, "largest offset of a perturbed copy along x and y (cm)")
+      ->capture_default_str();
+  cmd->add_option("--offset-deg", options->data.offset_deg, "largest angle offset of a perturbed copy (degrees)")
+      ->capture_default_str();
+  cmd->add_option("--recovery-steps", options->data.recovery_steps,
+                  "steps over which a perturbed copy's chunk returns to the demo")
+      ->capture_default_str();
   cmd->add_option("--max-demos", options->max_demos, "train on the first N demos only (0 = all)")
       ->capture_default_str();
   cmd->add_option("--chunk", config.chunk_length, "K, actions per chunk")->capture_default_str();

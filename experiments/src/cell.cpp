@@ -1,5 +1,7 @@
 #include "handcentric/experiments/cell.hpp"
 
+#include <algorithm>
+
 #include <cstdio>
 
 #include "handcentric/policy/model_file.hpp"
@@ -41,10 +43,16 @@ std::string digest(const std::string& bytes) {
 std::string cell_hash(const Cell& cell) {
   const std::string text = "handcentric table1 cell\ndemo_digest=" + cell.demo_digest +
                            "\ndemos=" + std::to_string(cell.demos) + "\ntrain_seed=" + std::to_string(cell.train_seed) +
-                           "\nmirror=" + (cell.data.mirror ? "1" : "0") +
-                           "\nmodel_format=" + std::to_string(policy::kModelFormatVersion) + "\n" +
+                           "\n" + cell.data.to_text() + "model_format=" + std::to_string(policy::kModelFormatVersion) + "\n" +
                            cell.config.to_text();
   return digest(text);
+}
+
+int automatic_steps(const sim::TrainingData& data, long long demo_samples) {
+  const long long samples = data.samples(demo_samples);
+  if (data.perturbed_copies == 0) return policy::training_budget(samples);
+  if (samples < 1) throw InvalidArgument("automatic_steps: no training samples (got " + std::to_string(samples) + ")");
+  return static_cast<int>(std::clamp(12 * samples, static_cast<long long>(policy::kBudgetMinSteps), 10000LL));
 }
 
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
@@ -57,10 +65,11 @@ Cell make_cell(const std::string& method, const std::string& representation, con
   cell.train_seed = train_seed;
   cell.demo_digest = demo_digest;
   cell.data = data;
+  cell.data.perturbation_seed = train_seed;  // as `handcentric train --seed` does
   cell.config.representation = representation;
   cell.config.head = policy::parse_head(head);
   if (steps > 0) cell.config.steps = steps;
-  if (cell.config.steps == 0) cell.config.steps = policy::training_budget(data.samples(demo_samples));
+  if (cell.config.steps == 0) cell.config.steps = automatic_steps(data, demo_samples);
   cell.config.validate();
   cell.hash = cell_hash(cell);
   return cell;

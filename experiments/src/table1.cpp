@@ -15,6 +15,7 @@
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/plot.hpp"
 #include "handcentric/experiments/progress.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -105,6 +106,10 @@ nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval, std:
                      {"train_seed", c.train_seed},
                      {"steps", c.config.steps},
                      {"mirror", c.data.mirror},
+                     {"perturbed_copies", c.data.perturbed_copies},
+                     {"offset_cm", c.data.offset_cm},
+                     {"offset_deg", c.data.offset_deg},
+                     {"recovery_steps", c.data.recovery_steps},
                      {"hash", c.hash}});
   }
   return {{"format", "handcentric-table1-cells"},
@@ -294,6 +299,9 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
                        shell_quote(cli) + " train --demos " + grid.demo_file + " --max-demos " +
                        std::to_string(cell.demos) + " --repr " + cell.config.representation + " --head " + cell.head +
                        " --steps " + std::to_string(cell.config.steps) + (cell.data.mirror ? "" : " --no-mirror") +
+                       " --perturbed-copies " + std::to_string(cell.data.perturbed_copies) + " --offset-cm " +
+                       format_number(cell.data.offset_cm) + " --offset-deg " + format_number(cell.data.offset_deg) +
+                       " --recovery-steps " + std::to_string(cell.data.recovery_steps) +
                        " --seed " + std::to_string(cell.train_seed) +
                        " --quiet --out " + cell.model_path() + " >/dev/null; }";
     for (const SceneSet set : kSceneSets) {
@@ -334,6 +342,11 @@ std::string collect_table1(const std::string& dir_text) {
       cell.config.steps = c.at("steps").get<int>();
       // Runs written before the mirror images existed trained on the demos only.
       cell.data.mirror = c.contains("mirror") && c.at("mirror").get<bool>();
+      // ... and before the perturbed copies, on none.
+      cell.data.perturbed_copies = c.value("perturbed_copies", 0);
+      cell.data.offset_cm = c.value("offset_cm", cell.data.offset_cm);
+      cell.data.offset_deg = c.value("offset_deg", cell.data.offset_deg);
+      cell.data.recovery_steps = c.value("recovery_steps", cell.data.recovery_steps);
       cell.hash = c.at("hash").get<std::string>();
       rows.push_back(collect_row(cell, eval, dir.string()));
     }

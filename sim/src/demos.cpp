@@ -1,7 +1,15 @@
 // Demo files of the 2D task (the shared format: demo_file.hpp, docs/SIM.md) and training scenes.
 #include "handcentric/sim/demos.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+
 #include "demo_file.hpp"
+#include "handcentric/sim/collision.hpp"
+#include "handcentric/sim/scenes.hpp"
 
 namespace handcentric::sim {
 namespace {
@@ -83,14 +91,105 @@ std::vector<Demo> with_mirrored_demos(const std::vector<Demo>& demos) {
   return all;
 }
 
+void TrainingData::validate() const {
+  const auto refuse = [](const std::string& what) { throw InvalidArgument("training data: " + what); };
+  if (perturbed_copies < 0 || perturbed_copies > 64) {
+    refuse("perturbed_copies must be in [0, 64], got " + std::to_string(perturbed_copies));
+  }
+  if (!(offset_cm >= 0.0 && offset_cm <= 10.0)) refuse("offset_cm must be in [0, 10], got " + std::to_string(offset_cm));
+  if (!(offset_deg >= 0.0 && offset_deg <= 90.0)) {
+    refuse("offset_deg must be in [0, 90], got " + std::to_string(offset_deg));
+  }
+  if (recovery_steps < 1) refuse("recovery_steps must be >= 1, got " + std::to_string(recovery_steps));
+}
+
+std::string TrainingData::to_text() const {
+  char text[256];
+  std::snprintf(text, sizeof text,
+                "mirror=%d\nperturbed_copies=%d\noffset_cm=%.17g\noffset_deg=%.17g\nrecovery_steps=%d\n"
+                "perturbation_seed=%llu\n",
+                mirror ? 1 : 0, perturbed_copies, offset_cm, offset_deg, recovery_steps,
+                static_cast<unsigned long long>(perturbation_seed));
+  return text;
+}
+
+namespace {
+
+struct PlanarPose {
+  double theta, x, y;
+};
+
+PlanarPose planar_parameters(const RigidTransform& hole_T_hand) {
+  const Eigen::Matrix3d& R = hole_T_hand.rotation().matrix();
+  return {std::atan2(R(1, 0), R(0, 0)), hole_T_hand.translation().x(), hole_T_hand.translation().y()};
+}
+
+// The perturbed copies of demo's samples (TrainingData::perturbed_copies): sample t of copy c
+// draws its offset from stream (seed, (demo_index, t, c)), so the copies do not depend on how
+// many others were dropped.
+void append_perturbed_scenes(const Demo& demo, std::uint64_t demo_index, int H, int K, const TrainingData& data,
+                             const CollisionChecker& checker, const PegHoleGeometry& geometry,
+                             std::vector<Scene>& scenes) {
+  const int T = static_cast<int>(demo.world_T_hand.size());
+  std::vector<RigidTransform> hole_T_hand;
+  hole_T_hand.reserve(demo.world_T_hand.size());
+  for (const RigidTransform& world_T_hand : demo.world_T_hand) {
+    hole_T_hand.push_back(demo.world_T_hole.inverse_compose(world_T_hand));
+  }
+  const auto pose = [&](int t) { return hole_T_hand[static_cast<std::size_t>(std::clamp(t, 0, T - 1))]; };
+  const double offset_rad = data.offset_deg * std::numbers::pi / 180.0;
+  for (int t = 0; t < T; ++t) {
+    for (int c = 0; c < data.perturbed_copies; ++c) {
+      const std::uint64_t index = (demo_index * 1'000'003ull + static_cast<std::uint64_t>(t)) * 65ull +
+                                  static_cast<std::uint64_t>(c);
+      std::mt19937_64 rng(stream_seed(data.perturbation_seed, index));
+      std::uniform_real_distribution<double> unit(-1.0, 1.0);
+      const double d_theta = offset_rad * unit(rng);
+      const double d_x = data.offset_cm * unit(rng);
+      const double d_y = data.offset_cm * unit(rng);
+      // Offset k steps after the perturbation: shrinks linearly to 0 at recovery_steps.
+      const auto moved = [&](int k) {
+        const double left = std::max(0.0, 1.0 - static_cast<double>(k) / data.recovery_steps);
+        const PlanarPose p = planar_parameters(pose(t + k));
+        return RigidTransform::planar(p.theta + left * d_theta, p.x + left * d_x, p.y + left * d_y);
+      };
+      bool valid = !checker.collides(moved(0));
+      for (int k = 1; valid && k <= std::min(K, data.recovery_steps); ++k) {
+        valid = !checker.motion_collides(moved(k - 1), moved(k));
+      }
+      if (!valid) continue;
+      Scene scene;
+      scene.world_T_hand_history.push_back(demo.world_T_hole * moved(0));
+      // The past as the demo had it: the perturbation happened at t.
+      for (int h = 1; h <= H; ++h) scene.world_T_hand_history.push_back(demo.world_T_hole * pose(t - h));
+      for (int k = 1; k <= K; ++k) scene.world_T_hand_chunk.push_back(demo.world_T_hole * moved(k));
+      scene.hand_points = eye_in_hand_points(demo.world_T_hole, scene.world_T_hand_history.front(), geometry);
+      scenes.push_back(std::move(scene));
+    }
+  }
+}
+
+}  // namespace
+
 std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K, int max_demos,
                                    const TrainingData& data, const PegHoleGeometry& geometry) {
+  data.validate();
   std::vector<Scene> scenes = training_scenes(demos, H, K, max_demos, geometry);
-  if (!data.mirror) return scenes;
   const std::size_t used = max_demos == 0 ? demos.size() : static_cast<std::size_t>(max_demos);
-  for (std::size_t i = 0; i < used; ++i) {
-    for (Scene& scene : training_scenes(mirrored_about_hole_axis(demos[i]), H, K, geometry)) {
-      scenes.push_back(std::move(scene));
+  if (data.mirror) {
+    for (std::size_t i = 0; i < used; ++i) {
+      for (Scene& scene : training_scenes(mirrored_about_hole_axis(demos[i]), H, K, geometry)) {
+        scenes.push_back(std::move(scene));
+      }
+    }
+  }
+  if (data.perturbed_copies > 0) {
+    const CollisionChecker checker(geometry);
+    for (std::size_t i = 0; i < used; ++i) {
+      append_perturbed_scenes(demos[i], 2 * i, H, K, data, checker, geometry, scenes);
+      if (data.mirror) {
+        append_perturbed_scenes(mirrored_about_hole_axis(demos[i]), 2 * i + 1, H, K, data, checker, geometry, scenes);
+      }
     }
   }
   return scenes;

@@ -44,12 +44,19 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   const Cell base = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff");
   CHECK(base.hash == make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff").hash);
   CHECK(base.hash.size() == 16);
-  // The library's automatic budget, for the 320 demo scenes and their 320 mirror images.
-  CHECK(base.config.steps == policy::training_budget(640));
+  // The automatic budget: 12 steps for each of the 320 demo scenes and their 320 mirror images
+  // (the perturbed copies add none), at most 10000; without copies trainer.hpp's budget.
+  CHECK(base.config.steps == 7680);
+  CHECK(make_cell("hand_centric", "hand_centric", "flow", 10, 1, 3200, "00ff").config.steps == 10000);
   sim::TrainingData demos_only;
   demos_only.mirror = false;
+  demos_only.perturbed_copies = 0;
   const Cell unmirrored = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 0, demos_only);
   CHECK(unmirrored.config.steps == policy::training_budget(320));
+  sim::TrainingData fewer_copies;
+  fewer_copies.perturbed_copies = 2;
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", base.config.steps,
+                               fewer_copies).hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", base.config.steps,
                                demos_only).hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 20, 1, 320, "00ff").hash);

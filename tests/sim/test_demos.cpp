@@ -1,7 +1,9 @@
 // Demo files (JSON Lines): exact round trip, atomic writes, and a clear error with the record
 // number for every kind of bad file; training scenes as the policy issue reads them.
 #include <catch2/catch.hpp>
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -222,7 +224,9 @@ TEST_CASE("mutant_a_mirror_that_keeps_the_angle_is_caught", "[unit]") {
 TEST_CASE("training_data_adds_the_mirror_images_after_the_demos_by_default", "[unit]") {
   const std::vector<Demo> demos = some_demos(3);
   const std::vector<Scene> plain = training_scenes(demos, 0, 4, 2);
-  const std::vector<Scene> mirrored = training_scenes(demos, 0, 4, 2, TrainingData());
+  TrainingData recipe;
+  recipe.perturbed_copies = 0;  // the copies have their own tests below
+  const std::vector<Scene> mirrored = training_scenes(demos, 0, 4, 2, recipe);
   REQUIRE(TrainingData().mirror);
   REQUIRE(mirrored.size() == 2 * plain.size());
   CHECK(TrainingData().samples(static_cast<long long>(plain.size())) == static_cast<long long>(mirrored.size()));
@@ -231,7 +235,7 @@ TEST_CASE("training_data_adds_the_mirror_images_after_the_demos_by_default", "[u
   for (std::size_t i = plain.size(); i < mirrored.size(); ++i) {
     CHECK(same_bits(mirrored[i].world_T_hand0(), of_mirrors[i].world_T_hand0()));
   }
-  TrainingData off;
+  TrainingData off = recipe;
   off.mirror = false;
   CHECK(training_scenes(demos, 0, 4, 2, off).size() == plain.size());
 }
@@ -255,4 +259,118 @@ TEST_CASE("demo_bytes_in_memory_parse_like_the_file_they_came_from", "[unit]") {
   CHECK_THROWS_WITH(parse_demos(truncated, "received demos"),
                     Contains("'received demos'") && Contains("record 3") && Contains("final newline"));
   std::filesystem::remove(path);
+}
+
+namespace {
+
+// A perturbed copy (TrainingData::perturbed_copies) must be a feasible recovery onto the demo:
+// the moved hand and every motion of its chunk free of the hole, the chunk back on the demo's
+// own poses from recovery_steps on, the observation seen from the moved hand, the offset within
+// its bounds. Returns the first violation, empty when there is none.
+std::string recovery_violation(const Scene& copy, const Demo& demo, const TrainingData& data) {
+  const CollisionChecker checker;
+  const auto hole_T = [&](const RigidTransform& world_T_hand) { return demo.world_T_hole.inverse_compose(world_T_hand); };
+  const RigidTransform& world_T_moved = copy.world_T_hand_history.front();
+  if (checker.collides(hole_T(world_T_moved))) return "the moved hand touches the hole";
+  RigidTransform previous = world_T_moved;
+  for (const RigidTransform& world_T_next : copy.world_T_hand_chunk) {
+    if (checker.motion_collides(hole_T(previous), hole_T(world_T_next))) return "a motion of the chunk touches the hole";
+    previous = world_T_next;
+  }
+  // The demo step t whose future the chunk rejoins: chunk[k - 1] = T_{t+k} for k >= recovery_steps.
+  const int T = static_cast<int>(demo.world_T_hand.size());
+  const int K = static_cast<int>(copy.world_T_hand_chunk.size());
+  const auto demo_pose = [&](int t) { return demo.world_T_hand[static_cast<std::size_t>(std::clamp(t, 0, T - 1))]; };
+  int rejoined_at = -1;
+  for (int t = 0; t < T && rejoined_at < 0; ++t) {
+    bool same = true;
+    for (int k = data.recovery_steps; k <= K && same; ++k) {
+      same = (copy.world_T_hand_chunk[static_cast<std::size_t>(k - 1)].matrix() - demo_pose(t + k).matrix()).norm() < 1e-9;
+    }
+    if (same) rejoined_at = t;
+  }
+  if (rejoined_at < 0) return "the chunk does not return to the demo's poses";
+  const RigidTransform offset = hole_T(demo_pose(rejoined_at)).inverse_compose(hole_T(world_T_moved));
+  // drawn in the hole's frame (x, y each within offset_cm): at most sqrt(2) offset_cm long
+  if (offset.translation().norm() > std::sqrt(2.0) * data.offset_cm + 1e-9) return "the offset is out of bounds";
+  if (offset.rotation().angle() > data.offset_deg * std::numbers::pi / 180.0 + 1e-9) return "the angle offset is out of bounds";
+  const auto seen = eye_in_hand_points(demo.world_T_hole, world_T_moved);
+  for (std::size_t i = 0; i < seen.size(); ++i) {
+    if ((seen[i] - copy.hand_points[i]).norm() > 1e-12) return "the observation is not the moved hand's";
+  }
+  return "";
+}
+
+TrainingData with_copies(int copies) {
+  TrainingData data;
+  data.mirror = false;
+  data.perturbed_copies = copies;
+  return data;
+}
+
+}  // namespace
+
+TEST_CASE("perturbed_copies_are_feasible_recoveries_onto_their_demo", "[unit]") {
+  const std::vector<Demo> demos = some_demos(3);
+  const TrainingData data = with_copies(3);
+  const std::vector<Scene> plain = training_scenes(demos, 0, 16, 0);
+  const std::vector<Scene> all = training_scenes(demos, 0, 16, 0, data);
+  REQUIRE(all.size() > plain.size());
+  CHECK(all.size() <= 4 * plain.size());  // copies that touch the hole are dropped
+  for (std::size_t i = 0; i < plain.size(); ++i) CHECK(same_bits(all[i].world_T_hand0(), plain[i].world_T_hand0()));
+  // The copies come demo after demo; each is checked against the demo whose future it rejoins.
+  int checked = 0;
+  for (std::size_t i = plain.size(); i < all.size(); ++i) {
+    std::string violation = "no demo";
+    for (const Demo& demo : demos) {
+      violation = recovery_violation(all[i], demo, data);
+      if (violation.empty() || violation != "the chunk does not return to the demo's poses") break;
+    }
+    INFO("copy " << i - plain.size());
+    CHECK(violation.empty());
+    ++checked;
+  }
+  CHECK(checked > static_cast<int>(plain.size()));  // most copies are kept: ~3 per sample, ~1/3 dropped
+  // the same seed gives the same bits, another seed other copies
+  const std::vector<Scene> again = training_scenes(demos, 0, 16, 0, data);
+  REQUIRE(again.size() == all.size());
+  for (std::size_t i = 0; i < all.size(); ++i) CHECK(same_bits(again[i].world_T_hand0(), all[i].world_T_hand0()));
+  TrainingData other = data;
+  other.perturbation_seed = 2;
+  CHECK_FALSE(same_bits(training_scenes(demos, 0, 16, 0, other).back().world_T_hand0(), all.back().world_T_hand0()));
+}
+
+TEST_CASE("mutant_a_copy_that_never_returns_to_its_demo_is_caught", "[unit]") {
+  // Planted faults on real copies: the whole chunk shifted by the offset for good (no recovery),
+  // and a copy moved into the wall.
+  const std::vector<Demo> demos = some_demos(1);
+  const TrainingData data = with_copies(2);
+  const std::vector<Scene> plain = training_scenes(demos, 0, 16, 0);
+  const std::vector<Scene> all = training_scenes(demos, 0, 16, 0, data);
+  REQUIRE(all.size() > plain.size() + 10);
+  int caught_drift = 0, caught_wall = 0;
+  for (std::size_t i = plain.size(); i < plain.size() + 10; ++i) {
+    REQUIRE(recovery_violation(all[i], demos[0], data).empty());
+    Scene drifting = all[i];
+    const RigidTransform shift = RigidTransform::planar(0.0, 0.3, 0.0);
+    for (RigidTransform& world_T_hand : drifting.world_T_hand_chunk) world_T_hand = world_T_hand * shift;
+    if (!recovery_violation(drifting, demos[0], data).empty()) ++caught_drift;
+    Scene in_wall = all[i];
+    in_wall.world_T_hand_history.front() = demos[0].world_T_hole * RigidTransform::planar(0.0, 3.0, -0.5);
+    if (!recovery_violation(in_wall, demos[0], data).empty()) ++caught_wall;
+  }
+  CHECK(caught_drift == 10);
+  CHECK(caught_wall == 10);
+}
+
+TEST_CASE("bad_training_data_recipes_are_typed_errors_naming_the_field", "[unit]") {
+  const std::vector<Demo> demos = some_demos(1);
+  TrainingData data = with_copies(-1);
+  HC_CHECK_THROWS(training_scenes(demos, 0, 4, 0, data), InvalidArgument, Contains("perturbed_copies") && Contains("-1"));
+  data = with_copies(1);
+  data.offset_cm = std::nan("");
+  HC_CHECK_THROWS(training_scenes(demos, 0, 4, 0, data), InvalidArgument, Contains("offset_cm"));
+  data = with_copies(1);
+  data.recovery_steps = 0;
+  HC_CHECK_THROWS(training_scenes(demos, 0, 4, 0, data), InvalidArgument, Contains("recovery_steps"));
 }

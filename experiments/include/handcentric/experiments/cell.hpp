@@ -53,10 +53,17 @@ std::string digest(const std::string& bytes);
 /// the model file format and the full PolicyConfig (policy/config.hpp to_text).
 std::string cell_hash(const Cell& cell);
 
+/// The automatic training budget (Adam steps) for `demo_samples` scenes of demos trained on
+/// under `data`, the one `handcentric train` and every table cell use. Without perturbed copies:
+/// trainer.hpp's training_budget of the samples with their mirror images (6 per sample, 3000 to
+/// 30000). With them: 12 steps per sample with mirror images (the copies add no steps), from
+/// 3000 to 10000. Measured on the tuning seeds (docs/EXPERIMENTS.md): with 4 copies, 100 demos
+/// insert 1.00 after 10000 steps as after 30000, and 10 demos 0.98 after 8160 steps (0.95 after
+/// 4080), so the copies make training shorter, not longer.
+int automatic_steps(const sim::TrainingData& data, long long demo_samples);
+
 /// A cell with its config from the library defaults (PolicyConfig{}), the method's
-/// representation and the head, and `steps` Adam steps (0: the automatic budget for the
-/// training samples that `data` makes of `demo_samples` demo scenes, trainer.hpp
-/// training_budget); hash set.
+/// representation and the head, and `steps` Adam steps (0: automatic_steps); hash set.
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
                std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps = 0,
                const sim::TrainingData& data = sim::TrainingData());

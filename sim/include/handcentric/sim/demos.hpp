@@ -16,6 +16,7 @@
 // (and that line's JSON tree, ~20 bytes per byte of the line) plus the poses it keeps, so a
 // hostile or broken file costs at most a few hundred MB (tests/sim/test_demo_limits.cpp measures it).
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -103,8 +104,27 @@ struct TrainingData {
   /// tuning seeds, hand-centric flow at 40 demos inserts 0.91 of the time with it and 0.74
   /// without at the same number of steps (docs/EXPERIMENTS.md).
   bool mirror = true;
-  /// The training samples of `demo_samples` demo scenes under this recipe.
+  /// Perturbed copies of each training sample (0: none), each a relabelled recovery: the hand
+  /// moved off the demo by a random planar offset (uniform in +-offset_cm along x and y and
+  /// +-offset_deg in angle, in the hole's frame), the chunk returning to the demo's poses over
+  /// `recovery_steps` steps (the offset shrinks linearly to 0), the observation seen from the
+  /// moved hand. A copy whose pose or motion touches the hole is dropped. Like mirror images, it
+  /// uses no expert call: the demo's own future is the label. 4 by default: on the tuning seeds,
+  /// hand-centric flow at 10 demos inserts 0.98 of the time with them and 0.03 without
+  /// (docs/EXPERIMENTS.md). perturbation_seed is the training run's seed (train --seed).
+  int perturbed_copies = 4;
+  double offset_cm = 1.0;
+  double offset_deg = 10.0;
+  int recovery_steps = 4;
+  std::uint64_t perturbation_seed = 1;
+  /// The samples of `demo_samples` demo scenes with their mirror images, the count a training
+  /// budget grows with (the perturbed copies, which vary those samples, are not counted).
   long long samples(long long demo_samples) const { return mirror ? 2 * demo_samples : demo_samples; }
+  /// Throws InvalidArgument naming the field for a negative count or offset, or recovery_steps < 1.
+  void validate() const;
+  /// Every field as "name=value" lines, in a fixed order: what a cache key of a model trained
+  /// on this recipe must include.
+  std::string to_text() const;
 };
 
 /// The training scenes of the first `max_demos` demos (0: all) and, with data.mirror, of their
