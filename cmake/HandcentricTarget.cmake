@@ -35,18 +35,13 @@ endfunction()
 function(handcentric_test name)
   cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
-  target_link_libraries(${name} PRIVATE ${ARG_DEPS} Catch2::Catch2 rapidcheck_catch)
+  # Catch's main and implementation come compiled once, from handcentric_catch_main
+  # (tests/CMakeLists.txt).
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} handcentric_catch_main rapidcheck_catch)
   target_include_directories(${name} PRIVATE "${PROJECT_SOURCE_DIR}/tests/support")
   # Catch2's single header and RapidCheck's are most of each test file's compile time: parse
   # them once per executable.
-  # (Not for the file that defines Catch's main: it compiles catch.hpp with CATCH_CONFIG_RUNNER.)
   target_precompile_headers(${name} PRIVATE <catch2/catch.hpp> <rapidcheck.h> <Eigen/Core>)
-  foreach(source IN LISTS ARG_SOURCES)
-    get_filename_component(file ${source} NAME)
-    if(file STREQUAL "main.cpp")
-      set_source_files_properties(${source} TARGET_DIRECTORY ${name} PROPERTIES SKIP_PRECOMPILE_HEADERS ON)
-    endif()
-  endforeach()
   handcentric_warnings(${name})
   foreach(label IN LISTS ARG_LABELS)
     catch_discover_tests(${name} TEST_SPEC "[${label}]" PROPERTIES LABELS ${label})
