@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -67,7 +68,10 @@ int run_train(const TrainOptions& options) {
   const std::size_t used = options.max_demos == 0 ? demos.size() : static_cast<std::size_t>(options.max_demos);
   const std::vector<Scene> scenes =
       sim::training_scenes(demos, config.history_length, config.chunk_length, options.max_demos, options.data);
-  if (config.steps == 0) config.steps = policy::training_budget(static_cast<long long>(scenes.size()));
+  if (config.steps == 0) {
+    config.steps = policy::training_budget(policy::c8::augmentation_copies(config.head) *
+                                           static_cast<long long>(scenes.size()));
+  }
 
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   const int report_every = terminal ? 50 : std::max(1, config.steps / 10);
@@ -100,7 +104,12 @@ void add_train_command(CLI::App& app, int& exit_code) {
   policy::PolicyConfig& config = options->config;
   cmd->add_option("--repr", config.representation, "absolute|relative|relative_diff|hand_centric")
       ->capture_default_str();
-  cmd->add_option("--head", options->head, "flow|ddpm|cvae|c8flow (c8flow needs --repr absolute)")
+  cmd->add_option("--head", options->head,
+                  "flow|ddpm|cvae|c8flow|c8ddpm (c8flow, c8ddpm need --repr absolute)")
+      ->capture_default_str();
+  cmd->add_option("--c8-centre-x", config.c8_centre_x, "c8ddpm: x of the C8 rotation centre (cm)")
+      ->capture_default_str();
+  cmd->add_option("--c8-centre-y", config.c8_centre_y, "c8ddpm: y of the C8 rotation centre (cm)")
       ->capture_default_str();
   cmd->add_option("--steps", config.steps, "Adam steps (0: the automatic budget for the number of training samples)")
       ->capture_default_str();

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 
@@ -49,7 +50,7 @@ std::string cell_hash(const Cell& cell) {
 
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
                std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps,
-               const sim::TrainingData& data) {
+               const sim::TrainingData& data, std::array<double, 2> c8_centre) {
   Cell cell;
   cell.method = method;
   cell.head = head;
@@ -59,8 +60,13 @@ Cell make_cell(const std::string& method, const std::string& representation, con
   cell.data = data;
   cell.config.representation = representation;
   cell.config.head = policy::parse_head(head);
+  cell.config.c8_centre_x = c8_centre[0];
+  cell.config.c8_centre_y = c8_centre[1];
   if (steps > 0) cell.config.steps = steps;
-  if (cell.config.steps == 0) cell.config.steps = policy::training_budget(data.samples(demo_samples));
+  if (cell.config.steps == 0) {
+    const long long copies = policy::c8::augmentation_copies(cell.config.head);
+    cell.config.steps = policy::training_budget(copies * data.samples(demo_samples));
+  }
   cell.config.validate();
   cell.hash = cell_hash(cell);
   return cell;

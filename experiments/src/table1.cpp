@@ -15,6 +15,7 @@
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/plot.hpp"
 #include "handcentric/experiments/progress.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -87,6 +88,14 @@ void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir, c
     const sim::RolloutSummary summary = sim::evaluate(trained, scenes, checker, seed, rollout_options);
     write_file_atomically(result.string(), eval_json(summary, trained.name(), distribution.name, seed) + "\n");
   }
+}
+
+// The train options that place c8ddpm's symmetry centre (none for other heads).
+std::string c8_centre_options(const policy::PolicyConfig& config) {
+  if (config.head != policy::HeadKind::c8ddpm) return "";
+  // "=": a negative coordinate is the option's value, not an option of its own.
+  return " --c8-centre-x=" + format_number(config.c8_centre_x) +
+         " --c8-centre-y=" + format_number(config.c8_centre_y);
 }
 
 std::string shell_quote(const std::string& text) {
@@ -233,7 +242,7 @@ Table1Grid prepare_table1(const Table1Options& options) {
         for (const int n : options.demo_counts) {
           grid.cells.push_back(make_cell(method.name, method.representation, head, n, seed,
                                          samples_upto[static_cast<std::size_t>(n)], demo_digest, options.steps,
-                                         options.data));
+                                         options.data, method.c8_centre));
         }
       }
     }
@@ -294,6 +303,7 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
                        shell_quote(cli) + " train --demos " + grid.demo_file + " --max-demos " +
                        std::to_string(cell.demos) + " --repr " + cell.config.representation + " --head " + cell.head +
                        " --steps " + std::to_string(cell.config.steps) + (cell.data.mirror ? "" : " --no-mirror") +
+                       c8_centre_options(cell.config) +
                        " --seed " + std::to_string(cell.train_seed) +
                        " --quiet --out " + cell.model_path() + " >/dev/null; }";
     for (const SceneSet set : kSceneSets) {

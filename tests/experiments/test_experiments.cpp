@@ -70,6 +70,26 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   CHECK(base.result_path(SceneSet::paired, eval) == "results/" + base.hash + ".paired-s100-n100.json");
 }
 
+TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget", "[unit]") {
+  const std::vector<Method> c8 = parse_methods("c8_centre,c8_base");
+  REQUIRE(c8.size() == 2);
+  CHECK(c8[0].fixed_head == "c8ddpm");
+  CHECK(c8[1].c8_centre == kRobotBase);
+  const auto c8_cell = [](const Method& m) {
+    return make_cell(m.name, m.representation, m.fixed_head, 10, 1, 320, "00ff", 0, {}, m.c8_centre);
+  };
+  const Cell centre = c8_cell(c8[0]), base = c8_cell(c8[1]);
+  // 320 demo scenes, their mirror images, and the 8 C8 images of each.
+  CHECK(centre.config.steps == policy::training_budget(8 * 640));
+  CHECK(centre.hash != base.hash);
+  CHECK(base.config.c8_centre_y == -60.0);
+  // A non-C8 cell ignores the centre, so its hash (and cached model) does not depend on it.
+  CHECK(make_cell("absolute", "absolute", "flow", 10, 1, 320, "00ff", 0, {}, kRobotBase).hash ==
+        make_cell("absolute", "absolute", "flow", 10, 1, 320, "00ff").hash);
+  REQUIRE(paper_row("c8_base", "c8ddpm"));
+  CHECK(paper_row("c8_base", "c8ddpm")->label == "Equivariant-DiffPo [7]");
+}
+
 TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
   HC_CHECK_THROWS(parse_int_list("5,x,10", "--demos"), InvalidArgument, Contains("'x'") && Contains("--demos"));
   HC_CHECK_THROWS(parse_int_list("5,-1", "--demos"), InvalidArgument, Contains("'-1'"));
@@ -78,6 +98,9 @@ TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
   HC_CHECK_THROWS(parse_seed_list("1,-2", "--train-seeds"), InvalidArgument, Contains("'-2'"));
   HC_CHECK_THROWS(parse_methods("hand_centric,diffusion"), InvalidArgument, Contains("'diffusion'"));
   HC_CHECK_THROWS(parse_methods("absolute,absolute"), InvalidArgument, Contains("twice"));
+  // The old C8 row is gone; the error names the two that replace it.
+  HC_CHECK_THROWS(parse_methods("c8flow"), InvalidArgument,
+                  Contains("'c8flow'") && Contains("c8_centre, c8_base"));
   HC_CHECK_THROWS(parse_heads("flow,gan"), InvalidArgument, Contains("'gan'"));
   Table1Options options;
   options.validate();
@@ -114,7 +137,7 @@ namespace {
 Row row(const std::string& method, int demos, double id, double ood) {
   Row r;
   r.method = method;
-  r.head = method == "c8flow" ? "c8flow" : "flow";
+  r.head = method.starts_with("c8_") ? "c8ddpm" : "flow";
   r.demos = demos;
   r.trials = 100;
   r.train_seed = 1;

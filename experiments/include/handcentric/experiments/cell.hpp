@@ -3,6 +3,7 @@
 // training seed, then scored on three scene sets. Its files are named by a hash of everything
 // that determines the trained model, so a rerun (--resume, or another machine running the plan)
 // finds finished work by name and redoes only what is missing.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -32,7 +33,7 @@ struct EvalSettings {
 
 struct Cell {
   std::string method;           ///< methods.hpp name
-  std::string head;             ///< flow, ddpm, cvae, c8flow
+  std::string head;             ///< flow, ddpm, cvae, c8ddpm
   int demos = 0;                ///< the first `demos` demos of the demo file
   std::uint64_t train_seed = 1;
   sim::TrainingData data;       ///< the demos' mirror images too, or not
@@ -56,9 +57,11 @@ std::string cell_hash(const Cell& cell);
 /// A cell with its config from the library defaults (PolicyConfig{}), the method's
 /// representation and the head, and `steps` Adam steps (0: the automatic budget for the
 /// training samples that `data` makes of `demo_samples` demo scenes, trainer.hpp
-/// training_budget); hash set.
+/// training_budget, times 8 for c8ddpm's augmented data), and `c8_centre` (x, y) as the point
+/// c8ddpm rotates about (other heads ignore it); hash set.
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
                std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps = 0,
-               const sim::TrainingData& data = sim::TrainingData());
+               const sim::TrainingData& data = sim::TrainingData(),
+               std::array<double, 2> c8_centre = {0.0, 0.0});
 
 }  // namespace handcentric::experiments

@@ -6,9 +6,10 @@
 
 namespace handcentric::policy {
 
-/// The generative head (Sec. 2.3 and App. B): rectified flow, DDPM, CVAE, or the
-/// C8-symmetrized flow (the analogue of Equivariant Diffusion Policy [7]).
-enum class HeadKind { flow, ddpm, cvae, c8flow };
+/// The generative head (Sec. 2.3 and App. B): rectified flow, DDPM, CVAE, the C8-symmetrized
+/// flow on absolute rotation vectors, or the C8 baseline of Table 1 (c8_planar.hpp): DDPM on
+/// planar poses, trained on the C8 orbit of its data (stand-ins for Equivariant-DiffPo [7]).
+enum class HeadKind { flow, ddpm, cvae, c8flow, c8ddpm };
 
 enum class Activation { silu, relu };
 
@@ -17,7 +18,7 @@ enum class Activation { silu, relu };
 /// the default.
 enum class LearningRateSchedule { constant, cosine };
 
-/// "flow", "ddpm", "cvae", "c8flow".
+/// "flow", "ddpm", "cvae", "c8flow", "c8ddpm".
 std::string to_string(HeadKind kind);
 /// Throws InvalidArgument naming the value and the valid names.
 HeadKind parse_head(const std::string& name);
@@ -78,6 +79,10 @@ struct PolicyConfig {
   int ddim_steps = 10;           ///< DDIM sampling steps
   int cvae_latent = 16;
   double cvae_kl_weight = 1e-2;
+  /// The point C8 rotates about (world x, y; the task's cm) for head c8ddpm (c8_planar.hpp).
+  /// Stored only for that head, so other heads' configs (and Table 1 hashes) are unchanged.
+  double c8_centre_x = 0.0;
+  double c8_centre_y = 0.0;
 
   /// Throws InvalidArgument naming the first out-of-range field and its valid range.
   void validate() const;
