@@ -92,7 +92,7 @@ void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir, c
 
 // The train options that place c8ddpm's symmetry centre (none for other heads).
 std::string c8_centre_options(const policy::PolicyConfig& config) {
-  if (config.head != policy::HeadKind::c8ddpm) return "";
+  if (!policy::is_c8_planar(config.head)) return "";
   // "=": a negative coordinate is the option's value, not an option of its own.
   return " --c8-centre-x=" + format_number(config.c8_centre_x) +
          " --c8-centre-y=" + format_number(config.c8_centre_y);

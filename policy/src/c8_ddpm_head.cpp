@@ -7,6 +7,8 @@
 //              normalization on every sample's whole C8 orbit about the centre, and each
 //              minibatch column is rotated by a uniformly drawn element of C8, which is drawing
 //              from the augmented set;
+//   c8flow_planar: the same with the rectified flow inside (flow_head.cpp), a control that
+//              separates the C8 encoding from the DDPM (docs/EXPERIMENTS.md);
 //   sampling : the DDPM's DDIM sampler on the encoded observation, started at noise_scale times
 //              the prior's noise (0: its mode, as the flow heads do; PolicyConfig::noise_scale).
 //
@@ -35,13 +37,14 @@ class C8DdpmHead final : public Head {
       : actions_(c8::action_layout(config)),
         observations_(c8::observation_layout(config)),
         centre_(c8::centre_of(config)),
-        inner_(make_ddpm_head(c8::inner_config(config), config.noise_scale)) {}
+        kind_(config.head),
+        inner_(make_inner(c8::inner_config(config), config.noise_scale)) {}
 
-  HeadKind kind() const override { return HeadKind::c8ddpm; }
+  HeadKind kind() const override { return kind_; }
 
   void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
                std::mt19937_64& rng) override {
-    if (actions.cols() == 0) throw InvalidArgument("c8ddpm: no training samples");
+    if (actions.cols() == 0) throw InvalidArgument(to_string(kind_) + ": no training samples");
     Eigen::MatrixXd a(actions_.planar_size(), actions.cols());
     Eigen::MatrixXd o(observations_.planar_size(), observations.cols());
     for (Eigen::Index j = 0; j < actions.cols(); ++j) {
@@ -92,8 +95,14 @@ class C8DdpmHead final : public Head {
         .cast<float>();
   }
 
+  static std::unique_ptr<Head> make_inner(const PolicyConfig& inner, double noise_scale) {
+    // The flow head reads noise_scale from its config; the DDPM head is told it.
+    return inner.head == HeadKind::ddpm ? make_ddpm_head(inner, noise_scale) : make_head(inner);
+  }
+
   c8::Layout actions_, observations_;
   Eigen::Vector2d centre_;
+  HeadKind kind_;
   std::unique_ptr<Head> inner_;
   Eigen::MatrixXf a_, o_;  // minibatch buffers
 };
@@ -102,8 +111,9 @@ class C8DdpmHead final : public Head {
 
 std::unique_ptr<Head> make_c8_ddpm_head(const PolicyConfig& config) {
   if (config.representation != "absolute") {
-    throw InvalidArgument("head c8ddpm encodes absolute poses, but the representation is '" +
-                          config.representation + "': use --repr absolute with --head c8ddpm");
+    throw InvalidArgument(
+        "head " + to_string(config.head) + " encodes absolute poses, but the representation is '" +
+        config.representation + "': use --repr absolute with --head " + to_string(config.head));
   }
   return std::make_unique<C8DdpmHead>(config);
 }

@@ -115,7 +115,7 @@ Eigen::Vector2d centre_of(const PolicyConfig& config) {
 }
 
 int augmentation_copies(HeadKind head) {
-  return head == HeadKind::c8ddpm ? 8 : 1;
+  return is_c8_planar(head) ? 8 : 1;
 }
 
 PolicyConfig inner_config(const PolicyConfig& config) {
@@ -124,7 +124,7 @@ PolicyConfig inner_config(const PolicyConfig& config) {
   check_size(config.observation_dimension, observation_layout(config).absolute_size(),
              "the observation dimension");
   PolicyConfig inner = config;
-  inner.head = HeadKind::ddpm;
+  inner.head = config.head == HeadKind::c8ddpm ? HeadKind::ddpm : HeadKind::flow;
   inner.action_dimension = action_layout(config).planar_size();
   inner.observation_dimension = observation_layout(config).planar_size();
   return inner;

@@ -18,16 +18,22 @@ std::string to_string(HeadKind kind) {
     case HeadKind::cvae: return "cvae";
     case HeadKind::c8flow: return "c8flow";
     case HeadKind::c8ddpm: return "c8ddpm";
+    case HeadKind::c8flow_planar: return "c8flow_planar";
   }
   return "?";
 }
 
 HeadKind parse_head(const std::string& name) {
-  for (HeadKind kind :
-       {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow, HeadKind::c8ddpm}) {
+  for (HeadKind kind : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow,
+                        HeadKind::c8ddpm, HeadKind::c8flow_planar}) {
     if (to_string(kind) == name) return kind;
   }
-  throw InvalidArgument("unknown head '" + name + "': use one of flow, ddpm, cvae, c8flow, c8ddpm");
+  throw InvalidArgument("unknown head '" + name +
+                        "': use one of flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar");
+}
+
+bool is_c8_planar(HeadKind kind) {
+  return kind == HeadKind::c8ddpm || kind == HeadKind::c8flow_planar;
 }
 
 std::string to_string(Activation activation) {
@@ -163,7 +169,7 @@ void PolicyConfig::validate() const {
 std::string PolicyConfig::to_text() const {
   std::string text;
   for (const Field& field : fields()) {
-    if (head != HeadKind::c8ddpm && field.key.starts_with("c8_")) continue;  // see config.hpp
+    if (!is_c8_planar(head) && field.key.starts_with("c8_")) continue;  // see config.hpp
     text += field.key + "=" + field.get(*this) + "\n";
   }
   return text;

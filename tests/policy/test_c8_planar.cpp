@@ -221,6 +221,14 @@ TEST_CASE("c8ddpm_trains_on_8x_the_budget_and_refuses_what_it_cannot_encode", "[
   CHECK(test::small_config(HeadKind::ddpm, "absolute", 1).to_text().find("c8_centre") ==
         std::string::npos);
 
+  // The rectified-flow control on the same encoding: its own kind, the same 8x budget.
+  PolicyConfig flow = config;
+  flow.head = HeadKind::c8flow_planar;
+  const LearnedPolicy flow_policy = train_policy(flow, scenes, 3);
+  CHECK(flow_policy.head().kind() == HeadKind::c8flow_planar);
+  CHECK(flow_policy.config().steps == training_budget(8 * 6));
+  CHECK(flow_policy.action_vector(scenes[0], 4).size() == 24);
+
   config.steps = 1;
   config.representation = "hand_centric";
   HC_CHECK_THROWS(train_policy(config, scenes, 3), InvalidArgument,

@@ -61,12 +61,13 @@ Eigen::MatrixXd orbit(const Eigen::MatrixXd& planar, const Eigen::Vector2d& cent
 /// The symmetry centre a c8ddpm config names (c8_centre_x, c8_centre_y).
 Eigen::Vector2d centre_of(const PolicyConfig& config);
 
-/// How many training samples each demo step stands for: 8 for c8ddpm, which trains on every
-/// sample's C8 orbit (the 8x augmented data), 1 for every other head. The automatic budget
-/// (training_budget) counts the augmented data: training_budget(copies * samples).
+/// How many training samples each demo step stands for: 8 for c8ddpm and c8flow_planar, which
+/// train on every sample's C8 orbit (the 8x augmented data), 1 for every other head. The automatic
+/// budget (training_budget) counts the augmented data: training_budget(copies * samples).
 int augmentation_copies(HeadKind head);
 
-/// The config of the network inside a c8ddpm head: a DDPM head on the planar dimensions.
+/// The config of the network inside a c8ddpm (c8flow_planar) head: a DDPM (flow) head on the
+/// planar dimensions.
 /// Throws InvalidArgument if config's action or observation dimension does not fit its layout
 /// (an observation with extra poses or scalars, which the C8 baseline does not transform).
 PolicyConfig inner_config(const PolicyConfig& config);
