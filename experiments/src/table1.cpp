@@ -400,8 +400,13 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
                 static_cast<unsigned long long>(demo_seed));
   text += line;
   text += header + "\n" + rule + "\n";
-  for (const auto& [m, h] : series) {
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const auto& [m, h] = series[i];
     const auto paper = paper_row(m, h);
+    // Two rows standing in for one paper row (c8_centre, c8_base): its line once, after both.
+    const auto next = i + 1 < series.size() ? paper_row(series[i + 1].first, series[i + 1].second)
+                                            : std::nullopt;
+    const bool paper_follows = paper && next && next->label == paper->label;
     const std::string label = m + "/" + h;
     std::string id = "| " + label + " | id |", ood = "| " + label + " | ood |", paired = "| " + label + " | ood paired |";
     std::string paper_line = "| " + (paper ? paper->label : std::string("-")) + " (paper) | id |";
@@ -415,7 +420,7 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
                                   : std::string("-"));
     }
     text += id + "\n" + ood + "\n" + paired + "\n";
-    if (paper) {
+    if (paper && !paper_follows) {
       std::string paper_ood = "| " + paper->label + " (paper) | ood |";
       for (const int n : counts) paper_ood += cell_text(n == 100 ? rate(paper->ood_at_100) : std::string("-"));
       text += paper_line + "\n" + paper_ood + "\n";

@@ -165,6 +165,16 @@ TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
   Row partial = row("relative", 10, 0.1, 0.0);
   partial.ood_success.reset();
   CHECK_THAT(table1_markdown({partial}, EvalSettings(), 1), Contains("| relative/flow | ood | - |"));
+  // The two C8 rows stand in for one paper row: its lines once, after both.
+  const std::string c8 =
+      table1_markdown({row("c8_centre", 100, 0.0, 0.0), row("c8_base", 100, 0.0, 0.0)}, EvalSettings(), 1);
+  const auto paper_line = c8.find("| Equivariant-DiffPo [7] (paper) | id | 0.27 |");
+  REQUIRE(paper_line != std::string::npos);
+  // The next mention is the paper's OOD line ("| " before the label), and there is no other.
+  const auto ood_line = c8.find("| Equivariant-DiffPo [7] (paper) | ood |");
+  CHECK(c8.find("Equivariant-DiffPo", c8.find('\n', paper_line)) == ood_line + 2);
+  CHECK(c8.find("Equivariant-DiffPo", ood_line + 3) == std::string::npos);
+  CHECK(c8.find("c8_base/c8ddpm | id") < paper_line);
 }
 
 TEST_CASE("the_figure_draws_one_colour_per_method_with_id_dots_and_ood_squares", "[unit]") {
