@@ -126,7 +126,7 @@ std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config) {
   return std::make_unique<DdpmHead>(config, 1.0);
 }
 
-// For c8ddpm (c8_ddpm_head.cpp), which samples like the flow heads, at config.noise_scale.
+// For c8ddpm (c8_planar_head.cpp), which samples like the flow heads, at config.noise_scale.
 std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config, double initial_noise) {
   return std::make_unique<DdpmHead>(config, initial_noise);
 }

@@ -13,7 +13,7 @@ std::unique_ptr<Head> make_flow_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_cvae_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_c8_flow_head(const PolicyConfig& config);
-std::unique_ptr<Head> make_c8_ddpm_head(const PolicyConfig& config);
+std::unique_ptr<Head> make_c8_planar_head(const PolicyConfig& config);
 
 std::unique_ptr<Head> make_head(const PolicyConfig& config) {
   config.validate();
@@ -28,7 +28,7 @@ std::unique_ptr<Head> make_head(const PolicyConfig& config) {
     case HeadKind::cvae: return make_cvae_head(config);
     case HeadKind::c8flow: return make_c8_flow_head(config);
     case HeadKind::c8ddpm:
-    case HeadKind::c8flow_planar: return make_c8_ddpm_head(config);
+    case HeadKind::c8flow_planar: return make_c8_planar_head(config);
   }
   throw InvalidArgument("make_head: unknown head");
 }

@@ -1,5 +1,5 @@
-// Head c8ddpm: the C8 baseline of Table 1, a stand-in for the 2D variant of Equivariant
-// Diffusion Policy [7] (c8_planar.hpp for the encoding and the group action).
+// Heads c8ddpm (the C8 baseline of Table 1, a stand-in for the 2D variant of Equivariant
+// Diffusion Policy [7]) and c8flow_planar; c8_planar.hpp has the encoding and the group action.
 //
 //   encoding : absolute actions and observations -> planar ones (x, y, z, cos, sin per pose;
 //              eye-in-hand points as they are), decoded back with theta = atan2(sin, cos);
@@ -18,7 +18,7 @@
 // Averaging the 8 sampled chunks g_k s(g_k^-1 o) would make the sampler exactly equivariant,
 // but an average of two different modes is a chunk no demo has, and the hole allows 0.05 cm.
 // So the trained model is equivariant only as far as the network learned it; [7]'s layers
-// are equivariant exactly (docs/TABLE1.md, "The C8 rows are not Equivariant-DiffPo").
+// are equivariant exactly (docs/EXPERIMENTS.md, "The C8 baseline": not [7] itself).
 #include <memory>
 
 #include "handcentric/core/errors.hpp"
@@ -31,9 +31,9 @@ std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config, double initial_
 
 namespace {
 
-class C8DdpmHead final : public Head {
+class C8PlanarHead final : public Head {
  public:
-  explicit C8DdpmHead(const PolicyConfig& config)
+  explicit C8PlanarHead(const PolicyConfig& config)
       : actions_(c8::action_layout(config)),
         observations_(c8::observation_layout(config)),
         centre_(c8::centre_of(config)),
@@ -109,13 +109,13 @@ class C8DdpmHead final : public Head {
 
 }  // namespace
 
-std::unique_ptr<Head> make_c8_ddpm_head(const PolicyConfig& config) {
+std::unique_ptr<Head> make_c8_planar_head(const PolicyConfig& config) {
   if (config.representation != "absolute") {
     throw InvalidArgument(
         "head " + to_string(config.head) + " encodes absolute poses, but the representation is '" +
         config.representation + "': use --repr absolute with --head " + to_string(config.head));
   }
-  return std::make_unique<C8DdpmHead>(config);
+  return std::make_unique<C8PlanarHead>(config);
 }
 
 }  // namespace handcentric::policy
