@@ -19,7 +19,7 @@ namespace {
 
 struct Table1CommandOptions {
   std::string demos = "5,10,20,40,60,80,100";
-  std::string methods = "hand_centric,relative,absolute,c8flow";
+  std::string methods = "hand_centric,relative,absolute,c8_centre,c8_base";
   std::string heads = "flow";
   std::string train_seeds = "1";
   experiments::Table1Options table;
@@ -63,8 +63,10 @@ void add_table1_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--demos", options->demos, "numbers of demos (nested: the first N of one demo file)")
       ->capture_default_str();
   cmd->add_option("--trials", t.eval.trials, "rollouts per cell and scene set")->capture_default_str();
-  cmd->add_option("--methods", options->methods, "hand_centric, relative, absolute, c8flow")->capture_default_str();
-  cmd->add_option("--heads", options->heads, "flow, ddpm, cvae (c8flow has its own)")->capture_default_str();
+  cmd->add_option("--methods", options->methods, "hand_centric, relative, absolute, c8_centre, c8_base")
+      ->capture_default_str();
+  cmd->add_option("--heads", options->heads, "flow, ddpm, cvae (c8_centre and c8_base use c8ddpm)")
+      ->capture_default_str();
   cmd->add_option("--seed", t.demo_seed, "seed of the demos")->capture_default_str();
   cmd->add_option("--train-seeds", options->train_seeds, "training seeds, one row each")->capture_default_str();
   cmd->add_option("--eval-seed", t.eval.eval_seed, "seed of the train-distribution and paired OOD scenes")

@@ -18,6 +18,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/cell.hpp"
+#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -72,7 +73,10 @@ int run_train(const TrainOptions& options) {
       sim::training_scenes(demos, config.history_length, config.chunk_length, options.max_demos, data);
   long long demo_samples = 0;  // one scene per pose of each demo trained on
   for (std::size_t i = 0; i < used; ++i) demo_samples += static_cast<long long>(demos[i].world_T_hand.size());
-  if (config.steps == 0) config.steps = experiments::automatic_steps(data, demo_samples);
+  if (config.steps == 0) {
+    // c8ddpm trains on 8 rotated copies of every scene: its budget counts them
+    config.steps = experiments::automatic_steps(data, policy::c8::augmentation_copies(config.head) * demo_samples);
+  }
 
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   const int report_every = terminal ? 50 : std::max(1, config.steps / 10);
@@ -107,7 +111,12 @@ void add_train_command(CLI::App& app, int& exit_code) {
   policy::PolicyConfig& config = options->config;
   cmd->add_option("--repr", config.representation, "absolute|relative|relative_diff|hand_centric")
       ->capture_default_str();
-  cmd->add_option("--head", options->head, "flow|ddpm|cvae|c8flow (c8flow needs --repr absolute)")
+  cmd->add_option("--head", options->head,
+                  "flow|ddpm|cvae|c8flow|c8ddpm|c8flow_planar (the c8 heads need --repr absolute)")
+      ->capture_default_str();
+  cmd->add_option("--c8-centre-x", config.c8_centre_x, "c8ddpm, c8flow_planar: x of the C8 centre (cm)")
+      ->capture_default_str();
+  cmd->add_option("--c8-centre-y", config.c8_centre_y, "c8ddpm, c8flow_planar: y of the C8 centre (cm)")
       ->capture_default_str();
   cmd->add_option("--steps", config.steps, "Adam steps (0: the automatic budget for the number of training samples)")
       ->capture_default_str();

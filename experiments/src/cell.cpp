@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 
@@ -49,15 +50,12 @@ std::string cell_hash(const Cell& cell) {
 }
 
 int automatic_steps(const sim::TrainingData& data, long long demo_samples) {
-  const long long samples = data.samples(demo_samples);
-  if (data.perturbed_copies == 0) return policy::training_budget(samples);
-  if (samples < 1) throw InvalidArgument("automatic_steps: no training samples (got " + std::to_string(samples) + ")");
-  return static_cast<int>(std::clamp(12 * samples, static_cast<long long>(policy::kBudgetMinSteps), 10000LL));
+  return policy::training_budget(data.samples(demo_samples));
 }
 
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
                std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps,
-               const sim::TrainingData& data) {
+               const sim::TrainingData& data, std::array<double, 2> c8_centre) {
   Cell cell;
   cell.method = method;
   cell.head = head;
@@ -68,8 +66,13 @@ Cell make_cell(const std::string& method, const std::string& representation, con
   cell.data.perturbation_seed = train_seed;  // as `handcentric train --seed` does
   cell.config.representation = representation;
   cell.config.head = policy::parse_head(head);
+  cell.config.c8_centre_x = c8_centre[0];
+  cell.config.c8_centre_y = c8_centre[1];
   if (steps > 0) cell.config.steps = steps;
-  if (cell.config.steps == 0) cell.config.steps = automatic_steps(data, demo_samples);
+  if (cell.config.steps == 0) {
+    const long long copies = policy::c8::augmentation_copies(cell.config.head);
+    cell.config.steps = automatic_steps(data, copies * demo_samples);
+  }
   cell.config.validate();
   cell.hash = cell_hash(cell);
   return cell;

@@ -8,6 +8,8 @@
 namespace handcentric::experiments {
 namespace {
 
+constexpr const char* kMethodNames = "hand_centric, relative, absolute, c8_centre, c8_base";
+
 std::vector<std::string> split(const std::string& list) {
   std::vector<std::string> items;
   std::stringstream in(list);
@@ -23,7 +25,11 @@ const std::vector<Method>& table1_methods() {
       {"hand_centric", "hand_centric", "", "Hand-Centric"},
       {"relative", "relative", "", "Relative-Action"},
       {"absolute", "absolute", "", "Absolute-Action"},
-      {"c8flow", "absolute", "c8flow", "C8-symmetrized flow (analogue of Equivariant-DiffPo [7])"},
+      {"c8_centre", "absolute", "c8ddpm",
+       "C8 DDPM about the workspace centre (0, 0) (stand-in for Equivariant-DiffPo [7])",
+       kWorkspaceCentre},
+      {"c8_base", "absolute", "c8ddpm",
+       "C8 DDPM about a robot base at (0, -60) (stand-in for Equivariant-DiffPo [7])", kRobotBase},
   };
   return methods;
 }
@@ -34,14 +40,16 @@ std::vector<Method> parse_methods(const std::string& list) {
     const auto& all = table1_methods();
     const auto it = std::find_if(all.begin(), all.end(), [&](const Method& m) { return m.name == name; });
     if (it == all.end()) {
-      throw InvalidArgument("--methods: unknown method '" + name + "': use hand_centric, relative, absolute, c8flow");
+      throw InvalidArgument("--methods: unknown method '" + name + "': use " + kMethodNames);
     }
     if (std::any_of(chosen.begin(), chosen.end(), [&](const Method& m) { return m.name == name; })) {
       throw InvalidArgument("--methods: '" + name + "' is listed twice: name each method once");
     }
     chosen.push_back(*it);
   }
-  if (chosen.empty()) throw InvalidArgument("--methods is empty: name at least one of hand_centric, relative, absolute, c8flow");
+  if (chosen.empty()) {
+    throw InvalidArgument(std::string("--methods is empty: name at least one of ") + kMethodNames);
+  }
   return chosen;
 }
 
@@ -70,7 +78,7 @@ std::optional<PaperRow> paper_row(const std::string& method, const std::string& 
   if (method == "absolute" && head == "flow") {
     return PaperRow{"Absolute-Action-Flow", {0.00, 0.00, 0.01, 0.06, 0.08, 0.12, 0.14}, 0.02};
   }
-  if (method == "c8flow") {
+  if (method == "c8_centre" || method == "c8_base") {
     return PaperRow{"Equivariant-DiffPo [7]", {0.00, 0.01, 0.03, 0.07, 0.12, 0.18, 0.27}, 0.12};
   }
   return std::nullopt;

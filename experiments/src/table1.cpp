@@ -90,6 +90,14 @@ void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir, c
   }
 }
 
+// The train options that place c8ddpm's symmetry centre (none for other heads).
+std::string c8_centre_options(const policy::PolicyConfig& config) {
+  if (!policy::is_c8_planar(config.head)) return "";
+  // "=": a negative coordinate is the option's value, not an option of its own.
+  return " --c8-centre-x=" + format_number(config.c8_centre_x) +
+         " --c8-centre-y=" + format_number(config.c8_centre_y);
+}
+
 std::string shell_quote(const std::string& text) {
   std::string quoted = "'";
   for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
@@ -238,7 +246,7 @@ Table1Grid prepare_table1(const Table1Options& options) {
         for (const int n : options.demo_counts) {
           grid.cells.push_back(make_cell(method.name, method.representation, head, n, seed,
                                          samples_upto[static_cast<std::size_t>(n)], demo_digest, options.steps,
-                                         options.data));
+                                         options.data, method.c8_centre));
         }
       }
     }
@@ -302,6 +310,7 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
                        " --perturbed-copies " + std::to_string(cell.data.perturbed_copies) + " --offset-cm " +
                        format_number(cell.data.offset_cm) + " --offset-deg " + format_number(cell.data.offset_deg) +
                        " --recovery-steps " + std::to_string(cell.data.recovery_steps) +
+                       c8_centre_options(cell.config) +
                        " --seed " + std::to_string(cell.train_seed) +
                        " --quiet --out " + cell.model_path() + " >/dev/null; }";
     for (const SceneSet set : kSceneSets) {
@@ -403,8 +412,13 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
                 static_cast<unsigned long long>(demo_seed));
   text += line;
   text += header + "\n" + rule + "\n";
-  for (const auto& [m, h] : series) {
+  for (std::size_t i = 0; i < series.size(); ++i) {
+    const auto& [m, h] = series[i];
     const auto paper = paper_row(m, h);
+    // Two rows standing in for one paper row (c8_centre, c8_base): its line once, after both.
+    const auto next = i + 1 < series.size() ? paper_row(series[i + 1].first, series[i + 1].second)
+                                            : std::nullopt;
+    const bool paper_follows = paper && next && next->label == paper->label;
     const std::string label = m + "/" + h;
     std::string id = "| " + label + " | id |", ood = "| " + label + " | ood |", paired = "| " + label + " | ood paired |";
     std::string paper_line = "| " + (paper ? paper->label : std::string("-")) + " (paper) | id |";
@@ -418,7 +432,7 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
                                   : std::string("-"));
     }
     text += id + "\n" + ood + "\n" + paired + "\n";
-    if (paper) {
+    if (paper && !paper_follows) {
       std::string paper_ood = "| " + paper->label + " (paper) | ood |";
       for (const int n : counts) paper_ood += cell_text(n == 100 ? rate(paper->ood_at_100) : std::string("-"));
       text += paper_line + "\n" + paper_ood + "\n";

@@ -17,15 +17,23 @@ std::string to_string(HeadKind kind) {
     case HeadKind::ddpm: return "ddpm";
     case HeadKind::cvae: return "cvae";
     case HeadKind::c8flow: return "c8flow";
+    case HeadKind::c8ddpm: return "c8ddpm";
+    case HeadKind::c8flow_planar: return "c8flow_planar";
   }
   return "?";
 }
 
 HeadKind parse_head(const std::string& name) {
-  for (HeadKind kind : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow}) {
+  for (HeadKind kind : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow,
+                        HeadKind::c8ddpm, HeadKind::c8flow_planar}) {
     if (to_string(kind) == name) return kind;
   }
-  throw InvalidArgument("unknown head '" + name + "': use one of flow, ddpm, cvae, c8flow");
+  throw InvalidArgument("unknown head '" + name +
+                        "': use one of flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar");
+}
+
+bool is_c8_planar(HeadKind kind) {
+  return kind == HeadKind::c8ddpm || kind == HeadKind::c8flow_planar;
 }
 
 std::string to_string(Activation activation) {
@@ -109,7 +117,7 @@ const std::vector<Field>& fields() {
       HC_DOUBLE_FIELD(weight_decay), HC_DOUBLE_FIELD(gradient_clip), HC_DOUBLE_FIELD(ema_decay),
       HC_INT_FIELD(euler_steps), HC_INT_FIELD(ddpm_train_steps), HC_INT_FIELD(ddim_steps),
       HC_INT_FIELD(cvae_latent), HC_DOUBLE_FIELD(cvae_kl_weight), HC_DOUBLE_FIELD(noise_scale),
-      HC_INT_FIELD(execute),
+      HC_INT_FIELD(execute), HC_DOUBLE_FIELD(c8_centre_x), HC_DOUBLE_FIELD(c8_centre_y),
   };
   return all;
 }
@@ -154,11 +162,16 @@ void PolicyConfig::validate() const {
           "1..ddpm_train_steps (" + s(ddpm_train_steps) + ")");
   require(cvae_latent >= 1 && cvae_latent <= 4096, "cvae_latent", s(cvae_latent), "1..4096");
   require(cvae_kl_weight >= 0.0, "cvae_kl_weight", format_number(cvae_kl_weight), ">= 0");
+  require(std::abs(c8_centre_x) <= 1e6, "c8_centre_x", format_number(c8_centre_x), "[-1e6, 1e6]");
+  require(std::abs(c8_centre_y) <= 1e6, "c8_centre_y", format_number(c8_centre_y), "[-1e6, 1e6]");
 }
 
 std::string PolicyConfig::to_text() const {
   std::string text;
-  for (const Field& field : fields()) text += field.key + "=" + field.get(*this) + "\n";
+  for (const Field& field : fields()) {
+    if (!is_c8_planar(head) && field.key.starts_with("c8_")) continue;  // see config.hpp
+    text += field.key + "=" + field.get(*this) + "\n";
+  }
   return text;
 }
 

@@ -40,8 +40,10 @@ std::vector<double> cosine_alpha_bar(int T) {
 
 class DdpmHead final : public NetworkHead {
  public:
-  explicit DdpmHead(const PolicyConfig& config)
-      : NetworkHead(config), alpha_bar_(cosine_alpha_bar(config.ddpm_train_steps)) {}
+  DdpmHead(const PolicyConfig& config, double initial_noise)
+      : NetworkHead(config),
+        alpha_bar_(cosine_alpha_bar(config.ddpm_train_steps)),
+        initial_noise_(static_cast<float>(initial_noise)) {}
   HeadKind kind() const override { return HeadKind::ddpm; }
 
   void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override {
@@ -94,7 +96,7 @@ class DdpmHead final : public NetworkHead {
     Eigen::MatrixXf x(config_.action_dimension, batch);
     fill_standard_normal(rng, x);
     const Eigen::VectorXf& active = action_normalizer_.active_float();
-    x.array().colwise() *= active.array();
+    x.array().colwise() *= active.array() * initial_noise_;
     Eigen::MatrixXf input, eps_hat, scratch[2];
     for (int i = 0; i < S; ++i) {
       const int k = T - 1 - i * (T / S);
@@ -115,10 +117,18 @@ class DdpmHead final : public NetworkHead {
  private:
   std::vector<double> alpha_bar_;
   float clip_ = 1.0f;  ///< max |normalized training action|, at least 1
+  float initial_noise_ = 1.0f;  ///< scale of x_T; 0 starts DDIM at the prior's mode
 };
 
 }  // namespace
 
-std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config) { return std::make_unique<DdpmHead>(config); }
+std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config) {
+  return std::make_unique<DdpmHead>(config, 1.0);
+}
+
+// For c8ddpm (c8_planar_head.cpp), which samples like the flow heads, at config.noise_scale.
+std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config, double initial_noise) {
+  return std::make_unique<DdpmHead>(config, initial_noise);
+}
 
 }  // namespace handcentric::policy

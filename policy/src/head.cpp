@@ -1,6 +1,7 @@
 #include "handcentric/policy/head.hpp"
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/losses.hpp"
 #include "handcentric/policy/time_embedding.hpp"
 #include "network_head.hpp"
@@ -12,6 +13,7 @@ std::unique_ptr<Head> make_flow_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_cvae_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_c8_flow_head(const PolicyConfig& config);
+std::unique_ptr<Head> make_c8_planar_head(const PolicyConfig& config);
 
 std::unique_ptr<Head> make_head(const PolicyConfig& config) {
   config.validate();
@@ -25,6 +27,8 @@ std::unique_ptr<Head> make_head(const PolicyConfig& config) {
     case HeadKind::ddpm: return make_ddpm_head(config);
     case HeadKind::cvae: return make_cvae_head(config);
     case HeadKind::c8flow: return make_c8_flow_head(config);
+    case HeadKind::c8ddpm:
+    case HeadKind::c8flow_planar: return make_c8_planar_head(config);
   }
   throw InvalidArgument("make_head: unknown head");
 }
@@ -50,6 +54,7 @@ std::uint64_t parameter_count(const PolicyConfig& config) {
                           " and observation_dimension " + std::to_string(config.observation_dimension) +
                           " must be set (>= 1) from the training data first");
   }
+  if (is_c8_planar(config.head)) return parameter_count(c8::inner_config(config));
   const auto actions = static_cast<std::uint64_t>(config.action_dimension);
   const auto observations = static_cast<std::uint64_t>(config.observation_dimension);
   const auto latent = static_cast<std::uint64_t>(config.cvae_latent);

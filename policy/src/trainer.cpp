@@ -9,6 +9,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/policy/c8_planar.hpp"
 
 namespace handcentric::policy {
 
@@ -47,7 +48,9 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
   config.validate();
   std::shared_ptr<const Representation> representation = make_representation(config.representation);
   if (data.size() == 0) throw InvalidScene("no training samples: give at least one demonstration step");
-  if (config.steps == 0) config.steps = training_budget(data.size());
+  if (config.steps == 0) {
+    config.steps = training_budget(c8::augmentation_copies(config.head) * data.size());
+  }
   config.action_dimension = static_cast<int>(data.actions.rows());
   config.observation_dimension = static_cast<int>(data.observations.rows());
   config.hand_points = data.hand_points;

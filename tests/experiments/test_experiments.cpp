@@ -44,10 +44,9 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   const Cell base = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff");
   CHECK(base.hash == make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff").hash);
   CHECK(base.hash.size() == 16);
-  // The automatic budget: 12 steps for each of the 320 demo scenes and their 320 mirror images
-  // (the perturbed copies add none), at most 10000; without copies trainer.hpp's budget.
-  CHECK(base.config.steps == 7680);
-  CHECK(make_cell("hand_centric", "hand_centric", "flow", 10, 1, 3200, "00ff").config.steps == 10000);
+  // The automatic budget, for the 320 demo scenes and their 320 mirror images (the perturbed
+  // copies add no steps).
+  CHECK(base.config.steps == policy::training_budget(640));
   sim::TrainingData demos_only;
   demos_only.mirror = false;
   demos_only.perturbed_copies = 0;
@@ -77,6 +76,32 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   CHECK(base.result_path(SceneSet::paired, eval) == "results/" + base.hash + ".paired-s100-n100.json");
 }
 
+TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget", "[unit]") {
+  const std::vector<Method> c8 = parse_methods("c8_centre,c8_base");
+  REQUIRE(c8.size() == 2);
+  CHECK(c8[0].fixed_head == "c8ddpm");
+  CHECK(c8[1].c8_centre == kRobotBase);
+  const auto c8_cell = [](const Method& m) {
+    return make_cell(m.name, m.representation, m.fixed_head, 10, 1, 320, "00ff", 0, {}, m.c8_centre);
+  };
+  const Cell centre = c8_cell(c8[0]), base = c8_cell(c8[1]);
+  // 320 demo scenes, their mirror images, and the 8 C8 images of each (the perturbed copies
+  // add no steps).
+  CHECK(centre.config.steps == automatic_steps(sim::TrainingData(), 8 * 320));
+  sim::TrainingData no_copies;
+  no_copies.perturbed_copies = 0;
+  CHECK(make_cell(c8[0].name, c8[0].representation, c8[0].fixed_head, 10, 1, 320, "00ff", 0, no_copies,
+                  c8[0].c8_centre)
+            .config.steps == policy::training_budget(8 * 640));
+  CHECK(centre.hash != base.hash);
+  CHECK(base.config.c8_centre_y == -60.0);
+  // A non-C8 cell ignores the centre, so its hash (and cached model) does not depend on it.
+  CHECK(make_cell("absolute", "absolute", "flow", 10, 1, 320, "00ff", 0, {}, kRobotBase).hash ==
+        make_cell("absolute", "absolute", "flow", 10, 1, 320, "00ff").hash);
+  REQUIRE(paper_row("c8_base", "c8ddpm"));
+  CHECK(paper_row("c8_base", "c8ddpm")->label == "Equivariant-DiffPo [7]");
+}
+
 TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
   HC_CHECK_THROWS(parse_int_list("5,x,10", "--demos"), InvalidArgument, Contains("'x'") && Contains("--demos"));
   HC_CHECK_THROWS(parse_int_list("5,-1", "--demos"), InvalidArgument, Contains("'-1'"));
@@ -85,6 +110,9 @@ TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
   HC_CHECK_THROWS(parse_seed_list("1,-2", "--train-seeds"), InvalidArgument, Contains("'-2'"));
   HC_CHECK_THROWS(parse_methods("hand_centric,diffusion"), InvalidArgument, Contains("'diffusion'"));
   HC_CHECK_THROWS(parse_methods("absolute,absolute"), InvalidArgument, Contains("twice"));
+  // The old C8 row is gone; the error names the two that replace it.
+  HC_CHECK_THROWS(parse_methods("c8flow"), InvalidArgument,
+                  Contains("'c8flow'") && Contains("c8_centre, c8_base"));
   HC_CHECK_THROWS(parse_heads("flow,gan"), InvalidArgument, Contains("'gan'"));
   Table1Options options;
   options.validate();
@@ -121,7 +149,7 @@ namespace {
 Row row(const std::string& method, int demos, double id, double ood) {
   Row r;
   r.method = method;
-  r.head = method == "c8flow" ? "c8flow" : "flow";
+  r.head = method.starts_with("c8_") ? "c8ddpm" : "flow";
   r.demos = demos;
   r.trials = 100;
   r.train_seed = 1;
@@ -149,6 +177,16 @@ TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
   Row partial = row("relative", 10, 0.1, 0.0);
   partial.ood_success.reset();
   CHECK_THAT(table1_markdown({partial}, EvalSettings(), 1), Contains("| relative/flow | ood | - |"));
+  // The two C8 rows stand in for one paper row: its lines once, after both.
+  const std::string c8 =
+      table1_markdown({row("c8_centre", 100, 0.0, 0.0), row("c8_base", 100, 0.0, 0.0)}, EvalSettings(), 1);
+  const auto paper_line = c8.find("| Equivariant-DiffPo [7] (paper) | id | 0.27 |");
+  REQUIRE(paper_line != std::string::npos);
+  // The next mention is the paper's OOD line ("| " before the label), and there is no other.
+  const auto ood_line = c8.find("| Equivariant-DiffPo [7] (paper) | ood |");
+  CHECK(c8.find("Equivariant-DiffPo", c8.find('\n', paper_line)) == ood_line + 2);
+  CHECK(c8.find("Equivariant-DiffPo", ood_line + 3) == std::string::npos);
+  CHECK(c8.find("c8_base/c8ddpm | id") < paper_line);
 }
 
 TEST_CASE("the_figure_draws_one_colour_per_method_with_id_dots_and_ood_squares", "[unit]") {

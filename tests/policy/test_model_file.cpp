@@ -93,3 +93,39 @@ TEST_CASE("missing_or_unwritable_model_paths_are_typed_errors", "[unit]") {
   HC_CHECK_THROWS(save_model(small_policy(), "/nonexistent/dir/x.model"), FileError,
                   Catch::Contains("/nonexistent/dir/x.model"));
 }
+
+TEST_CASE("c8ddpm_models_keep_their_centre_and_a_damaged_centre_is_a_typed_error", "[unit]") {
+  // Planar scenes (c8ddpm encodes rotations about z only): the hand turns about z.
+  std::vector<Scene> scenes;
+  for (int i = 0; i < 8; ++i) {
+    Scene scene;
+    for (int h = 0; h < 3; ++h) {
+      scene.world_T_hand_history.push_back(RigidTransform::planar(0.3 * i - h, i, h));
+    }
+    for (int k = 0; k < 4; ++k) {
+      scene.world_T_hand_chunk.push_back(RigidTransform::planar(0.3 * i + k, i + k, 1));
+    }
+    scene.hand_points = {Eigen::Vector3d(1.0, 0.1 * i, 0.0), Eigen::Vector3d(-1.0, 0.2, 0.0)};
+    scenes.push_back(scene);
+  }
+  PolicyConfig config = test::small_config(HeadKind::c8ddpm, "absolute", 20);
+  config.c8_centre_x = 2.5;
+  config.c8_centre_y = -60.0;
+  const LearnedPolicy policy = train_policy(config, scenes, 3);
+  const std::string bytes = serialize_model(policy);
+  const LearnedPolicy loaded = deserialize_model(bytes, "c8.model");
+  CHECK(loaded.config().c8_centre_x == 2.5);
+  CHECK(loaded.config().c8_centre_y == -60.0);
+  CHECK(loaded.action_vector(scenes[0], 4) == policy.action_vector(scenes[0], 4));
+  std::string edited = bytes;
+  const std::size_t at = edited.find("c8_centre_y=-60");
+  REQUIRE(at != std::string::npos);
+  edited[at + std::strlen("c8_centre_y=-6")] = 'x';
+  HC_CHECK_THROWS(deserialize_model(with_valid_checksum(edited), "centre.model"), InvalidModelFile,
+                  Catch::Contains("centre.model") && Catch::Contains("c8_centre_y"));
+  edited = bytes;
+  edited[at + 3] ^= 0x20;  // "c8_Centre_y": an unknown key, even with a valid checksum
+  CHECK_THROWS_AS(deserialize_model(with_valid_checksum(edited), "key.model"), InvalidModelFile);
+  CHECK_THROWS_AS(deserialize_model(bytes.substr(0, bytes.size() - 9), "cut.model"),
+                  InvalidModelFile);
+}

@@ -3,6 +3,7 @@
 // training seed, then scored on three scene sets. Its files are named by a hash of everything
 // that determines the trained model, so a rerun (--resume, or another machine running the plan)
 // finds finished work by name and redoes only what is missing.
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -32,7 +33,7 @@ struct EvalSettings {
 
 struct Cell {
   std::string method;           ///< methods.hpp name
-  std::string head;             ///< flow, ddpm, cvae, c8flow
+  std::string head;             ///< flow, ddpm, cvae, c8ddpm
   int demos = 0;                ///< the first `demos` demos of the demo file
   std::uint64_t train_seed = 1;
   sim::TrainingData data;       ///< the demos' mirror images too, or not
@@ -54,18 +55,20 @@ std::string digest(const std::string& bytes);
 std::string cell_hash(const Cell& cell);
 
 /// The automatic training budget (Adam steps) for `demo_samples` scenes of demos trained on
-/// under `data`, the one `handcentric train` and every table cell use. Without perturbed copies:
-/// trainer.hpp's training_budget of the samples with their mirror images (6 per sample, 3000 to
-/// 30000). With them: 12 steps per sample with mirror images (the copies add no steps), from
-/// 3000 to 10000. Measured on the tuning seeds (docs/EXPERIMENTS.md): with 4 copies, 100 demos
-/// insert 1.00 after 10000 steps as after 30000, and 10 demos 0.98 after 8160 steps (0.95 after
-/// 4080), so the copies make training shorter, not longer.
+/// under `data`, the one `handcentric train` and every table cell use: trainer.hpp's
+/// training_budget of the samples with their mirror images (6 per sample, 3000 to 30000); the
+/// perturbed copies add no steps. Measured on the tuning seeds (docs/EXPERIMENTS.md): with 4
+/// copies 100 demos insert 1.00 after 10000 steps already, but relative actions need the 30000
+/// (0.35 after 10000, 0.61 after 30000), and every method gets the same budget.
 int automatic_steps(const sim::TrainingData& data, long long demo_samples);
 
 /// A cell with its config from the library defaults (PolicyConfig{}), the method's
-/// representation and the head, and `steps` Adam steps (0: automatic_steps); hash set.
+/// representation and the head, and `steps` Adam steps (0: automatic_steps, of 8 times the
+/// demo samples for c8ddpm's augmented data), and `c8_centre` (x, y) as the point c8ddpm rotates
+/// about (other heads ignore it); hash set.
 Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
                std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps = 0,
-               const sim::TrainingData& data = sim::TrainingData());
+               const sim::TrainingData& data = sim::TrainingData(),
+               std::array<double, 2> c8_centre = {0.0, 0.0});
 
 }  // namespace handcentric::experiments

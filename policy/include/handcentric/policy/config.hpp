@@ -6,9 +6,11 @@
 
 namespace handcentric::policy {
 
-/// The generative head (Sec. 2.3 and App. B): rectified flow, DDPM, CVAE, or the
-/// C8-symmetrized flow (the analogue of Equivariant Diffusion Policy [7]).
-enum class HeadKind { flow, ddpm, cvae, c8flow };
+/// The generative head (Sec. 2.3 and App. B): rectified flow, DDPM, CVAE, the C8-symmetrized
+/// flow on absolute rotation vectors, or the C8 baseline of Table 1 (c8_planar.hpp): DDPM on
+/// planar poses, trained on the C8 orbit of its data (stand-ins for Equivariant-DiffPo [7]),
+/// or the same with the rectified flow (c8flow_planar, a control for the DDPM).
+enum class HeadKind { flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar };
 
 enum class Activation { silu, relu };
 
@@ -17,10 +19,12 @@ enum class Activation { silu, relu };
 /// the default.
 enum class LearningRateSchedule { constant, cosine };
 
-/// "flow", "ddpm", "cvae", "c8flow".
+/// "flow", "ddpm", "cvae", "c8flow", "c8ddpm", "c8flow_planar".
 std::string to_string(HeadKind kind);
 /// Throws InvalidArgument naming the value and the valid names.
 HeadKind parse_head(const std::string& name);
+/// c8ddpm or c8flow_planar: the heads on the planar C8 encoding, which read c8_centre_*.
+bool is_c8_planar(HeadKind kind);
 std::string to_string(Activation activation);
 Activation parse_activation(const std::string& name);
 /// "constant", "cosine".
@@ -78,6 +82,11 @@ struct PolicyConfig {
   int ddim_steps = 10;           ///< DDIM sampling steps
   int cvae_latent = 16;
   double cvae_kl_weight = 1e-2;
+  /// The point C8 rotates about (world x, y; the task's cm) for heads c8ddpm and c8flow_planar
+  /// (c8_planar.hpp).
+  /// Stored only for that head, so other heads' configs (and Table 1 hashes) are unchanged.
+  double c8_centre_x = 0.0;
+  double c8_centre_y = 0.0;
 
   /// Throws InvalidArgument naming the first out-of-range field and its valid range.
   void validate() const;

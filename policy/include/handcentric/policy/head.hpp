@@ -9,6 +9,8 @@
 //   c8flow : rectified flow whose sampler averages the velocity over the 8 rotations about world
 //            z through the origin, f(x) = 1/8 sum_g g_* f(g^-1 x), on ABSOLUTE actions: the
 //            analogue of Equivariant Diffusion Policy [7] (not [7] itself; see c8_action.hpp)
+//   c8ddpm : DDPM on planar poses (x, y, z, cos, sin) trained on the C8 orbit of its data about
+//            config.c8_centre_*: Table 1's stand-in for [7] (c8_planar.hpp)
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
@@ -51,7 +53,7 @@ class Head {
 
 /// The head `config.head` for the dimensions in `config` (action_dimension and
 /// observation_dimension must be set). Throws InvalidArgument for a bad config, and for c8flow
-/// with a representation other than "absolute".
+/// or c8ddpm with a representation other than "absolute".
 std::unique_ptr<Head> make_head(const PolicyConfig& config);
 
 /// The number of float32 weights make_head(config) holds (and a model file stores), computed
