@@ -43,6 +43,7 @@ struct EvalOptions {
   bool json = false;
   double noise_scale = std::numeric_limits<double>::quiet_NaN();  // NaN: the model's own
   int execute = 0;            // 0: the model's own
+  int euler_steps = 0;        // 0: the model's own
   bool strict = false;
   std::string rotate_deg;
 };
@@ -61,6 +62,7 @@ int run_insert3d_eval(const EvalOptions& options) {
   policy::SamplingOverrides overrides;
   if (!std::isnan(options.noise_scale)) overrides.noise_scale = options.noise_scale;
   if (options.execute != 0) overrides.execute = options.execute;
+  if (options.euler_steps != 0) overrides.euler_steps = options.euler_steps;
   const LoadedInsert3dPolicy loaded = load_insert3d_policy(options.model, overrides);
   const ChunkPolicy* policy = loaded.policy.get();
   const experiments::Insert3dCounts counts = experiments::evaluate_insert3d(
@@ -97,6 +99,7 @@ int run_eval(const EvalOptions& options) {
   policy::SamplingOverrides overrides;
   if (!std::isnan(options.noise_scale)) overrides.noise_scale = options.noise_scale;
   if (options.execute != 0) overrides.execute = options.execute;
+  if (options.euler_steps != 0) overrides.euler_steps = options.euler_steps;
   const LoadedPolicy loaded =
       load_chunk_policy(options.model, options.policy.empty() ? "expert" : options.policy, overrides);
   const auto& policy = loaded.policy;
@@ -151,6 +154,7 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--noise-scale", options->noise_scale,
                   "a model's sampler noise instead of its own (0: the most likely chunk, eq. 6)");
   cmd->add_option("--execute", options->execute, "poses of each chunk a model executes instead of its own");
+  cmd->add_option("--euler-steps", options->euler_steps, "a flow model's Euler steps instead of its own");
   cmd->add_flag("--json", options->json,
                 "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, \"invalid\": count, ...}");
   cmd->add_flag("--strict", options->strict,

@@ -36,6 +36,15 @@ void add_table2_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--methods", options->methods, "representations, one row each (comma-separated)")
       ->delimiter(',')
       ->capture_default_str();
+  cmd->add_option("--perturb-copies", options->perturbation.copies,
+                  "noise-injected copies of every training scene (DART; 0: the demos only)")
+      ->capture_default_str();
+  cmd->add_option("--perturb-cm", options->perturbation.max_cm,
+                  "largest move of a copy's hand, per axis, in the hand frame (cm)")
+      ->capture_default_str();
+  cmd->add_option("--perturb-deg", options->perturbation.max_deg,
+                  "largest turn of a copy's hand, per rotation-vector axis (deg)")
+      ->capture_default_str();
   cmd->add_flag("--quiet", options->quiet, "no progress lines on stderr");
   cmd->callback([options, &exit_code] {
     const auto rows = experiments::run_table2(*options);

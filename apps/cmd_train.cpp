@@ -21,6 +21,7 @@
 #include "commands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -88,8 +89,9 @@ int run_train(const TrainOptions& options) {
     const std::vector<sim::insert3d::Demo> demos = sim::insert3d::load_demos(options.demos);
     demo_count = demos.size();
     check_max_demos(options, demo_count);
-    scenes = sim::insert3d::training_scenes(demos, config.history_length, config.chunk_length,
-                                            options.max_demos);
+    // The policy input of the 3D task: the corners and the slot points computed from them.
+    scenes = experiments::with_slot_key_points(sim::insert3d::training_scenes(
+        demos, config.history_length, config.chunk_length, options.max_demos));
   }
   const std::size_t used =
       options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);

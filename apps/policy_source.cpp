@@ -1,5 +1,6 @@
 #include "policy_source.hpp"
 
+#include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/experiments/table2.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -29,10 +30,11 @@ LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
     loaded.policy = std::make_unique<sim::insert3d::ClosedLoopExpert>();
     return loaded;
   }
-  auto model = std::make_unique<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
+  auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
   policy::require_task(*model, policy::kTaskInsert3d, model_path);
   loaded.rollout_options = experiments::insert3d_rollout_options(model->config());
-  loaded.policy = std::move(model);
+  // 3D models are trained on the corners and the slot points computed from them (cmd_train).
+  loaded.policy = std::make_unique<experiments::SlotKeyPointPolicy>(std::move(model));
   return loaded;
 }
 

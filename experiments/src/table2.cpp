@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <iostream>
 #include <mutex>
+#include <numbers>
+#include <random>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -17,8 +19,10 @@
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/experiments/wilson.hpp"
 #include "handcentric/policy/trainer.hpp"
+#include "handcentric/sim/insert3d/camera.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
 #include "handcentric/sim/scenes.hpp"
 
@@ -81,6 +85,47 @@ std::vector<insert3d::Demo> insert3d_train_demos(int count, std::uint64_t seed) 
   return std::move(run.demos);
 }
 
+void Perturbation::validate() const {
+  if (copies < 0 || copies > 100) {
+    throw InvalidArgument("--perturb-copies " + std::to_string(copies) +
+                          " is out of range: use 0..100");
+  }
+  if (!(max_cm >= 0.0 && max_cm < 1e3) || !(max_deg >= 0.0 && max_deg <= 180.0)) {
+    throw InvalidArgument("perturbation sizes " + std::to_string(max_cm) + " cm, " +
+                          std::to_string(max_deg) +
+                          " deg are out of range: use [0, 1000) cm and [0, 180] deg");
+  }
+}
+
+std::vector<Scene> insert3d_training_data(const std::vector<insert3d::Demo>& demos, int H, int K,
+                                          const Perturbation& perturbation, std::uint64_t seed) {
+  perturbation.validate();
+  const insert3d::BladeSlotGeometry geometry;
+  std::mt19937_64 rng(sim::stream_seed(seed, 0x7e57));
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double max_rad = perturbation.max_deg * std::numbers::pi / 180.0;
+  std::vector<Scene> scenes;
+  for (const insert3d::Demo& demo : demos) {
+    const std::vector<Scene> own = insert3d::training_scenes(demo, H, K, geometry);
+    scenes.insert(scenes.end(), own.begin(), own.end());
+    for (int copy = 0; copy < perturbation.copies; ++copy) {
+      for (Scene scene : own) {
+        const Eigen::Vector3d dp(unit(rng), unit(rng), unit(rng));
+        const Eigen::Vector3d dr(unit(rng), unit(rng), unit(rng));
+        // hand_T_moved: a small rigid motion expressed in the hand's own frame.
+        const RigidTransform hand_T_moved(Rotation::exp(max_rad * dr), perturbation.max_cm * dp);
+        for (RigidTransform& world_T_hand : scene.world_T_hand_history)
+          world_T_hand = world_T_hand * hand_T_moved;
+        const auto corners =
+            insert3d::opening_corners_in_hand(geometry, scene.world_T_hand0(), demo.world_T_slot);
+        scene.hand_points.assign(corners.begin(), corners.end());
+        scenes.push_back(std::move(scene));
+      }
+    }
+  }
+  return scenes;
+}
+
 void Table2Options::validate() const {
   if (demos < 1 || demos > 1000) {
     throw InvalidArgument("--demos " + std::to_string(demos) + " is out of range: use 1..1000");
@@ -96,6 +141,7 @@ void Table2Options::validate() const {
                           " is negative: use 0 (automatic) or more");
   if (methods.empty()) throw InvalidArgument("table2: no method: give at least one representation");
   for (const std::string& method : methods) make_representation(method);  // names the valid ones
+  perturbation.validate();
 }
 
 namespace {
@@ -112,13 +158,15 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
   config.task = policy::kTaskInsert3d;
   config.representation = method;
   config.steps = options.steps;
-  const policy::LearnedPolicy trained = policy::train_policy(config, scenes, options.seed);
-  const insert3d::RolloutOptions rollout_options = insert3d_rollout_options(trained.config());
+  const auto model = std::make_shared<const policy::LearnedPolicy>(
+      policy::train_policy(config, with_slot_key_points(scenes), options.seed));
+  const SlotKeyPointPolicy trained(model);
+  const insert3d::RolloutOptions rollout_options = insert3d_rollout_options(model->config());
   Table2Row row;
   row.method = method;
   row.demos = options.demos;
   row.seed = options.seed;
-  row.steps = trained.config().steps;
+  row.steps = model->config().steps;
   const std::uint64_t eval_seed = options.seed + 1;
   row.train = evaluate_insert3d(trained, insert3d::SceneDistribution::train(), options.trials,
                                 eval_seed, rollout_options);
@@ -147,8 +195,8 @@ std::vector<Table2Row> run_table2(const Table2Options& options) {
   std::filesystem::create_directories(options.out);
   const policy::PolicyConfig defaults;
   const std::vector<insert3d::Demo> demos = insert3d_train_demos(options.demos, options.seed);
-  const std::vector<Scene> scenes =
-      insert3d::training_scenes(demos, defaults.history_length, defaults.chunk_length);
+  const std::vector<Scene> scenes = insert3d_training_data(
+      demos, defaults.history_length, defaults.chunk_length, options.perturbation, options.seed);
   if (!options.quiet) {
     std::cerr << "table2: " << demos.size() << " demos (" << scenes.size() << " training samples), "
               << options.methods.size() << " methods, " << options.trials

@@ -106,3 +106,26 @@ TEST_CASE("table2_options_name_the_bad_value", "[unit]") {
   options.methods = {"hand_centric", "bogus"};
   CHECK_THROWS_WITH(options.validate(), Contains("bogus"));
 }
+
+TEST_CASE("table2_noise_injected_copies_move_the_hand_and_keep_the_demos_chunk", "[unit]") {
+  const std::vector<sim::insert3d::Demo> demos = insert3d_train_demos(2, 5);
+  const std::vector<Scene> plain = insert3d_training_data(demos, 0, 16, Perturbation{}, 3);
+  const std::vector<Scene> noisy =
+      insert3d_training_data(demos, 0, 16, Perturbation{1, 0.15, 1.0}, 3);
+  const std::size_t first = demos[0].world_T_hand.size();
+  REQUIRE(noisy.size() == 2 * plain.size());
+  REQUIRE(plain.size() == first + demos[1].world_T_hand.size());
+  for (std::size_t t = 0; t < first; ++t) {
+    const Scene& original = plain[t];
+    const Scene& copy = noisy[first + t];  // the first demo's copies follow its own scenes
+    const RigidTransform delta = original.world_T_hand0().inverse_compose(copy.world_T_hand0());
+    CHECK(delta.translation().cwiseAbs().maxCoeff() <= 0.15 + 1e-12);
+    CHECK(delta.translation().norm() > 0.0);
+    CHECK(distance(copy.world_T_hand_chunk.back(), original.world_T_hand_chunk.back()) == 0.0);
+    // The corners are observed from the moved hand: mapped to the world they land where they did.
+    const Eigen::Vector3d corner = copy.world_T_hand0() * copy.hand_points[0];
+    CHECK((corner - original.world_T_hand0() * original.hand_points[0]).norm() < 1e-9);
+  }
+  CHECK_THROWS_WITH(insert3d_training_data(demos, 0, 16, Perturbation{101, 0.1, 1.0}, 3),
+                    Contains("--perturb-copies 101"));
+}

@@ -2,10 +2,13 @@
 // out on a 3D scene and on g * scene for random g in SE(3) with the same noise seeds, drives the
 // hand along g times its original trajectory to the same outcome, whatever the network learned.
 // The planted fault is the same loop with absolute actions: its trajectories do not move with g.
+// The policies see what table2's and `handcentric eval --task insert3d`'s do: the corners and the
+// slot points computed from them (experiments/insert3d_key_points.hpp).
 #include <catch2/catch.hpp>
 #include <random>
 
 #include "handcentric/core/sampling.hpp"
+#include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/policy/errors.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -33,8 +36,8 @@ policy::LearnedPolicy trained_3d_policy(const std::string& representation) {
   config.steps = 300;
   config.batch_size = 64;
   config.history_length = kHistory;
-  return policy::train_policy(
-      config, insert3d::training_scenes(run.demos, kHistory, config.chunk_length), 5);
+  const auto samples = insert3d::training_scenes(run.demos, kHistory, config.chunk_length);
+  return policy::train_policy(config, experiments::with_slot_key_points(samples), 5);
 }
 
 // The largest |g T_t - T'_t| (cm + Frobenius of the rotation) over rollouts of 3 train scenes
@@ -71,7 +74,9 @@ double worst_gap(const ChunkPolicy& policy, bool& same_outcomes) {
 
 TEST_CASE("a_trained_hand_centric_3d_policy_is_se3_equivariant_in_closed_loop", "[property]") {
   bool same_outcomes = false;
-  const double gap = worst_gap(trained_3d_policy("hand_centric"), same_outcomes);
+  const experiments::SlotKeyPointPolicy policy(
+      std::make_shared<policy::LearnedPolicy>(trained_3d_policy("hand_centric")));
+  const double gap = worst_gap(policy, same_outcomes);
   INFO("largest gap between g * rollout(scene) and rollout(g * scene): " << gap);
   CHECK(gap < 1e-9);
   CHECK(same_outcomes);
@@ -79,9 +84,29 @@ TEST_CASE("a_trained_hand_centric_3d_policy_is_se3_equivariant_in_closed_loop", 
 
 TEST_CASE("mutant_absolute_3d_policy_is_not_se3_equivariant_in_closed_loop", "[property]") {
   bool same_outcomes = false;
-  const double gap = worst_gap(trained_3d_policy("absolute"), same_outcomes);
+  const experiments::SlotKeyPointPolicy policy(
+      std::make_shared<policy::LearnedPolicy>(trained_3d_policy("absolute")));
+  const double gap = worst_gap(policy, same_outcomes);
   INFO("largest gap: " << gap);
   CHECK(gap > 1.0);  // centimetres: the moved rollout goes elsewhere
+}
+
+TEST_CASE("the_slot_key_points_are_the_slot_seen_from_the_hand_and_need_four_corners", "[unit]") {
+  const insert3d::BladeSlotGeometry geometry;
+  const insert3d::TaskScene scene =
+      insert3d::sample_scene(insert3d::SceneDistribution::random_se3(), 4, 0);
+  const Scene observation = insert3d::observe(scene, {scene.world_T_hand_start}, 0);
+  const Scene input = experiments::with_slot_key_points(observation);
+  REQUIRE(input.hand_points.size() == 4u + experiments::kSlotKeyPoints);
+  const RigidTransform hand_T_slot = scene.world_T_hand_start.inverse_compose(scene.world_T_slot);
+  CHECK((input.hand_points.back() - hand_T_slot * Eigen::Vector3d(0, 0, -insert3d::kSlotDepth))
+            .norm() < 1e-9);
+  const double outer_x = geometry.inner_half_x() + insert3d::kSlotWallThickness;
+  const double outer_y = geometry.inner_half_y() + insert3d::kSlotWallThickness;
+  CHECK((input.hand_points[6] - hand_T_slot * Eigen::Vector3d(outer_x, outer_y, 0)).norm() < 1e-9);
+  Scene three = observation;
+  three.hand_points.pop_back();
+  CHECK_THROWS_AS(experiments::with_slot_key_points(three), InvalidScene);
 }
 
 TEST_CASE("a_model_records_its_task_and_a_2d_model_on_the_3d_task_is_a_typed_error", "[unit]") {
@@ -95,6 +120,7 @@ TEST_CASE("a_model_records_its_task_and_a_2d_model_on_the_3d_task_is_a_typed_err
   CHECK_THROWS_WITH(policy::PolicyConfig::from_text("task=peg3d\n"),
                     Catch::Contains("'peg3d'") && Catch::Contains("peg2d or insert3d"));
   const policy::LearnedPolicy model = trained_3d_policy("hand_centric");
+  CHECK(model.config().hand_points == 4 + experiments::kSlotKeyPoints);
   const policy::LearnedPolicy reloaded =
       policy::deserialize_model(policy::serialize_model(model), "m.hcm");
   CHECK(reloaded.config().task == "insert3d");

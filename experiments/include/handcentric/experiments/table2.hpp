@@ -57,6 +57,27 @@ Insert3dCounts evaluate_insert3d(const ChunkPolicy& policy,
 /// InvalidArgument for count < 1 or when too few scenes are solved.
 std::vector<sim::insert3d::Demo> insert3d_train_demos(int count, std::uint64_t seed);
 
+/// Noise injection into the training data (DART, Laskey et al. 2017): besides each demo's own
+/// training scenes, `copies` copies of each in which the hand's poses (T_0 and its history) are
+/// moved in the hand frame by a random delta (translation uniform in [-cm, cm]^3, rotation
+/// vector uniform in [-deg, deg]^3), the corners re-observed from there and the chunk left as the
+/// demo's next K poses: the policy sees what to do when it is a little off the demonstrated path,
+/// which the demos alone never show. Deltas act in the hand frame, so the data stays invariant in
+/// distribution and the hand-centric policy stays equivariant (Theorem 1 holds for any data).
+struct Perturbation {
+  int copies = 0;
+  double max_cm = 0.15;
+  double max_deg = 1.0;
+  /// Throws InvalidArgument for copies outside 0..100 or a negative or non-finite size.
+  void validate() const;
+};
+
+/// The training scenes of `demos` (H, K) and their perturbed copies (demo after demo), drawn
+/// from the stream `seed`.
+std::vector<Scene> insert3d_training_data(const std::vector<sim::insert3d::Demo>& demos, int H,
+                                          int K, const Perturbation& perturbation,
+                                          std::uint64_t seed);
+
 struct Table2Options {
   int demos = 100;
   int trials = 100;
@@ -65,6 +86,7 @@ struct Table2Options {
   int jobs = 0;   ///< trainings at once; 0: one per hardware thread
   int steps = 0;  ///< Adam steps per policy; 0: the library's automatic budget
   std::vector<std::string> methods = {"hand_centric", "relative", "absolute"};
+  Perturbation perturbation;
   bool quiet = false;
 
   /// Throws InvalidArgument naming the bad value and the fix (demos outside 1..1000, trials
