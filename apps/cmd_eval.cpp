@@ -154,7 +154,8 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--noise-scale", options->noise_scale,
                   "a model's sampler noise instead of its own (0: the most likely chunk, eq. 6)");
   cmd->add_option("--execute", options->execute, "poses of each chunk a model executes instead of its own");
-  cmd->add_option("--euler-steps", options->euler_steps, "a flow model's Euler steps instead of its own");
+  cmd->add_option("--euler-steps", options->euler_steps,
+                  "a flow model's Euler steps instead of its own");
   cmd->add_flag("--json", options->json,
                 "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, \"invalid\": count, ...}");
   cmd->add_flag("--strict", options->strict,
