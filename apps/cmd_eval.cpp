@@ -5,7 +5,8 @@
 // away a long evaluation; --strict stops at it with an error instead.
 // Policies: --policy expert|straight|hold (no file needed), or --model FILE: a trained model
 // (policy/model_file.hpp), when this build has the policy module. With --task insert3d: the 3D
-// blade insertion (sim/insert3d/rollout.hpp), for now with --policy expert only.
+// blade insertion (sim/insert3d/rollout.hpp), with --policy expert or a model trained with
+// `handcentric train --task insert3d` (a model of the other task is a TaskMismatch error).
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -19,6 +20,7 @@
 #include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/experiments/results.hpp"
+#include "handcentric/experiments/table2.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/expert_check.hpp"
 #include "handcentric/sim/insert3d/rollout.hpp"
@@ -41,42 +43,48 @@ struct EvalOptions {
   bool json = false;
   double noise_scale = std::numeric_limits<double>::quiet_NaN();  // NaN: the model's own
   int execute = 0;            // 0: the model's own
+  int euler_steps = 0;        // 0: the model's own
   bool strict = false;
   std::string rotate_deg;
 };
 
-// The 3D blade insertion: closed-loop expert rollouts on --dist train|ood|random-se3 or
-// --rotate-deg scenes, counted as in 2D.
+// The 3D blade insertion: closed-loop rollouts of the expert or a 3D model on --dist
+// train|ood|random-se3 or --rotate-deg scenes, counted as in 2D.
 int run_insert3d_eval(const EvalOptions& options) {
-  if (!options.model.empty() || (!options.policy.empty() && options.policy != "expert")) {
-    throw InvalidArgument("--task insert3d evaluates --policy expert only so far; learned and scripted policies "
-                          "run on the 2D task (--task peg2d)");
+  if (!options.policy.empty() && options.policy != "expert") {
+    throw InvalidArgument(
+        "--policy " + options.policy +
+        " is a 2D scripted policy: with --task insert3d use "
+        "--policy expert or --model FILE (from `handcentric train --task insert3d`)");
   }
   const sim::insert3d::SceneDistribution distribution =
       insert3d_distribution(options.dist, options.rotate_deg, options.hole_angle_deg, options.transform);
-  const sim::insert3d::CollisionChecker checker;
-  const sim::insert3d::ClosedLoopExpert expert;
-  int counts[4] = {0, 0, 0, 0};
-  int clipped = 0;
-  const auto scenes = sim::insert3d::sample_scenes(distribution, options.trials, options.seed);
-  for (std::size_t i = 0; i < scenes.size(); ++i) {
-    const sim::insert3d::Rollout result =
-        sim::insert3d::rollout(expert, scenes[i], sim::stream_seed(options.seed, i), checker);
-    ++counts[static_cast<int>(result.outcome)];
-    clipped += result.clipped;
-  }
+  policy::SamplingOverrides overrides;
+  if (!std::isnan(options.noise_scale)) overrides.noise_scale = options.noise_scale;
+  if (options.execute != 0) overrides.execute = options.execute;
+  if (options.euler_steps != 0) overrides.euler_steps = options.euler_steps;
+  const LoadedInsert3dPolicy loaded = load_insert3d_policy(options.model, overrides);
+  const ChunkPolicy* policy = loaded.policy.get();
+  const experiments::Insert3dCounts counts = experiments::evaluate_insert3d(
+      *policy, distribution, options.trials, options.seed, loaded.rollout_options);
   const double n = options.trials;
-  const nlohmann::json summary = {{"task", "insert3d"},  {"trials", options.trials},
-                                  {"success", counts[0] / n},  {"collision", counts[1] / n},
-                                  {"timeout", counts[2] / n},  {"invalid", counts[3]},
-                                  {"clipped", clipped},        {"policy", expert.name()},
-                                  {"dist", distribution.name()}, {"seed", options.seed}};
+  const nlohmann::json summary = {{"task", "insert3d"},
+                                  {"trials", options.trials},
+                                  {"success", counts.success / n},
+                                  {"collision", counts.collision / n},
+                                  {"timeout", counts.timeout / n},
+                                  {"invalid", counts.invalid},
+                                  {"clipped", counts.clipped},
+                                  {"policy", policy->name()},
+                                  {"dist", distribution.name()},
+                                  {"seed", options.seed}};
   if (options.json) {
     std::cout << summary.dump() << "\n";
   } else {
-    std::cout << "policy " << expert.name() << " on " << options.trials << " insert3d '" << distribution.name()
-              << "' scenes (seed " << options.seed << "): success " << counts[0] / n << ", collision " << counts[1] / n
-              << ", timeout " << counts[2] / n << ", invalid " << counts[3] << "; " << clipped
+    std::cout << "policy " << policy->name() << " on " << options.trials << " insert3d '"
+              << distribution.name() << "' scenes (seed " << options.seed << "): success "
+              << counts.success / n << ", collision " << counts.collision / n << ", timeout "
+              << counts.timeout / n << ", invalid " << counts.invalid << "; " << counts.clipped
               << " commands clipped to the step limits\n";
   }
   return 0;
@@ -91,6 +99,7 @@ int run_eval(const EvalOptions& options) {
   policy::SamplingOverrides overrides;
   if (!std::isnan(options.noise_scale)) overrides.noise_scale = options.noise_scale;
   if (options.execute != 0) overrides.execute = options.execute;
+  if (options.euler_steps != 0) overrides.euler_steps = options.euler_steps;
   const LoadedPolicy loaded =
       load_chunk_policy(options.model, options.policy.empty() ? "expert" : options.policy, overrides);
   const auto& policy = loaded.policy;
@@ -119,7 +128,9 @@ int run_eval(const EvalOptions& options) {
 void add_eval_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<EvalOptions>();
   CLI::App* cmd = app.add_subcommand("eval", "closed-loop rollouts of a policy on the 2D peg-in-hole task or the 3D blade insertion");
-  cmd->add_option("--task", options->task, "peg2d (the 2D task) or insert3d (the 3D blade insertion, --policy expert)")
+  cmd->add_option("--task", options->task,
+                  "peg2d (the 2D task) or insert3d (the 3D blade insertion: --policy expert or an "
+                  "insert3d --model)")
       ->check(CLI::IsMember({"peg2d", "insert3d"}))
       ->capture_default_str();
   auto* model = cmd->add_option("--model", options->model, "a trained model file (from `handcentric train`)");
@@ -143,6 +154,8 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--noise-scale", options->noise_scale,
                   "a model's sampler noise instead of its own (0: the most likely chunk, eq. 6)");
   cmd->add_option("--execute", options->execute, "poses of each chunk a model executes instead of its own");
+  cmd->add_option("--euler-steps", options->euler_steps,
+                  "a flow model's Euler steps instead of its own");
   cmd->add_flag("--json", options->json,
                 "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, \"invalid\": count, ...}");
   cmd->add_flag("--strict", options->strict,

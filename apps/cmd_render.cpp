@@ -1,11 +1,16 @@
 // `handcentric render`: PNG drawings of the 2D insertion task (sim/draw.hpp): one scene, a demo
-// file, or one closed-loop rollout.
+// file, or one closed-loop rollout; with --task insert3d, a 3D scene or a rollout of the expert or
+// a 3D model from a fixed viewpoint, the hand camera's depth images beside it
+// (experiments/insert3d_drawing.hpp).
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "commands.hpp"
+#include "insert3d_options.hpp"
 #include "policy_source.hpp"
+#include "handcentric/experiments/insert3d_drawing.hpp"
+#include "handcentric/experiments/table2.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
@@ -19,6 +24,8 @@ namespace handcentric::apps {
 namespace {
 
 struct RenderOptions {
+  std::string task = "peg2d";
+  std::string rotate_deg;
   bool scene = false;
   std::string demos;
   bool rollout = false;
@@ -32,7 +39,46 @@ struct RenderOptions {
   std::string out;
 };
 
+// The 3D task: scene --index of --dist or --rotate-deg, alone (--scene) or with a rollout.
+int run_insert3d_render(const RenderOptions& options) {
+  if (!options.demos.empty()) {
+    throw InvalidArgument(
+        "--demos draws 2D demo files only; with --task insert3d use --scene or --rollout");
+  }
+  if (options.policy != "expert") {
+    throw InvalidArgument("--policy " + options.policy +
+                          " is a 2D scripted policy: with --task insert3d use "
+                          "--policy expert or --model FILE");
+  }
+  const sim::insert3d::SceneDistribution distribution = insert3d_distribution(
+      options.rotate_deg.empty() ? options.dist : "", options.rotate_deg, "", "");
+  const sim::insert3d::TaskScene scene =
+      sim::insert3d::sample_scene(distribution, options.seed, options.index);
+  sim::insert3d::Rollout rollout;
+  std::string what = "scene";
+  if (options.scene) {
+    rollout.world_T_hand = {scene.world_T_hand_start};
+  } else {
+    const LoadedInsert3dPolicy loaded = load_insert3d_policy(options.model);
+    const ChunkPolicy& policy = *loaded.policy;
+    const sim::insert3d::CollisionChecker checker;
+    rollout = sim::insert3d::rollout(policy, scene, sim::stream_seed(options.seed, options.index),
+                                     checker, loaded.rollout_options);
+    what = "rollout (" + sim::insert3d::to_string(rollout.outcome) + " after " +
+           std::to_string(rollout.world_T_hand.size() - 1) + " steps)";
+    what += " of " + policy.name();
+  }
+  const std::string caption = "insert3d '" + distribution.name() + "' scene " +
+                              std::to_string(options.index) + " (seed " +
+                              std::to_string(options.seed) + "): " + what;
+  sim::write_png(options.out, experiments::draw_insert3d_rollout(scene, rollout, caption));
+  std::cout << "wrote " << what << " to " << options.out << "\n";
+  return 0;
+}
+
 int run_render(const RenderOptions& options) {
+  if (options.task == "insert3d") return run_insert3d_render(options);
+  refuse_3d_options(options.dist, options.rotate_deg);
   const sim::CollisionChecker checker;
   sim::Image image;
   std::string what;
@@ -62,7 +108,15 @@ int run_render(const RenderOptions& options) {
 
 void add_render_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<RenderOptions>();
-  CLI::App* cmd = app.add_subcommand("render", "PNG of a scene, a demo file or a rollout of the 2D task");
+  CLI::App* cmd = app.add_subcommand(
+      "render", "PNG of a scene, a demo file or a rollout (2D, or 3D with --task insert3d)");
+  cmd->add_option("--task", options->task,
+                  "peg2d (the 2D task) or insert3d (the 3D blade insertion)")
+      ->check(CLI::IsMember({"peg2d", "insert3d"}))
+      ->capture_default_str();
+  cmd->add_option(
+      "--rotate-deg", options->rotate_deg,
+      "insert3d: a train scene under the global rotation RX,RY,RZ (XYZ Euler, degrees)");
   auto* scene = cmd->add_flag("--scene", options->scene, "draw scene --index of --dist / --seed");
   auto* demos = cmd->add_option("--demos", options->demos, "draw the demos of this file (in the hole frame)");
   auto* rollout = cmd->add_flag("--rollout", options->rollout, "draw a rollout of --policy on scene --index");
@@ -71,7 +125,10 @@ void add_render_command(CLI::App& app, int& exit_code) {
   auto* policy = cmd->add_option("--policy", options->policy, "policy of --rollout")
                      ->check(CLI::IsMember(sim::scripted_policy_names()))->capture_default_str();
   cmd->add_option("--model", options->model, "a trained model for --rollout (instead of --policy)")->excludes(policy);
-  cmd->add_option("--dist", options->dist, "train, ood or a hole-angle range A:B in degrees")->capture_default_str();
+  cmd->add_option(
+         "--dist", options->dist,
+         "train, ood or a hole-angle range A:B in degrees (insert3d: train, ood, random-se3)")
+      ->capture_default_str();
   cmd->add_option("--seed", options->seed, "seed of the scene stream (as in `handcentric eval`)")->capture_default_str();
   cmd->add_option("--index", options->index, "which scene of the stream")->capture_default_str();
   cmd->add_option("--max", options->max_demos, "at most this many demos (--demos)")->capture_default_str();

@@ -2,6 +2,10 @@
 // (sim/demos.hpp), written to a model file (policy/model_file.hpp).
 //
 //   handcentric train --demos demos.jsonl --out m.model   # the library defaults (PolicyConfig)
+//   handcentric train --task insert3d --demos d3.jsonl --out m3.hcm   # the 3D blade insertion
+//
+// The model records its task (PolicyConfig::task); demos of the other task are refused by their
+// loader, naming both tasks. The 3D task has no mirror images (--no-mirror is implied).
 //
 // Progress on stderr (step, loss, samples/s, ETA): one line rewritten in place on a terminal, a
 // line every 10% otherwise; the final summary line on stdout.
@@ -18,17 +22,20 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/cell.hpp"
+#include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/demos.hpp"
+#include "handcentric/sim/insert3d/demos.hpp"
 
 namespace handcentric::apps {
 namespace {
 
 // The library's PolicyConfig holds every default; the command line only overrides it.
 struct TrainOptions {
+  std::string task = policy::kTaskPeg2d;
   std::string demos, out;
   policy::PolicyConfig config;
   std::string head = policy::to_string(config.head);
@@ -46,6 +53,14 @@ std::string clock_text(double seconds) {
   return text;
 }
 
+void check_max_demos(const TrainOptions& options, std::size_t held) {
+  if (options.max_demos < 0 || options.max_demos > static_cast<int>(held)) {
+    throw InvalidArgument("--max-demos " + std::to_string(options.max_demos) + " but '" +
+                          options.demos + "' holds " + std::to_string(held) +
+                          " demos: give 0 (all) up to " + std::to_string(held));
+  }
+}
+
 int run_train(const TrainOptions& options) {
   policy::PolicyConfig config = options.config;
   config.head = policy::parse_head(options.head);
@@ -61,18 +76,35 @@ int run_train(const TrainOptions& options) {
                           " does not exist: create it first");
   }
 
-  const std::vector<sim::Demo> demos = sim::load_demos(options.demos);
-  if (options.max_demos < 0 || options.max_demos > static_cast<int>(demos.size())) {
-    throw InvalidArgument("--max-demos " + std::to_string(options.max_demos) + " but '" + options.demos + "' holds " +
-                          std::to_string(demos.size()) + " demos: give 0 (all) up to " + std::to_string(demos.size()));
-  }
-  const std::size_t used = options.max_demos == 0 ? demos.size() : static_cast<std::size_t>(options.max_demos);
+  config.task = options.task;
+  const bool planar = options.task == policy::kTaskPeg2d;
+  // The 2D task's recipe (mirror images, perturbed copies); the 3D task trains on its demos.
   sim::TrainingData data = options.data;
+  data.mirror = planar && options.data.mirror;
+  data.perturbed_copies = planar ? options.data.perturbed_copies : 0;
   data.perturbation_seed = options.seed;  // one seed names the whole training run
-  const std::vector<Scene> scenes =
-      sim::training_scenes(demos, config.history_length, config.chunk_length, options.max_demos, data);
+  std::size_t demo_count = 0;
   long long demo_samples = 0;  // one scene per pose of each demo trained on
-  for (std::size_t i = 0; i < used; ++i) demo_samples += static_cast<long long>(demos[i].world_T_hand.size());
+  std::vector<Scene> scenes;
+  if (planar) {
+    const std::vector<sim::Demo> demos = sim::load_demos(options.demos);
+    demo_count = demos.size();
+    check_max_demos(options, demo_count);
+    scenes = sim::training_scenes(demos, config.history_length, config.chunk_length,
+                                  options.max_demos, data);
+    const std::size_t used = options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
+    for (std::size_t i = 0; i < used; ++i) demo_samples += static_cast<long long>(demos[i].world_T_hand.size());
+  } else {
+    const std::vector<sim::insert3d::Demo> demos = sim::insert3d::load_demos(options.demos);
+    demo_count = demos.size();
+    check_max_demos(options, demo_count);
+    // The policy input of the 3D task: the corners and the slot points computed from them.
+    scenes = experiments::with_slot_key_points(sim::insert3d::training_scenes(
+        demos, config.history_length, config.chunk_length, options.max_demos));
+    demo_samples = static_cast<long long>(scenes.size());
+  }
+  const std::size_t used =
+      options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
   if (config.steps == 0) {
     // c8ddpm trains on 8 rotated copies of every scene: its budget counts them
     config.steps = experiments::automatic_steps(data, policy::c8::augmentation_copies(config.head) * demo_samples);
@@ -93,12 +125,12 @@ int run_train(const TrainOptions& options) {
   const policy::LearnedPolicy trained = policy::train_policy(config, scenes, options.seed, progress, report_every);
   policy::save_model(trained, options.out);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  std::cout << "trained " << trained.name() << " on " << scenes.size() << " scenes from " << used << " demos"
-            << (data.mirror ? " and their mirror images" : "")
+  std::cout << "trained " << trained.name() << " on " << scenes.size() << " scenes from " << used
+            << " demos" << (data.mirror ? " and their mirror images" : "")
             << (data.perturbed_copies > 0 ? " (" + std::to_string(data.perturbed_copies) + " perturbed copies each)" : "")
-            << ": "
-            << config.steps << " steps, final loss " << last_loss << ", " << static_cast<long>(last_rate)
-            << " samples/s (" << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
+            << " (task " << config.task << "): " << config.steps << " steps, final loss " << last_loss << ", "
+            << static_cast<long>(last_rate) << " samples/s ("
+            << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
             << " -> " << options.out << "\n";
   return 0;
 }
@@ -106,6 +138,11 @@ int run_train(const TrainOptions& options) {
 void add_train_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<TrainOptions>();
   CLI::App* cmd = app.add_subcommand("train", "train a policy on demonstrations and write a model file");
+  cmd->add_option(
+         "--task", options->task,
+         "peg2d (the 2D peg-in-hole) or insert3d (the 3D blade insertion); the demos' task")
+      ->check(CLI::IsMember({policy::kTaskPeg2d, policy::kTaskInsert3d}))
+      ->capture_default_str();
   cmd->add_option("--demos", options->demos, "demo file (handcentric demos --out)")->required();
   cmd->add_option("--out", options->out, "model file to write (atomically)")->required();
   policy::PolicyConfig& config = options->config;

@@ -1,5 +1,7 @@
 #include "policy_source.hpp"
 
+#include "handcentric/experiments/insert3d_key_points.hpp"
+#include "handcentric/experiments/table2.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/sim/policies.hpp"
@@ -15,8 +17,24 @@ LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string&
     return loaded;
   }
   auto model = std::make_unique<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
+  policy::require_task(*model, policy::kTaskPeg2d, model_path);  // the 2D rollouts' observations
   loaded.rollout_options = sim::RolloutOptions::for_policy(model->config().history_length, model->config().execute);
   loaded.policy = std::move(model);
+  return loaded;
+}
+
+LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
+                                          const policy::SamplingOverrides& overrides) {
+  LoadedInsert3dPolicy loaded;
+  if (model_path.empty()) {
+    loaded.policy = std::make_unique<sim::insert3d::ClosedLoopExpert>();
+    return loaded;
+  }
+  auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
+  policy::require_task(*model, policy::kTaskInsert3d, model_path);
+  loaded.rollout_options = experiments::insert3d_rollout_options(model->config());
+  // 3D models are trained on the corners and the slot points computed from them (cmd_train).
+  loaded.policy = std::make_unique<experiments::SlotKeyPointPolicy>(std::move(model));
   return loaded;
 }
 

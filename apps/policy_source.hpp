@@ -6,6 +6,7 @@
 
 #include "handcentric/core/chunk_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
+#include "handcentric/sim/insert3d/rollout.hpp"
 #include "handcentric/sim/rollout.hpp"
 
 namespace handcentric::apps {
@@ -24,5 +25,14 @@ struct LoadedPolicy {
 /// `overrides` apply to a model only.
 LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string& scripted_name,
                                const policy::SamplingOverrides& overrides = {});
+
+/// The same for the 3D task: the model in `model_path` (which must be an insert3d model, else
+/// TaskMismatch) with its H, execute and replans, or the closed-loop 3D expert when it is empty.
+struct LoadedInsert3dPolicy {
+  std::unique_ptr<ChunkPolicy> policy;
+  sim::insert3d::RolloutOptions rollout_options;
+};
+LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
+                                          const policy::SamplingOverrides& overrides = {});
 
 }  // namespace handcentric::apps

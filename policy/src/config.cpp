@@ -101,16 +101,25 @@ double parse_double(const std::string& key, const std::string& text) {
 
 const std::vector<Field>& fields() {
   static const std::vector<Field> all = {
+      Field{"task", [](const PolicyConfig& c) { return c.task; },
+            [](PolicyConfig& c, const std::string& v) { c.task = v; }},
       Field{"head", [](const PolicyConfig& c) { return to_string(c.head); },
             [](PolicyConfig& c, const std::string& v) { c.head = parse_head(v); }},
       Field{"representation", [](const PolicyConfig& c) { return c.representation; },
             [](PolicyConfig& c, const std::string& v) { c.representation = v; }},
-      HC_INT_FIELD(chunk_length), HC_INT_FIELD(history_length), HC_INT_FIELD(hand_points),
-      HC_INT_FIELD(world_points), HC_INT_FIELD(action_dimension), HC_INT_FIELD(observation_dimension),
-      HC_INT_FIELD(hidden_width), HC_INT_FIELD(hidden_layers),
+      HC_INT_FIELD(chunk_length),
+      HC_INT_FIELD(history_length),
+      HC_INT_FIELD(hand_points),
+      HC_INT_FIELD(world_points),
+      HC_INT_FIELD(action_dimension),
+      HC_INT_FIELD(observation_dimension),
+      HC_INT_FIELD(hidden_width),
+      HC_INT_FIELD(hidden_layers),
       Field{"activation", [](const PolicyConfig& c) { return to_string(c.activation); },
             [](PolicyConfig& c, const std::string& v) { c.activation = parse_activation(v); }},
-      HC_INT_FIELD(time_embedding), HC_INT_FIELD(steps), HC_INT_FIELD(batch_size),
+      HC_INT_FIELD(time_embedding),
+      HC_INT_FIELD(steps),
+      HC_INT_FIELD(batch_size),
       HC_DOUBLE_FIELD(learning_rate),
       Field{"lr_schedule", [](const PolicyConfig& c) { return to_string(c.lr_schedule); },
             [](PolicyConfig& c, const std::string& v) { c.lr_schedule = parse_schedule(v); }},
@@ -134,6 +143,8 @@ constexpr int kMaxDimension = 1 << 20;
 
 void PolicyConfig::validate() const {
   const auto s = [](auto v) { return std::to_string(v); };
+  require(task == kTaskPeg2d || task == kTaskInsert3d, "task", "'" + task + "'",
+          "peg2d or insert3d");
   require(chunk_length >= 1 && chunk_length <= 1024, "chunk_length", s(chunk_length), "1..1024");
   require(history_length >= 0 && history_length <= 1024, "history_length", s(history_length), "0..1024");
   // Upper bounds keep every size a network is built from (sums and products of these) far from
@@ -170,6 +181,7 @@ std::string PolicyConfig::to_text() const {
   std::string text;
   for (const Field& field : fields()) {
     if (!is_c8_planar(head) && field.key.starts_with("c8_")) continue;  // see config.hpp
+    if (field.key == "task" && task == kTaskPeg2d) continue;  // absent reads as peg2d
     text += field.key + "=" + field.get(*this) + "\n";
   }
   return text;

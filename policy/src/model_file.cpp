@@ -132,4 +132,12 @@ LearnedPolicy load_model(const std::string& path, const SamplingOverrides& overr
   return deserialize_model(bytes, path, overrides);
 }
 
+void require_task(const LearnedPolicy& policy, const std::string& task, const std::string& source) {
+  const std::string& trained = policy.config().task;
+  if (trained == task) return;
+  throw TaskMismatch(source + ": a model trained on task '" + trained + "', used on task '" + task +
+                     "': pass --task " + trained + " to use it, or train a model for " + task +
+                     " with `handcentric train --task " + task + " --demos <" + task + " demos>`");
+}
+
 }  // namespace handcentric::policy

@@ -32,7 +32,17 @@ std::string to_string(LearningRateSchedule schedule);
 /// Throws InvalidArgument naming the value and the valid names.
 LearningRateSchedule parse_schedule(const std::string& name);
 
+/// The tasks a model can be trained for: the 2D peg-in-hole ("peg2d", Sec. 4.2) and the 3D blade
+/// insertion ("insert3d", Table 2's analogue). Observations of the two differ in shape and
+/// meaning, so a model only runs on the task it was trained for.
+inline constexpr const char* kTaskPeg2d = "peg2d";
+inline constexpr const char* kTaskInsert3d = "insert3d";
+
 struct PolicyConfig {
+  /// The task the model was trained on. to_text writes the line only for a task other than
+  /// peg2d, so 2D model files (and the table1 cell hashes over this text) are unchanged, and a
+  /// file without it (every model written before the 3D task) reads as peg2d.
+  std::string task = kTaskPeg2d;
   HeadKind head = HeadKind::flow;
   std::string representation = "hand_centric";
   int chunk_length = 16;  ///< K

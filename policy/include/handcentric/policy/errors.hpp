@@ -11,4 +11,11 @@ class InvalidModelFile : public Error {
   using Error::Error;
 };
 
+/// A model used on a task it was not trained for (a 2D model on the 3D task or the reverse): the
+/// message names the file, both tasks and the fix.
+class TaskMismatch : public InvalidArgument {
+ public:
+  using InvalidArgument::InvalidArgument;
+};
+
 }  // namespace handcentric

@@ -53,4 +53,8 @@ void save_model(const LearnedPolicy& policy, const std::string& path);
 /// kMaxModelFileBytes, which is checked before reading).
 LearnedPolicy load_model(const std::string& path, const SamplingOverrides& overrides = {});
 
+/// Throws TaskMismatch naming `source`, the model's task, `task` and the fix unless `policy` was
+/// trained for `task` (PolicyConfig::task; a file without one is a peg2d model).
+void require_task(const LearnedPolicy& policy, const std::string& task, const std::string& source);
+
 }  // namespace handcentric::policy

@@ -1,0 +1,28 @@
+#pragma once
+// A drawing of the 3D blade insertion (OpenCV imgproc): the scene and a rollout seen by a
+// pinhole camera from a fixed world direction, and beside it the hand camera's depth images
+// (sim/insert3d/camera.hpp) at the rollout's first and last pose (the first only for a scene).
+//
+//   left  : the block's five boxes (grey wireframe, the opening's corners orange), the blade's
+//           outline every few steps (light to dark blue over time), the last blade green on
+//           success, red on collision, grey otherwise; the hand origin's path; a caption;
+//   right : the two depth images, 8x enlarged, near bright and far dark.
+// The viewpoint looks from the world direction (1, -1.5, 1), 55 cm from the midpoint of the slot
+// and the hand's start, world +z up on the page, so a rotated scene looks rotated.
+#include <string>
+
+#include "handcentric/sim/draw.hpp"
+#include "handcentric/sim/insert3d/camera.hpp"
+#include "handcentric/sim/insert3d/rollout.hpp"
+#include "handcentric/sim/insert3d/scenes.hpp"
+
+namespace handcentric::experiments {
+
+/// The scene and `rollout` (its world_T_hand may hold the start pose only: the scene alone),
+/// with `caption` under it. Throws InvalidArgument for an empty rollout.
+sim::Image draw_insert3d_rollout(const sim::insert3d::TaskScene& scene,
+                                 const sim::insert3d::Rollout& rollout, const std::string& caption,
+                                 const sim::insert3d::BladeSlotGeometry& geometry = {},
+                                 const sim::insert3d::DepthCamera& camera = {});
+
+}  // namespace handcentric::experiments

@@ -1,0 +1,142 @@
+#include "handcentric/experiments/insert3d_drawing.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+
+#include "drawing.hpp"
+#include "handcentric/core/errors.hpp"
+
+namespace handcentric::experiments {
+namespace {
+
+namespace insert3d = sim::insert3d;
+using drawing::rgb;
+using drawing::text;
+
+constexpr int kViewWidth = 760;
+constexpr int kViewHeight = 640;
+constexpr int kDepthScale = 8;
+
+// A pinhole looking at `target` from target + distance * direction, world +z up on the page.
+struct ViewCamera {
+  Eigen::Vector3d eye, right, up, forward;
+  double focal = 900.0;
+
+  ViewCamera(const Eigen::Vector3d& target, const Eigen::Vector3d& direction, double distance) {
+    forward = -direction.normalized();
+    eye = target - distance * forward;
+    right = forward.cross(Eigen::Vector3d::UnitZ()).normalized();
+    up = right.cross(forward);
+  }
+
+  cv::Point project(const Eigen::Vector3d& world_point) const {
+    const Eigen::Vector3d v = world_point - eye;
+    const double depth = std::max(1.0, v.dot(forward));
+    return {static_cast<int>(std::lround(kViewWidth / 2.0 + focal * v.dot(right) / depth)),
+            static_cast<int>(std::lround(kViewHeight / 2.0 - focal * v.dot(up) / depth))};
+  }
+};
+
+// The 12 edges of a box given in `frame_T_box` coordinates by world_T_frame.
+void draw_box(cv::Mat& canvas, const ViewCamera& view, const RigidTransform& world_T_frame,
+              const insert3d::Box3& box, const cv::Scalar& colour, int thickness) {
+  std::array<cv::Point, 8> corners;
+  for (int i = 0; i < 8; ++i) {
+    const Eigen::Vector3d local((i & 1) ? box.max.x() : box.min.x(),
+                                (i & 2) ? box.max.y() : box.min.y(),
+                                (i & 4) ? box.max.z() : box.min.z());
+    corners[static_cast<std::size_t>(i)] = view.project(world_T_frame * local);
+  }
+  for (int i = 0; i < 8; ++i) {
+    for (int bit : {1, 2, 4}) {
+      if ((i & bit) == 0) {
+        cv::line(canvas, corners[static_cast<std::size_t>(i)],
+                 corners[static_cast<std::size_t>(i | bit)], colour, thickness, cv::LINE_AA);
+      }
+    }
+  }
+}
+
+// The depth image, enlarged, near bright: depth d maps to 255 (1 - d / max_range).
+cv::Mat depth_panel(const insert3d::DepthImage& image, double max_range) {
+  cv::Mat panel(image.height * kDepthScale, image.width * kDepthScale, CV_8UC3);
+  for (int row = 0; row < image.height; ++row) {
+    for (int col = 0; col < image.width; ++col) {
+      const double shade = 255.0 * std::clamp(1.0 - image.at(row, col) / max_range, 0.0, 1.0);
+      const cv::Scalar grey(shade, shade, shade);
+      cv::rectangle(panel, cv::Rect(col * kDepthScale, row * kDepthScale, kDepthScale, kDepthScale),
+                    grey, cv::FILLED);
+    }
+  }
+  return panel;
+}
+
+}  // namespace
+
+sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3d::Rollout& rollout,
+                                 const std::string& caption,
+                                 const insert3d::BladeSlotGeometry& geometry,
+                                 const insert3d::DepthCamera& camera) {
+  if (rollout.world_T_hand.empty())
+    throw InvalidArgument("draw_insert3d_rollout: the rollout has no pose");
+  geometry.validate();
+  camera.validate();
+  const int panel_width = camera.width * kDepthScale;
+  const int width = kViewWidth + panel_width + 40;
+  cv::Mat canvas(kViewHeight, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  // Aimed between the slot's opening and the hand's start, so both are in view at any placement.
+  const Eigen::Vector3d target =
+      0.5 * (scene.world_T_slot.translation() + scene.world_T_hand_start.translation());
+  const ViewCamera view(target, Eigen::Vector3d(1.0, -1.5, 1.0), 55.0);
+  for (const insert3d::Box3& wall : geometry.slot_walls()) {
+    draw_box(canvas, view, scene.world_T_slot, wall, rgb(110, 110, 110), 1);
+  }
+  for (const Eigen::Vector3d& corner : geometry.opening_corners()) {
+    cv::circle(canvas, view.project(scene.world_T_slot * corner), 5, rgb(240, 140, 20), cv::FILLED,
+               cv::LINE_AA);
+  }
+  const std::size_t n = rollout.world_T_hand.size();
+  const std::size_t every = std::max<std::size_t>(1, n / 12);
+  for (std::size_t t = 0; t + 1 < n; t += every) {
+    const double s = n == 1 ? 0.0 : static_cast<double>(t) / static_cast<double>(n - 1);
+    const cv::Scalar blue =
+        rgb(static_cast<int>(170 - 140 * s), static_cast<int>(200 - 120 * s), 240);
+    draw_box(canvas, view, rollout.world_T_hand[t], geometry.blade_in_hand(), blue, 1);
+  }
+  for (std::size_t t = 1; t < n; ++t) {
+    cv::line(canvas, view.project(rollout.world_T_hand[t - 1].translation()),
+             view.project(rollout.world_T_hand[t].translation()), rgb(30, 60, 200), 2, cv::LINE_AA);
+  }
+  const cv::Scalar last_colour =
+      n == 1 ? rgb(30, 60, 200)
+      : rollout.outcome == insert3d::Outcome::success
+          ? rgb(sim::kSuccessRgb[0], sim::kSuccessRgb[1], sim::kSuccessRgb[2])
+      : rollout.outcome == insert3d::Outcome::collision
+          ? rgb(sim::kCollisionRgb[0], sim::kCollisionRgb[1], sim::kCollisionRgb[2])
+          : rgb(120, 120, 120);
+  draw_box(canvas, view, rollout.world_T_hand.back(), geometry.blade_in_hand(), last_colour, 3);
+  text(canvas, caption, {12, kViewHeight - 16}, 0.5);
+  text(canvas, "fixed view from world (1, -1.5, 1), world z up", {12, 22}, 0.5);
+
+  const int x0 = kViewWidth + 20;
+  const auto paste = [&](const RigidTransform& world_T_hand, int y, const std::string& label) {
+    const cv::Mat panel =
+        depth_panel(insert3d::render_depth(geometry, camera, world_T_hand, scene.world_T_slot),
+                    camera.max_range);
+    panel.copyTo(canvas(cv::Rect(x0, y, panel.cols, panel.rows)));
+    cv::rectangle(canvas, cv::Rect(x0, y, panel.cols, panel.rows), rgb(20, 20, 20), 1);
+    text(canvas, label, {x0, y - 8}, 0.5);
+  };
+  paste(rollout.world_T_hand.front(), 60, "hand camera depth, first pose");
+  if (n > 1) {
+    paste(rollout.world_T_hand.back(), 60 + camera.height * kDepthScale + 60,
+          "hand camera depth, last pose");
+  }
+  return drawing::to_image(canvas);
+}
+
+}  // namespace handcentric::experiments

@@ -1,0 +1,131 @@
+// Table 2's analogue (experiments/table2.hpp): the JSON schema the issue asks for (checked by a
+// schema check that a planted row without random_se3_success fails), the Markdown beside the
+// paper's numbers, the figure, and the options' errors. The end-to-end run is a CLI test.
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/table2.hpp"
+
+using namespace handcentric;
+using namespace handcentric::experiments;
+using Catch::Matchers::Contains;
+
+namespace {
+
+// The problems of a table2.json document against the issue's schema: {"rows": [{"method",
+// "demos", "trials", "train_success", "ood_success", "random_se3_success"}]} with rates in
+// [0, 1] and a Wilson interval around each rate. Empty when it conforms.
+std::vector<std::string> schema_problems(const nlohmann::json& doc) {
+  std::vector<std::string> problems;
+  if (!doc.contains("rows") || !doc["rows"].is_array() || doc["rows"].empty())
+    return {"no rows array"};
+  for (const auto& row : doc["rows"]) {
+    if (!row.contains("method") || !row["method"].is_string()) problems.push_back("method");
+    for (const char* key : {"demos", "trials"}) {
+      if (!row.contains(key) || !row[key].is_number_integer() || row[key] < 1)
+        problems.push_back(key);
+    }
+    for (const std::string set : {"train", "ood", "random_se3"}) {
+      const std::string key = set + "_success";
+      if (!row.contains(key) || !row[key].is_number() || row[key] < 0.0 || row[key] > 1.0) {
+        problems.push_back(key);
+        continue;
+      }
+      const auto& ci = row.value(set + "_wilson95", nlohmann::json());
+      if (!ci.is_array() || ci.size() != 2 || ci[0] > row[key] || ci[1] < row[key]) {
+        problems.push_back(set + "_wilson95");
+      }
+    }
+  }
+  return problems;
+}
+
+Table2Row sample_row(const std::string& method, int train, int ood, int random_se3) {
+  Table2Row row;
+  row.method = method;
+  row.demos = 10;
+  row.seed = 1;
+  row.steps = 3000;
+  row.train = {20, train, 20 - train, 0, 0, 0};
+  row.ood = {20, ood, 0, 0, 20 - ood, 0};  // invalid
+  row.random_se3 = {20, random_se3, 0, 20 - random_se3, 0, 0};
+  return row;
+}
+
+}  // namespace
+
+TEST_CASE("table2_json_has_the_issue_schema", "[unit]") {
+  const std::vector<Table2Row> rows = {sample_row("hand_centric", 19, 19, 19),
+                                       sample_row("absolute", 18, 0, 1)};
+  const nlohmann::json doc = nlohmann::json::parse(table2_json(rows));
+  CHECK(schema_problems(doc).empty());
+  CHECK(doc["rows"][0]["method"] == "hand_centric");
+  CHECK(doc["rows"][1]["ood_success"] == 0.0);
+  CHECK(doc["rows"][1]["train_success"] == Approx(0.9));
+  CHECK(doc["rows"][1]["random_se3_counts"]["timeout"] == 19);
+  CHECK(doc["rows"][1]["ood_counts"]["invalid"] == 20);
+}
+
+TEST_CASE("mutant_table2_schema_check_fails_on_a_row_without_random_se3_success", "[unit]") {
+  nlohmann::json doc = nlohmann::json::parse(table2_json({sample_row("relative", 10, 2, 3)}));
+  doc["rows"][0].erase("random_se3_success");
+  CHECK(schema_problems(doc) == std::vector<std::string>{"random_se3_success"});
+  doc = nlohmann::json::parse(table2_json({sample_row("relative", 10, 2, 3)}));
+  doc["rows"][0]["ood_wilson95"] = {0.5, 0.9};  // does not contain the rate 0.1
+  CHECK(schema_problems(doc) == std::vector<std::string>{"ood_wilson95"});
+}
+
+TEST_CASE("table2_markdown_sits_beside_the_papers_real_robot_numbers", "[unit]") {
+  const std::string md = table2_markdown({sample_row("hand_centric", 19, 18, 19)});
+  CHECK_THAT(md, Contains("| flow / hand_centric | 10 | 3000 | 0.95 ["));
+  CHECK_THAT(md, Contains("| hand-centric (paper) | 26/30 (0.87) | 5/5 (1.00) |"));
+  CHECK_THAT(md, Contains("real robot"));
+}
+
+TEST_CASE("table2_figure_draws_one_bar_per_method_and_set", "[unit]") {
+  const sim::Image image =
+      draw_table2({sample_row("hand_centric", 20, 20, 20), sample_row("absolute", 20, 0, 0)});
+  CHECK(image.width == 900);
+  CHECK(image.height == 520);
+  CHECK(image.count_pixels(0, 114, 178) > 1000);  // the train bars' colour
+  CHECK_THROWS_AS(draw_table2({}), InvalidArgument);
+}
+
+TEST_CASE("table2_options_name_the_bad_value", "[unit]") {
+  Table2Options options;
+  options.demos = 0;
+  CHECK_THROWS_WITH(options.validate(), Contains("--demos 0") && Contains("1..1000"));
+  options = Table2Options();
+  options.trials = -3;
+  CHECK_THROWS_WITH(options.validate(), Contains("--trials -3"));
+  options = Table2Options();
+  options.methods = {"hand_centric", "bogus"};
+  CHECK_THROWS_WITH(options.validate(), Contains("bogus"));
+}
+
+TEST_CASE("table2_noise_injected_copies_move_the_hand_and_keep_the_demos_chunk", "[unit]") {
+  const std::vector<sim::insert3d::Demo> demos = insert3d_train_demos(2, 5);
+  const std::vector<Scene> plain = insert3d_training_data(demos, 0, 16, Perturbation{}, 3);
+  const std::vector<Scene> noisy =
+      insert3d_training_data(demos, 0, 16, Perturbation{1, 0.15, 1.0}, 3);
+  const std::size_t first = demos[0].world_T_hand.size();
+  REQUIRE(noisy.size() == 2 * plain.size());
+  REQUIRE(plain.size() == first + demos[1].world_T_hand.size());
+  for (std::size_t t = 0; t < first; ++t) {
+    const Scene& original = plain[t];
+    const Scene& copy = noisy[first + t];  // the first demo's copies follow its own scenes
+    const RigidTransform delta = original.world_T_hand0().inverse_compose(copy.world_T_hand0());
+    CHECK(delta.translation().cwiseAbs().maxCoeff() <= 0.15 + 1e-12);
+    CHECK(delta.translation().norm() > 0.0);
+    CHECK(distance(copy.world_T_hand_chunk.back(), original.world_T_hand_chunk.back()) == 0.0);
+    // The corners are observed from the moved hand: mapped to the world they land where they did.
+    const Eigen::Vector3d corner = copy.world_T_hand0() * copy.hand_points[0];
+    CHECK((corner - original.world_T_hand0() * original.hand_points[0]).norm() < 1e-9);
+  }
+  CHECK_THROWS_WITH(insert3d_training_data(demos, 0, 16, Perturbation{101, 0.1, 1.0}, 3),
+                    Contains("--perturb-copies 101"));
+}
