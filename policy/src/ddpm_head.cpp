@@ -122,8 +122,11 @@ class DdpmHead final : public NetworkHead {
 
 }  // namespace
 
+// DDIM starts at config.noise_scale times the prior's noise, as the flow heads' Euler
+// integration does: 0 (the default) samples the most likely chunk (eq. 6), which the 0.1 cm
+// clearance needs (docs/EXPERIMENTS.md).
 std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config) {
-  return std::make_unique<DdpmHead>(config, 1.0);
+  return std::make_unique<DdpmHead>(config, config.noise_scale);
 }
 
 // For c8ddpm (c8_planar_head.cpp), which samples like the flow heads, at config.noise_scale.
