@@ -62,13 +62,14 @@ int run_audit_section(const ReportOptions& options, std::ostream& out) {
 struct PageOptions {
   std::string out;                     ///< empty: print the report on stdout
   bool full = false;                   ///< the paper's whole grid instead of the quick one
-  // The quick page's defaults keep it within ~5 minutes on two cores: Table 1 at the paper's
-  // headline count (100 demos, where its OOD column is), Fig. 5 where the heads differ most.
+  // The quick page's defaults keep it within 5 minutes on two cores: Table 1 at the paper's
+  // headline count (100 demos, where its OOD column is), Fig. 5 at 10 demos (with 40 the page
+  // took 318 s on an idle machine; docs/BENCHMARKS.md).
   std::string demos = "100";           ///< the quick Table 1's demo counts
   int trials = 30;                     ///< rollouts per scene set of the quick tables
   // One C8 row (the workspace centre), as many rows as before the C8 baseline had two.
   std::string methods = "hand_centric,relative,absolute,c8_centre";
-  std::string ablation_demos = "40";   ///< Fig. 5 (App. B): flow, ddpm and cvae heads
+  std::string ablation_demos = "10";   ///< Fig. 5 (App. B): flow, ddpm and cvae heads
   int steps = 0;                       ///< 0: the library's automatic training budget
   int jobs = 0;
 };
