@@ -42,8 +42,8 @@ struct EvalOptions {
   std::string transform;
   bool json = false;
   double noise_scale = std::numeric_limits<double>::quiet_NaN();  // NaN: the model's own
-  int execute = 0;            // 0: the model's own
-  int euler_steps = 0;        // 0: the model's own
+  int execute = 0;                                                // 0: the model's own
+  int euler_steps = 0;                                            // 0: the model's own
   bool strict = false;
   std::string rotate_deg;
 };
@@ -57,8 +57,8 @@ int run_insert3d_eval(const EvalOptions& options) {
         " is a 2D scripted policy: with --task insert3d use "
         "--policy expert or --model FILE (from `handcentric train --task insert3d`)");
   }
-  const sim::insert3d::SceneDistribution distribution =
-      insert3d_distribution(options.dist, options.rotate_deg, options.hole_angle_deg, options.transform);
+  const sim::insert3d::SceneDistribution distribution = insert3d_distribution(
+      options.dist, options.rotate_deg, options.hole_angle_deg, options.transform);
   policy::SamplingOverrides overrides;
   if (!std::isnan(options.noise_scale)) overrides.noise_scale = options.noise_scale;
   if (options.execute != 0) overrides.execute = options.execute;
@@ -91,7 +91,8 @@ int run_insert3d_eval(const EvalOptions& options) {
 }
 
 int run_eval(const EvalOptions& options) {
-  if (options.trials < 1) throw InvalidArgument("--trials must be at least 1, got " + std::to_string(options.trials));
+  if (options.trials < 1)
+    throw InvalidArgument("--trials must be at least 1, got " + std::to_string(options.trials));
   if (options.task == "insert3d") return run_insert3d_eval(options);
   refuse_3d_options(options.dist, options.rotate_deg);
   const sim::SceneDistribution distribution =
@@ -100,71 +101,90 @@ int run_eval(const EvalOptions& options) {
   if (!std::isnan(options.noise_scale)) overrides.noise_scale = options.noise_scale;
   if (options.execute != 0) overrides.execute = options.execute;
   if (options.euler_steps != 0) overrides.euler_steps = options.euler_steps;
-  const LoadedPolicy loaded =
-      load_chunk_policy(options.model, options.policy.empty() ? "expert" : options.policy, overrides);
+  const LoadedPolicy loaded = load_chunk_policy(
+      options.model, options.policy.empty() ? "expert" : options.policy, overrides);
   const auto& policy = loaded.policy;
   auto scenes = sim::sample_scenes(distribution, options.trials, options.seed);
-  if (!options.transform.empty()) scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
+  if (!options.transform.empty())
+    scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
   const sim::CollisionChecker checker;
   sim::RolloutOptions rollout_options = loaded.rollout_options;
   rollout_options.stop_on_invalid = options.strict;
-  const sim::RolloutSummary summary = sim::evaluate(*policy, scenes, checker, options.seed, rollout_options);
+  const sim::RolloutSummary summary =
+      sim::evaluate(*policy, scenes, checker, options.seed, rollout_options);
   if (summary.invalid > 0) {
     std::cerr << "handcentric: warning: " << summary.invalid << " of " << summary.trials
-              << " trials invalid (counted as failures): the first is scene " << summary.first_invalid_scene << ", "
-              << summary.first_invalid_reason << "; --strict stops at the first instead\n";
+              << " trials invalid (counted as failures): the first is scene "
+              << summary.first_invalid_scene << ", " << summary.first_invalid_reason
+              << "; --strict stops at the first instead\n";
   }
   if (options.json) {
-    std::cout << experiments::eval_json(summary, policy->name(), distribution.name, options.seed) << "\n";
+    std::cout << experiments::eval_json(summary, policy->name(), distribution.name, options.seed)
+              << "\n";
   } else {
-    std::cout << "policy " << policy->name() << " on " << summary.trials << " '" << distribution.name
-              << "' scenes (seed " << options.seed << "): success " << summary.success << ", collision "
-              << summary.collision << ", timeout " << summary.timeout << ", invalid " << summary.invalid << "; "
-              << summary.clipped << " commands clipped to the step limits\n";
+    std::cout << "policy " << policy->name() << " on " << summary.trials << " '"
+              << distribution.name << "' scenes (seed " << options.seed << "): success "
+              << summary.success << ", collision " << summary.collision << ", timeout "
+              << summary.timeout << ", invalid " << summary.invalid << "; " << summary.clipped
+              << " commands clipped to the step limits\n";
   }
   return 0;
 }
 
 void add_eval_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<EvalOptions>();
-  CLI::App* cmd = app.add_subcommand("eval", "closed-loop rollouts of a policy on the 2D peg-in-hole task or the 3D blade insertion");
+  CLI::App* cmd = app.add_subcommand(
+      "eval",
+      "closed-loop rollouts of a policy on the 2D peg-in-hole task or the 3D blade insertion");
   cmd->add_option("--task", options->task,
                   "peg2d (the 2D task) or insert3d (the 3D blade insertion: --policy expert or an "
                   "insert3d --model)")
       ->check(CLI::IsMember({"peg2d", "insert3d"}))
       ->capture_default_str();
-  auto* model = cmd->add_option("--model", options->model, "a trained model file (from `handcentric train`)");
-  auto* policy = cmd->add_option("--policy", options->policy, "a policy without a file: expert, straight, hold")
+  auto* model =
+      cmd->add_option("--model", options->model, "a trained model file (from `handcentric train`)");
+  auto* policy = cmd->add_option("--policy", options->policy,
+                                 "a policy without a file: expert, straight, hold")
                      ->check(CLI::IsMember(sim::scripted_policy_names()));
   model->excludes(policy);
   policy->excludes(model);
-  auto* dist = cmd->add_option("--dist", options->dist, "scene distribution: train or ood (insert3d: also random-se3)")
+  auto* dist = cmd->add_option("--dist", options->dist,
+                               "scene distribution: train or ood (insert3d: also random-se3)")
                    ->check(CLI::IsMember({"train", "ood", "random-se3"}));
-  auto* angle = cmd->add_option("--hole-angle-deg", options->hole_angle_deg, "hole angles A:B in degrees, instead of --dist");
+  auto* angle = cmd->add_option("--hole-angle-deg", options->hole_angle_deg,
+                                "hole angles A:B in degrees, instead of --dist");
   dist->excludes(angle);
   angle->excludes(dist);
-  auto* rotate = cmd->add_option("--rotate-deg", options->rotate_deg,
-                                 "insert3d: train scenes under the global rotation RX,RY,RZ (XYZ Euler, degrees)");
+  auto* rotate = cmd->add_option(
+      "--rotate-deg", options->rotate_deg,
+      "insert3d: train scenes under the global rotation RX,RY,RZ (XYZ Euler, degrees)");
   rotate->excludes(dist);
   rotate->excludes(angle);
-  cmd->add_option("--trials", options->trials, "number of scenes (one rollout each)")->capture_default_str();
-  cmd->add_option("--transform", options->transform,
-                  "apply the global planar transform DEG,X,Y (degrees about z, then cm) to every scene");
-  cmd->add_option("--seed", options->seed, "seed of the scenes and of the policy's noise")->capture_default_str();
+  cmd->add_option("--trials", options->trials, "number of scenes (one rollout each)")
+      ->capture_default_str();
+  cmd->add_option(
+      "--transform", options->transform,
+      "apply the global planar transform DEG,X,Y (degrees about z, then cm) to every scene");
+  cmd->add_option("--seed", options->seed, "seed of the scenes and of the policy's noise")
+      ->capture_default_str();
   cmd->add_option("--noise-scale", options->noise_scale,
                   "a model's sampler noise instead of its own (0: the most likely chunk, eq. 6)");
-  cmd->add_option("--execute", options->execute, "poses of each chunk a model executes instead of its own");
+  cmd->add_option("--execute", options->execute,
+                  "poses of each chunk a model executes instead of its own");
   cmd->add_option("--euler-steps", options->euler_steps,
                   "a flow model's Euler steps instead of its own");
   cmd->add_flag("--json", options->json,
-                "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, \"invalid\": count, ...}");
+                "print {\"trials\": N, \"success\": rate, \"collision\": rate, \"timeout\": rate, "
+                "\"invalid\": count, ...}");
   cmd->add_flag("--strict", options->strict,
-                "stop with an error at the first non-finite pose from the policy (default: count the trial as invalid)");
+                "stop with an error at the first non-finite pose from the policy (default: count "
+                "the trial as invalid)");
   cmd->callback([options, &exit_code] {
     if (options->dist.empty() && options->hole_angle_deg.empty() && options->rotate_deg.empty()) {
       throw CLI::RequiredError("--dist, --hole-angle-deg or --rotate-deg");
     }
-    if (options->model.empty() && options->policy.empty()) throw CLI::RequiredError("--model or --policy");
+    if (options->model.empty() && options->policy.empty())
+      throw CLI::RequiredError("--model or --policy");
     exit_code = run_eval(*options);
   });
 }
@@ -176,15 +196,19 @@ int run_sim_section(std::ostream& out) {
   constexpr int kScenes = 200;
   constexpr int kRollouts = 50;
   constexpr std::uint64_t kSeed = 1;
-  out << "sim: 2D peg-in-hole (Sec. 4.2), expert demos on " << kScenes << " scenes and closed-loop expert rollouts on "
-      << kRollouts << " scenes per distribution, seed " << kSeed << "\n";
+  out << "sim: 2D peg-in-hole (Sec. 4.2), expert demos on " << kScenes
+      << " scenes and closed-loop expert rollouts on " << kRollouts
+      << " scenes per distribution, seed " << kSeed << "\n";
   int status = 0;
-  for (const auto& distribution : {sim::SceneDistribution::train(), sim::SceneDistribution::ood()}) {
+  for (const auto& distribution :
+       {sim::SceneDistribution::train(), sim::SceneDistribution::ood()}) {
     const sim::ExpertCheck check = sim::check_expert(distribution, kScenes, kRollouts, kSeed);
     char line[200];
-    std::snprintf(line, sizeof(line), "  %-5s expert solved %5.1f%% (discard rate %.3f), closed loop %d/%d success  %s\n",
-                  distribution.name.c_str(), 100.0 * check.solved_rate, check.discard_rate, check.rollout_success,
-                  check.rollouts, check.passes() ? "ok" : "BELOW THE 99% BAR");
+    std::snprintf(
+        line, sizeof(line),
+        "  %-5s expert solved %5.1f%% (discard rate %.3f), closed loop %d/%d success  %s\n",
+        distribution.name.c_str(), 100.0 * check.solved_rate, check.discard_rate,
+        check.rollout_success, check.rollouts, check.passes() ? "ok" : "BELOW THE 99% BAR");
     out << line;
     if (!check.passes()) status = 1;
   }
@@ -192,8 +216,9 @@ int run_sim_section(std::ostream& out) {
   return status;
 }
 
-const ReportSection sim_section(40, "sim",
-                                 [](std::ostream& out, const ReportOptions&) { return run_sim_section(out); });
+const ReportSection sim_section(40, "sim", [](std::ostream& out, const ReportOptions&) {
+  return run_sim_section(out);
+});
 
 }  // namespace
 }  // namespace handcentric::apps

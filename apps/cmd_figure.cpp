@@ -20,10 +20,12 @@ struct FigureOptions {
 int run_flow_figure(const FigureOptions& options) {
   const experiments::FlowFigure figure = experiments::compute_flow_figure(options.flow);
   experiments::write_flow_figure_png(options.out, figure);
-  std::cout << "wrote Fig. 3 to " << options.out << ": how far a global transform g moves a_1 (all six numbers)\n";
+  std::cout << "wrote Fig. 3 to " << options.out
+            << ": how far a global transform g moves a_1 (all six numbers)\n";
   for (const auto& column : figure.columns) {
     std::printf("  %-13s %-9.3g %s\n", column.representation.c_str(), column.a1_change,
-                column.a1_change < 1e-9 ? "(invariant: the flow problem is the same)" : "(the flow problem moved)");
+                column.a1_change < 1e-9 ? "(invariant: the flow problem is the same)"
+                                        : "(the flow problem moved)");
   }
   return 0;
 }
@@ -34,12 +36,20 @@ void add_figure_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<FigureOptions>();
   CLI::App* flow = cmd->add_subcommand(
       "flow", "Fig. 3: the flow towards the first action, before and after a global transform g");
-  flow->add_option("--demos", options->flow.demos, "expert demos whose training samples are drawn")->capture_default_str();
-  flow->add_option("--seed", options->flow.seed, "seed of the scenes, the expert and the noise draws")->capture_default_str();
-  flow->add_option("--noise-draws", options->flow.noise_draws, "arrows per panel")->capture_default_str();
-  flow->add_option("--rotate-deg", options->flow.rotation_deg, "g's rotation about the world z axis")->capture_default_str();
-  flow->add_option("--shift-x", options->flow.translation_x, "g's translation along x (cm)")->capture_default_str();
-  flow->add_option("--shift-y", options->flow.translation_y, "g's translation along y (cm)")->capture_default_str();
+  flow->add_option("--demos", options->flow.demos, "expert demos whose training samples are drawn")
+      ->capture_default_str();
+  flow->add_option("--seed", options->flow.seed,
+                   "seed of the scenes, the expert and the noise draws")
+      ->capture_default_str();
+  flow->add_option("--noise-draws", options->flow.noise_draws, "arrows per panel")
+      ->capture_default_str();
+  flow->add_option("--rotate-deg", options->flow.rotation_deg,
+                   "g's rotation about the world z axis")
+      ->capture_default_str();
+  flow->add_option("--shift-x", options->flow.translation_x, "g's translation along x (cm)")
+      ->capture_default_str();
+  flow->add_option("--shift-y", options->flow.translation_y, "g's translation along y (cm)")
+      ->capture_default_str();
   flow->add_option("--out", options->out, "output PNG (written atomically)")->required();
   flow->callback([options, &exit_code] { exit_code = run_flow_figure(*options); });
 }

@@ -34,7 +34,8 @@ int run_prove(const ProveOptions& options) {
 void add_prove_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<ProveOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "prove", "check every claim of the paper as an exact certificate (identity or counterexample)");
+      "prove",
+      "check every claim of the paper as an exact certificate (identity or counterexample)");
   cmd->add_flag(
       "--json", options->json,
       "print {\"claims\": [{\"id\", \"statement\", \"kind\", \"verified\", \"witness\", ...}]}");
@@ -45,15 +46,17 @@ void add_prove_command(CLI::App& app, int& exit_code) {
 
 int run_proofs_section(std::ostream& out) {
   const std::vector<proofs::ClaimOutcome> outcomes = proofs::certify_all(proofs::paper_claims());
-  out << "handcentric prove: the paper's claims as exact certificates (details: `handcentric prove`, "
+  out << "handcentric prove: the paper's claims as exact certificates (details: `handcentric "
+         "prove`, "
          "docs/CLAIMS.md)\n"
       << proofs::summary_text(outcomes);
   return proofs::count_verified(outcomes) == static_cast<int>(outcomes.size()) ? 0 : 1;
 }
 
 const CommandRegistration prove_command("prove", add_prove_command);
-const ReportSection proofs_section(20, "proofs",
-                                 [](std::ostream& out, const ReportOptions&) { return run_proofs_section(out); });
+const ReportSection proofs_section(20, "proofs", [](std::ostream& out, const ReportOptions&) {
+  return run_proofs_section(out);
+});
 
 }  // namespace
 }  // namespace handcentric::apps

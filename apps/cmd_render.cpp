@@ -19,7 +19,6 @@
 #include "handcentric/sim/rollout.hpp"
 #include "handcentric/sim/scenes.hpp"
 
-
 namespace handcentric::apps {
 namespace {
 
@@ -83,22 +82,27 @@ int run_render(const RenderOptions& options) {
   sim::Image image;
   std::string what;
   if (!options.demos.empty()) {
-    if (options.max_demos < 1) throw InvalidArgument("--max must be at least 1, got " + std::to_string(options.max_demos));
+    if (options.max_demos < 1)
+      throw InvalidArgument("--max must be at least 1, got " + std::to_string(options.max_demos));
     auto demos = sim::load_demos(options.demos);
-    if (demos.size() > static_cast<std::size_t>(options.max_demos)) demos.resize(static_cast<std::size_t>(options.max_demos));
+    if (demos.size() > static_cast<std::size_t>(options.max_demos))
+      demos.resize(static_cast<std::size_t>(options.max_demos));
     image = sim::draw_demos(demos, checker.geometry(), options.size);
     what = std::to_string(demos.size()) + " demos";
   } else {
-    const sim::TaskScene scene = sim::sample_scene(sim::SceneDistribution::parse(options.dist), options.seed, options.index);
+    const sim::TaskScene scene =
+        sim::sample_scene(sim::SceneDistribution::parse(options.dist), options.seed, options.index);
     if (options.scene) {
       image = sim::draw_scene(scene, checker.geometry(), options.size);
       what = "scene";
     } else {
       const LoadedPolicy loaded = load_chunk_policy(options.model, options.policy);
-      const sim::Rollout rollout = sim::rollout(*loaded.policy, scene, checker,
-                                                sim::stream_seed(options.seed, options.index), loaded.rollout_options);
+      const sim::Rollout rollout =
+          sim::rollout(*loaded.policy, scene, checker,
+                       sim::stream_seed(options.seed, options.index), loaded.rollout_options);
       image = sim::draw_rollout(scene, rollout, checker.geometry(), options.size);
-      what = "rollout (" + sim::outcome_name(rollout.outcome) + " after " + std::to_string(rollout.steps) + " steps)";
+      what = "rollout (" + sim::outcome_name(rollout.outcome) + " after " +
+             std::to_string(rollout.steps) + " steps)";
     }
   }
   sim::write_png(options.out, image);
@@ -118,24 +122,32 @@ void add_render_command(CLI::App& app, int& exit_code) {
       "--rotate-deg", options->rotate_deg,
       "insert3d: a train scene under the global rotation RX,RY,RZ (XYZ Euler, degrees)");
   auto* scene = cmd->add_flag("--scene", options->scene, "draw scene --index of --dist / --seed");
-  auto* demos = cmd->add_option("--demos", options->demos, "draw the demos of this file (in the hole frame)");
-  auto* rollout = cmd->add_flag("--rollout", options->rollout, "draw a rollout of --policy on scene --index");
+  auto* demos =
+      cmd->add_option("--demos", options->demos, "draw the demos of this file (in the hole frame)");
+  auto* rollout =
+      cmd->add_flag("--rollout", options->rollout, "draw a rollout of --policy on scene --index");
   scene->excludes(demos)->excludes(rollout);
   demos->excludes(rollout);
   auto* policy = cmd->add_option("--policy", options->policy, "policy of --rollout")
-                     ->check(CLI::IsMember(sim::scripted_policy_names()))->capture_default_str();
-  cmd->add_option("--model", options->model, "a trained model for --rollout (instead of --policy)")->excludes(policy);
+                     ->check(CLI::IsMember(sim::scripted_policy_names()))
+                     ->capture_default_str();
+  cmd->add_option("--model", options->model, "a trained model for --rollout (instead of --policy)")
+      ->excludes(policy);
   cmd->add_option(
          "--dist", options->dist,
          "train, ood or a hole-angle range A:B in degrees (insert3d: train, ood, random-se3)")
       ->capture_default_str();
-  cmd->add_option("--seed", options->seed, "seed of the scene stream (as in `handcentric eval`)")->capture_default_str();
+  cmd->add_option("--seed", options->seed, "seed of the scene stream (as in `handcentric eval`)")
+      ->capture_default_str();
   cmd->add_option("--index", options->index, "which scene of the stream")->capture_default_str();
-  cmd->add_option("--max", options->max_demos, "at most this many demos (--demos)")->capture_default_str();
-  cmd->add_option("--size", options->size, "image width and height in pixels")->capture_default_str();
+  cmd->add_option("--max", options->max_demos, "at most this many demos (--demos)")
+      ->capture_default_str();
+  cmd->add_option("--size", options->size, "image width and height in pixels")
+      ->capture_default_str();
   cmd->add_option("--out", options->out, "output PNG (written atomically)")->required();
   cmd->callback([options, &exit_code] {
-    if (!options->scene && options->demos.empty() && !options->rollout) throw CLI::RequiredError("--scene, --demos or --rollout");
+    if (!options->scene && options->demos.empty() && !options->rollout)
+      throw CLI::RequiredError("--scene, --demos or --rollout");
     exit_code = run_render(*options);
   });
 }

@@ -60,24 +60,24 @@ int run_audit_section(const ReportOptions& options, std::ostream& out) {
 }
 
 struct PageOptions {
-  std::string out;                     ///< empty: print the report on stdout
-  bool full = false;                   ///< the paper's whole grid instead of the quick one
+  std::string out;    ///< empty: print the report on stdout
+  bool full = false;  ///< the paper's whole grid instead of the quick one
   // The quick page's defaults keep it within 5 minutes on two cores: Table 1 at the paper's
   // headline count (100 demos, where its OOD column is), Fig. 5 at 10 demos (with 40 the page
   // took 318 s on an idle machine; docs/BENCHMARKS.md).
-  std::string demos = "100";           ///< the quick Table 1's demo counts
-  int trials = 30;                     ///< rollouts per scene set of the quick tables
+  std::string demos = "100";  ///< the quick Table 1's demo counts
+  int trials = 30;            ///< rollouts per scene set of the quick tables
   // One C8 row (the workspace centre), as many rows as before the C8 baseline had two.
   std::string methods = "hand_centric,relative,absolute,c8_centre";
-  std::string ablation_demos = "10";   ///< Fig. 5 (App. B): flow, ddpm and cvae heads
-  int steps = 0;                       ///< 0: the library's automatic training budget
+  std::string ablation_demos = "10";  ///< Fig. 5 (App. B): flow, ddpm and cvae heads
+  int steps = 0;                      ///< 0: the library's automatic training budget
   int jobs = 0;
 };
 
 // Runs a Table 1 grid into `dir` (resuming what is there) and returns its Markdown.
 std::string table_into(const std::string& dir, const std::vector<int>& demo_counts, int trials,
-                       const std::vector<experiments::Method>& methods, const std::vector<std::string>& heads,
-                       const PageOptions& page) {
+                       const std::vector<experiments::Method>& methods,
+                       const std::vector<std::string>& heads, const PageOptions& page) {
   experiments::Table1Options table;
   table.demo_counts = demo_counts;
   table.eval.trials = trials;
@@ -95,7 +95,8 @@ std::string table_into(const std::string& dir, const std::vector<int>& demo_coun
 }
 
 std::string section_title(const std::string& name) {
-  if (name == "audit") return "Audit: which global transforms each representation is invariant under";
+  if (name == "audit")
+    return "Audit: which global transforms each representation is invariant under";
   if (name == "proofs") return "Certificates: the paper's claims, exactly";
   if (name == "sim") return "The 2D peg-in-hole task: the expert's bar";
   return name;
@@ -119,9 +120,12 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
   std::filesystem::create_directories(dir);
   std::ostringstream md;
   md << "# handcentric report\n\n"
-     << "What this library checks of \"Guaranteed SE(3)-Equivariant Control via Hand-Centric Behavior "
-        "Cloning\", run on this machine: the audit of the built-in representations, the exact certificates, "
-        "the 2D sim's own bar, Fig. 3, Table 1 and Fig. 5. Regenerate with `handcentric report --out DIR"
+     << "What this library checks of \"Guaranteed SE(3)-Equivariant Control via Hand-Centric "
+        "Behavior "
+        "Cloning\", run on this machine: the audit of the built-in representations, the exact "
+        "certificates, "
+        "the 2D sim's own bar, Fig. 3, Table 1 and Fig. 5. Regenerate with `handcentric report "
+        "--out DIR"
      << (page.full ? " --full" : "") << "`.\n\n";
   int status = 0;
   const std::vector<RegisteredSection> sections = report_sections();
@@ -129,45 +133,55 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
     std::ostringstream text;
     const int section_status = section.run(text, options);
     if (section_status != 0) status = 1;
-    md << "## " << section_title(section.name) << (section_status == 0 ? "" : " (FAILS its bar)") << "\n\n```\n" << text.str()
-       << "```\n\n";
+    md << "## " << section_title(section.name) << (section_status == 0 ? "" : " (FAILS its bar)")
+       << "\n\n```\n"
+       << text.str() << "```\n\n";
   }
 
   std::fprintf(stderr, "report: Fig. 3\n");
-  experiments::write_flow_figure_png((dir / "fig3.png").string(), experiments::compute_flow_figure());
+  experiments::write_flow_figure_png((dir / "fig3.png").string(),
+                                     experiments::compute_flow_figure());
   md << "## Fig. 3: the flow of the first action under a global transform\n\n"
-     << "Rows: a demonstrated chunk and the same chunk after a global transform g; columns: absolute, "
+     << "Rows: a demonstrated chunk and the same chunk after a global transform g; columns: "
+        "absolute, "
         "relative and hand-centric actions (`handcentric figure flow`).\n\n![Fig. 3](fig3.png)\n\n";
 
-  const std::vector<int> demo_counts =
-      page.full ? std::vector<int>(experiments::kPaperDemoCounts.begin(), experiments::kPaperDemoCounts.end())
-                : experiments::parse_int_list(page.demos, "--demos");
+  const std::vector<int> demo_counts = page.full
+                                           ? std::vector<int>(experiments::kPaperDemoCounts.begin(),
+                                                              experiments::kPaperDemoCounts.end())
+                                           : experiments::parse_int_list(page.demos, "--demos");
   const int trials = page.full ? 100 : page.trials;
-  std::fprintf(stderr, "report: Table 1 (%zu demo counts, %d trials per scene set)\n", demo_counts.size(), trials);
+  std::fprintf(stderr, "report: Table 1 (%zu demo counts, %d trials per scene set)\n",
+               demo_counts.size(), trials);
   const std::string table = table_into((dir / "table1").string(), demo_counts, trials,
                                        experiments::parse_methods(page.methods), {"flow"}, page);
   md << "## Table 1" << (page.full ? "" : " (quick)") << "\n\n";
   if (!page.full) {
     md << "A quick run: demo counts " << page.demos << " only, " << trials
-       << " rollouts per scene set (the paper: 5 to 100 demos, 100 trials); `--full` runs the paper's grid. "
+       << " rollouts per scene set (the paper: 5 to 100 demos, 100 trials); `--full` runs the "
+          "paper's grid. "
           "Models and results are in `table1/`.\n\n";
   }
   md << demoted(table) << "\n![Table 1](table1/table1.png)\n\n";
 
   const std::vector<int> ablation_counts =
-      page.full ? std::vector<int>{10, 40, 100} : experiments::parse_int_list(page.ablation_demos, "--ablation-demos");
+      page.full ? std::vector<int>{10, 40, 100}
+                : experiments::parse_int_list(page.ablation_demos, "--ablation-demos");
   std::fprintf(stderr, "report: Fig. 5 (heads flow, ddpm, cvae)\n");
-  const std::string ablation =
-      table_into((dir / "fig5").string(), ablation_counts, trials, experiments::parse_methods("hand_centric,absolute"),
-                 {"flow", "ddpm", "cvae"}, page);
+  const std::string ablation = table_into((dir / "fig5").string(), ablation_counts, trials,
+                                          experiments::parse_methods("hand_centric,absolute"),
+                                          {"flow", "ddpm", "cvae"}, page);
   md << "## Fig. 5: the learning algorithm against the representation (App. B)\n\n"
-     << "Hand-centric and absolute actions, each with a flow, a DDPM and a CVAE head, at demo counts "
+     << "Hand-centric and absolute actions, each with a flow, a DDPM and a CVAE head, at demo "
+        "counts "
      << (page.full ? std::string("10, 40, 100") : page.ablation_demos) << ", " << trials
-     << " rollouts per scene set. The paper's finding: the representation, not the learning algorithm, "
+     << " rollouts per scene set. The paper's finding: the representation, not the learning "
+        "algorithm, "
         "decides success.\n\n"
      << demoted(ablation) << "\n![Fig. 5](fig5/table1.png)\n\n";
 
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   char took[96];
   std::snprintf(took, sizeof took, "made in %.0f s of wall time", seconds);
   md << "The page was " << took << ".\n";
@@ -187,16 +201,26 @@ void add_report_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--seed", options->seed, "seed of the audit section")->capture_default_str();
   cmd->add_option("--out", page->out,
-                  "write the report as a page: DIR/index.html and index.md, with a quick Table 1 and Figs. 3 and 5");
-  cmd->add_flag("--full", page->full, "with --out: the paper's whole grid (7 demo counts, 100 trials)");
-  cmd->add_option("--demos", page->demos, "with --out: the quick Table 1's demo counts")->capture_default_str();
-  cmd->add_option("--trials", page->trials, "with --out: rollouts per scene set of the quick tables")->capture_default_str();
+                  "write the report as a page: DIR/index.html and index.md, with a quick Table 1 "
+                  "and Figs. 3 and 5");
+  cmd->add_flag("--full", page->full,
+                "with --out: the paper's whole grid (7 demo counts, 100 trials)");
+  cmd->add_option("--demos", page->demos, "with --out: the quick Table 1's demo counts")
+      ->capture_default_str();
+  cmd->add_option("--trials", page->trials,
+                  "with --out: rollouts per scene set of the quick tables")
+      ->capture_default_str();
   cmd->add_option("--methods", page->methods, "with --out: Table 1's rows")->capture_default_str();
-  cmd->add_option("--ablation-demos", page->ablation_demos, "with --out: Fig. 5's demo counts")->capture_default_str();
-  cmd->add_option("--steps", page->steps, "with --out: Adam steps per cell (0: the library's budget)")->capture_default_str();
-  cmd->add_option("--jobs", page->jobs, "with --out: trainings at once (0: one per core)")->capture_default_str();
+  cmd->add_option("--ablation-demos", page->ablation_demos, "with --out: Fig. 5's demo counts")
+      ->capture_default_str();
+  cmd->add_option("--steps", page->steps,
+                  "with --out: Adam steps per cell (0: the library's budget)")
+      ->capture_default_str();
+  cmd->add_option("--jobs", page->jobs, "with --out: trainings at once (0: one per core)")
+      ->capture_default_str();
   cmd->callback([options, page, &exit_code] {
-    exit_code = page->out.empty() ? run_main_report(std::cout, *options) : write_report_page(*options, *page);
+    exit_code = page->out.empty() ? run_main_report(std::cout, *options)
+                                  : write_report_page(*options, *page);
   });
 }
 

@@ -46,8 +46,9 @@ int run_table1_command(Table1CommandOptions options) {
   const experiments::Table1Grid grid = experiments::prepare_table1(table);
   if (options.plan) {
     const int jobs = experiments::write_plan(grid, table.eval, this_executable());
-    std::cout << "wrote " << jobs << " jobs to " << grid.dir << "/jobs.txt; run them (e.g. parallel -j 2 < "
-              << grid.dir << "/jobs.txt), then: handcentric table1 --collect " << grid.dir << "\n";
+    std::cout << "wrote " << jobs << " jobs to " << grid.dir
+              << "/jobs.txt; run them (e.g. parallel -j 2 < " << grid.dir
+              << "/jobs.txt), then: handcentric table1 --collect " << grid.dir << "\n";
     return 0;
   }
   experiments::run_table1(table, grid);
@@ -59,30 +60,42 @@ int run_table1_command(Table1CommandOptions options) {
 void add_table1_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<Table1CommandOptions>();
   experiments::Table1Options& t = options->table;
-  CLI::App* cmd = app.add_subcommand("table1", "the paper's Table 1: train and score every cell, print the table");
-  cmd->add_option("--demos", options->demos, "numbers of demos (nested: the first N of one demo file)")
+  CLI::App* cmd = app.add_subcommand(
+      "table1", "the paper's Table 1: train and score every cell, print the table");
+  cmd->add_option("--demos", options->demos,
+                  "numbers of demos (nested: the first N of one demo file)")
       ->capture_default_str();
-  cmd->add_option("--trials", t.eval.trials, "rollouts per cell and scene set")->capture_default_str();
-  cmd->add_option("--methods", options->methods, "hand_centric, relative, absolute, c8_centre, c8_base")
+  cmd->add_option("--trials", t.eval.trials, "rollouts per cell and scene set")
+      ->capture_default_str();
+  cmd->add_option("--methods", options->methods,
+                  "hand_centric, relative, absolute, c8_centre, c8_base")
       ->capture_default_str();
   cmd->add_option("--heads", options->heads, "flow, ddpm, cvae (c8_centre and c8_base use c8ddpm)")
       ->capture_default_str();
   cmd->add_option("--seed", t.demo_seed, "seed of the demos")->capture_default_str();
-  cmd->add_option("--train-seeds", options->train_seeds, "training seeds, one row each")->capture_default_str();
-  cmd->add_option("--eval-seed", t.eval.eval_seed, "seed of the train-distribution and paired OOD scenes")
+  cmd->add_option("--train-seeds", options->train_seeds, "training seeds, one row each")
       ->capture_default_str();
-  cmd->add_option("--ood-seed", t.eval.ood_seed, "seed of the independent OOD scenes")->capture_default_str();
-  cmd->add_option("--steps", t.steps, "Adam steps per cell (0: the library's automatic budget)")->capture_default_str();
-  cmd->add_option("--jobs", t.jobs, "trainings at once (0: one per hardware thread)")->capture_default_str();
+  cmd->add_option("--eval-seed", t.eval.eval_seed,
+                  "seed of the train-distribution and paired OOD scenes")
+      ->capture_default_str();
+  cmd->add_option("--ood-seed", t.eval.ood_seed, "seed of the independent OOD scenes")
+      ->capture_default_str();
+  cmd->add_option("--steps", t.steps, "Adam steps per cell (0: the library's automatic budget)")
+      ->capture_default_str();
+  cmd->add_option("--jobs", t.jobs, "trainings at once (0: one per hardware thread)")
+      ->capture_default_str();
   auto* out = cmd->add_option("--out", t.out, "output directory")->capture_default_str();
-  cmd->add_flag("--no-mirror{false}", t.data.mirror,
-                "train every cell on its demos only, not also on their mirror images about the hole axis");
+  cmd->add_flag(
+      "--no-mirror{false}", t.data.mirror,
+      "train every cell on its demos only, not also on their mirror images about the hole axis");
   cmd->add_option("--perturbed-copies", t.data.perturbed_copies,
                   "relabelled recovery copies of each training sample (0: none)")
       ->capture_default_str();
   cmd->add_flag("--resume", t.resume, "reuse the models and results already in --out");
-  auto* plan = cmd->add_flag("--plan", options->plan, "write --out/jobs.txt (one shell line per cell) and stop");
-  auto* collect = cmd->add_option("--collect", options->collect, "build the table from the results in DIR");
+  auto* plan = cmd->add_flag("--plan", options->plan,
+                             "write --out/jobs.txt (one shell line per cell) and stop");
+  auto* collect =
+      cmd->add_option("--collect", options->collect, "build the table from the results in DIR");
   cmd->add_flag("--quiet", t.quiet, "no progress display");
   collect->excludes(plan);
   collect->excludes(out);

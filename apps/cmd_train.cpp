@@ -67,7 +67,8 @@ int run_train(const TrainOptions& options) {
   config.lr_schedule = policy::parse_schedule(options.lr_schedule);
   make_representation(config.representation);  // an unknown name fails before the demos load
   if (config.steps < 0) {
-    throw InvalidArgument("--steps must be >= 1, or 0 for the automatic budget, got " + std::to_string(config.steps));
+    throw InvalidArgument("--steps must be >= 1, or 0 for the automatic budget, got " +
+                          std::to_string(config.steps));
   }
   config.validate();
   const std::filesystem::path out_dir = std::filesystem::absolute(options.out).parent_path();
@@ -92,8 +93,10 @@ int run_train(const TrainOptions& options) {
     check_max_demos(options, demo_count);
     scenes = sim::training_scenes(demos, config.history_length, config.chunk_length,
                                   options.max_demos, data);
-    const std::size_t used = options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
-    for (std::size_t i = 0; i < used; ++i) demo_samples += static_cast<long long>(demos[i].world_T_hand.size());
+    const std::size_t used =
+        options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
+    for (std::size_t i = 0; i < used; ++i)
+      demo_samples += static_cast<long long>(demos[i].world_T_hand.size());
   } else {
     const std::vector<sim::insert3d::Demo> demos = sim::insert3d::load_demos(options.demos);
     demo_count = demos.size();
@@ -107,7 +110,8 @@ int run_train(const TrainOptions& options) {
       options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
   if (config.steps == 0) {
     // c8ddpm trains on 8 rotated copies of every scene: its budget counts them
-    config.steps = experiments::automatic_steps(data, policy::c8::augmentation_copies(config.head) * demo_samples);
+    config.steps = experiments::automatic_steps(
+        data, policy::c8::augmentation_copies(config.head) * demo_samples);
   }
 
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
@@ -117,19 +121,24 @@ int run_train(const TrainOptions& options) {
     last_loss = p.loss;
     last_rate = p.samples_per_second;
     if (options.quiet) return;
-    std::fprintf(stderr, "%sstep %d/%d  loss %.5f  %.0f samples/s  ETA %s%s", terminal ? "\r" : "", p.step, p.steps,
-                 p.loss, p.samples_per_second, clock_text(p.eta_seconds).c_str(), terminal ? "  " : "\n");
+    std::fprintf(stderr, "%sstep %d/%d  loss %.5f  %.0f samples/s  ETA %s%s", terminal ? "\r" : "",
+                 p.step, p.steps, p.loss, p.samples_per_second, clock_text(p.eta_seconds).c_str(),
+                 terminal ? "  " : "\n");
     if (terminal && p.step == p.steps) std::fprintf(stderr, "\n");
   };
   const auto start = std::chrono::steady_clock::now();
-  const policy::LearnedPolicy trained = policy::train_policy(config, scenes, options.seed, progress, report_every);
+  const policy::LearnedPolicy trained =
+      policy::train_policy(config, scenes, options.seed, progress, report_every);
   policy::save_model(trained, options.out);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "trained " << trained.name() << " on " << scenes.size() << " scenes from " << used
             << " demos" << (data.mirror ? " and their mirror images" : "")
-            << (data.perturbed_copies > 0 ? " (" + std::to_string(data.perturbed_copies) + " perturbed copies each)" : "")
-            << " (task " << config.task << "): " << config.steps << " steps, final loss " << last_loss << ", "
-            << static_cast<long>(last_rate) << " samples/s ("
+            << (data.perturbed_copies > 0
+                    ? " (" + std::to_string(data.perturbed_copies) + " perturbed copies each)"
+                    : "")
+            << " (task " << config.task << "): " << config.steps << " steps, final loss "
+            << last_loss << ", " << static_cast<long>(last_rate) << " samples/s ("
             << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
             << " -> " << options.out << "\n";
   return 0;
@@ -137,7 +146,8 @@ int run_train(const TrainOptions& options) {
 
 void add_train_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<TrainOptions>();
-  CLI::App* cmd = app.add_subcommand("train", "train a policy on demonstrations and write a model file");
+  CLI::App* cmd =
+      app.add_subcommand("train", "train a policy on demonstrations and write a model file");
   cmd->add_option(
          "--task", options->task,
          "peg2d (the 2D peg-in-hole) or insert3d (the 3D blade insertion); the demos' task")
@@ -151,21 +161,29 @@ void add_train_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--head", options->head,
                   "flow|ddpm|cvae|c8flow|c8ddpm|c8flow_planar (the c8 heads need --repr absolute)")
       ->capture_default_str();
-  cmd->add_option("--c8-centre-x", config.c8_centre_x, "c8ddpm, c8flow_planar: x of the C8 centre (cm)")
+  cmd->add_option("--c8-centre-x", config.c8_centre_x,
+                  "c8ddpm, c8flow_planar: x of the C8 centre (cm)")
       ->capture_default_str();
-  cmd->add_option("--c8-centre-y", config.c8_centre_y, "c8ddpm, c8flow_planar: y of the C8 centre (cm)")
+  cmd->add_option("--c8-centre-y", config.c8_centre_y,
+                  "c8ddpm, c8flow_planar: y of the C8 centre (cm)")
       ->capture_default_str();
-  cmd->add_option("--steps", config.steps, "Adam steps (0: the automatic budget for the number of training samples)")
+  cmd->add_option("--steps", config.steps,
+                  "Adam steps (0: the automatic budget for the number of training samples)")
       ->capture_default_str();
-  cmd->add_option("--seed", options->seed, "seed of initialization, minibatches, noise and the perturbed copies")->capture_default_str();
+  cmd->add_option("--seed", options->seed,
+                  "seed of initialization, minibatches, noise and the perturbed copies")
+      ->capture_default_str();
   cmd->add_flag("--no-mirror{false}", options->data.mirror,
                 "train on the demos only, not also on their mirror images about the hole axis");
   cmd->add_option("--perturbed-copies", options->data.perturbed_copies,
-                  "relabelled recovery copies of each training sample, the hand moved off the demo (0: none)")
+                  "relabelled recovery copies of each training sample, the hand moved off the demo "
+                  "(0: none)")
       ->capture_default_str();
-  cmd->add_option("--offset-cm", options->data.offset_cm, "largest offset of a perturbed copy along x and y (cm)")
+  cmd->add_option("--offset-cm", options->data.offset_cm,
+                  "largest offset of a perturbed copy along x and y (cm)")
       ->capture_default_str();
-  cmd->add_option("--offset-deg", options->data.offset_deg, "largest angle offset of a perturbed copy (degrees)")
+  cmd->add_option("--offset-deg", options->data.offset_deg,
+                  "largest angle offset of a perturbed copy (degrees)")
       ->capture_default_str();
   cmd->add_option("--recovery-steps", options->data.recovery_steps,
                   "steps over which a perturbed copy's chunk returns to the demo")
@@ -173,17 +191,22 @@ void add_train_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--max-demos", options->max_demos, "train on the first N demos only (0 = all)")
       ->capture_default_str();
   cmd->add_option("--chunk", config.chunk_length, "K, actions per chunk")->capture_default_str();
-  cmd->add_option("--history", config.history_length, "H, past poses in the observation")->capture_default_str();
+  cmd->add_option("--history", config.history_length, "H, past poses in the observation")
+      ->capture_default_str();
   cmd->add_option("--batch", config.batch_size, "minibatch size")->capture_default_str();
   cmd->add_option("--width", config.hidden_width, "hidden layer width")->capture_default_str();
   cmd->add_option("--layers", config.hidden_layers, "hidden layers")->capture_default_str();
   cmd->add_option("--lr", config.learning_rate, "Adam learning rate")->capture_default_str();
-  cmd->add_option("--ema", config.ema_decay, "keep the moving average of the weights with this decay (0: off; 0.999 is usual)")
+  cmd->add_option("--ema", config.ema_decay,
+                  "keep the moving average of the weights with this decay (0: off; 0.999 is usual)")
       ->capture_default_str();
-  cmd->add_option("--lr-schedule", options->lr_schedule, "constant|cosine (from --lr down to ~0 at the last step)")
+  cmd->add_option("--lr-schedule", options->lr_schedule,
+                  "constant|cosine (from --lr down to ~0 at the last step)")
       ->capture_default_str();
-  cmd->add_option("--euler-steps", config.euler_steps, "Euler steps of the flow sampler")->capture_default_str();
-  cmd->add_option("--time-embedding", config.time_embedding, "sinusoidal features of t (even), 0 for t itself")
+  cmd->add_option("--euler-steps", config.euler_steps, "Euler steps of the flow sampler")
+      ->capture_default_str();
+  cmd->add_option("--time-embedding", config.time_embedding,
+                  "sinusoidal features of t (even), 0 for t itself")
       ->capture_default_str();
   cmd->add_flag("--quiet", options->quiet, "no progress display");
   cmd->callback([options, &exit_code] { exit_code = run_train(*options); });

@@ -8,8 +8,9 @@
 #include "handcentric/core/errors.hpp"
 
 int main(int argc, char** argv) {
-  CLI::App app{"handcentric: executable claims of hand-centric SE(3)-equivariant behavior cloning.\n"
-               "Without a subcommand it prints the main report."};
+  CLI::App app{
+      "handcentric: executable claims of hand-centric SE(3)-equivariant behavior cloning.\n"
+      "Without a subcommand it prints the main report."};
   app.require_subcommand(0, 1);
   int exit_code = 0;
   for (const auto& command : handcentric::apps::registered_commands()) command.add(app, exit_code);

@@ -18,7 +18,8 @@ LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string&
   }
   auto model = std::make_unique<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
   policy::require_task(*model, policy::kTaskPeg2d, model_path);  // the 2D rollouts' observations
-  loaded.rollout_options = sim::RolloutOptions::for_policy(model->config().history_length, model->config().execute);
+  loaded.rollout_options =
+      sim::RolloutOptions::for_policy(model->config().history_length, model->config().execute);
   loaded.policy = std::move(model);
   return loaded;
 }

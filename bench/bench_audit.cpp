@@ -42,9 +42,15 @@ void BM_audit_one(benchmark::State& state, const std::string& name) {
     benchmark::DoNotOptimize(results);
   }
 }
-BENCHMARK_CAPTURE(BM_audit_one, absolute, std::string("absolute"))->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK_CAPTURE(BM_audit_one, hand_centric, std::string("hand_centric"))->Unit(benchmark::kMillisecond)->Iterations(3);
-BENCHMARK_CAPTURE(BM_audit_one, actionflow, std::string("actionflow"))->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK_CAPTURE(BM_audit_one, absolute, std::string("absolute"))
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+BENCHMARK_CAPTURE(BM_audit_one, hand_centric, std::string("hand_centric"))
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+BENCHMARK_CAPTURE(BM_audit_one, actionflow, std::string("actionflow"))
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
 
 // The pipe's own cost: a plug-in that answers at once (three lines of Python that copy the id
 // and send six zeros), per round trip with a scene of H = 2, K = 16; compare with
@@ -56,11 +62,13 @@ void BM_pipe_round_trip(benchmark::State& state) {
       10.0);
   std::mt19937_64 rng(1);
   std::uint64_t i = 0;
-  plugin.encode_actions(random_scene(rng, 2, 16, 2, 0, 10.0));  // warm up: Python's start is not the pipe's
+  plugin.encode_actions(
+      random_scene(rng, 2, 16, 2, 0, 10.0));  // warm up: Python's start is not the pipe's
   const double asking0 = plugin.seconds_asking(), waiting0 = plugin.seconds_waiting();
   for (auto _ : state) {
     Scene scene = random_scene(rng, 2, 16, 2, 0, 10.0);
-    scene.world_T_hand_history[0] = RigidTransform::from_translation(Eigen::Vector3d(static_cast<double>(++i), 0, 0));
+    scene.world_T_hand_history[0] =
+        RigidTransform::from_translation(Eigen::Vector3d(static_cast<double>(++i), 0, 0));
     benchmark::DoNotOptimize(plugin.encode_actions(scene));  // a new scene: never from the cache
   }
   state.counters["pipe_share"] =

@@ -31,9 +31,12 @@ void product(benchmark::State& state, Op op_a, Op op_b, int m, int n, int k, Epi
   const std::vector<float> a = random(static_cast<std::size_t>(lda) * (op_a == Op::none ? k : m));
   const std::vector<float> b = random(static_cast<std::size_t>(ldb) * (op_b == Op::none ? n : k));
   const std::vector<float> bias = random(m), activation = random(static_cast<std::size_t>(m) * n);
-  std::vector<float> c(static_cast<std::size_t>(m) * n), sigmoid = random(static_cast<std::size_t>(m) * n);
+  std::vector<float> c(static_cast<std::size_t>(m) * n),
+      sigmoid = random(static_cast<std::size_t>(m) * n);
   for (float& s : sigmoid) s = 0.5f + 0.5f * s;
-  Gemm gemm{op_a, op_b, m, n, k, a.data(), lda, b.data(), ldb, op_b == Op::none ? bias.data() : nullptr, c.data(), m};
+  Gemm gemm{op_a,     op_b, m,        n,   k,
+            a.data(), lda,  b.data(), ldb, op_b == Op::none ? bias.data() : nullptr,
+            c.data(), m};
   gemm.epilogue = epilogue;
   gemm.sigmoid = sigmoid.data();
   gemm.lds = m;
@@ -47,18 +50,25 @@ void product(benchmark::State& state, Op op_a, Op op_b, int m, int n, int k, Epi
 }
 
 // Forward: Z = W X + b (then SiLU on hidden layers, keeping sigmoid(Z)).
-BENCHMARK_CAPTURE(product, forward_first_layer_silu, Op::none, Op::none, 256, kBatch, 57, Epilogue::silu);
-BENCHMARK_CAPTURE(product, forward_hidden_layer_silu, Op::none, Op::none, 256, kBatch, 256, Epilogue::silu);
-BENCHMARK_CAPTURE(product, forward_hidden_layer_no_epilogue, Op::none, Op::none, 256, kBatch, 256, Epilogue::none);
-BENCHMARK_CAPTURE(product, forward_output_layer, Op::none, Op::none, 24, kBatch, 256, Epilogue::none);
+BENCHMARK_CAPTURE(product, forward_first_layer_silu, Op::none, Op::none, 256, kBatch, 57,
+                  Epilogue::silu);
+BENCHMARK_CAPTURE(product, forward_hidden_layer_silu, Op::none, Op::none, 256, kBatch, 256,
+                  Epilogue::silu);
+BENCHMARK_CAPTURE(product, forward_hidden_layer_no_epilogue, Op::none, Op::none, 256, kBatch, 256,
+                  Epilogue::none);
+BENCHMARK_CAPTURE(product, forward_output_layer, Op::none, Op::none, 24, kBatch, 256,
+                  Epilogue::none);
 // Backward: dW = delta A^T, and delta_below = (W^T delta) SiLU'.
-BENCHMARK_CAPTURE(product, dw_output_layer, Op::none, Op::transpose, 24, 256, kBatch, Epilogue::none);
-BENCHMARK_CAPTURE(product, dx_output_layer_silu_derivative, Op::transpose, Op::none, 256, kBatch, 24,
-                  Epilogue::silu_derivative);
-BENCHMARK_CAPTURE(product, dw_hidden_layer, Op::none, Op::transpose, 256, 256, kBatch, Epilogue::none);
-BENCHMARK_CAPTURE(product, dx_hidden_layer_silu_derivative, Op::transpose, Op::none, 256, kBatch, 256,
-                  Epilogue::silu_derivative);
-BENCHMARK_CAPTURE(product, dw_first_layer, Op::none, Op::transpose, 256, 57, kBatch, Epilogue::none);
+BENCHMARK_CAPTURE(product, dw_output_layer, Op::none, Op::transpose, 24, 256, kBatch,
+                  Epilogue::none);
+BENCHMARK_CAPTURE(product, dx_output_layer_silu_derivative, Op::transpose, Op::none, 256, kBatch,
+                  24, Epilogue::silu_derivative);
+BENCHMARK_CAPTURE(product, dw_hidden_layer, Op::none, Op::transpose, 256, 256, kBatch,
+                  Epilogue::none);
+BENCHMARK_CAPTURE(product, dx_hidden_layer_silu_derivative, Op::transpose, Op::none, 256, kBatch,
+                  256, Epilogue::silu_derivative);
+BENCHMARK_CAPTURE(product, dw_first_layer, Op::none, Op::transpose, 256, 57, kBatch,
+                  Epilogue::none);
 
 }  // namespace
 

@@ -50,7 +50,8 @@ Eigen::MatrixXd random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937
 void BM_flow_train_step_batch256(benchmark::State& state) {
   const PolicyConfig config = anchor_config(HeadKind::flow);
   std::mt19937_64 rng(1);
-  const Eigen::MatrixXd actions = random_matrix(24, 4096, rng), observations = random_matrix(32, 4096, rng);
+  const Eigen::MatrixXd actions = random_matrix(24, 4096, rng),
+                        observations = random_matrix(32, 4096, rng);
   auto head = make_head(config);
   head->prepare(actions, observations, rng);
   const Eigen::MatrixXf batch_a = actions.leftCols(256).cast<float>();
@@ -70,10 +71,18 @@ void sample_batch1(benchmark::State& state, HeadKind kind) {
   const Eigen::MatrixXf o = observations.col(0).cast<float>();
   for (auto _ : state) benchmark::DoNotOptimize(head->sample(o, rng));
 }
-void BM_flow_sample_10_euler_steps_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::flow); }
-void BM_ddpm_sample_10_ddim_steps_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::ddpm); }
-void BM_cvae_sample_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::cvae); }
-void BM_c8flow_sample_10_euler_steps_batch1(benchmark::State& state) { sample_batch1(state, HeadKind::c8flow); }
+void BM_flow_sample_10_euler_steps_batch1(benchmark::State& state) {
+  sample_batch1(state, HeadKind::flow);
+}
+void BM_ddpm_sample_10_ddim_steps_batch1(benchmark::State& state) {
+  sample_batch1(state, HeadKind::ddpm);
+}
+void BM_cvae_sample_batch1(benchmark::State& state) {
+  sample_batch1(state, HeadKind::cvae);
+}
+void BM_c8flow_sample_10_euler_steps_batch1(benchmark::State& state) {
+  sample_batch1(state, HeadKind::c8flow);
+}
 BENCHMARK(BM_flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ddpm_sample_10_ddim_steps_batch1)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_cvae_sample_batch1)->Unit(benchmark::kMicrosecond);
@@ -90,7 +99,8 @@ BENCHMARK(BM_c8flow_sample_10_euler_steps_batch1)->Unit(benchmark::kMicrosecond)
 #else
 #define HANDCENTRIC_NO_INTERPROCEDURAL noipa
 #endif
-__attribute__((target("avx512f"), HANDCENTRIC_NO_INTERPROCEDURAL)) float fma_probe(long iterations) {
+__attribute__((target("avx512f"), HANDCENTRIC_NO_INTERPROCEDURAL)) float fma_probe(
+    long iterations) {
   __m512 acc[24];
   for (int i = 0; i < 24; ++i) acc[i] = _mm512_set1_ps(0.001f * static_cast<float>(i));
   const __m512 x = _mm512_set1_ps(0.999f), y = _mm512_set1_ps(1e-4f);
@@ -116,7 +126,8 @@ void BM_avx512_fma_peak(benchmark::State& state) {
   long iterations = kIterations;
   benchmark::DoNotOptimize(iterations);  // opaque: the loop cannot be folded
   for (auto _ : state) benchmark::DoNotOptimize(fma_probe(iterations));
-  state.SetItemsProcessed(state.iterations() * kIterations * 24 * 32);  // flops: 24 FMAs x 16 lanes x 2
+  state.SetItemsProcessed(state.iterations() * kIterations * 24 *
+                          32);  // flops: 24 FMAs x 16 lanes x 2
 }
 BENCHMARK(BM_avx512_fma_peak)->Unit(benchmark::kMillisecond);
 #endif
@@ -131,7 +142,8 @@ void BM_mlp_infer_batch1(benchmark::State& state) {
     mlp.infer(input, output, scratch);
     input(0, 0) = output(0, 0) * 1e-3f;  // a dependency, as between Euler steps
   }
-  state.SetBytesProcessed(state.iterations() * mlp.parameter_count() * 4);  // bytes/s = weight bytes read
+  state.SetBytesProcessed(state.iterations() * mlp.parameter_count() *
+                          4);  // bytes/s = weight bytes read
 }
 BENCHMARK(BM_mlp_infer_batch1)->Unit(benchmark::kMicrosecond);
 

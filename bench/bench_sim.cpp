@@ -21,7 +21,8 @@ std::vector<RigidTransform> poses_near_the_hole(int n) {
   std::mt19937_64 rng(1);
   std::vector<RigidTransform> poses;
   for (int i = 0; i < n; ++i) {
-    poses.push_back(RigidTransform::planar((uniform01(rng) - 0.5) * 1.57, 12.0 * uniform01(rng) - 6.0, 14.0 * uniform01(rng)));
+    poses.push_back(RigidTransform::planar((uniform01(rng) - 0.5) * 1.57,
+                                           12.0 * uniform01(rng) - 6.0, 14.0 * uniform01(rng)));
   }
   return poses;
 }
@@ -38,7 +39,8 @@ BENCHMARK(BM_CollisionQuery);
 void BM_MotionCheckInsertionStep(benchmark::State& state) {
   // one 0.5 cm control step down the hole, 0.05 from both walls: the expensive case
   const CollisionChecker checker;
-  const RigidTransform from = RigidTransform::planar(0.0, 0.0, 5.0), to = RigidTransform::planar(0.0, 0.0, 4.5);
+  const RigidTransform from = RigidTransform::planar(0.0, 0.0, 5.0),
+                       to = RigidTransform::planar(0.0, 0.0, 4.5);
   for (auto _ : state) benchmark::DoNotOptimize(checker.motion_collides(from, to));
   state.SetItemsProcessed(state.iterations());
 }

@@ -75,7 +75,9 @@ std::string shape_of(const py::array& a) {
   return out.str();
 }
 
-std::string type_name(py::handle value) { return py::str(py::type::handle_of(value).attr("__name__")); }
+std::string type_name(py::handle value) {
+  return py::str(py::type::handle_of(value).attr("__name__"));
+}
 
 /// `value` as a C-contiguous float64 array; DtypeError for anything that is not real numbers
 /// (lists, tuples, NumPy arrays of any integer or float dtype and objects with __array__, such
@@ -86,7 +88,8 @@ RealArray real_array(py::handle value, const std::string& what) {
   if (value.is_none()) throw DtypeError(what + " is None; expected an array of real numbers");
   py::array any = py::array::ensure(value);
   if (!any) {
-    throw DtypeError(what + " is a " + type_name(value) + " that NumPy cannot read as an array of real numbers");
+    throw DtypeError(what + " is a " + type_name(value) +
+                     " that NumPy cannot read as an array of real numbers");
   }
   const char kind = any.dtype().kind();
   if (kind != 'f' && kind != 'i' && kind != 'u') {
@@ -99,22 +102,25 @@ RealArray real_array(py::handle value, const std::string& what) {
 void require_finite(const double* data, py::ssize_t n, const std::string& what) {
   for (py::ssize_t i = 0; i < n; ++i) {
     if (!std::isfinite(data[i])) {
-      throw InvalidArgument(what + " holds a non-finite number (" + std::to_string(data[i]) + ") at flat index " +
-                            std::to_string(i) + "; every entry must be finite");
+      throw InvalidArgument(what + " holds a non-finite number (" + std::to_string(data[i]) +
+                            ") at flat index " + std::to_string(i) +
+                            "; every entry must be finite");
     }
   }
 }
 
 Eigen::VectorXd vector_from(py::handle value, const std::string& what) {
   const auto a = real_array(value, what);
-  if (a.ndim() != 1) throw ShapeError(what + " has shape " + shape_of(a) + "; expected a 1-D array (n,)");
+  if (a.ndim() != 1)
+    throw ShapeError(what + " has shape " + shape_of(a) + "; expected a 1-D array (n,)");
   require_finite(a.data(), a.size(), what);
   return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
 }
 
 Eigen::Vector3d vector3_from(py::handle value, const std::string& what) {
   const Eigen::VectorXd v = vector_from(value, what);
-  if (v.size() != 3) throw ShapeError(what + " has shape (" + std::to_string(v.size()) + ",); expected (3,)");
+  if (v.size() != 3)
+    throw ShapeError(what + " has shape (" + std::to_string(v.size()) + ",); expected (3,)");
   return v;
 }
 
@@ -128,11 +134,12 @@ Eigen::Matrix4d matrix4(const double* m) {
 /// A stack of poses (n, 4, 4), n >= 1; each validated as a rigid transform unless `loose`, where
 /// the rotation block is taken as it is (a float32 policy's is orthonormal to ~1e-7 only, as for
 /// the --policy-exec pipe) and only the last row is checked (to 1e-6).
-std::vector<RigidTransform> poses_from(py::handle value, const std::string& what, bool loose = false,
-                                       const char* expected = "(n, 4, 4)") {
+std::vector<RigidTransform> poses_from(py::handle value, const std::string& what,
+                                       bool loose = false, const char* expected = "(n, 4, 4)") {
   const auto a = real_array(value, what);
   if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4 || a.shape(0) < 1) {
-    throw ShapeError(what + " has shape " + shape_of(a) + "; expected " + expected + " with at least one pose");
+    throw ShapeError(what + " has shape " + shape_of(a) + "; expected " + expected +
+                     " with at least one pose");
   }
   require_finite(a.data(), a.size(), what);
   std::vector<RigidTransform> out;
@@ -143,10 +150,12 @@ std::vector<RigidTransform> poses_from(py::handle value, const std::string& what
       out.push_back(RigidTransform::from_matrix(M));
       continue;
     }
-    const double row = std::abs(M(3, 0)) + std::abs(M(3, 1)) + std::abs(M(3, 2)) + std::abs(M(3, 3) - 1.0);
+    const double row =
+        std::abs(M(3, 0)) + std::abs(M(3, 1)) + std::abs(M(3, 2)) + std::abs(M(3, 3) - 1.0);
     if (!(row <= 1e-6)) {
-      throw ShapeError(what + "[" + std::to_string(k) + "] has last row (" + std::to_string(M(3, 0)) + ", " +
-                       std::to_string(M(3, 1)) + ", " + std::to_string(M(3, 2)) + ", " + std::to_string(M(3, 3)) +
+      throw ShapeError(what + "[" + std::to_string(k) + "] has last row (" +
+                       std::to_string(M(3, 0)) + ", " + std::to_string(M(3, 1)) + ", " +
+                       std::to_string(M(3, 2)) + ", " + std::to_string(M(3, 3)) +
                        "); a pose is [[R, p], [0, 0, 0, 1]]");
     }
     out.push_back(RigidTransform::unchecked(M.topLeftCorner<3, 3>(), M.topRightCorner<3, 1>()));
@@ -167,10 +176,12 @@ std::vector<Eigen::Vector3d> points_from(py::handle value, const std::string& wh
   if (value.is_none()) return {};
   const auto a = real_array(value, what);
   if (a.size() == 0) return {};
-  if (a.ndim() != 2 || a.shape(1) != 3) throw ShapeError(what + " has shape " + shape_of(a) + "; expected (n, 3)");
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw ShapeError(what + " has shape " + shape_of(a) + "; expected (n, 3)");
   require_finite(a.data(), a.size(), what);
   std::vector<Eigen::Vector3d> out(static_cast<std::size_t>(a.shape(0)));
-  for (py::ssize_t i = 0; i < a.shape(0); ++i) out[static_cast<std::size_t>(i)] = Eigen::Vector3d(a.data() + 3 * i);
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    out[static_cast<std::size_t>(i)] = Eigen::Vector3d(a.data() + 3 * i);
   return out;
 }
 
@@ -268,10 +279,12 @@ std::string scene_key(const Scene& scene, bool with_chunk) {
     for (const RigidTransform& T : scene.world_T_hand_chunk) append(key, T);
   for (const auto* points : {&scene.hand_points, &scene.world_points}) {
     count(points->size());
-    for (const Eigen::Vector3d& q : *points) key.append(reinterpret_cast<const char*>(q.data()), 3 * sizeof(double));
+    for (const Eigen::Vector3d& q : *points)
+      key.append(reinterpret_cast<const char*>(q.data()), 3 * sizeof(double));
   }
   for (const auto& [name, T] : scene.extra_poses) append(key, T);
-  for (const auto& [name, x] : scene.scalars) key.append(reinterpret_cast<const char*>(&x), sizeof(x));
+  for (const auto& [name, x] : scene.scalars)
+    key.append(reinterpret_cast<const char*>(&x), sizeof(x));
   return key;
 }
 
@@ -299,8 +312,11 @@ class Cache {
 class PythonRepresentation final : public Representation {
  public:
   PythonRepresentation(py::object actions, py::object observation, py::object decode, bool extras)
-      : actions_(std::move(actions)), observation_(std::move(observation)), decode_(std::move(decode)),
-        extras_(extras), name_("python: " + callable_name(actions_)) {}
+      : actions_(std::move(actions)),
+        observation_(std::move(observation)),
+        decode_(std::move(decode)),
+        extras_(extras),
+        name_("python: " + callable_name(actions_)) {}
 
   std::string name() const override { return name_; }
   bool has_observation() const { return !observation_.is_none(); }
@@ -309,9 +325,11 @@ class PythonRepresentation final : public Representation {
     scene.validate();
     std::string key = scene_key(scene, true);
     if (const auto* hit = actions_cache_.find(key)) return *hit;
-    py::object result = call(actions_, array_of(scene.world_T_hand_history), array_of(scene.world_T_hand_chunk),
-                             array_of(scene.hand_points), array_of(scene.world_points), **extras_kwargs(scene, extras_));
-    return actions_cache_.put(std::move(key), vector_from(result, "the result of actions function " + name_));
+    py::object result = call(actions_, array_of(scene.world_T_hand_history),
+                             array_of(scene.world_T_hand_chunk), array_of(scene.hand_points),
+                             array_of(scene.world_points), **extras_kwargs(scene, extras_));
+    return actions_cache_.put(std::move(key),
+                              vector_from(result, "the result of actions function " + name_));
   }
 
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
@@ -319,11 +337,12 @@ class PythonRepresentation final : public Representation {
     scene.validate_observation();
     std::string key = scene_key(scene, false);
     if (const auto* hit = observation_cache_.find(key)) return *hit;
-    py::object result = call(observation_, array_of(scene.world_T_hand_history), array_of(scene.hand_points),
-                             array_of(scene.world_points), **extras_kwargs(scene, extras_));
-    return observation_cache_.put(std::move(key),
-                                  vector_from(result, "the result of observation function " +
-                                                          callable_name(observation_)));
+    py::object result =
+        call(observation_, array_of(scene.world_T_hand_history), array_of(scene.hand_points),
+             array_of(scene.world_points), **extras_kwargs(scene, extras_));
+    return observation_cache_.put(
+        std::move(key),
+        vector_from(result, "the result of observation function " + callable_name(observation_)));
   }
 
   bool can_decode() const override { return !decode_.is_none(); }
@@ -335,12 +354,15 @@ class PythonRepresentation final : public Representation {
     return decode_in_scene(actions, observation);
   }
 
-  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions, const Scene& observation) const override {
-    if (!can_decode()) throw InvalidArgument(name_ + " has no decode function: pass decode= to audit it");
+  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
+                                              const Scene& observation) const override {
+    if (!can_decode())
+      throw InvalidArgument(name_ + " has no decode function: pass decode= to audit it");
     py::object result = call(decode_, array_of(actions), array_of(observation.world_T_hand_history),
                              array_of(observation.hand_points), array_of(observation.world_points),
                              **extras_kwargs(observation, extras_));
-    return poses_from(result, "the result of decode function " + callable_name(decode_), true, "(K, 4, 4)");
+    return poses_from(result, "the result of decode function " + callable_name(decode_), true,
+                      "(K, 4, 4)");
   }
 
  private:
@@ -355,24 +377,31 @@ class PythonRepresentation final : public Representation {
 class PythonPolicy final : public props::NoisyPolicy {
  public:
   PythonPolicy(py::object policy, Eigen::Index noise, bool extras)
-      : policy_(std::move(policy)), noise_(noise), extras_(extras), name_("python: " + callable_name(policy_)) {}
+      : policy_(std::move(policy)),
+        noise_(noise),
+        extras_(extras),
+        name_("python: " + callable_name(policy_)) {}
 
   std::string name() const override { return name_; }
   Eigen::Index noise_dimension() const override { return noise_; }
 
-  std::vector<RigidTransform> act(const Scene& observation, const Eigen::VectorXd& noise) const override {
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  const Eigen::VectorXd& noise) const override {
     observation.validate_observation();
     std::string key = scene_key(observation, false);
-    key.append(reinterpret_cast<const char*>(noise.data()), sizeof(double) * static_cast<std::size_t>(noise.size()));
+    key.append(reinterpret_cast<const char*>(noise.data()),
+               sizeof(double) * static_cast<std::size_t>(noise.size()));
     if (const auto* hit = cache_.find(key)) return *hit;
-    py::object result = call(policy_, array_of(observation.world_T_hand_history), array_of(observation.hand_points),
-                             array_of(observation.world_points), array_of(noise),
-                             **extras_kwargs(observation, extras_));
-    std::vector<RigidTransform> chunk = poses_from(result, "the chunk returned by policy " + name_, true, "(K, 4, 4)");
+    py::object result = call(policy_, array_of(observation.world_T_hand_history),
+                             array_of(observation.hand_points), array_of(observation.world_points),
+                             array_of(noise), **extras_kwargs(observation, extras_));
+    std::vector<RigidTransform> chunk =
+        poses_from(result, "the chunk returned by policy " + name_, true, "(K, 4, 4)");
     if (chunk_length_ == 0) chunk_length_ = chunk.size();
     if (chunk.size() != chunk_length_) {
-      throw ShapeError("policy " + name_ + " returned " + std::to_string(chunk.size()) + " poses after " +
-                       std::to_string(chunk_length_) + " earlier; the chunk length K must not change");
+      throw ShapeError("policy " + name_ + " returned " + std::to_string(chunk.size()) +
+                       " poses after " + std::to_string(chunk_length_) +
+                       " earlier; the chunk length K must not change");
     }
     return cache_.put(std::move(key), std::move(chunk));
   }
@@ -405,7 +434,9 @@ std::vector<props::Group> groups_of(py::handle value) {
     if (name == "all") return props::all_groups();
     out.push_back(props::parse_group(name));  // InvalidArgument naming the valid names
   }
-  if (out.empty()) throw InvalidArgument("groups is empty; name at least one of translation, rotation, se2, se3, c8");
+  if (out.empty())
+    throw InvalidArgument(
+        "groups is empty; name at least one of translation, rotation, se2, se3, c8");
   return out;
 }
 
@@ -460,17 +491,20 @@ props::ClassifierOptions classifier_for(const CommonOptions& o) {
   return c;
 }
 
-py::object json_loads(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
+py::object json_loads(const std::string& text) {
+  return py::module_::import("json").attr("loads")(text);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Assertions
 
 std::string describe(const props::Verdict& v, const std::string& name, bool policy) {
   std::ostringstream out;
-  out << name << ": " << (policy ? "not equivariant" : to_string(v.component) + " not invariant") << " under "
-      << props::to_string(v.group) << " (" << props::to_string(v.mode) << ", " << props::to_string(v.view)
-      << ", " << props::to_string(v.method) << "); largest error " << v.max_error << ", failed on far case "
-      << v.cases << ", seed " << v.seed << ", tolerance " << v.relative_tolerance << " (1 + L)\n";
+  out << name << ": " << (policy ? "not equivariant" : to_string(v.component) + " not invariant")
+      << " under " << props::to_string(v.group) << " (" << props::to_string(v.mode) << ", "
+      << props::to_string(v.view) << ", " << props::to_string(v.method) << "); largest error "
+      << v.max_error << ", failed on far case " << v.cases << ", seed " << v.seed << ", tolerance "
+      << v.relative_tolerance << " (1 + L)\n";
   if (!v.note.empty()) out << "  note: " << v.note << "\n";
   if (v.witness) {
     out << "  shrunk witness (poses as rotation vector r and translation p; before/after = "
@@ -495,115 +529,144 @@ void assert_all_hold(const props::Classification& c, bool policy, const std::str
     failures += describe(v, c.name, policy);
   }
   if (failed == 0) return;
-  raise_assertion(std::to_string(failed) + " of " + std::to_string(c.verdicts.size()) + " checks failed\n" +
-                  failures + hint);
+  raise_assertion(std::to_string(failed) + " of " + std::to_string(c.verdicts.size()) +
+                  " checks failed\n" + failures + hint);
 }
 
 props::Component component_of(const std::string& name) {
-  for (props::Component c : {props::Component::actions, props::Component::observation, props::Component::flow_input,
-                             props::Component::flow_target}) {
+  for (props::Component c : {props::Component::actions, props::Component::observation,
+                             props::Component::flow_input, props::Component::flow_target}) {
     if (props::to_string(c) == name) return c;
   }
-  throw InvalidArgument("unknown component '" + name + "'; use actions, observation, flow_input or flow_target");
+  throw InvalidArgument("unknown component '" + name +
+                        "'; use actions, observation, flow_input or flow_target");
 }
 
 // ---------------------------------------------------------------------------------------------
 // The module's functions
 
-py::dict audit(py::object actions, py::object observation, py::handle groups, py::handle views, int cases,
-               std::uint64_t seed, std::optional<double> tolerance, const std::string& precision, py::object decode,
-               py::handle extra_poses, py::handle scalars) {
-  if (!PyCallable_Check(actions.ptr())) throw DtypeError("actions must be callable, got a " + type_name(actions));
-  for (const auto& [what, fn] : {std::pair<const char*, py::handle>{"observation", observation}, {"decode", decode}}) {
+py::dict audit(py::object actions, py::object observation, py::handle groups, py::handle views,
+               int cases, std::uint64_t seed, std::optional<double> tolerance,
+               const std::string& precision, py::object decode, py::handle extra_poses,
+               py::handle scalars) {
+  if (!PyCallable_Check(actions.ptr()))
+    throw DtypeError("actions must be callable, got a " + type_name(actions));
+  for (const auto& [what, fn] :
+       {std::pair<const char*, py::handle>{"observation", observation}, {"decode", decode}}) {
     if (!fn.is_none() && !PyCallable_Check(fn.ptr())) {
       throw DtypeError(std::string(what) + " must be callable or None, got a " + type_name(fn));
     }
   }
-  const CommonOptions o = common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
+  const CommonOptions o =
+      common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
-  auto representation = std::make_shared<PythonRepresentation>(actions, observation, decode, extras);
+  auto representation =
+      std::make_shared<PythonRepresentation>(actions, observation, decode, extras);
   props::ClassifierOptions c = classifier_for(o);
   c.observation = representation->has_observation();
   const props::Classification result = props::classify_representation(representation, c);
   return json_loads(props::audit_json({result}))["representations"][py::int_(0)];
 }
 
-py::dict audit_policy(py::object policy, py::handle groups, py::handle views, int cases, std::uint64_t seed,
-                      std::optional<double> tolerance, const std::string& precision, int noise,
-                      py::handle extra_poses, py::handle scalars) {
-  if (!PyCallable_Check(policy.ptr())) throw DtypeError("policy must be callable, got a " + type_name(policy));
-  if (noise < 1) throw InvalidArgument("noise must be at least 1 (numbers per call), got " + std::to_string(noise));
-  const CommonOptions o = common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
+py::dict audit_policy(py::object policy, py::handle groups, py::handle views, int cases,
+                      std::uint64_t seed, std::optional<double> tolerance,
+                      const std::string& precision, int noise, py::handle extra_poses,
+                      py::handle scalars) {
+  if (!PyCallable_Check(policy.ptr()))
+    throw DtypeError("policy must be callable, got a " + type_name(policy));
+  if (noise < 1)
+    throw InvalidArgument("noise must be at least 1 (numbers per call), got " +
+                          std::to_string(noise));
+  const CommonOptions o =
+      common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
-  const props::Classification result =
-      props::classify_policy(std::make_shared<PythonPolicy>(policy, noise, extras), classifier_for(o));
+  const props::Classification result = props::classify_policy(
+      std::make_shared<PythonPolicy>(policy, noise, extras), classifier_for(o));
   return json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
 }
 
 void assert_invariant(py::object fn, const std::string& group, const std::string& component_name,
                       py::object observation, py::handle views, int cases, std::uint64_t seed,
-                      std::optional<double> tolerance, const std::string& precision, py::handle extra_poses,
-                      py::handle scalars) {
+                      std::optional<double> tolerance, const std::string& precision,
+                      py::handle extra_poses, py::handle scalars) {
   if (!PyCallable_Check(fn.ptr())) throw DtypeError("fn must be callable, got a " + type_name(fn));
   const props::Component component = component_of(component_name);
-  const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision, extra_poses, scalars);
+  const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
+                                         extra_poses, scalars);
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
   props::ClassifierOptions c = classifier_for(o);
   props::Classification result;
   if (component == props::Component::observation) {
     // fn is the observation function; the actions are never asked for.
-    auto representation = std::make_shared<PythonRepresentation>(py::cpp_function([](py::args) { return py::none(); }),
-                                                                 fn, py::none(), extras);
+    auto representation = std::make_shared<PythonRepresentation>(
+        py::cpp_function([](py::args) { return py::none(); }), fn, py::none(), extras);
     result.name = "python: " + callable_name(fn);
     for (props::View view : c.views) {
       const props::CheckOptions check = props::with_view(c.check, view);
       const props::SceneFunction f = props::observation_of(representation);
       result.verdicts.push_back(props::with_float32_note(
           props::check_invariance(f, component, o.audit.groups[0], check), c,
-          [&](const props::CheckOptions& again) { return props::check_invariance(f, component, o.audit.groups[0], again); }));
+          [&](const props::CheckOptions& again) {
+            return props::check_invariance(f, component, o.audit.groups[0], again);
+          }));
     }
   } else {
-    auto representation = std::make_shared<PythonRepresentation>(fn, observation, py::none(), extras);
+    auto representation =
+        std::make_shared<PythonRepresentation>(fn, observation, py::none(), extras);
     c.observation = false;
     c.injectivity = false;
     c.flow = component != props::Component::actions;
     result = props::classify_representation(representation, c);
-    std::erase_if(result.verdicts, [component](const props::Verdict& v) { return v.component != component; });
+    std::erase_if(result.verdicts,
+                  [component](const props::Verdict& v) { return v.component != component; });
   }
-  assert_all_hold(result, false,
-                  "replay: the same call with seed=" + std::to_string(seed) + " finds the same witness");
+  assert_all_hold(
+      result, false,
+      "replay: the same call with seed=" + std::to_string(seed) + " finds the same witness");
 }
 
-void assert_equivariant(py::object policy, const std::string& group, const std::string& mode, py::handle views,
-                        int cases, std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
-                        int noise, py::handle extra_poses, py::handle scalars) {
-  if (!PyCallable_Check(policy.ptr())) throw DtypeError("policy must be callable, got a " + type_name(policy));
-  if (noise < 1) throw InvalidArgument("noise must be at least 1 (numbers per call), got " + std::to_string(noise));
+void assert_equivariant(py::object policy, const std::string& group, const std::string& mode,
+                        py::handle views, int cases, std::uint64_t seed,
+                        std::optional<double> tolerance, const std::string& precision, int noise,
+                        py::handle extra_poses, py::handle scalars) {
+  if (!PyCallable_Check(policy.ptr()))
+    throw DtypeError("policy must be callable, got a " + type_name(policy));
+  if (noise < 1)
+    throw InvalidArgument("noise must be at least 1 (numbers per call), got " +
+                          std::to_string(noise));
   if (mode != "pointwise" && mode != "distribution" && mode != "both") {
-    throw InvalidArgument("unknown mode '" + mode + "'; use pointwise (the same noise for o and g o), "
+    throw InvalidArgument("unknown mode '" + mode +
+                          "'; use pointwise (the same noise for o and g o), "
                           "distribution (independent noise) or both");
   }
-  const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision, extra_poses, scalars);
+  const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
+                                         extra_poses, scalars);
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
   props::ClassifierOptions c = classifier_for(o);
   c.in_distribution = mode != "pointwise";
-  props::Classification result = props::classify_policy(std::make_shared<PythonPolicy>(policy, noise, extras), c);
+  props::Classification result =
+      props::classify_policy(std::make_shared<PythonPolicy>(policy, noise, extras), c);
   if (mode == "distribution") {
-    std::erase_if(result.verdicts, [](const props::Verdict& v) { return v.mode != props::Mode::distribution; });
+    std::erase_if(result.verdicts,
+                  [](const props::Verdict& v) { return v.mode != props::Mode::distribution; });
   }
-  const bool pointwise_failed = std::any_of(result.verdicts.begin(), result.verdicts.end(), [](const props::Verdict& v) {
-    return !v.invariant && v.mode == props::Mode::pointwise;
-  });
-  std::string hint = "replay: the same call with seed=" + std::to_string(seed) + " finds the same witness";
+  const bool pointwise_failed = std::any_of(
+      result.verdicts.begin(), result.verdicts.end(),
+      [](const props::Verdict& v) { return !v.invariant && v.mode == props::Mode::pointwise; });
+  std::string hint =
+      "replay: the same call with seed=" + std::to_string(seed) + " finds the same witness";
   if (pointwise_failed && mode == "pointwise") {
-    hint += "\nA policy equivariant only in law (e.g. noise added in the world frame) passes mode='distribution'.";
+    hint +=
+        "\nA policy equivariant only in law (e.g. noise added in the world frame) passes "
+        "mode='distribution'.";
   }
   assert_all_hold(result, true, hint);
 }
 
 // Built-ins on NumPy
 
-Scene scene_from(py::handle history, py::handle chunk, py::handle hand_points, py::handle world_points) {
+Scene scene_from(py::handle history, py::handle chunk, py::handle hand_points,
+                 py::handle world_points) {
   Scene scene;
   scene.world_T_hand_history = poses_from(history, "history", false, "(H+1, 4, 4)");
   if (!chunk.is_none()) scene.world_T_hand_chunk = poses_from(chunk, "chunk", false, "(K, 4, 4)");
@@ -626,8 +689,10 @@ PYBIND11_MODULE(handcentric, m) {
   using namespace handcentric;
   using namespace handcentric::python;
   namespace props = handcentric::props;
-  m.doc() = "Audit action representations and whole policies for equivariance under global rigid transforms "
-            "(docs/AUDIT.md, docs/AUDIT_YOUR_POLICY.md).";
+  m.doc() =
+      "Audit action representations and whole policies for equivariance under global rigid "
+      "transforms "
+      "(docs/AUDIT.md, docs/AUDIT_YOUR_POLICY.md).";
   m.attr("__version__") = HANDCENTRIC_VERSION;
 
   static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
@@ -654,59 +719,78 @@ PYBIND11_MODULE(handcentric, m) {
   m.attr("VIEWS") = both_views;
   m.attr("REPRESENTATIONS") = py::cast(builtin_representation_names());
 
-  m.def("audit", &audit, py::arg("actions"), py::arg("observation") = py::none(), py::arg("groups") = all_groups,
-        py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+  m.def("audit", &audit, py::arg("actions"), py::arg("observation") = py::none(),
+        py::arg("groups") = all_groups, py::arg("views") = both_views,
+        py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
         py::arg("tolerance") = py::none(), py::arg("precision") = "float64", py::kw_only(),
-        py::arg("decode") = py::none(), py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
-        R"doc(Audit a representation written in Python; returns one representation of `handcentric audit --json`.
+        py::arg("decode") = py::none(), py::arg("extra_poses") = py::tuple(),
+        py::arg("scalars") = py::tuple(),
+        R"doc(Audit a representation written in Python.
 
-actions(history, chunk, hand_points, world_points) -> 1-D array, with history (H+1, 4, 4) (index 0 = T_0,
-the hand now, then T_-1, ...), chunk (K, 4, 4) = T_1..T_K, hand_points (n, 3) in the hand frame at T_0,
-world_points (m, 3) in the world frame; every pose is world_T_hand. observation(history, hand_points,
-world_points) -> 1-D array (optional). decode(actions, history, hand_points, world_points) -> (K, 4, 4)
-(optional: lets the audit prove the map injective). The flow components are the rectified flow's (eq. 5).
-With extra_poses / scalars (names), every callable also gets extra_poses={name: (4, 4)}, scalars={name: x}.)doc");
+Returns one representation of `handcentric audit --json`.
+actions(history, chunk, hand_points, world_points) -> 1-D array, with history (H+1, 4, 4)
+(index 0 = T_0, the hand now, then T_-1, ...), chunk (K, 4, 4) = T_1..T_K, hand_points (n, 3)
+in the hand frame at T_0, world_points (m, 3) in the world frame; every pose is world_T_hand.
+observation(history, hand_points, world_points) -> 1-D array (optional).
+decode(actions, history, hand_points, world_points) -> (K, 4, 4) (optional: lets the audit
+prove the map injective). The flow components are the rectified flow's (eq. 5).
+With extra_poses / scalars (names), every callable also gets extra_poses={name: (4, 4)},
+scalars={name: x}.)doc");
 
   m.def("audit_policy", &audit_policy, py::arg("policy"), py::arg("groups") = all_groups,
         py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
-        py::arg("tolerance") = py::none(), py::arg("precision") = "float64", py::arg("noise") = props::kPolicyNoise,
-        py::kw_only(), py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
-        R"doc(Audit a whole policy (eq. 4) pointwise and in distribution; returns one policy of `audit --json`.
+        py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
+        py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
+        py::arg("scalars") = py::tuple(),
+        R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
-policy(history, hand_points, world_points, noise) -> (K, 4, 4), the world-frame chunk T_1..T_K; noise is a
-float64 vector of `noise` standard normals and must be the policy's only randomness.)doc");
+Returns one policy of `audit --json`.
+policy(history, hand_points, world_points, noise) -> (K, 4, 4), the world-frame chunk
+T_1..T_K; noise is a float64 vector of `noise` standard normals and must be the policy's only
+randomness.)doc");
 
-  m.def("assert_invariant", &assert_invariant, py::arg("fn"), py::arg("group"), py::arg("component") = "actions",
-        py::kw_only(), py::arg("observation") = py::none(), py::arg("views") = both_views,
-        py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1, py::arg("tolerance") = py::none(),
-        py::arg("precision") = "float64", py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
-        R"doc(Raise AssertionError, with the shrunk witness, unless `component` is invariant under `group`.
+  m.def("assert_invariant", &assert_invariant, py::arg("fn"), py::arg("group"),
+        py::arg("component") = "actions", py::kw_only(), py::arg("observation") = py::none(),
+        py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+        py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
+        py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
+        R"doc(Raise AssertionError unless `component` is invariant under `group`.
 
-component "actions": fn is the actions function; "observation": fn is the observation function;
-"flow_input" / "flow_target": fn is the actions function, observation= the observation function, and the
-rectified flow is checked pointwise and in distribution. Every view in `views` must hold.)doc");
+The error carries the shrunk witness.
+component "actions": fn is the actions function; "observation": fn is the observation
+function; "flow_input" / "flow_target": fn is the actions function, observation= the
+observation function, and the rectified flow is checked pointwise and in distribution.
+Every view in `views` must hold.)doc");
 
-  m.def("assert_equivariant", &assert_equivariant, py::arg("policy"), py::arg("group"), py::kw_only(),
-        py::arg("mode") = "pointwise", py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases,
-        py::arg("seed") = 1, py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
-        py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
-        R"doc(Raise AssertionError, with the shrunk witness, unless policy(g o, n) = g policy(o, n) under `group`.
+  m.def("assert_equivariant", &assert_equivariant, py::arg("policy"), py::arg("group"),
+        py::kw_only(), py::arg("mode") = "pointwise", py::arg("views") = both_views,
+        py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+        py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
+        py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
+        py::arg("scalars") = py::tuple(),
+        R"doc(Raise AssertionError unless policy(g o, n) = g policy(o, n) under `group`.
 
-mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which implies the law's),
-"distribution" (independent noise: the laws compared) or "both". Every view in `views` must hold.)doc");
+The error carries the shrunk witness.
+mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which
+implies the law's), "distribution" (independent noise: the laws compared) or "both".
+Every view in `views` must hold.)doc");
 
   m.def(
       "encode_actions",
-      [](const std::string& name, py::handle history, py::handle chunk, py::handle hand_points, py::handle world_points) {
-        return array_of(make_representation(name)->encode_actions(scene_from(history, chunk, hand_points, world_points)));
+      [](const std::string& name, py::handle history, py::handle chunk, py::handle hand_points,
+         py::handle world_points) {
+        return array_of(make_representation(name)->encode_actions(
+            scene_from(history, chunk, hand_points, world_points)));
       },
-      py::arg("representation"), py::arg("history"), py::arg("chunk"), py::arg("hand_points") = py::none(),
-      py::arg("world_points") = py::none(), "A built-in representation's action vector (6 numbers per pose).");
+      py::arg("representation"), py::arg("history"), py::arg("chunk"),
+      py::arg("hand_points") = py::none(), py::arg("world_points") = py::none(),
+      "A built-in representation's action vector (6 numbers per pose).");
   m.def(
       "encode_observation",
-      [](const std::string& name, py::handle history, py::handle hand_points, py::handle world_points) {
-        return array_of(
-            make_representation(name)->encode_observation(scene_from(history, py::none(), hand_points, world_points)));
+      [](const std::string& name, py::handle history, py::handle hand_points,
+         py::handle world_points) {
+        return array_of(make_representation(name)->encode_observation(
+            scene_from(history, py::none(), hand_points, world_points)));
       },
       py::arg("representation"), py::arg("history"), py::arg("hand_points") = py::none(),
       py::arg("world_points") = py::none(), "A built-in representation's observation vector.");
@@ -714,7 +798,8 @@ mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee
       "decode",
       [](const std::string& name, py::handle actions, py::handle world_T_hand0) {
         const auto representation = make_representation(name);
-        const RigidTransform T0 = RigidTransform::from_matrix(matrix4_from(world_T_hand0, "world_T_hand0"));
+        const RigidTransform T0 =
+            RigidTransform::from_matrix(matrix4_from(world_T_hand0, "world_T_hand0"));
         return array_of(representation->decode_actions(vector_from(actions, "actions"), T0));
       },
       py::arg("representation"), py::arg("actions"), py::arg("world_T_hand0"),
@@ -748,7 +833,8 @@ mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee
       "se3_exp",
       [](py::handle twist) {
         const Eigen::VectorXd v = vector_from(twist, "twist");
-        if (v.size() != 6) throw ShapeError("twist has shape (" + std::to_string(v.size()) + ",); expected (6,)");
+        if (v.size() != 6)
+          throw ShapeError("twist has shape (" + std::to_string(v.size()) + ",); expected (6,)");
         return array_of(RigidTransform::exp(Twist(v)).matrix());
       },
       py::arg("twist"), "exp of a twist (rho, omega), (6,) -> (4, 4)");
@@ -767,13 +853,15 @@ mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee
         return out;
       },
       py::arg("path"),
-      "A `handcentric demos` file as a list of {'world_T_hole': (4, 4), 'world_T_hand': (T, 4, 4)}.");
+      "A `handcentric demos` file as a list of {'world_T_hole': (4, 4), 'world_T_hand': (T, 4, "
+      "4)}.");
   m.def(
       "training_scenes",
       [](const std::string& path, int history, int chunk) {
         std::vector<Scene> scenes;
         for (const sim::Demo& demo : sim::load_demos(path)) {
-          for (Scene& s : sim::training_scenes(demo, history, chunk)) scenes.push_back(std::move(s));
+          for (Scene& s : sim::training_scenes(demo, history, chunk))
+            scenes.push_back(std::move(s));
         }
         const auto n = static_cast<py::ssize_t>(scenes.size());
         py::array_t<double> H({n, py::ssize_t{history + 1}, py::ssize_t{4}, py::ssize_t{4}});
@@ -784,7 +872,8 @@ mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee
           const Scene& s = scenes[static_cast<std::size_t>(i)];
           auto copy = [i](py::array_t<double>& into, const py::array_t<double>& one) {
             const auto per = static_cast<std::size_t>(one.size());
-            std::memcpy(into.mutable_data() + per * static_cast<std::size_t>(i), one.data(), per * sizeof(double));
+            std::memcpy(into.mutable_data() + per * static_cast<std::size_t>(i), one.data(),
+                        per * sizeof(double));
           };
           copy(H, array_of(s.world_T_hand_history));
           copy(K, array_of(s.world_T_hand_chunk));
@@ -797,6 +886,8 @@ mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee
         return d;
       },
       py::arg("path"), py::kw_only(), py::arg("history") = 0, py::arg("chunk") = 8,
-      "Every control step of every demo in a file, stacked: {'history': (N, H+1, 4, 4), 'chunk': (N, K, 4, 4), "
-      "'hand_points': (N, 2, 3)} (the sim's eye-in-hand points: the hole's corners in the hand frame).");
+      "Every control step of every demo in a file, stacked: {'history': (N, H+1, 4, 4), 'chunk': "
+      "(N, K, 4, 4), "
+      "'hand_points': (N, 2, 3)} (the sim's eye-in-hand points: the hole's corners in the hand "
+      "frame).");
 }

@@ -36,13 +36,16 @@ RectifiedFlow::RectifiedFlow(std::shared_ptr<const Representation> representatio
   if (!representation_) throw InvalidArgument("RectifiedFlow needs a representation, got null");
 }
 
-std::string RectifiedFlow::name() const { return "rectified_flow(" + representation_->name() + ")"; }
+std::string RectifiedFlow::name() const {
+  return "rectified_flow(" + representation_->name() + ")";
+}
 
 Eigen::Index RectifiedFlow::noise_dimension(const Scene& scene) const {
   return representation_->encode_actions(scene).size();
 }
 
-FlowSample RectifiedFlow::operator()(const Scene& scene, const Eigen::VectorXd& eps, double t) const {
+FlowSample RectifiedFlow::operator()(const Scene& scene, const Eigen::VectorXd& eps,
+                                     double t) const {
   const Eigen::VectorXd a = representation_->encode_actions(scene);
   require_noise(eps, a.size(), t, name());
   // eq. (5): x_t = t a + (1 - t) eps, regression target a - eps.
@@ -54,7 +57,8 @@ Eigen::Index ActionFlowTarget::noise_dimension(const Scene& scene) const {
   return 3 * static_cast<Eigen::Index>(scene.world_T_hand_chunk.size());
 }
 
-FlowSample ActionFlowTarget::operator()(const Scene& scene, const Eigen::VectorXd& eps, double t) const {
+FlowSample ActionFlowTarget::operator()(const Scene& scene, const Eigen::VectorXd& eps,
+                                        double t) const {
   scene.validate();
   require_noise(eps, noise_dimension(scene), t, name());
   const Eigen::Index K = scene.chunk_length();

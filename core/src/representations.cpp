@@ -56,8 +56,8 @@ Eigen::Index chunk_length_of(const Eigen::VectorXd& actions, const std::string& 
                           "; it must be 6K (translation and rotation vector per action), K >= 1");
   }
   if (!actions.allFinite()) {
-    throw InvalidArgument(representation + " action vector has a non-finite entry: " +
-                          format_matrix(actions));
+    throw InvalidArgument(representation +
+                          " action vector has a non-finite entry: " + format_matrix(actions));
   }
   return actions.size() / kPoseSize;
 }
@@ -117,9 +117,9 @@ std::vector<RigidTransform> RelativeRepresentation::decode_actions(
   std::vector<RigidTransform> chunk;
   chunk.reserve(static_cast<std::size_t>(K));
   for (Eigen::Index k = 0; k < K; ++k) {
-    chunk.push_back(RigidTransform::unchecked(
-        R0 * so3::exp(actions.segment<3>(kPoseSize * k + 3)),
-        world_T_hand0.translation() + actions.segment<3>(kPoseSize * k)));
+    chunk.push_back(
+        RigidTransform::unchecked(R0 * so3::exp(actions.segment<3>(kPoseSize * k + 3)),
+                                  world_T_hand0.translation() + actions.segment<3>(kPoseSize * k)));
   }
   return chunk;
 }
@@ -150,9 +150,9 @@ std::vector<RigidTransform> RelativeDiffRepresentation::decode_actions(
   std::vector<RigidTransform> chunk;
   chunk.reserve(static_cast<std::size_t>(K));
   for (Eigen::Index k = 0; k < K; ++k) {
-    chunk.push_back(RigidTransform::unchecked(
-        so3::exp(r0 + actions.segment<3>(kPoseSize * k + 3)),
-        world_T_hand0.translation() + actions.segment<3>(kPoseSize * k)));
+    chunk.push_back(
+        RigidTransform::unchecked(so3::exp(r0 + actions.segment<3>(kPoseSize * k + 3)),
+                                  world_T_hand0.translation() + actions.segment<3>(kPoseSize * k)));
   }
   return chunk;
 }

@@ -28,7 +28,8 @@ Eigen::Matrix3d left_jacobian(const Eigen::Vector3d& omega) {
     ::sincos(half, &s, &c);
     const double phi = 2.0 * half;
     const Eigen::Matrix3d U = so3::hat(u);
-    return Eigen::Matrix3d::Identity() + (2.0 * s * s / phi) * U + (1.0 - 2.0 * s * c / phi) * U * U;
+    return Eigen::Matrix3d::Identity() + (2.0 * s * s / phi) * U +
+           (1.0 - 2.0 * s * c / phi) * U * U;
   }
   const double phi = std::sqrt(phi2);
   double b, c;

@@ -19,10 +19,10 @@ Rotation Rotation::from_matrix(const Eigen::Matrix3d& R) {
   // -inf into nan, and "nan > tolerance" is false.
   const double orthonormality_error = (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
   if (!(orthonormality_error <= kOrthonormalityTolerance)) {
-    throw InvalidRotation("matrix is not orthonormal: |R^T R - I|_F = " +
-                          format_number(orthonormality_error) + " > " +
-                          format_number(kOrthonormalityTolerance) + " for R = " + format_matrix(R) +
-                          "; project it with Rotation::nearest(R) if it is a rounded rotation");
+    throw InvalidRotation(
+        "matrix is not orthonormal: |R^T R - I|_F = " + format_number(orthonormality_error) +
+        " > " + format_number(kOrthonormalityTolerance) + " for R = " + format_matrix(R) +
+        "; project it with Rotation::nearest(R) if it is a rounded rotation");
   }
   const double determinant = R.determinant();
   if (!(determinant > 0.0)) {
@@ -52,7 +52,8 @@ Rotation Rotation::nearest(const Eigen::Matrix3d& M) {
 Rotation Rotation::from_quaternion(double w, double x, double y, double z) {
   const Eigen::Vector4d given(w, x, y, z);
   if (!given.allFinite()) {
-    throw InvalidRotation("quaternion has a non-finite entry: (w, x, y, z) = " + format_matrix(given));
+    throw InvalidRotation("quaternion has a non-finite entry: (w, x, y, z) = " +
+                          format_matrix(given));
   }
   Eigen::Vector4d q = given;
   double norm2 = q.squaredNorm();
@@ -80,7 +81,8 @@ Rotation Rotation::from_quaternion(double w, double x, double y, double z) {
 
 Rotation Rotation::exp(const Eigen::Vector3d& rotation_vector) {
   if (!rotation_vector.allFinite()) {
-    throw InvalidRotation("rotation vector has a non-finite entry: " + format_matrix(rotation_vector));
+    throw InvalidRotation("rotation vector has a non-finite entry: " +
+                          format_matrix(rotation_vector));
   }
   return Rotation(so3::exp(rotation_vector));
 }
@@ -95,10 +97,16 @@ Rotation Rotation::about_z(double angle) {
   return Rotation(R);
 }
 
-Eigen::Vector3d Rotation::log() const { return so3::log(world_R_body_); }
+Eigen::Vector3d Rotation::log() const {
+  return so3::log(world_R_body_);
+}
 
-double Rotation::angle() const { return so3::angle(world_R_body_); }
+double Rotation::angle() const {
+  return so3::angle(world_R_body_);
+}
 
-double distance(const Rotation& a, const Rotation& b) { return (a.matrix() - b.matrix()).norm(); }
+double distance(const Rotation& a, const Rotation& b) {
+  return (a.matrix() - b.matrix()).norm();
+}
 
 }  // namespace handcentric

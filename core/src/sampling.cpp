@@ -58,8 +58,6 @@ RigidTransform random_transform(std::mt19937_64& rng, double max_abs) {
   return RigidTransform(R, uniform_box(rng, max_abs));
 }
 
-
-
 namespace {
 
 RigidTransform random_step(std::mt19937_64& rng) {
@@ -73,8 +71,9 @@ RigidTransform random_step(std::mt19937_64& rng) {
 Scene random_scene(std::mt19937_64& rng, int H, int K, int hand_points, int world_points,
                    double max_abs) {
   if (H < 0 || K < 1 || hand_points < 0 || world_points < 0) {
-    throw InvalidArgument("random_scene needs H >= 0, K >= 1 and non-negative point counts, got H = " +
-                          std::to_string(H) + ", K = " + std::to_string(K));
+    throw InvalidArgument(
+        "random_scene needs H >= 0, K >= 1 and non-negative point counts, got H = " +
+        std::to_string(H) + ", K = " + std::to_string(K));
   }
   Scene scene;
   scene.world_T_hand_history.push_back(random_transform(rng, max_abs));

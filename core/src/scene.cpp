@@ -56,7 +56,8 @@ Scene operator*(const RigidTransform& g, const Scene& scene) {
   }
   moved.hand_points = scene.hand_points;  // eye-in-hand: unchanged (Sec. 3.2)
   moved.extra_poses.reserve(scene.extra_poses.size());
-  for (const auto& [name, world_T_other] : scene.extra_poses) moved.extra_poses.emplace_back(name, g * world_T_other);
+  for (const auto& [name, world_T_other] : scene.extra_poses)
+    moved.extra_poses.emplace_back(name, g * world_T_other);
   moved.scalars = scene.scalars;
   return moved;
 }

@@ -128,7 +128,8 @@ Eigen::Vector3d log(const Eigen::Matrix3d& R) {
   const Eigen::Vector3d sin_axis = skew_vector(R);  // sin(phi) v
   const double sine = sin_axis.norm();
   const double cosine = 0.5 * (R.trace() - 1.0);
-  const double inv_sine = 1.0 / sine;  // before the call, so the division overlaps it (inf at 0: unused)
+  const double inv_sine =
+      1.0 / sine;  // before the call, so the division overlaps it (inf at 0: unused)
   const double phi = angle_from(sine, cosine);
 
   if (cosine > kNearPiCosine) {

@@ -32,7 +32,8 @@ class HalfHandCentric final : public handcentric::Representation {
   }
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     Eigen::VectorXd o(3 * static_cast<Eigen::Index>(scene.hand_points.size()));
-    for (std::size_t i = 0; i < scene.hand_points.size(); ++i) o.segment<3>(3 * static_cast<Eigen::Index>(i)) = scene.hand_points[i];
+    for (std::size_t i = 0; i < scene.hand_points.size(); ++i)
+      o.segment<3>(3 * static_cast<Eigen::Index>(i)) = scene.hand_points[i];
     return o;
   }
   std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
@@ -61,7 +62,8 @@ auto actions_invariant_under(handcentric::props::Group group) {
 }  // namespace
 
 TEST_CASE("half_hand_centric_actions_are_translation_invariant", "[property]") {
-  handcentric::props::require_property("translation", actions_invariant_under(handcentric::props::Group::translation));
+  handcentric::props::require_property(
+      "translation", actions_invariant_under(handcentric::props::Group::translation));
 }
 
 TEST_CASE("half_hand_centric_actions_are_not_rotation_invariant", "[property]") {

@@ -12,18 +12,24 @@ namespace handcentric::experiments {
 
 std::string to_string(SceneSet set) {
   switch (set) {
-    case SceneSet::id: return "id";
-    case SceneSet::ood: return "ood";
-    case SceneSet::paired: return "paired";
+    case SceneSet::id:
+      return "id";
+    case SceneSet::ood:
+      return "ood";
+    case SceneSet::paired:
+      return "paired";
   }
   return "?";
 }
 
 std::string Cell::describe() const {
-  return method + "/" + head + ", " + std::to_string(demos) + " demos, train seed " + std::to_string(train_seed);
+  return method + "/" + head + ", " + std::to_string(demos) + " demos, train seed " +
+         std::to_string(train_seed);
 }
 
-std::string Cell::model_path() const { return "models/" + hash + ".hcm"; }
+std::string Cell::model_path() const {
+  return "models/" + hash + ".hcm";
+}
 
 std::string Cell::result_path(SceneSet set, const EvalSettings& eval) const {
   return "results/" + hash + "." + to_string(set) + "-s" + std::to_string(eval.seed(set)) + "-n" +
@@ -42,10 +48,11 @@ std::string digest(const std::string& bytes) {
 }
 
 std::string cell_hash(const Cell& cell) {
-  const std::string text = "handcentric table1 cell\ndemo_digest=" + cell.demo_digest +
-                           "\ndemos=" + std::to_string(cell.demos) + "\ntrain_seed=" + std::to_string(cell.train_seed) +
-                           "\n" + cell.data.to_text() + "model_format=" + std::to_string(policy::kModelFormatVersion) + "\n" +
-                           cell.config.to_text();
+  const std::string text =
+      "handcentric table1 cell\ndemo_digest=" + cell.demo_digest +
+      "\ndemos=" + std::to_string(cell.demos) + "\ntrain_seed=" + std::to_string(cell.train_seed) +
+      "\n" + cell.data.to_text() + "model_format=" + std::to_string(policy::kModelFormatVersion) +
+      "\n" + cell.config.to_text();
   return digest(text);
 }
 
@@ -53,9 +60,10 @@ int automatic_steps(const sim::TrainingData& data, long long demo_samples) {
   return policy::training_budget(data.samples(demo_samples));
 }
 
-Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
-               std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps,
-               const sim::TrainingData& data, std::array<double, 2> c8_centre) {
+Cell make_cell(const std::string& method, const std::string& representation,
+               const std::string& head, int demos, std::uint64_t train_seed, long long demo_samples,
+               const std::string& demo_digest, int steps, const sim::TrainingData& data,
+               std::array<double, 2> c8_centre) {
   Cell cell;
   cell.method = method;
   cell.head = head;

@@ -9,7 +9,9 @@
 
 namespace handcentric::experiments::drawing {
 
-inline cv::Scalar rgb(int r, int g, int b) { return cv::Scalar(b, g, r); }  // OpenCV stores BGR
+inline cv::Scalar rgb(int r, int g, int b) {
+  return cv::Scalar(b, g, r);
+}  // OpenCV stores BGR
 
 inline void text(cv::Mat& canvas, const std::string& s, cv::Point at, double scale = 0.5,
                  const cv::Scalar& colour = rgb(20, 20, 20)) {

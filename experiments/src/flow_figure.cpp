@@ -25,7 +25,9 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kHistory = 0;
 constexpr int kChunk = 16;
 
-Eigen::Vector2d first_position(const Eigen::VectorXd& actions) { return actions.head<2>(); }
+Eigen::Vector2d first_position(const Eigen::VectorXd& actions) {
+  return actions.head<2>();
+}
 
 // A column's plotting window: every point of both rows and the noise, with a margin, square.
 struct Window {
@@ -53,26 +55,35 @@ PanelBox flow_panel_box(int column, int row, int panel_size) {
 
 void FlowFigureOptions::validate() const {
   if (demos < 1 || demos > 1000) {
-    throw InvalidArgument("flow figure: demos = " + std::to_string(demos) + " is outside [1, 1000]");
+    throw InvalidArgument("flow figure: demos = " + std::to_string(demos) +
+                          " is outside [1, 1000]");
   }
   if (noise_draws < 1 || noise_draws > 200) {
-    throw InvalidArgument("flow figure: noise_draws = " + std::to_string(noise_draws) + " is outside [1, 200]");
+    throw InvalidArgument("flow figure: noise_draws = " + std::to_string(noise_draws) +
+                          " is outside [1, 200]");
   }
-  if (!std::isfinite(rotation_deg) || !std::isfinite(translation_x) || !std::isfinite(translation_y)) {
-    throw InvalidArgument("flow figure: the transform g needs finite numbers (rotation_deg, translation_x/_y)");
+  if (!std::isfinite(rotation_deg) || !std::isfinite(translation_x) ||
+      !std::isfinite(translation_y)) {
+    throw InvalidArgument(
+        "flow figure: the transform g needs finite numbers (rotation_deg, translation_x/_y)");
   }
 }
 
 FlowFigure compute_flow_figure(const FlowFigureOptions& options) {
   options.validate();
   const sim::CollisionChecker checker;
-  const auto task_scenes = sim::sample_scenes(sim::SceneDistribution::train(), options.demos, options.seed);
+  const auto task_scenes =
+      sim::sample_scenes(sim::SceneDistribution::train(), options.demos, options.seed);
   const sim::ExpertRun run = sim::expert_demos(task_scenes, options.seed, checker);
-  if (run.demos.empty()) throw Error("flow figure: the expert solved none of the " + std::to_string(options.demos) + " scenes");
-  const std::vector<Scene> scenes = sim::training_scenes(run.demos, kHistory, kChunk, 0, checker.geometry());
+  if (run.demos.empty())
+    throw Error("flow figure: the expert solved none of the " + std::to_string(options.demos) +
+                " scenes");
+  const std::vector<Scene> scenes =
+      sim::training_scenes(run.demos, kHistory, kChunk, 0, checker.geometry());
 
   FlowFigure figure;
-  figure.g = RigidTransform::planar(options.rotation_deg * kPi / 180.0, options.translation_x, options.translation_y);
+  figure.g = RigidTransform::planar(options.rotation_deg * kPi / 180.0, options.translation_x,
+                                    options.translation_y);
   std::mt19937_64 rng(options.seed);
   for (int i = 0; i < options.noise_draws; ++i) {
     const double x = standard_normal(rng);
@@ -86,7 +97,8 @@ FlowFigure compute_flow_figure(const FlowFigureOptions& options) {
     FlowColumn column;
     column.representation = name;
     column.training_positions.reserve(scenes.size());
-    for (const Scene& scene : scenes) column.training_positions.push_back(first_position(representation->encode_actions(scene)));
+    for (const Scene& scene : scenes)
+      column.training_positions.push_back(first_position(representation->encode_actions(scene)));
     const Eigen::VectorXd a_original = representation->encode_actions(chosen);
     const Eigen::VectorXd a_moved = representation->encode_actions(moved);
     column.original = first_position(a_original);
@@ -100,16 +112,21 @@ FlowFigure compute_flow_figure(const FlowFigureOptions& options) {
 sim::Image draw_flow_figure(const FlowFigure& figure, int panel_size) {
   if (figure.columns.empty()) throw InvalidArgument("draw_flow_figure: no columns to draw");
   if (panel_size < 160 || panel_size > 2000) {
-    throw InvalidArgument("draw_flow_figure: panel_size " + std::to_string(panel_size) + " is outside [160, 2000]");
+    throw InvalidArgument("draw_flow_figure: panel_size " + std::to_string(panel_size) +
+                          " is outside [160, 2000]");
   }
   const int columns = static_cast<int>(figure.columns.size());
   const int width = kLeft + columns * (panel_size + kGap);
   const int height = kTop + 2 * (panel_size + kCaption) + 40;
   cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   const cv::Scalar blue = rgb(86, 140, 210), orange = rgb(230, 120, 0), grey = rgb(150, 150, 150);
-  text(canvas, "Fig. 3: flow of a_1's position towards one chunk's a_1 (orange) and all training a_1 (blue)",
-       cv::Point(kLeft, 28), 0.6);
-  text(canvas, "x, y in cm, each column at one scale; + marks the origin of the representation's frame; grey dots: noise draws",
+  text(
+      canvas,
+      "Fig. 3: flow of a_1's position towards one chunk's a_1 (orange) and all training a_1 (blue)",
+      cv::Point(kLeft, 28), 0.6);
+  text(canvas,
+       "x, y in cm, each column at one scale; + marks the origin of the representation's frame; "
+       "grey dots: noise draws",
        cv::Point(kLeft, 52), 0.45);
   const char* row_names[2] = {"chunk", "g * chunk"};
   for (int row = 0; row < 2; ++row) {
@@ -127,15 +144,18 @@ sim::Image draw_flow_figure(const FlowFigure& figure, int panel_size) {
         return cv::Point(x0 + static_cast<int>(std::lround((0.5 + s.x()) * panel_size)),
                          y0 + static_cast<int>(std::lround((0.5 - s.y()) * panel_size)));
       };
-      cv::rectangle(canvas, cv::Point(x0, y0), cv::Point(x0 + panel_size, y0 + panel_size), grey, 1);
+      cv::rectangle(canvas, cv::Point(x0, y0), cv::Point(x0 + panel_size, y0 + panel_size), grey,
+                    1);
       // The origin of the representation's frame (the world's, or the hand's now).
       const cv::Point origin = px(Eigen::Vector2d::Zero());
       cv::drawMarker(canvas, origin, grey, cv::MARKER_CROSS, 12, 1);
-      for (const auto& p : column.training_positions) cv::circle(canvas, px(p), 2, blue, cv::FILLED, cv::LINE_AA);
+      for (const auto& p : column.training_positions)
+        cv::circle(canvas, px(p), 2, blue, cv::FILLED, cv::LINE_AA);
       const Eigen::Vector2d target = row == 0 ? column.original : column.transformed;
       for (const auto& eps : figure.noise) {
         cv::circle(canvas, px(eps), 3, grey, cv::FILLED, cv::LINE_AA);
-        cv::arrowedLine(canvas, px(eps), px(eps + 0.92 * (target - eps)), orange, 1, cv::LINE_AA, 0, 0.04);
+        cv::arrowedLine(canvas, px(eps), px(eps + 0.92 * (target - eps)), orange, 1, cv::LINE_AA, 0,
+                        0.04);
       }
       cv::circle(canvas, px(target), 6, orange, cv::FILLED, cv::LINE_AA);
       if (row == 0) text(canvas, column.representation, cv::Point(x0 + 5, y0 - 8), 0.6);

@@ -6,7 +6,9 @@
 namespace handcentric::experiments {
 namespace {
 
-bool starts_with(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+bool starts_with(const std::string& s, const std::string& prefix) {
+  return s.compare(0, prefix.size(), prefix) == 0;
+}
 
 // Escapes `text` and turns `code` spans into <code> elements.
 std::string inline_html(const std::string& text) {
@@ -47,10 +49,13 @@ bool is_image(const std::string& line) {
 }
 
 const char* kStyle =
-    "body{font-family:system-ui,sans-serif;max-width:1400px;margin:2em auto;padding:0 1em;color:#222}"
+    "body{font-family:system-ui,sans-serif;max-width:1400px;margin:2em auto;padding:0 "
+    "1em;color:#222}"
     "pre{background:#f6f6f6;padding:.8em;white-space:pre-wrap;font-size:13px;line-height:1.35}"
-    "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:.25em .6em;text-align:left}"
-    "th{background:#f0f0f0}img{max-width:100%;border:1px solid #ddd}code{background:#f3f3f3;padding:0 .2em}";
+    "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:.25em "
+    ".6em;text-align:left}"
+    "th{background:#f0f0f0}img{max-width:100%;border:1px solid "
+    "#ddd}code{background:#f3f3f3;padding:0 .2em}";
 
 }  // namespace
 
@@ -59,12 +64,23 @@ std::string html_escape(const std::string& text) {
   out.reserve(text.size());
   for (char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&#39;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -78,8 +94,8 @@ std::string markdown_to_html(const std::string& markdown, const std::string& tit
     while (std::getline(stream, line)) lines.push_back(line);
   }
   std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << html_escape(title)
-       << "</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n";
+  html << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>"
+       << html_escape(title) << "</title>\n<style>" << kStyle << "</style>\n</head>\n<body>\n";
   std::string paragraph;
   const auto flush_paragraph = [&] {
     if (!paragraph.empty()) html << "<p>" << inline_html(paragraph) << "</p>\n";
@@ -90,20 +106,24 @@ std::string markdown_to_html(const std::string& markdown, const std::string& tit
     if (starts_with(line, "```")) {
       flush_paragraph();
       html << "<pre>";
-      for (++i; i < lines.size() && !starts_with(lines[i], "```"); ++i) html << html_escape(lines[i]) << "\n";
+      for (++i; i < lines.size() && !starts_with(lines[i], "```"); ++i)
+        html << html_escape(lines[i]) << "\n";
       html << "</pre>\n";
     } else if (starts_with(line, "### ") || starts_with(line, "## ") || starts_with(line, "# ")) {
       flush_paragraph();
       const std::size_t level = line.find(' ');
-      html << "<h" << level << ">" << inline_html(line.substr(level + 1)) << "</h" << level << ">\n";
-    } else if (starts_with(line, "|") && i + 1 < lines.size() && starts_with(lines[i + 1], "|---")) {
+      html << "<h" << level << ">" << inline_html(line.substr(level + 1)) << "</h" << level
+           << ">\n";
+    } else if (starts_with(line, "|") && i + 1 < lines.size() &&
+               starts_with(lines[i + 1], "|---")) {
       flush_paragraph();
       html << "<table>\n<tr>";
       for (const auto& cell : table_cells(line)) html << "<th>" << inline_html(cell) << "</th>";
       html << "</tr>\n";
       for (i += 2; i < lines.size() && starts_with(lines[i], "|"); ++i) {
         html << "<tr>";
-        for (const auto& cell : table_cells(lines[i])) html << "<td>" << inline_html(cell) << "</td>";
+        for (const auto& cell : table_cells(lines[i]))
+          html << "<td>" << inline_html(cell) << "</td>";
         html << "</tr>\n";
       }
       --i;
@@ -111,7 +131,8 @@ std::string markdown_to_html(const std::string& markdown, const std::string& tit
     } else if (starts_with(line, "- ")) {
       flush_paragraph();
       html << "<ul>\n";
-      for (; i < lines.size() && starts_with(lines[i], "- "); ++i) html << "<li>" << inline_html(lines[i].substr(2)) << "</li>\n";
+      for (; i < lines.size() && starts_with(lines[i], "- "); ++i)
+        html << "<li>" << inline_html(lines[i].substr(2)) << "</li>\n";
       --i;
       html << "</ul>\n";
     } else if (!line.empty() && is_image(line)) {
@@ -119,7 +140,8 @@ std::string markdown_to_html(const std::string& markdown, const std::string& tit
       const std::size_t middle = line.find("](");
       const std::string alt = line.substr(2, middle - 2);
       const std::string src = line.substr(middle + 2, line.size() - middle - 3);
-      html << "<p><img src=\"" << html_escape(src) << "\" alt=\"" << html_escape(alt) << "\"></p>\n";
+      html << "<p><img src=\"" << html_escape(src) << "\" alt=\"" << html_escape(alt)
+           << "\"></p>\n";
     } else if (line.find_first_not_of(' ') == std::string::npos) {
       flush_paragraph();
     } else {

@@ -38,11 +38,13 @@ std::vector<Method> parse_methods(const std::string& list) {
   std::vector<Method> chosen;
   for (const std::string& name : split(list)) {
     const auto& all = table1_methods();
-    const auto it = std::find_if(all.begin(), all.end(), [&](const Method& m) { return m.name == name; });
+    const auto it =
+        std::find_if(all.begin(), all.end(), [&](const Method& m) { return m.name == name; });
     if (it == all.end()) {
       throw InvalidArgument("--methods: unknown method '" + name + "': use " + kMethodNames);
     }
-    if (std::any_of(chosen.begin(), chosen.end(), [&](const Method& m) { return m.name == name; })) {
+    if (std::any_of(chosen.begin(), chosen.end(),
+                    [&](const Method& m) { return m.name == name; })) {
       throw InvalidArgument("--methods: '" + name + "' is listed twice: name each method once");
     }
     chosen.push_back(*it);
@@ -64,7 +66,8 @@ std::vector<std::string> parse_heads(const std::string& list) {
     }
     heads.push_back(head);
   }
-  if (heads.empty()) throw InvalidArgument("--heads is empty: name at least one of flow, ddpm, cvae");
+  if (heads.empty())
+    throw InvalidArgument("--heads is empty: name at least one of flow, ddpm, cvae");
   return heads;
 }
 

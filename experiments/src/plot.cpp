@@ -15,13 +15,15 @@ using drawing::rgb;
 using drawing::text;
 
 // Colour-blind-safe (Okabe-Ito) colours, one per series in row order.
-const cv::Scalar kColours[] = {rgb(0, 114, 178), rgb(213, 94, 0), rgb(0, 158, 115), rgb(204, 121, 167),
-                               rgb(230, 159, 0), rgb(86, 180, 233), rgb(0, 0, 0)};
+const cv::Scalar kColours[] = {rgb(0, 114, 178),   rgb(213, 94, 0),  rgb(0, 158, 115),
+                               rgb(204, 121, 167), rgb(230, 159, 0), rgb(86, 180, 233),
+                               rgb(0, 0, 0)};
 
 }  // namespace
 
 sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
-  if (rows.empty()) throw InvalidArgument("draw_table1: no rows to draw (no cell has a result yet)");
+  if (rows.empty())
+    throw InvalidArgument("draw_table1: no rows to draw (no cell has a result yet)");
   cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   const int left = 70, right = width - 300, top = 70, bottom = height - 60;
   int max_demos = 0;
@@ -61,32 +63,39 @@ sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
     const cv::Scalar colour = kColours[s % std::size(kColours)];
     std::vector<const Row*> points;
     for (const Row& r : rows) {
-      if (r.method == series[s].first && r.head == series[s].second && r.train_seed == seed) points.push_back(&r);
+      if (r.method == series[s].first && r.head == series[s].second && r.train_seed == seed)
+        points.push_back(&r);
     }
-    std::sort(points.begin(), points.end(), [](const Row* a, const Row* b) { return a->demos < b->demos; });
-    const int shift = static_cast<int>(std::lround((static_cast<double>(s) - 0.5 * (series.size() - 1)) * 5.0));
+    std::sort(points.begin(), points.end(),
+              [](const Row* a, const Row* b) { return a->demos < b->demos; });
+    const int shift =
+        static_cast<int>(std::lround((static_cast<double>(s) - 0.5 * (series.size() - 1)) * 5.0));
     const int ood_shift = shift + 7;
     const Row* previous = nullptr;
     for (const Row* r : points) {
       const double x = r->demos;
       if (r->id_success) {
-        if (r->id_ci) cv::line(canvas, px(x, r->id_ci->lo, shift), px(x, r->id_ci->hi, shift), colour, 1, cv::LINE_AA);
-        if (previous && previous->id_success) {
-          cv::line(canvas, px(previous->demos, *previous->id_success, shift), px(x, *r->id_success, shift), colour, 2,
+        if (r->id_ci)
+          cv::line(canvas, px(x, r->id_ci->lo, shift), px(x, r->id_ci->hi, shift), colour, 1,
                    cv::LINE_AA);
+        if (previous && previous->id_success) {
+          cv::line(canvas, px(previous->demos, *previous->id_success, shift),
+                   px(x, *r->id_success, shift), colour, 2, cv::LINE_AA);
         }
         cv::circle(canvas, px(x, *r->id_success, shift), 5, colour, cv::FILLED, cv::LINE_AA);
       }
       if (r->ood_success) {
         if (r->ood_ci) {
-          cv::line(canvas, px(x, r->ood_ci->lo, ood_shift), px(x, r->ood_ci->hi, ood_shift), colour, 1, cv::LINE_AA);
+          cv::line(canvas, px(x, r->ood_ci->lo, ood_shift), px(x, r->ood_ci->hi, ood_shift), colour,
+                   1, cv::LINE_AA);
         }
         if (previous && previous->ood_success) {
-          dashed(canvas, px(previous->demos, *previous->ood_success, ood_shift), px(x, *r->ood_success, ood_shift),
-                 colour);
+          dashed(canvas, px(previous->demos, *previous->ood_success, ood_shift),
+                 px(x, *r->ood_success, ood_shift), colour);
         }
         const cv::Point c = px(x, *r->ood_success, ood_shift);
-        cv::rectangle(canvas, c - cv::Point(5, 5), c + cv::Point(5, 5), rgb(255, 255, 255), cv::FILLED);
+        cv::rectangle(canvas, c - cv::Point(5, 5), c + cv::Point(5, 5), rgb(255, 255, 255),
+                      cv::FILLED);
         cv::rectangle(canvas, c - cv::Point(5, 5), c + cv::Point(5, 5), colour, 2, cv::LINE_AA);
       }
       previous = r;
@@ -100,10 +109,12 @@ sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
   const cv::Point key(right + 20, top + 40 + 28 * static_cast<int>(series.size()));
   cv::circle(canvas, key + cv::Point(15, 0), 5, rgb(90, 90, 90), cv::FILLED, cv::LINE_AA);
   text(canvas, "train-distribution scenes", key + cv::Point(40, 5));
-  cv::rectangle(canvas, key + cv::Point(10, 23), key + cv::Point(20, 33), rgb(90, 90, 90), 2, cv::LINE_AA);
+  cv::rectangle(canvas, key + cv::Point(10, 23), key + cv::Point(20, 33), rgb(90, 90, 90), 2,
+                cv::LINE_AA);
   text(canvas, "OOD scenes (own seed)", key + cv::Point(40, 33));
   char seed_text[64];
-  std::snprintf(seed_text, sizeof seed_text, "training seed %llu", static_cast<unsigned long long>(seed));
+  std::snprintf(seed_text, sizeof seed_text, "training seed %llu",
+                static_cast<unsigned long long>(seed));
   text(canvas, seed_text, key + cv::Point(40, 61));
 
   return drawing::to_image(canvas);

@@ -21,14 +21,18 @@ nlohmann::json optional_interval(const std::optional<Interval>& value) {
 
 }  // namespace
 
-std::string eval_json(const sim::RolloutSummary& summary, const std::string& policy, const std::string& dist,
-                      std::uint64_t seed) {
+std::string eval_json(const sim::RolloutSummary& summary, const std::string& policy,
+                      const std::string& dist, std::uint64_t seed) {
   const double n = summary.trials;
-  const nlohmann::json out = {{"trials", summary.trials},          {"success", summary.success / n},
-                              {"collision", summary.collision / n}, {"timeout", summary.timeout / n},
-                              {"invalid", summary.invalid},        {"clipped", summary.clipped},
+  const nlohmann::json out = {{"trials", summary.trials},
+                              {"success", summary.success / n},
+                              {"collision", summary.collision / n},
+                              {"timeout", summary.timeout / n},
+                              {"invalid", summary.invalid},
+                              {"clipped", summary.clipped},
                               {"policy", policy},
-                              {"dist", dist},                      {"seed", seed}};
+                              {"dist", dist},
+                              {"seed", seed}};
   return out.dump();
 }
 
@@ -40,7 +44,8 @@ sim::RolloutSummary parse_eval_json(const std::string& text, const std::string& 
     if (summary.trials < 1) throw std::runtime_error("trials < 1");
     const auto count = [&](const char* key) {
       const double rate = j.at(key).get<double>();
-      if (!(rate >= 0.0 && rate <= 1.0)) throw std::runtime_error(std::string(key) + " is not a rate in [0, 1]");
+      if (!(rate >= 0.0 && rate <= 1.0))
+        throw std::runtime_error(std::string(key) + " is not a rate in [0, 1]");
       return static_cast<int>(std::lround(rate * summary.trials));
     };
     summary.success = count("success");
@@ -49,8 +54,8 @@ sim::RolloutSummary parse_eval_json(const std::string& text, const std::string& 
     summary.clipped = j.at("clipped").get<int>();
     return summary;
   } catch (const std::exception& e) {
-    throw InvalidArgument("result file '" + source + "' is not `handcentric eval --json` output (" + e.what() +
-                          "): delete it and run its job again");
+    throw InvalidArgument("result file '" + source + "' is not `handcentric eval --json` output (" +
+                          e.what() + "): delete it and run its job again");
   }
 }
 
@@ -80,7 +85,9 @@ Row collect_row(const Cell& cell, const EvalSettings& eval, const std::string& d
         row.ood_success = rate;
         row.ood_ci = wilson_interval(summary.success, summary.trials);
         break;
-      case SceneSet::paired: row.ood_paired_success = rate; break;
+      case SceneSet::paired:
+        row.ood_paired_success = rate;
+        break;
     }
   }
   return row;

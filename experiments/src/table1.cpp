@@ -66,12 +66,13 @@ bool cell_done(const Cell& cell, const EvalSettings& eval, const fs::path& dir) 
 }
 
 // Trains (or loads) the cell's model and writes each missing result file.
-void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir, const std::vector<sim::Demo>& demos) {
+void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir,
+              const std::vector<sim::Demo>& demos) {
   const fs::path model_path = dir / cell.model_path();
   const policy::LearnedPolicy trained = [&] {
     if (fs::exists(model_path)) return policy::load_model(model_path.string());
-    const auto scenes =
-        sim::training_scenes(demos, cell.config.history_length, cell.config.chunk_length, cell.demos, cell.data);
+    const auto scenes = sim::training_scenes(demos, cell.config.history_length,
+                                             cell.config.chunk_length, cell.demos, cell.data);
     policy::LearnedPolicy model = policy::train_policy(cell.config, scenes, cell.train_seed);
     policy::save_model(model, model_path.string());
     return model;
@@ -85,8 +86,10 @@ void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir, c
     const sim::SceneDistribution distribution = distribution_of(set);
     const std::uint64_t seed = eval.seed(set);
     const auto scenes = sim::sample_scenes(distribution, eval.trials, seed);
-    const sim::RolloutSummary summary = sim::evaluate(trained, scenes, checker, seed, rollout_options);
-    write_file_atomically(result.string(), eval_json(summary, trained.name(), distribution.name, seed) + "\n");
+    const sim::RolloutSummary summary =
+        sim::evaluate(trained, scenes, checker, seed, rollout_options);
+    write_file_atomically(result.string(),
+                          eval_json(summary, trained.name(), distribution.name, seed) + "\n");
   }
 }
 
@@ -104,7 +107,8 @@ std::string shell_quote(const std::string& text) {
   return quoted + "'";
 }
 
-nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval, std::uint64_t demo_seed) {
+nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval,
+                          std::uint64_t demo_seed) {
   nlohmann::json cells = nlohmann::json::array();
   for (const Cell& c : grid.cells) {
     cells.push_back({{"method", c.method},
@@ -124,7 +128,8 @@ nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval, std:
           {"version", 1},
           {"demo_file", grid.demo_file},
           {"demo_seed", demo_seed},
-          {"eval", {{"trials", eval.trials}, {"eval_seed", eval.eval_seed}, {"ood_seed", eval.ood_seed}}},
+          {"eval",
+           {{"trials", eval.trials}, {"eval_seed", eval.eval_seed}, {"ood_seed", eval.ood_seed}}},
           {"cells", cells}};
 }
 
@@ -146,21 +151,30 @@ std::string rate(const std::optional<double>& value) {
 }  // namespace
 
 void Table1Options::validate() const {
-  if (demo_counts.empty()) throw InvalidArgument("--demos is empty: give numbers of demos, e.g. 5,10,100");
+  if (demo_counts.empty())
+    throw InvalidArgument("--demos is empty: give numbers of demos, e.g. 5,10,100");
   std::set<int> seen;
   for (const int n : demo_counts) {
-    if (n < 1 || n > 1000) throw InvalidArgument("--demos: " + std::to_string(n) + " is outside 1..1000");
-    if (!seen.insert(n).second) throw InvalidArgument("--demos: " + std::to_string(n) + " is listed twice");
+    if (n < 1 || n > 1000)
+      throw InvalidArgument("--demos: " + std::to_string(n) + " is outside 1..1000");
+    if (!seen.insert(n).second)
+      throw InvalidArgument("--demos: " + std::to_string(n) + " is listed twice");
   }
-  if (steps < 0) throw InvalidArgument("--steps must be >= 0 (0: the automatic budget), got " + std::to_string(steps));
+  if (steps < 0)
+    throw InvalidArgument("--steps must be >= 0 (0: the automatic budget), got " +
+                          std::to_string(steps));
   if (methods.empty()) throw InvalidArgument("--methods is empty: name at least one method");
   if (heads.empty()) throw InvalidArgument("--heads is empty: name at least one head");
   if (train_seeds.empty()) throw InvalidArgument("--train-seeds is empty: give at least one seed");
-  if (eval.trials < 1) throw InvalidArgument("--trials must be at least 1, got " + std::to_string(eval.trials));
-  if (jobs < 0) throw InvalidArgument("--jobs must be >= 0 (0: one per hardware thread), got " + std::to_string(jobs));
+  if (eval.trials < 1)
+    throw InvalidArgument("--trials must be at least 1, got " + std::to_string(eval.trials));
+  if (jobs < 0)
+    throw InvalidArgument("--jobs must be >= 0 (0: one per hardware thread), got " +
+                          std::to_string(jobs));
   if (eval.ood_seed == eval.eval_seed) {
-    throw InvalidArgument("--ood-seed " + std::to_string(eval.ood_seed) +
-                          " equals --eval-seed: the independent OOD scenes would be the paired ones; choose another");
+    throw InvalidArgument(
+        "--ood-seed " + std::to_string(eval.ood_seed) +
+        " equals --eval-seed: the independent OOD scenes would be the paired ones; choose another");
   }
 }
 
@@ -175,7 +189,8 @@ std::vector<int> parse_int_list(const std::string& text, const std::string& opti
       used = 0;
     }
     if (used == 0 || used != item.size() || value < 1) {
-      throw InvalidArgument(option + " '" + text + "': '" + item + "' is not a positive integer; give e.g. 5,10,100");
+      throw InvalidArgument(option + " '" + text + "': '" + item +
+                            "' is not a positive integer; give e.g. 5,10,100");
     }
     values.push_back(value);
   }
@@ -194,7 +209,8 @@ std::vector<std::uint64_t> parse_seed_list(const std::string& text, const std::s
       used = 0;
     }
     if (used == 0 || used != item.size() || item.front() == '-') {
-      throw InvalidArgument(option + " '" + text + "': '" + item + "' is not a non-negative integer; give e.g. 1,2,3");
+      throw InvalidArgument(option + " '" + text + "': '" + item +
+                            "' is not a non-negative integer; give e.g. 1,2,3");
     }
     values.push_back(value);
   }
@@ -209,32 +225,37 @@ Table1Grid prepare_table1(const Table1Options& options) {
   grid.dir = dir.string();
   if (fs::exists(dir / "cells.json") && !options.resume) {
     throw InvalidArgument("--out '" + options.out +
-                          "' already holds a Table 1 run (cells.json): pass --resume to finish it, or choose another --out");
+                          "' already holds a Table 1 run (cells.json): pass --resume to finish it, "
+                          "or choose another --out");
   }
   std::error_code error;
   fs::create_directories(dir / "models", error);
   fs::create_directories(dir / "results", error);
   if (error || !fs::is_directory(dir / "results")) {
-    throw FileError("cannot create the directory '" + dir.string() + "' (" + error.message() + "): check --out");
+    throw FileError("cannot create the directory '" + dir.string() + "' (" + error.message() +
+                    "): check --out");
   }
   const int largest = *std::max_element(options.demo_counts.begin(), options.demo_counts.end());
-  grid.demo_file = "demos-seed" + std::to_string(options.demo_seed) + "-n" + std::to_string(largest) + ".jsonl";
+  grid.demo_file =
+      "demos-seed" + std::to_string(options.demo_seed) + "-n" + std::to_string(largest) + ".jsonl";
   const fs::path demo_path = dir / grid.demo_file;
   if (!fs::exists(demo_path)) {
     const sim::CollisionChecker checker;
-    const auto scenes = sim::sample_scenes(sim::SceneDistribution::train(), largest, options.demo_seed);
+    const auto scenes =
+        sim::sample_scenes(sim::SceneDistribution::train(), largest, options.demo_seed);
     const sim::ExpertRun run = sim::expert_demos(scenes, options.demo_seed, checker);
     if (static_cast<int>(run.demos.size()) < largest) {
       throw InvalidArgument("the expert solved " + std::to_string(run.demos.size()) + " of " +
-                            std::to_string(largest) + " scenes of demo seed " + std::to_string(options.demo_seed) +
-                            ": choose another --seed");
+                            std::to_string(largest) + " scenes of demo seed " +
+                            std::to_string(options.demo_seed) + ": choose another --seed");
     }
     sim::save_demos(demo_path.string(), run.demos, checker.geometry());
   }
   const std::string demo_bytes = read_text(demo_path);
   const std::string demo_digest = digest(demo_bytes);
   const std::vector<sim::Demo> demos = sim::load_demos(demo_path.string());
-  std::vector<long long> samples_upto(demos.size() + 1, 0);  // training samples of the first n demos
+  std::vector<long long> samples_upto(demos.size() + 1,
+                                      0);  // training samples of the first n demos
   for (std::size_t i = 0; i < demos.size(); ++i) {
     samples_upto[i + 1] = samples_upto[i] + static_cast<long long>(demos[i].world_T_hand.size());
   }
@@ -245,8 +266,8 @@ Table1Grid prepare_table1(const Table1Options& options) {
       for (const std::uint64_t seed : options.train_seeds) {
         for (const int n : options.demo_counts) {
           grid.cells.push_back(make_cell(method.name, method.representation, head, n, seed,
-                                         samples_upto[static_cast<std::size_t>(n)], demo_digest, options.steps,
-                                         options.data, method.c8_centre));
+                                         samples_upto[static_cast<std::size_t>(n)], demo_digest,
+                                         options.steps, options.data, method.c8_centre));
         }
       }
     }
@@ -268,7 +289,9 @@ void run_table1(const Table1Options& options, const Table1Grid& grid) {
   }
   std::stable_sort(order.begin(), order.end(),
                    [](const Cell* a, const Cell* b) { return a->config.steps > b->config.steps; });
-  const int jobs = options.jobs > 0 ? options.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  const int jobs = options.jobs > 0
+                       ? options.jobs
+                       : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   Progress progress(static_cast<int>(order.size()), total_work, stderr, options.quiet);
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
@@ -285,14 +308,16 @@ void run_table1(const Table1Options& options, const Table1Grid& grid) {
         if (!skipped) run_cell(cell, options.eval, dir, demos);
       } catch (const std::exception& e) {
         const std::lock_guard lock(error_mutex);
-        if (!failed.exchange(true)) error = "Table 1 cell " + cell.describe() + " failed: " + e.what();
+        if (!failed.exchange(true))
+          error = "Table 1 cell " + cell.describe() + " failed: " + e.what();
         return;
       }
       progress.finish(id, cell_work(cell, options.eval), skipped);
     }
   };
   std::vector<std::thread> threads;
-  for (int id = 0; id < std::min<int>(jobs, static_cast<int>(order.size())); ++id) threads.emplace_back(worker, id);
+  for (int id = 0; id < std::min<int>(jobs, static_cast<int>(order.size())); ++id)
+    threads.emplace_back(worker, id);
   for (std::thread& thread : threads) thread.join();
   if (failed) throw Error(error + " (finished cells are kept: rerun with --resume)");
 }
@@ -303,22 +328,24 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
   int count = 0;
   for (const Cell& cell : grid.cells) {
     if (cell_done(cell, eval, dir)) continue;
-    std::string line = "cd " + shell_quote(grid.dir) + " && { test -f " + cell.model_path() + " || " +
-                       shell_quote(cli) + " train --demos " + grid.demo_file + " --max-demos " +
-                       std::to_string(cell.demos) + " --repr " + cell.config.representation + " --head " + cell.head +
-                       " --steps " + std::to_string(cell.config.steps) + (cell.data.mirror ? "" : " --no-mirror") +
-                       " --perturbed-copies " + std::to_string(cell.data.perturbed_copies) + " --offset-cm " +
-                       format_number(cell.data.offset_cm) + " --offset-deg " + format_number(cell.data.offset_deg) +
-                       " --recovery-steps " + std::to_string(cell.data.recovery_steps) +
-                       c8_centre_options(cell.config) +
-                       " --seed " + std::to_string(cell.train_seed) +
-                       " --quiet --out " + cell.model_path() + " >/dev/null; }";
+    std::string line =
+        "cd " + shell_quote(grid.dir) + " && { test -f " + cell.model_path() + " || " +
+        shell_quote(cli) + " train --demos " + grid.demo_file + " --max-demos " +
+        std::to_string(cell.demos) + " --repr " + cell.config.representation + " --head " +
+        cell.head + " --steps " + std::to_string(cell.config.steps) +
+        (cell.data.mirror ? "" : " --no-mirror") + " --perturbed-copies " +
+        std::to_string(cell.data.perturbed_copies) + " --offset-cm " +
+        format_number(cell.data.offset_cm) + " --offset-deg " +
+        format_number(cell.data.offset_deg) + " --recovery-steps " +
+        std::to_string(cell.data.recovery_steps) + c8_centre_options(cell.config) + " --seed " +
+        std::to_string(cell.train_seed) + " --quiet --out " + cell.model_path() + " >/dev/null; }";
     for (const SceneSet set : kSceneSets) {
       const std::string result = cell.result_path(set, eval);
-      line += " && { test -f " + result + " || { " + shell_quote(cli) + " eval --model " + cell.model_path() +
-              " --dist " + (set == SceneSet::id ? "train" : "ood") + " --trials " + std::to_string(eval.trials) +
-              " --seed " + std::to_string(eval.seed(set)) + " --json > " + result + ".tmp && mv " + result + ".tmp " +
-              result + "; }; }";
+      line += " && { test -f " + result + " || { " + shell_quote(cli) + " eval --model " +
+              cell.model_path() + " --dist " + (set == SceneSet::id ? "train" : "ood") +
+              " --trials " + std::to_string(eval.trials) + " --seed " +
+              std::to_string(eval.seed(set)) + " --json > " + result + ".tmp && mv " + result +
+              ".tmp " + result + "; }; }";
     }
     lines += line + "\n";
     ++count;
@@ -331,7 +358,9 @@ std::string collect_table1(const std::string& dir_text) {
   const fs::path dir = fs::absolute(dir_text);
   const fs::path cells_path = dir / "cells.json";
   if (!fs::exists(cells_path)) {
-    throw InvalidArgument("'" + dir_text + "' holds no cells.json: give the --out of a `handcentric table1` or --plan run");
+    throw InvalidArgument(
+        "'" + dir_text +
+        "' holds no cells.json: give the --out of a `handcentric table1` or --plan run");
   }
   EvalSettings eval;
   std::uint64_t demo_seed = 0;
@@ -360,7 +389,8 @@ std::string collect_table1(const std::string& dir_text) {
       rows.push_back(collect_row(cell, eval, dir.string()));
     }
   } catch (const nlohmann::json::exception& e) {
-    throw InvalidArgument("'" + cells_path.string() + "' is damaged (" + e.what() + "): run --plan or table1 again");
+    throw InvalidArgument("'" + cells_path.string() + "' is damaged (" + e.what() +
+                          "): run --plan or table1 again");
   }
   const std::string markdown = table1_markdown(rows, eval, demo_seed);
   write_file_atomically((dir / "table1.json").string(), rows_json(rows));
@@ -369,7 +399,8 @@ std::string collect_table1(const std::string& dir_text) {
   return markdown;
 }
 
-std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval, std::uint64_t demo_seed) {
+std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval,
+                            std::uint64_t demo_seed) {
   std::vector<int> counts;
   std::vector<std::pair<std::string, std::string>> series;  // (method, head) in row order
   std::set<std::uint64_t> seeds;
@@ -382,7 +413,8 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
   }
   std::sort(counts.begin(), counts.end());
   // Mean over the training seeds that have the value.
-  const auto mean = [&](const std::string& m, const std::string& h, int n, auto field) -> std::optional<double> {
+  const auto mean = [&](const std::string& m, const std::string& h, int n,
+                        auto field) -> std::optional<double> {
     double sum = 0.0;
     int k = 0;
     for (const Row& r : rows) {
@@ -402,39 +434,46 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
   }
   std::string text = "# Table 1 on this library\n\n";
   char line[512];
-  std::snprintf(line, sizeof line,
-                "Success over %d closed-loop rollouts per cell (mean over %zu training seed%s). Scenes: `id` = "
-                "train distribution, eval seed %llu; `ood` = bottom-up holes, their own seed %llu; `ood paired` = "
-                "the global transforms of the id scenes (same seed, same noise: equal to id exactly when the policy "
-                "is equivariant). Demos: the first N of `demos --n 100 --dist train --seed %llu`.\n\n",
-                eval.trials, seeds.size(), seeds.size() == 1 ? "" : "s",
-                static_cast<unsigned long long>(eval.eval_seed), static_cast<unsigned long long>(eval.ood_seed),
-                static_cast<unsigned long long>(demo_seed));
+  std::snprintf(
+      line, sizeof line,
+      "Success over %d closed-loop rollouts per cell (mean over %zu training seed%s). Scenes: `id` "
+      "= "
+      "train distribution, eval seed %llu; `ood` = bottom-up holes, their own seed %llu; `ood "
+      "paired` = "
+      "the global transforms of the id scenes (same seed, same noise: equal to id exactly when the "
+      "policy "
+      "is equivariant). Demos: the first N of `demos --n 100 --dist train --seed %llu`.\n\n",
+      eval.trials, seeds.size(), seeds.size() == 1 ? "" : "s",
+      static_cast<unsigned long long>(eval.eval_seed),
+      static_cast<unsigned long long>(eval.ood_seed), static_cast<unsigned long long>(demo_seed));
   text += line;
   text += header + "\n" + rule + "\n";
   for (std::size_t i = 0; i < series.size(); ++i) {
     const auto& [m, h] = series[i];
     const auto paper = paper_row(m, h);
     // Two rows standing in for one paper row (c8_centre, c8_base): its line once, after both.
-    const auto next = i + 1 < series.size() ? paper_row(series[i + 1].first, series[i + 1].second)
-                                            : std::nullopt;
+    const auto next =
+        i + 1 < series.size() ? paper_row(series[i + 1].first, series[i + 1].second) : std::nullopt;
     const bool paper_follows = paper && next && next->label == paper->label;
     const std::string label = m + "/" + h;
-    std::string id = "| " + label + " | id |", ood = "| " + label + " | ood |", paired = "| " + label + " | ood paired |";
+    std::string id = "| " + label + " | id |", ood = "| " + label + " | ood |",
+                paired = "| " + label + " | ood paired |";
     std::string paper_line = "| " + (paper ? paper->label : std::string("-")) + " (paper) | id |";
     for (const int n : counts) {
       id += cell_text(rate(mean(m, h, n, &Row::id_success)));
       ood += cell_text(rate(mean(m, h, n, &Row::ood_success)));
       paired += cell_text(rate(mean(m, h, n, &Row::ood_paired_success)));
       const auto* at = std::find(kPaperDemoCounts.begin(), kPaperDemoCounts.end(), n);
-      paper_line += cell_text(paper && at != kPaperDemoCounts.end()
-                                  ? rate(paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())])
-                                  : std::string("-"));
+      paper_line += cell_text(
+          paper && at != kPaperDemoCounts.end()
+              ? rate(paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())])
+              : std::string("-"));
     }
     text += id + "\n" + ood + "\n" + paired + "\n";
     if (paper && !paper_follows) {
       std::string paper_ood = "| " + paper->label + " (paper) | ood |";
-      for (const int n : counts) paper_ood += cell_text(n == 100 ? rate(paper->ood_at_100) : std::string("-"));
+      for (const int n : counts)
+        paper_ood += cell_text(n == 100 ? rate(paper->ood_at_100) : std::string("-"));
       text += paper_line + "\n" + paper_ood + "\n";
     }
   }

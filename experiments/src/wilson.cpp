@@ -11,7 +11,8 @@ namespace handcentric::experiments {
 Interval wilson_interval(int successes, int trials, double z) {
   if (trials < 1 || successes < 0 || successes > trials) {
     throw InvalidArgument("wilson_interval: " + std::to_string(successes) + " successes in " +
-                          std::to_string(trials) + " trials: need trials >= 1 and 0 <= successes <= trials");
+                          std::to_string(trials) +
+                          " trials: need trials >= 1 and 0 <= successes <= trials");
   }
   const double n = trials, p = successes / n, z2 = z * z;
   const double denominator = 1.0 + z2 / n;

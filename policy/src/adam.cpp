@@ -13,17 +13,18 @@ Adam::Adam(Eigen::Index parameter_count, AdamOptions options) : options_(options
   if (!(options.learning_rate > 0.0) || !(options.beta1 >= 0.0 && options.beta1 < 1.0) ||
       !(options.beta2 >= 0.0 && options.beta2 < 1.0) || !(options.epsilon >= 0.0) ||
       !(options.weight_decay >= 0.0)) {
-    throw InvalidArgument("Adam: learning rate " + format_number(options.learning_rate) + ", betas " +
-                          format_number(options.beta1) + ", " + format_number(options.beta2) +
-                          ", epsilon " + format_number(options.epsilon) + ", weight decay " +
-                          format_number(options.weight_decay) +
-                          ": use lr > 0, betas in [0, 1), epsilon >= 0, weight decay >= 0");
+    throw InvalidArgument(
+        "Adam: learning rate " + format_number(options.learning_rate) + ", betas " +
+        format_number(options.beta1) + ", " + format_number(options.beta2) + ", epsilon " +
+        format_number(options.epsilon) + ", weight decay " + format_number(options.weight_decay) +
+        ": use lr > 0, betas in [0, 1), epsilon >= 0, weight decay >= 0");
   }
   m_ = Eigen::VectorXf::Zero(parameter_count);
   v_ = Eigen::VectorXf::Zero(parameter_count);
 }
 
-void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient, float gradient_scale) {
+void Adam::step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient,
+                float gradient_scale) {
   if (parameters.size() != m_.size() || gradient.size() != m_.size()) {
     throw InvalidArgument("Adam::step: " + std::to_string(parameters.size()) + " parameters and " +
                           std::to_string(gradient.size()) + " gradients, expected " +
@@ -62,7 +63,8 @@ float gradient_clip_scale(const Eigen::VectorXf& gradient, double max_norm, doub
 
 void Adam::set_learning_rate(double learning_rate) {
   if (!(learning_rate > 0.0) || !std::isfinite(learning_rate)) {
-    throw InvalidArgument("Adam: learning rate " + format_number(learning_rate) + ": use a finite lr > 0");
+    throw InvalidArgument("Adam: learning rate " + format_number(learning_rate) +
+                          ": use a finite lr > 0");
   }
   options_.learning_rate = learning_rate;
 }

@@ -9,10 +9,18 @@ namespace handcentric::policy {
 
 static_assert(std::endian::native == std::endian::little, "model files are written little-endian");
 
-void ByteWriter::raw(const void* data, std::size_t size) { bytes_.append(static_cast<const char*>(data), size); }
-void ByteWriter::u32(std::uint32_t value) { raw(&value, sizeof value); }
-void ByteWriter::u64(std::uint64_t value) { raw(&value, sizeof value); }
-void ByteWriter::f64(double value) { raw(&value, sizeof value); }
+void ByteWriter::raw(const void* data, std::size_t size) {
+  bytes_.append(static_cast<const char*>(data), size);
+}
+void ByteWriter::u32(std::uint32_t value) {
+  raw(&value, sizeof value);
+}
+void ByteWriter::u64(std::uint64_t value) {
+  raw(&value, sizeof value);
+}
+void ByteWriter::f64(double value) {
+  raw(&value, sizeof value);
+}
 void ByteWriter::string(const std::string& value) {
   u64(value.size());
   raw(value.data(), value.size());
@@ -26,12 +34,17 @@ void ByteWriter::doubles(const Eigen::VectorXd& values) {
   raw(values.data(), sizeof(double) * static_cast<std::size_t>(values.size()));
 }
 
-ByteReader::ByteReader(const std::string& bytes, std::string source, std::size_t begin, std::size_t end)
-    : bytes_(bytes), source_(std::move(source)), position_(begin), end_(std::min(end, bytes.size())) {}
+ByteReader::ByteReader(const std::string& bytes, std::string source, std::size_t begin,
+                       std::size_t end)
+    : bytes_(bytes),
+      source_(std::move(source)),
+      position_(begin),
+      end_(std::min(end, bytes.size())) {}
 
 void ByteReader::fail(const std::string& what) const {
-  throw InvalidModelFile(source_ + ": " + what + " (at byte " + std::to_string(position_) +
-                         "); the file is damaged or not a handcentric model: train it again with `handcentric train`");
+  throw InvalidModelFile(
+      source_ + ": " + what + " (at byte " + std::to_string(position_) +
+      "); the file is damaged or not a handcentric model: train it again with `handcentric train`");
 }
 
 void ByteReader::take(void* out, std::size_t size) {
@@ -58,7 +71,8 @@ double ByteReader::f64() {
 
 std::string ByteReader::string(std::size_t max_length) {
   const std::uint64_t size = u64();
-  if (size > max_length || size > end_ - position_) fail("a string of " + std::to_string(size) + " bytes");
+  if (size > max_length || size > end_ - position_)
+    fail("a string of " + std::to_string(size) + " bytes");
   std::string value(bytes_.data() + position_, size);
   position_ += size;
   return value;
@@ -70,9 +84,11 @@ Vector allocate_vector(ByteReader& reader, Eigen::Index expected) {
   using Scalar = typename Vector::Scalar;
   const std::uint64_t size = reader.u64();
   if (expected >= 0 && size != static_cast<std::uint64_t>(expected)) {
-    reader.fail("an array of " + std::to_string(size) + " numbers where " + std::to_string(expected) + " belong");
+    reader.fail("an array of " + std::to_string(size) + " numbers where " +
+                std::to_string(expected) + " belong");
   }
-  if (size > reader.remaining() / sizeof(Scalar)) reader.fail("truncated: an array of " + std::to_string(size) + " numbers");
+  if (size > reader.remaining() / sizeof(Scalar))
+    reader.fail("truncated: an array of " + std::to_string(size) + " numbers");
   Vector values(static_cast<Eigen::Index>(size));
   return values;
 }

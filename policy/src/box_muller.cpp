@@ -10,7 +10,8 @@ namespace handcentric::policy {
 
 void box_muller_pairs(std::ptrdiff_t pairs, const std::uint64_t* bits, float* out) {
   for (std::ptrdiff_t i = 0; i < pairs; ++i) {
-    const float u1 = static_cast<float>(BoxMuller::high24(bits[i]) + 1) * BoxMuller::kTwoPow24Inverse;
+    const float u1 =
+        static_cast<float>(BoxMuller::high24(bits[i]) + 1) * BoxMuller::kTwoPow24Inverse;
     const float u2 = static_cast<float>(BoxMuller::low24(bits[i])) * BoxMuller::kTwoPow24Inverse;
     const float radius = std::sqrt(-2.0f * std::log(u1));
     const float angle = 2.0f * std::numbers::pi_v<float> * u2;

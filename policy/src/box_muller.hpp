@@ -11,7 +11,9 @@ namespace handcentric::policy {
 
 struct BoxMuller {
   static std::uint32_t high24(std::uint64_t bits) { return static_cast<std::uint32_t>(bits >> 40); }
-  static std::uint32_t low24(std::uint64_t bits) { return static_cast<std::uint32_t>(bits >> 8) & 0xFFFFFFu; }
+  static std::uint32_t low24(std::uint64_t bits) {
+    return static_cast<std::uint32_t>(bits >> 8) & 0xFFFFFFu;
+  }
   static constexpr float kTwoPow24Inverse = 0x1.0p-24f;
 };
 

@@ -38,15 +38,17 @@ Eigen::Matrix3d right_jacobian_inverse(const Eigen::Vector3d& r) {
   // Jr^{-1}(r) = I + 1/2 [r]x + (1 / t^2 - cot(t / 2) / (2 t)) [r]x^2; finite at t = pi.
   const double t = r.norm();
   const Eigen::Matrix3d K = so3::hat(r);
-  const double c = t < 1e-4 ? 1.0 / 12.0 + t * t / 720.0 : 1.0 / (t * t) - 1.0 / (2.0 * t * std::tan(t / 2.0));
+  const double c =
+      t < 1e-4 ? 1.0 / 12.0 + t * t / 720.0 : 1.0 / (t * t) - 1.0 / (2.0 * t * std::tan(t / 2.0));
   return Eigen::Matrix3d::Identity() + 0.5 * K + c * K * K;
 }
 
 namespace {
 void check_length(Eigen::Index size, Eigen::Index expected, const std::string& what) {
   if (size != expected) {
-    throw InvalidArgument("C8 action on " + what + ": length " + std::to_string(size) + ", expected " +
-                          std::to_string(expected) + " (an absolute vector of the trained layout)");
+    throw InvalidArgument("C8 action on " + what + ": length " + std::to_string(size) +
+                          ", expected " + std::to_string(expected) +
+                          " (an absolute vector of the trained layout)");
   }
 }
 void act_on_poses(const Eigen::Matrix3d& R, Eigen::Ref<Eigen::VectorXd> poses) {
@@ -64,19 +66,21 @@ Eigen::VectorXd act_on_actions(const Eigen::Matrix3d& R, const Eigen::VectorXd& 
   return out;
 }
 
-Eigen::VectorXd act_on_observation(const Eigen::Matrix3d& R, const Eigen::VectorXd& o, int history_length,
-                                   int hand_points) {
+Eigen::VectorXd act_on_observation(const Eigen::Matrix3d& R, const Eigen::VectorXd& o,
+                                   int history_length, int hand_points) {
   const Eigen::Index poses = 6 * (history_length + 1), hand = 3 * hand_points;
   if (o.size() < poses + hand || (o.size() - poses - hand) % 3 != 0) {
     check_length(o.size(), poses + hand, "observation");
   }
   Eigen::VectorXd out = o;
   act_on_poses(R, out.head(poses));
-  for (Eigen::Index i = poses + hand; i + 3 <= out.size(); i += 3) out.segment<3>(i) = R * o.segment<3>(i);
+  for (Eigen::Index i = poses + hand; i + 3 <= out.size(); i += 3)
+    out.segment<3>(i) = R * o.segment<3>(i);
   return out;
 }
 
-Eigen::VectorXd push_velocity(const Eigen::Matrix3d& R, const Eigen::VectorXd& a, const Eigen::VectorXd& v) {
+Eigen::VectorXd push_velocity(const Eigen::Matrix3d& R, const Eigen::VectorXd& a,
+                              const Eigen::VectorXd& v) {
   check_length(v.size(), a.size(), "a velocity");
   check_length(a.size(), (a.size() / 6) * 6, "actions");
   Eigen::VectorXd out(v.size());
@@ -84,7 +88,8 @@ Eigen::VectorXd push_velocity(const Eigen::Matrix3d& R, const Eigen::VectorXd& a
     out.segment<3>(i) = R * v.segment<3>(i);
     const Eigen::Vector3d r = a.segment<3>(i + 3);
     const Eigen::Vector3d r_moved = so3::log(R * so3::exp(r));
-    out.segment<3>(i + 3) = right_jacobian_inverse(r_moved) * (right_jacobian(r) * v.segment<3>(i + 3));
+    out.segment<3>(i + 3) =
+        right_jacobian_inverse(r_moved) * (right_jacobian(r) * v.segment<3>(i + 3));
   }
   return out;
 }

@@ -23,7 +23,8 @@ namespace {
 template <typename Act>
 Normalizer orbit_normalizer(const Eigen::MatrixXd& data, Act act, Eigen::Index rotated_end) {
   if (data.cols() == 0) throw InvalidArgument("c8flow: no training samples");
-  Eigen::VectorXd sum = Eigen::VectorXd::Zero(data.rows()), sum_sq = Eigen::VectorXd::Zero(data.rows());
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(data.rows()),
+                  sum_sq = Eigen::VectorXd::Zero(data.rows());
   for (Eigen::Index j = 0; j < data.cols(); ++j) {
     for (int k = 0; k < 8; ++k) {
       const Eigen::VectorXd v = act(c8::rotation(k), Eigen::VectorXd(data.col(j)));
@@ -54,14 +55,18 @@ class C8FlowHead final : public FlowHead {
   using FlowHead::FlowHead;
   HeadKind kind() const override { return HeadKind::c8flow; }
 
-  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override {
+  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+               std::mt19937_64& rng) override {
     action_normalizer_ = orbit_normalizer(
-        actions, [](const Eigen::Matrix3d& R, const Eigen::VectorXd& a) { return c8::act_on_actions(R, a); },
+        actions,
+        [](const Eigen::Matrix3d& R, const Eigen::VectorXd& a) { return c8::act_on_actions(R, a); },
         actions.rows());
     const int H = config_.history_length, hand = config_.hand_points;
     observation_normalizer_ = orbit_normalizer(
         observations,
-        [H, hand](const Eigen::Matrix3d& R, const Eigen::VectorXd& o) { return c8::act_on_observation(R, o, H, hand); },
+        [H, hand](const Eigen::Matrix3d& R, const Eigen::VectorXd& o) {
+          return c8::act_on_observation(R, o, H, hand);
+        },
         6 * (H + 1));
     network_.initialize(rng);
   }
@@ -73,8 +78,8 @@ class C8FlowHead final : public FlowHead {
     for (Eigen::Index j = 0; j < actions.cols(); ++j) {
       const Eigen::Matrix3d R = c8::rotation(static_cast<int>(rng() % 8));
       a_.col(j) = c8::act_on_actions(R, actions.col(j).cast<double>()).cast<float>();
-      o_.col(j) = c8::act_on_observation(R, observations.col(j).cast<double>(), config_.history_length,
-                                         config_.hand_points)
+      o_.col(j) = c8::act_on_observation(R, observations.col(j).cast<double>(),
+                                         config_.history_length, config_.hand_points)
                       .cast<float>();
     }
     action_normalizer_.normalize(a_);
@@ -83,7 +88,8 @@ class C8FlowHead final : public FlowHead {
   }
 
   /// f (raw coordinates) at the 8 points (g_k^{-1} x, g_k^{-1} o), pushed forward and averaged.
-  Eigen::VectorXd velocity(const Eigen::VectorXd& x, const Eigen::VectorXd& o, double t, bool symmetrized) const {
+  Eigen::VectorXd velocity(const Eigen::VectorXd& x, const Eigen::VectorXd& o, double t,
+                           bool symmetrized) const {
     const int copies = symmetrized ? 8 : 1;
     std::vector<Eigen::VectorXd> points(copies);
     Eigen::MatrixXf xs(x.size(), copies), os(o.size(), copies);
@@ -91,7 +97,8 @@ class C8FlowHead final : public FlowHead {
       const Eigen::Matrix3d R_inverse = c8::rotation(-k);
       points[k] = c8::act_on_actions(R_inverse, x);
       xs.col(k) = points[k].cast<float>();
-      os.col(k) = c8::act_on_observation(R_inverse, o, config_.history_length, config_.hand_points).cast<float>();
+      os.col(k) = c8::act_on_observation(R_inverse, o, config_.history_length, config_.hand_points)
+                      .cast<float>();
     }
     action_normalizer_.normalize(xs);
     observation_normalizer_.normalize(os);
@@ -109,7 +116,8 @@ class C8FlowHead final : public FlowHead {
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
     Eigen::MatrixXf x0(config_.action_dimension, observations.cols());
     fill_standard_normal(rng, x0);
-    x0.array().colwise() *= action_normalizer_.active_float().array() * static_cast<float>(config_.noise_scale);
+    x0.array().colwise() *=
+        action_normalizer_.active_float().array() * static_cast<float>(config_.noise_scale);
     action_normalizer_.denormalize(x0);
     Eigen::MatrixXf out(x0.rows(), x0.cols());
     const int steps = config_.euler_steps;
@@ -135,8 +143,8 @@ std::unique_ptr<Head> make_c8_flow_head(const PolicyConfig& config) {
   return std::make_unique<C8FlowHead>(config);
 }
 
-Eigen::VectorXd c8_velocity(const Head& head, const Eigen::VectorXd& x, const Eigen::VectorXd& o, double t,
-                            bool symmetrized) {
+Eigen::VectorXd c8_velocity(const Head& head, const Eigen::VectorXd& x, const Eigen::VectorXd& o,
+                            double t, bool symmetrized) {
   const auto* c8_head = dynamic_cast<const C8FlowHead*>(&head);
   if (c8_head == nullptr) {
     throw InvalidArgument("c8_velocity needs a c8flow head, got " + to_string(head.kind()));

@@ -13,12 +13,18 @@ namespace handcentric::policy {
 
 std::string to_string(HeadKind kind) {
   switch (kind) {
-    case HeadKind::flow: return "flow";
-    case HeadKind::ddpm: return "ddpm";
-    case HeadKind::cvae: return "cvae";
-    case HeadKind::c8flow: return "c8flow";
-    case HeadKind::c8ddpm: return "c8ddpm";
-    case HeadKind::c8flow_planar: return "c8flow_planar";
+    case HeadKind::flow:
+      return "flow";
+    case HeadKind::ddpm:
+      return "ddpm";
+    case HeadKind::cvae:
+      return "cvae";
+    case HeadKind::c8flow:
+      return "c8flow";
+    case HeadKind::c8ddpm:
+      return "c8ddpm";
+    case HeadKind::c8flow_planar:
+      return "c8flow_planar";
   }
   return "?";
 }
@@ -58,8 +64,11 @@ LearningRateSchedule parse_schedule(const std::string& name) {
 
 namespace {
 
-void require(bool ok, const std::string& field, const std::string& value, const std::string& range) {
-  if (!ok) throw InvalidArgument("policy config: " + field + " = " + value + " is out of range: use " + range);
+void require(bool ok, const std::string& field, const std::string& value,
+             const std::string& range) {
+  if (!ok)
+    throw InvalidArgument("policy config: " + field + " = " + value + " is out of range: use " +
+                          range);
 }
 
 // One entry per stored field: how to print it and how to parse it.
@@ -88,15 +97,22 @@ double parse_double(const std::string& key, const std::string& text) {
   return value;
 }
 
-#define HC_INT_FIELD(name)                                                   \
-  Field {                                                                    \
-    #name, [](const PolicyConfig& c) { return std::to_string(c.name); },     \
-        [](PolicyConfig& c, const std::string& v) { c.name = parse_int(#name, v); } \
+#define HC_INT_FIELD(name)                                                                        \
+  Field {                                                                                         \
+#name, [](const PolicyConfig&                                                                 \
+                  c) { return std::to_string(c.name); },                                          \
+                                                      [](PolicyConfig & c,                        \
+                                                         const std::string&                       \
+                                                             v) { c.name = parse_int(#name, v); } \
   }
-#define HC_DOUBLE_FIELD(name)                                                   \
-  Field {                                                                       \
-    #name, [](const PolicyConfig& c) { return format_number(c.name); },         \
-        [](PolicyConfig& c, const std::string& v) { c.name = parse_double(#name, v); } \
+#define HC_DOUBLE_FIELD(name)                                                                    \
+  Field {                                                                                        \
+#name,                                                                                       \
+        [](const PolicyConfig&                                                                   \
+               c) { return format_number(c.name); },                                             \
+                                                  [](PolicyConfig & c,                           \
+                                                     const std::string&                          \
+                                                         v) { c.name = parse_double(#name, v); } \
   }
 
 const std::vector<Field>& fields() {
@@ -123,10 +139,18 @@ const std::vector<Field>& fields() {
       HC_DOUBLE_FIELD(learning_rate),
       Field{"lr_schedule", [](const PolicyConfig& c) { return to_string(c.lr_schedule); },
             [](PolicyConfig& c, const std::string& v) { c.lr_schedule = parse_schedule(v); }},
-      HC_DOUBLE_FIELD(weight_decay), HC_DOUBLE_FIELD(gradient_clip), HC_DOUBLE_FIELD(ema_decay),
-      HC_INT_FIELD(euler_steps), HC_INT_FIELD(ddpm_train_steps), HC_INT_FIELD(ddim_steps),
-      HC_INT_FIELD(cvae_latent), HC_DOUBLE_FIELD(cvae_kl_weight), HC_DOUBLE_FIELD(noise_scale),
-      HC_INT_FIELD(execute), HC_DOUBLE_FIELD(c8_centre_x), HC_DOUBLE_FIELD(c8_centre_y),
+      HC_DOUBLE_FIELD(weight_decay),
+      HC_DOUBLE_FIELD(gradient_clip),
+      HC_DOUBLE_FIELD(ema_decay),
+      HC_INT_FIELD(euler_steps),
+      HC_INT_FIELD(ddpm_train_steps),
+      HC_INT_FIELD(ddim_steps),
+      HC_INT_FIELD(cvae_latent),
+      HC_DOUBLE_FIELD(cvae_kl_weight),
+      HC_DOUBLE_FIELD(noise_scale),
+      HC_INT_FIELD(execute),
+      HC_DOUBLE_FIELD(c8_centre_x),
+      HC_DOUBLE_FIELD(c8_centre_y),
   };
   return all;
 }
@@ -146,29 +170,38 @@ void PolicyConfig::validate() const {
   require(task == kTaskPeg2d || task == kTaskInsert3d, "task", "'" + task + "'",
           "peg2d or insert3d");
   require(chunk_length >= 1 && chunk_length <= 1024, "chunk_length", s(chunk_length), "1..1024");
-  require(history_length >= 0 && history_length <= 1024, "history_length", s(history_length), "0..1024");
+  require(history_length >= 0 && history_length <= 1024, "history_length", s(history_length),
+          "0..1024");
   // Upper bounds keep every size a network is built from (sums and products of these) far from
   // int overflow, and a model file's config from describing an absurd network.
   require(hand_points >= 0 && hand_points <= kMaxPoints, "hand_points", s(hand_points), "0..65536");
-  require(world_points >= 0 && world_points <= kMaxPoints, "world_points", s(world_points), "0..65536");
-  require(action_dimension >= 0 && action_dimension <= kMaxDimension, "action_dimension", s(action_dimension),
-          "0..1048576");
-  require(observation_dimension >= 0 && observation_dimension <= kMaxDimension, "observation_dimension",
-          s(observation_dimension), "0..1048576");
+  require(world_points >= 0 && world_points <= kMaxPoints, "world_points", s(world_points),
+          "0..65536");
+  require(action_dimension >= 0 && action_dimension <= kMaxDimension, "action_dimension",
+          s(action_dimension), "0..1048576");
+  require(observation_dimension >= 0 && observation_dimension <= kMaxDimension,
+          "observation_dimension", s(observation_dimension), "0..1048576");
   require(hidden_width >= 1 && hidden_width <= 65536, "hidden_width", s(hidden_width), "1..65536");
   require(hidden_layers >= 1 && hidden_layers <= 64, "hidden_layers", s(hidden_layers), "1..64");
-  require(time_embedding == 0 || (time_embedding >= 2 && time_embedding % 2 == 0 && time_embedding <= 1024),
+  require(time_embedding == 0 ||
+              (time_embedding >= 2 && time_embedding % 2 == 0 && time_embedding <= 1024),
           "time_embedding", s(time_embedding), "0 (raw t) or an even number 2..1024");
   require(steps >= 0, "steps", s(steps), ">= 0");
   require(batch_size >= 1 && batch_size <= 1 << 20, "batch_size", s(batch_size), "1..1048576");
-  require(learning_rate > 0.0 && learning_rate < 10.0, "learning_rate", format_number(learning_rate), "(0, 10)");
-  require(weight_decay >= 0.0 && weight_decay < 1.0, "weight_decay", format_number(weight_decay), "[0, 1)");
+  require(learning_rate > 0.0 && learning_rate < 10.0, "learning_rate",
+          format_number(learning_rate), "(0, 10)");
+  require(weight_decay >= 0.0 && weight_decay < 1.0, "weight_decay", format_number(weight_decay),
+          "[0, 1)");
   require(gradient_clip >= 0.0, "gradient_clip", format_number(gradient_clip), ">= 0 (0 disables)");
-  require(ema_decay >= 0.0 && ema_decay < 1.0, "ema_decay", format_number(ema_decay), "[0, 1) (0 disables)");
-  require(noise_scale >= 0.0 && noise_scale <= 10.0, "noise_scale", format_number(noise_scale), "[0, 10]");
-  require(execute >= 1 && execute <= 1024, "execute", s(execute), "1..1024 (a rollout runs at most the K poses it has)");
+  require(ema_decay >= 0.0 && ema_decay < 1.0, "ema_decay", format_number(ema_decay),
+          "[0, 1) (0 disables)");
+  require(noise_scale >= 0.0 && noise_scale <= 10.0, "noise_scale", format_number(noise_scale),
+          "[0, 10]");
+  require(execute >= 1 && execute <= 1024, "execute", s(execute),
+          "1..1024 (a rollout runs at most the K poses it has)");
   require(euler_steps >= 1 && euler_steps <= 10000, "euler_steps", s(euler_steps), "1..10000");
-  require(ddpm_train_steps >= 2 && ddpm_train_steps <= 10000, "ddpm_train_steps", s(ddpm_train_steps), "2..10000");
+  require(ddpm_train_steps >= 2 && ddpm_train_steps <= 10000, "ddpm_train_steps",
+          s(ddpm_train_steps), "2..10000");
   require(ddim_steps >= 1 && ddim_steps <= ddpm_train_steps, "ddim_steps", s(ddim_steps),
           "1..ddpm_train_steps (" + s(ddpm_train_steps) + ")");
   require(cvae_latent >= 1 && cvae_latent <= 4096, "cvae_latent", s(cvae_latent), "1..4096");
@@ -181,7 +214,7 @@ std::string PolicyConfig::to_text() const {
   std::string text;
   for (const Field& field : fields()) {
     if (!is_c8_planar(head) && field.key.starts_with("c8_")) continue;  // see config.hpp
-    if (field.key == "task" && task == kTaskPeg2d) continue;  // absent reads as peg2d
+    if (field.key == "task" && task == kTaskPeg2d) continue;            // absent reads as peg2d
     text += field.key + "=" + field.get(*this) + "\n";
   }
   return text;
@@ -194,7 +227,8 @@ PolicyConfig PolicyConfig::from_text(const std::string& text) {
   while (std::getline(in, line)) {
     if (line.empty()) continue;
     const auto eq = line.find('=');
-    if (eq == std::string::npos) throw InvalidArgument("policy config: line '" + line + "' is not key=value");
+    if (eq == std::string::npos)
+      throw InvalidArgument("policy config: line '" + line + "' is not key=value");
     const std::string key = line.substr(0, eq);
     bool known = false;
     for (const Field& field : fields()) {

@@ -28,9 +28,11 @@ class CvaeHead final : public Head {
       : config_(config),
         action_normalizer_(config.action_dimension),
         observation_normalizer_(config.observation_dimension),
-        encoder_(widths(config, config.action_dimension + config.observation_dimension, 2 * config.cvae_latent),
+        encoder_(widths(config, config.action_dimension + config.observation_dimension,
+                        2 * config.cvae_latent),
                  config.activation),
-        decoder_(widths(config, config.cvae_latent + config.observation_dimension, config.action_dimension),
+        decoder_(widths(config, config.cvae_latent + config.observation_dimension,
+                        config.action_dimension),
                  config.activation),
         encoder_adam_(encoder_.parameter_count(), options(config)),
         decoder_adam_(decoder_.parameter_count(), options(config)),
@@ -38,7 +40,8 @@ class CvaeHead final : public Head {
 
   HeadKind kind() const override { return HeadKind::cvae; }
 
-  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override {
+  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+               std::mt19937_64& rng) override {
     action_normalizer_ = Normalizer::fit(actions);
     observation_normalizer_ = Normalizer::fit(observations);
     encoder_.initialize(rng);
@@ -53,7 +56,8 @@ class CvaeHead final : public Head {
     observation_normalizer_.normalize(o_);
     noise_.resize(config_.cvae_latent, actions.cols());
     fill_standard_normal(rng, noise_);
-    const double loss = cvae_loss_and_gradients<float>(encoder_, decoder_, a_, o_, noise_, config_.cvae_kl_weight, buffers_);
+    const double loss = cvae_loss_and_gradients<float>(encoder_, decoder_, a_, o_, noise_,
+                                                       config_.cvae_kl_weight, buffers_);
     step(decoder_, decoder_adam_);
     step(encoder_, encoder_adam_);
     decoder_average_.update(decoder_.parameters());
@@ -71,7 +75,8 @@ class CvaeHead final : public Head {
   }
 
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
-    const Eigen::Index batch = observations.cols(), dobs = observations.rows(), Z = config_.cvae_latent;
+    const Eigen::Index batch = observations.cols(), dobs = observations.rows(),
+                       Z = config_.cvae_latent;
     Eigen::MatrixXf input(Z + dobs, batch), output, scratch[2];
     fill_standard_normal(rng, input.topRows(Z));
     input.bottomRows(dobs) = observations;
@@ -98,7 +103,8 @@ class CvaeHead final : public Head {
     return AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay};
   }
   void step(Mlp& network, Adam& adam) {
-    adam.step(network.parameters(), network.gradient(), gradient_clip_scale(network.gradient(), config_.gradient_clip));
+    adam.step(network.parameters(), network.gradient(),
+              gradient_clip_scale(network.gradient(), config_.gradient_clip));
   }
 
   PolicyConfig config_;
@@ -112,6 +118,8 @@ class CvaeHead final : public Head {
 
 }  // namespace
 
-std::unique_ptr<Head> make_cvae_head(const PolicyConfig& config) { return std::make_unique<CvaeHead>(config); }
+std::unique_ptr<Head> make_cvae_head(const PolicyConfig& config) {
+  return std::make_unique<CvaeHead>(config);
+}
 
 }  // namespace handcentric::policy

@@ -3,8 +3,9 @@
 namespace handcentric::policy {
 
 template <typename Scalar>
-double cvae_loss_and_gradients(MlpT<Scalar>& encoder, MlpT<Scalar>& decoder, const MatrixX<Scalar>& a,
-                               const MatrixX<Scalar>& o, const MatrixX<Scalar>& noise, double kl_weight,
+double cvae_loss_and_gradients(MlpT<Scalar>& encoder, MlpT<Scalar>& decoder,
+                               const MatrixX<Scalar>& a, const MatrixX<Scalar>& o,
+                               const MatrixX<Scalar>& noise, double kl_weight,
                                CvaeBuffers<Scalar>& b) {
   const Eigen::Index batch = a.cols(), da = a.rows(), dobs = o.rows(), Z = noise.rows();
   const auto clamp = static_cast<Scalar>(kCvaeLogVarClamp);
@@ -27,7 +28,8 @@ double cvae_loss_and_gradients(MlpT<Scalar>& encoder, MlpT<Scalar>& decoder, con
   b.d_stats.resize(2 * Z, batch);
   b.d_stats.topRows(Z) = d_decoder_input.topRows(Z) + b.d_mu;
   b.d_stats.bottomRows(Z) =
-      (d_decoder_input.topRows(Z).array() * noise.array() * b.sigma.array() * Scalar(0.5) + b.d_log_var.array())
+      (d_decoder_input.topRows(Z).array() * noise.array() * b.sigma.array() * Scalar(0.5) +
+       b.d_log_var.array())
           .matrix();
   b.d_stats.bottomRows(Z).array() *= (b.raw_log_var.array().abs() < clamp).template cast<Scalar>();
   encoder.backward(b.d_stats);
@@ -37,8 +39,9 @@ double cvae_loss_and_gradients(MlpT<Scalar>& encoder, MlpT<Scalar>& decoder, con
 template double cvae_loss_and_gradients<float>(MlpT<float>&, MlpT<float>&, const MatrixX<float>&,
                                                const MatrixX<float>&, const MatrixX<float>&, double,
                                                CvaeBuffers<float>&);
-template double cvae_loss_and_gradients<double>(MlpT<double>&, MlpT<double>&, const MatrixX<double>&,
-                                                const MatrixX<double>&, const MatrixX<double>&, double,
+template double cvae_loss_and_gradients<double>(MlpT<double>&, MlpT<double>&,
+                                                const MatrixX<double>&, const MatrixX<double>&,
+                                                const MatrixX<double>&, double,
                                                 CvaeBuffers<double>&);
 
 }  // namespace handcentric::policy

@@ -8,7 +8,8 @@ namespace handcentric::policy {
 
 Dataset encode_scenes(const Representation& representation, const std::vector<Scene>& scenes,
                       int history_length, int chunk_length) {
-  if (scenes.empty()) throw InvalidScene("no training scenes: give at least one demonstration step");
+  if (scenes.empty())
+    throw InvalidScene("no training scenes: give at least one demonstration step");
   Dataset data;
   data.hand_points = static_cast<int>(scenes.front().hand_points.size());
   data.world_points = static_cast<int>(scenes.front().world_points.size());
@@ -22,16 +23,18 @@ Dataset encode_scenes(const Representation& representation, const std::vector<Sc
       throw InvalidScene(where + error.what());
     }
     if (scene.history_length() != history_length || scene.chunk_length() != chunk_length) {
-      throw InvalidScene(where + "history H = " + std::to_string(scene.history_length()) + " and chunk K = " +
-                         std::to_string(scene.chunk_length()) + ", but the policy is configured for H = " +
+      throw InvalidScene(where + "history H = " + std::to_string(scene.history_length()) +
+                         " and chunk K = " + std::to_string(scene.chunk_length()) +
+                         ", but the policy is configured for H = " +
                          std::to_string(history_length) + ", K = " + std::to_string(chunk_length) +
                          ": cut the demonstrations with the same H and K");
     }
     if (static_cast<int>(scene.hand_points.size()) != data.hand_points ||
         static_cast<int>(scene.world_points.size()) != data.world_points) {
       throw InvalidScene(where + std::to_string(scene.hand_points.size()) + " eye-in-hand and " +
-                         std::to_string(scene.world_points.size()) + " world points, but scene 0 has " +
-                         std::to_string(data.hand_points) + " and " + std::to_string(data.world_points) +
+                         std::to_string(scene.world_points.size()) +
+                         " world points, but scene 0 has " + std::to_string(data.hand_points) +
+                         " and " + std::to_string(data.world_points) +
                          ": every scene needs the same points");
     }
     const Eigen::VectorXd a = representation.encode_actions(scene);

@@ -2,12 +2,15 @@
 // al. 2021, eta = 0) in config.ddim_steps steps. In normalized coordinates, like the flow head.
 //
 //   schedule  cosine (Nichol & Dhariwal 2021): abar(s) = cos^2(((s / T) + 0.008) / 1.008 * pi / 2)
-//             normalized by abar(0), beta_k = min(1 - abar_k / abar_{k-1}, 0.999), abar_k = prod(1 - beta)
+//             normalized by abar(0), beta_k = min(1 - abar_k / abar_{k-1}, 0.999),
+//             abar_k = prod(1 - beta)
 //   training  k uniform in 0..T-1, x = sqrt(abar_k) a + sqrt(1 - abar_k) eps, target eps,
 //             network input [x, time features of (k + 1) / T, o]
-//   sampling  tau_i = T - 1 - i * (T / S), i = 0..S-1; x0_hat = (x - sqrt(1 - abar) eps_hat) / sqrt(abar),
+//   sampling  tau_i = T - 1 - i * (T / S), i = 0..S-1;
+//             x0_hat = (x - sqrt(1 - abar) eps_hat) / sqrt(abar),
 //             clipped to the range of the normalized training actions (at least +-1), as
-//             Diffusion Policy clips to its data range; x <- sqrt(abar_prev) x0_hat + sqrt(1 - abar_prev) eps_hat.
+//             Diffusion Policy clips to its data range;
+//             x <- sqrt(abar_prev) x0_hat + sqrt(1 - abar_prev) eps_hat.
 //             Without the clip, the first step (abar_{T-1} ~ 2e-7) multiplies any error in
 //             eps_hat by ~2000 and the later steps start far outside the training distribution.
 #include <algorithm>
@@ -46,7 +49,8 @@ class DdpmHead final : public NetworkHead {
         initial_noise_(static_cast<float>(initial_noise)) {}
   HeadKind kind() const override { return HeadKind::ddpm; }
 
-  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override {
+  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+               std::mt19937_64& rng) override {
     NetworkHead::prepare(actions, observations, rng);
     Eigen::MatrixXf normalized = actions.cast<float>();
     action_normalizer_.normalize(normalized);
@@ -75,7 +79,8 @@ class DdpmHead final : public NetworkHead {
     const int T = config_.ddpm_train_steps;
     noise_.resize(a_.rows(), batch);
     fill_standard_normal(rng, noise_);
-    noise_.array().colwise() *= action_normalizer_.active_float().array();  // constant dims: no noise
+    noise_.array().colwise() *=
+        action_normalizer_.active_float().array();  // constant dims: no noise
     t_.resize(batch);
     x_.resize(a_.rows(), batch);
     for (Eigen::Index j = 0; j < batch; ++j) {
@@ -108,7 +113,8 @@ class DdpmHead final : public NetworkHead {
       Eigen::MatrixXf x0 = (x - static_cast<float>(std::sqrt(1.0 - abar)) * eps_hat) /
                            static_cast<float>(std::sqrt(abar));
       x0 = x0.cwiseMax(-clip_).cwiseMin(clip_);
-      x = static_cast<float>(std::sqrt(abar_prev)) * x0 + static_cast<float>(std::sqrt(1.0 - abar_prev)) * eps_hat;
+      x = static_cast<float>(std::sqrt(abar_prev)) * x0 +
+          static_cast<float>(std::sqrt(1.0 - abar_prev)) * eps_hat;
     }
     action_normalizer_.denormalize(x);
     return x;
@@ -116,7 +122,7 @@ class DdpmHead final : public NetworkHead {
 
  private:
   std::vector<double> alpha_bar_;
-  float clip_ = 1.0f;  ///< max |normalized training action|, at least 1
+  float clip_ = 1.0f;           ///< max |normalized training action|, at least 1
   float initial_noise_ = 1.0f;  ///< scale of x_T; 0 starts DDIM at the prior's mode
 };
 

@@ -1,5 +1,6 @@
 // Rectified flow matching, Sec. 2.3:
-//   training  x_t = t a + (1 - t) eps,  target u = a - eps,  L = |f_theta(x_t, t, o) - u|^2   eq. (5)
+//   training  x_t = t a + (1 - t) eps,  target u = a - eps,
+//             L = |f_theta(x_t, t, o) - u|^2                                           eq. (5)
 //   sampling  x_0 = eps,  x_{n+1} = x_n + (1/N) f_theta(x_n, n/N, o),  n = 0..N-1 (Euler)
 // in normalized coordinates (normalizer.hpp), eps ~ N(0, I) there; dimensions that are constant
 // in the training data (normalizer.hpp, active = 0) get no noise and no velocity.
@@ -37,7 +38,8 @@ double FlowHead::train_normalized(std::mt19937_64& rng) {
   return regress(network_.forward(input_), target_);
 }
 
-Eigen::MatrixXf FlowHead::normalized_velocity(const Eigen::MatrixXf& x, double t, const Eigen::MatrixXf& o) const {
+Eigen::MatrixXf FlowHead::normalized_velocity(const Eigen::MatrixXf& x, double t,
+                                              const Eigen::MatrixXf& o) const {
   Eigen::MatrixXf input, output, scratch[2];
   assemble(x, Eigen::VectorXd::Constant(x.cols(), t), o, input);
   network_.infer(input, output, scratch);
@@ -71,6 +73,8 @@ Eigen::MatrixXf FlowHead::sample(const Eigen::MatrixXf& observations, std::mt199
   return x;
 }
 
-std::unique_ptr<Head> make_flow_head(const PolicyConfig& config) { return std::make_unique<FlowHead>(config); }
+std::unique_ptr<Head> make_flow_head(const PolicyConfig& config) {
+  return std::make_unique<FlowHead>(config);
+}
 
 }  // namespace handcentric::policy

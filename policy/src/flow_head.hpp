@@ -14,7 +14,8 @@ class FlowHead : public NetworkHead {
 
   /// The learned velocity in NORMALIZED coordinates, f_theta(x_t, t, o) of eq. (5), for
   /// normalized x (columns) and normalized o.
-  Eigen::MatrixXf normalized_velocity(const Eigen::MatrixXf& x, double t, const Eigen::MatrixXf& o) const;
+  Eigen::MatrixXf normalized_velocity(const Eigen::MatrixXf& x, double t,
+                                      const Eigen::MatrixXf& o) const;
 
  protected:
   /// One step on already normalized actions a_ and observations o_ (the buffers).

@@ -19,23 +19,30 @@ std::unique_ptr<Head> make_head(const PolicyConfig& config) {
   config.validate();
   if (config.action_dimension < 1 || config.observation_dimension < 1) {
     throw InvalidArgument("make_head: action_dimension " + std::to_string(config.action_dimension) +
-                          " and observation_dimension " + std::to_string(config.observation_dimension) +
+                          " and observation_dimension " +
+                          std::to_string(config.observation_dimension) +
                           " must be set (>= 1) from the training data first");
   }
   switch (config.head) {
-    case HeadKind::flow: return make_flow_head(config);
-    case HeadKind::ddpm: return make_ddpm_head(config);
-    case HeadKind::cvae: return make_cvae_head(config);
-    case HeadKind::c8flow: return make_c8_flow_head(config);
+    case HeadKind::flow:
+      return make_flow_head(config);
+    case HeadKind::ddpm:
+      return make_ddpm_head(config);
+    case HeadKind::cvae:
+      return make_cvae_head(config);
+    case HeadKind::c8flow:
+      return make_c8_flow_head(config);
     case HeadKind::c8ddpm:
-    case HeadKind::c8flow_planar: return make_c8_planar_head(config);
+    case HeadKind::c8flow_planar:
+      return make_c8_planar_head(config);
   }
   throw InvalidArgument("make_head: unknown head");
 }
 
 namespace {
 // Weights of an MLP input -> hidden_layers x hidden_width -> output (W and b of every layer).
-std::uint64_t mlp_parameter_count(std::uint64_t input, const PolicyConfig& config, std::uint64_t output) {
+std::uint64_t mlp_parameter_count(std::uint64_t input, const PolicyConfig& config,
+                                  std::uint64_t output) {
   const auto width = static_cast<std::uint64_t>(config.hidden_width);
   std::uint64_t total = 0, fan_in = input;
   for (int l = 0; l < config.hidden_layers; ++l) {
@@ -50,8 +57,9 @@ std::uint64_t parameter_count(const PolicyConfig& config) {
   // The same checks as make_head; validate() bounds every size, so nothing below overflows.
   config.validate();
   if (config.action_dimension < 1 || config.observation_dimension < 1) {
-    throw InvalidArgument("parameter_count: action_dimension " + std::to_string(config.action_dimension) +
-                          " and observation_dimension " + std::to_string(config.observation_dimension) +
+    throw InvalidArgument("parameter_count: action_dimension " +
+                          std::to_string(config.action_dimension) + " and observation_dimension " +
+                          std::to_string(config.observation_dimension) +
                           " must be set (>= 1) from the training data first");
   }
   if (is_c8_planar(config.head)) return parameter_count(c8::inner_config(config));
@@ -81,7 +89,8 @@ NetworkHead::NetworkHead(const PolicyConfig& config)
       action_normalizer_(config.action_dimension),
       observation_normalizer_(config.observation_dimension),
       network_(network_widths(config, config.action_dimension), config.activation),
-      adam_(network_.parameter_count(), AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}),
+      adam_(network_.parameter_count(),
+            AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}),
       average_(config.ema_decay) {}
 
 void NetworkHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
@@ -91,10 +100,12 @@ void NetworkHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd&
   network_.initialize(rng);
 }
 
-int NetworkHead::time_rows() const { return time_feature_count(config_.time_embedding); }
+int NetworkHead::time_rows() const {
+  return time_feature_count(config_.time_embedding);
+}
 
-void NetworkHead::assemble(const Eigen::MatrixXf& x, const Eigen::VectorXd& t, const Eigen::MatrixXf& o,
-                           Eigen::MatrixXf& input) const {
+void NetworkHead::assemble(const Eigen::MatrixXf& x, const Eigen::VectorXd& t,
+                           const Eigen::MatrixXf& o, Eigen::MatrixXf& input) const {
   const Eigen::Index da = x.rows(), dt = time_rows(), batch = x.cols();
   input.resize(da + dt + o.rows(), batch);
   input.topRows(da) = x;

@@ -6,28 +6,37 @@
 
 namespace handcentric::policy {
 
-LearnedPolicy::LearnedPolicy(PolicyConfig config, std::shared_ptr<const Representation> representation,
+LearnedPolicy::LearnedPolicy(PolicyConfig config,
+                             std::shared_ptr<const Representation> representation,
                              std::shared_ptr<const Head> head)
-    : config_(std::move(config)), representation_(std::move(representation)), head_(std::move(head)) {
-  if (!representation_ || !head_) throw InvalidArgument("LearnedPolicy: null representation or head");
+    : config_(std::move(config)),
+      representation_(std::move(representation)),
+      head_(std::move(head)) {
+  if (!representation_ || !head_)
+    throw InvalidArgument("LearnedPolicy: null representation or head");
   if (representation_->name() != config_.representation || head_->kind() != config_.head) {
-    throw InvalidArgument("LearnedPolicy: config says " + to_string(config_.head) + "/" + config_.representation +
-                          " but got " + to_string(head_->kind()) + "/" + representation_->name());
+    throw InvalidArgument("LearnedPolicy: config says " + to_string(config_.head) + "/" +
+                          config_.representation + " but got " + to_string(head_->kind()) + "/" +
+                          representation_->name());
   }
 }
 
-std::string LearnedPolicy::name() const { return to_string(config_.head) + "/" + config_.representation; }
+std::string LearnedPolicy::name() const {
+  return to_string(config_.head) + "/" + config_.representation;
+}
 
-Eigen::VectorXd LearnedPolicy::action_vector(const Scene& observation, std::uint64_t noise_seed) const {
+Eigen::VectorXd LearnedPolicy::action_vector(const Scene& observation,
+                                             std::uint64_t noise_seed) const {
   observation.validate_observation();
   if (observation.history_length() != config_.history_length ||
       static_cast<int>(observation.hand_points.size()) != config_.hand_points ||
       static_cast<int>(observation.world_points.size()) != config_.world_points) {
-    throw InvalidScene("observation with H = " + std::to_string(observation.history_length()) + ", " +
-                       std::to_string(observation.hand_points.size()) + " eye-in-hand and " +
-                       std::to_string(observation.world_points.size()) + " world points, but " + name() +
-                       " was trained with H = " + std::to_string(config_.history_length) + ", " +
-                       std::to_string(config_.hand_points) + " and " + std::to_string(config_.world_points) +
+    throw InvalidScene("observation with H = " + std::to_string(observation.history_length()) +
+                       ", " + std::to_string(observation.hand_points.size()) + " eye-in-hand and " +
+                       std::to_string(observation.world_points.size()) + " world points, but " +
+                       name() + " was trained with H = " + std::to_string(config_.history_length) +
+                       ", " + std::to_string(config_.hand_points) + " and " +
+                       std::to_string(config_.world_points) +
                        ": give observations shaped like the training data");
   }
   // Step 1: the observation in the representation's frame (hand-centric: eq. (3)).
@@ -36,15 +45,19 @@ Eigen::VectorXd LearnedPolicy::action_vector(const Scene& observation, std::uint
   std::mt19937_64 rng(noise_seed);
   const Eigen::VectorXd a = head_->sample(o, rng).col(0).cast<double>();
   if (!a.allFinite()) {
-    throw NonFiniteAction(name() + " produced a non-finite action for this observation: is it far outside the "
-                       "training data (units, frames)?");
+    throw NonFiniteAction(
+        name() +
+        " produced a non-finite action for this observation: is it far outside the "
+        "training data (units, frames)?");
   }
   return a;
 }
 
-std::vector<RigidTransform> LearnedPolicy::act(const Scene& observation, std::uint64_t noise_seed) const {
+std::vector<RigidTransform> LearnedPolicy::act(const Scene& observation,
+                                               std::uint64_t noise_seed) const {
   // Step 3: back to the world frame through the current hand pose T_0 (eq. (1) inverted).
-  return representation_->decode_actions(action_vector(observation, noise_seed), observation.world_T_hand0());
+  return representation_->decode_actions(action_vector(observation, noise_seed),
+                                         observation.world_T_hand0());
 }
 
 }  // namespace handcentric::policy

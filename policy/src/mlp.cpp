@@ -34,7 +34,8 @@ MlpT<Scalar>::MlpT(std::vector<int> widths, Activation activation)
 
 template <typename Scalar>
 Eigen::Map<const typename MlpT<Scalar>::Matrix> MlpT<Scalar>::W(int layer) const {
-  return Eigen::Map<const Matrix>(parameters_.data() + offsets_[layer], widths_[layer + 1], widths_[layer]);
+  return Eigen::Map<const Matrix>(parameters_.data() + offsets_[layer], widths_[layer + 1],
+                                  widths_[layer]);
 }
 
 template <typename Scalar>
@@ -81,12 +82,21 @@ using kernels::Op;
 // out (rows x batch) = W in + b 1^T (float: then SiLU in place when `silu`, with sigmoid(z)
 // into `sigmoid` when it is not null).
 template <typename Scalar, typename W, typename B, typename In, typename Out>
-void affine(const W& weights, const B& bias, const In& in, Out& out, bool silu = false, Scalar* sigmoid = nullptr) {
+void affine(const W& weights, const B& bias, const In& in, Out& out, bool silu = false,
+            Scalar* sigmoid = nullptr) {
   out.resize(weights.rows(), in.cols());
   if constexpr (std::is_same_v<Scalar, float>) {
-    kernels::Gemm problem{Op::none, Op::none, static_cast<int>(weights.rows()), static_cast<int>(in.cols()),
-                          static_cast<int>(weights.cols()), weights.data(), static_cast<int>(weights.rows()),
-                          in.data(), static_cast<int>(in.outerStride()), bias.data(), out.data(),
+    kernels::Gemm problem{Op::none,
+                          Op::none,
+                          static_cast<int>(weights.rows()),
+                          static_cast<int>(in.cols()),
+                          static_cast<int>(weights.cols()),
+                          weights.data(),
+                          static_cast<int>(weights.rows()),
+                          in.data(),
+                          static_cast<int>(in.outerStride()),
+                          bias.data(),
+                          out.data(),
                           static_cast<int>(out.rows())};
     if (silu) {
       problem.epilogue = kernels::Epilogue::silu;
@@ -104,9 +114,10 @@ void affine(const W& weights, const B& bias, const In& in, Out& out, bool silu =
 template <typename Scalar, typename Delta, typename A, typename DW>
 void outer(const Delta& delta, const A& a, DW& dW) {
   if constexpr (std::is_same_v<Scalar, float>) {
-    kernels::active().gemm({Op::none, Op::transpose, static_cast<int>(delta.rows()), static_cast<int>(a.rows()),
-                                 static_cast<int>(delta.cols()), delta.data(), static_cast<int>(delta.rows()),
-                                 a.data(), static_cast<int>(a.rows()), nullptr, dW.data(), static_cast<int>(dW.rows())});
+    kernels::active().gemm(
+        {Op::none, Op::transpose, static_cast<int>(delta.rows()), static_cast<int>(a.rows()),
+         static_cast<int>(delta.cols()), delta.data(), static_cast<int>(delta.rows()), a.data(),
+         static_cast<int>(a.rows()), nullptr, dW.data(), static_cast<int>(dW.rows())});
   } else {
     dW.noalias() = delta * a.transpose();
   }
@@ -119,9 +130,17 @@ void transposed(const W& weights, const Delta& delta, Out& out, const Scalar* ac
                 Scalar* sigmoid = nullptr) {
   out.resize(weights.cols(), delta.cols());
   if constexpr (std::is_same_v<Scalar, float>) {
-    kernels::Gemm problem{Op::transpose, Op::none, static_cast<int>(weights.cols()), static_cast<int>(delta.cols()),
-                          static_cast<int>(weights.rows()), weights.data(), static_cast<int>(weights.rows()),
-                          delta.data(), static_cast<int>(delta.rows()), nullptr, out.data(),
+    kernels::Gemm problem{Op::transpose,
+                          Op::none,
+                          static_cast<int>(weights.cols()),
+                          static_cast<int>(delta.cols()),
+                          static_cast<int>(weights.rows()),
+                          weights.data(),
+                          static_cast<int>(weights.rows()),
+                          delta.data(),
+                          static_cast<int>(delta.rows()),
+                          nullptr,
+                          out.data(),
                           static_cast<int>(out.rows())};
     if (activation != nullptr) {
       problem.epilogue = kernels::Epilogue::silu_derivative;
@@ -173,7 +192,8 @@ const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::forward(const Eigen::Ref<cons
 }
 
 template <typename Scalar>
-const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::backward(const Eigen::Ref<const Matrix>& d_output) {
+const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::backward(
+    const Eigen::Ref<const Matrix>& d_output) {
   return delta_[propagate(d_output, true)];
 }
 
@@ -187,8 +207,9 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
   const Eigen::Index batch = a_[0].cols();
   if (d_output.rows() != output_size() || d_output.cols() != batch) {
     throw InvalidArgument("Mlp::backward: d_output is " + std::to_string(d_output.rows()) + "x" +
-                          std::to_string(d_output.cols()) + ", expected " + std::to_string(output_size()) +
-                          "x" + std::to_string(batch) + " (call forward() first)");
+                          std::to_string(d_output.cols()) + ", expected " +
+                          std::to_string(output_size()) + "x" + std::to_string(batch) +
+                          " (call forward() first)");
   }
   int current = 0;
   delta_[current] = d_output;
@@ -202,7 +223,8 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
       if (activation_ == Activation::silu) {
         // SiLU'(z) = s (1 + z (1 - s)) = s + a (1 - s), s = sigmoid(z) kept by forward().
         if constexpr (kFloat) {
-          kernels::active().silu_backward(delta.size(), a_[l + 1].data(), sigmoid_[l].data(), delta.data());
+          kernels::active().silu_backward(delta.size(), a_[l + 1].data(), sigmoid_[l].data(),
+                                          delta.data());
         } else {
           const auto s = sigmoid_[l].array();
           delta.array() *= s * (Scalar(1) + z_[l].array() * (Scalar(1) - s));
@@ -218,9 +240,10 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
     if constexpr (std::is_same_v<Scalar, float>) {
       // db = delta 1: the batch-1 kernel (GEMV) against a vector of ones.
       if (ones_.size() != delta.cols()) ones_ = Vector::Ones(delta.cols());
-      kernels::active().gemm({Op::none, Op::none, static_cast<int>(delta.rows()), 1, static_cast<int>(delta.cols()),
-                              delta.data(), static_cast<int>(delta.rows()), ones_.data(), static_cast<int>(delta.cols()),
-                              nullptr, db.data(), static_cast<int>(delta.rows())});
+      kernels::active().gemm(
+          {Op::none, Op::none, static_cast<int>(delta.rows()), 1, static_cast<int>(delta.cols()),
+           delta.data(), static_cast<int>(delta.rows()), ones_.data(),
+           static_cast<int>(delta.cols()), nullptr, db.data(), static_cast<int>(delta.rows())});
     } else {
       db.noalias() = delta.rowwise().sum();
     }
@@ -236,7 +259,8 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
 }
 
 template <typename Scalar>
-void MlpT<Scalar>::infer(const Eigen::Ref<const Matrix>& input, Matrix& output, Matrix (&scratch)[2]) const {
+void MlpT<Scalar>::infer(const Eigen::Ref<const Matrix>& input, Matrix& output,
+                         Matrix (&scratch)[2]) const {
   if (input.rows() != input_size()) {
     throw InvalidArgument("Mlp input has " + std::to_string(input.rows()) + " rows, expected " +
                           std::to_string(input_size()));

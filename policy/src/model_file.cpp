@@ -39,28 +39,34 @@ LearnedPolicy deserialize_model(const std::string& bytes, const std::string& sou
   ByteReader header(bytes, source);
   if (bytes.size() > kMaxModelFileBytes) {
     throw InvalidModelFile(source + ": " + std::to_string(bytes.size()) + " bytes, more than the " +
-                           std::to_string(kMaxModelFileBytes) + " a model file may have: give a file written by "
+                           std::to_string(kMaxModelFileBytes) +
+                           " a model file may have: give a file written by "
                            "`handcentric train --out`");
   }
   if (bytes.size() < sizeof kMagic || bytes.compare(0, sizeof kMagic, kMagic, sizeof kMagic) != 0) {
-    throw InvalidModelFile(source + ": not a handcentric model file (it does not start with HCPOLICY): give a "
-                           "file written by `handcentric train --out`");
+    throw InvalidModelFile(
+        source +
+        ": not a handcentric model file (it does not start with HCPOLICY): give a "
+        "file written by `handcentric train --out`");
   }
   if (bytes.size() < kHeaderBytes + 8) header.fail("truncated header");
   header.u64();  // the magic, checked above
   const std::uint32_t version = header.u32();
   if (version != kModelFormatVersion) {
-    throw InvalidModelFile(source + ": model format version " + std::to_string(version) + ", this build reads version " +
-                           std::to_string(kModelFormatVersion) + ": retrain the model with this build");
+    throw InvalidModelFile(source + ": model format version " + std::to_string(version) +
+                           ", this build reads version " + std::to_string(kModelFormatVersion) +
+                           ": retrain the model with this build");
   }
   const std::uint64_t payload_size = header.u64();
   if (payload_size != bytes.size() - kHeaderBytes - 8) {
-    header.fail("the header announces " + std::to_string(payload_size) + " payload bytes but the file has " +
+    header.fail("the header announces " + std::to_string(payload_size) +
+                " payload bytes but the file has " +
                 std::to_string(bytes.size() - kHeaderBytes - 8) + " (truncated or appended to)");
   }
   std::uint64_t stored = 0;
   std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
-  if (stored != fnv1a64(bytes.data(), bytes.size() - 8)) header.fail("checksum mismatch (corrupted)");
+  if (stored != fnv1a64(bytes.data(), bytes.size() - 8))
+    header.fail("checksum mismatch (corrupted)");
 
   ByteReader in(bytes, source, kHeaderBytes, bytes.size() - 8);
   PolicyConfig config;
@@ -76,8 +82,8 @@ LearnedPolicy deserialize_model(const std::string& bytes, const std::string& sou
   const std::string representation_name = in.string(256);
   const std::string head_name = in.string(256);
   if (representation_name != config.representation || head_name != to_string(config.head)) {
-    in.fail("the config says " + to_string(config.head) + "/" + config.representation + " but the file stores " +
-            head_name + "/" + representation_name);
+    in.fail("the config says " + to_string(config.head) + "/" + config.representation +
+            " but the file stores " + head_name + "/" + representation_name);
   }
   // Before make_head allocates the network (and Adam's state beside it): the weights it
   // describes must be in this file, so a damaged or hostile config cannot ask for more memory
@@ -113,20 +119,25 @@ void save_model(const LearnedPolicy& policy, const std::string& path) {
 LearnedPolicy load_model(const std::string& path, const SamplingOverrides& overrides) {
   std::error_code error;
   if (!std::filesystem::is_regular_file(path, error)) {
-    throw InvalidModelFile(path + ": no such model file: give the path written by `handcentric train --out`");
+    throw InvalidModelFile(
+        path + ": no such model file: give the path written by `handcentric train --out`");
   }
   const std::uintmax_t size = std::filesystem::file_size(path, error);
-  if (error) throw InvalidModelFile(path + ": cannot read the file's size (" + error.message() + "): check its permissions");
+  if (error)
+    throw InvalidModelFile(path + ": cannot read the file's size (" + error.message() +
+                           "): check its permissions");
   if (size > kMaxModelFileBytes) {
     throw InvalidModelFile(path + ": " + std::to_string(size) + " bytes, more than the " +
-                           std::to_string(kMaxModelFileBytes) + " a model file may have (checked before reading): "
+                           std::to_string(kMaxModelFileBytes) +
+                           " a model file may have (checked before reading): "
                            "give a file written by `handcentric train --out`");
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InvalidModelFile(path + ": cannot open the file: check its permissions");
   std::string bytes(static_cast<std::size_t>(size), '\0');
   in.read(bytes.data(), static_cast<std::streamsize>(size));
-  if (static_cast<std::uintmax_t>(in.gcount()) != size || in.peek() != std::char_traits<char>::eof()) {
+  if (static_cast<std::uintmax_t>(in.gcount()) != size ||
+      in.peek() != std::char_traits<char>::eof()) {
     throw InvalidModelFile(path + ": the file changed while it was read: load it again");
   }
   return deserialize_model(bytes, path, overrides);

@@ -15,7 +15,8 @@ namespace handcentric::policy {
 class NetworkHead : public Head {
  public:
   explicit NetworkHead(const PolicyConfig& config);
-  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations, std::mt19937_64& rng) override;
+  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+               std::mt19937_64& rng) override;
   void write(ByteWriter& out) const override;
   void read(ByteReader& in) override;
   void set_learning_rate(double learning_rate) override { adam_.set_learning_rate(learning_rate); }

@@ -20,13 +20,14 @@ Normalizer::Normalizer(Eigen::VectorXd mean, Eigen::VectorXd scale, Eigen::Vecto
   }
   for (Eigen::Index i = 0; i < active_.size(); ++i) {
     if (active_[i] != 0.0 && active_[i] != 1.0) {
-      throw InvalidArgument("Normalizer: activity flag " + std::to_string(i) + " is " + format_number(active_[i]) +
-                            ": use 0 (constant dimension) or 1");
+      throw InvalidArgument("Normalizer: activity flag " + std::to_string(i) + " is " +
+                            format_number(active_[i]) + ": use 0 (constant dimension) or 1");
     }
   }
   if (mean_.size() != scale_.size()) {
     throw InvalidArgument("Normalizer: " + std::to_string(mean_.size()) + " means but " +
-                          std::to_string(scale_.size()) + " scales; give one of each per dimension");
+                          std::to_string(scale_.size()) +
+                          " scales; give one of each per dimension");
   }
   for (Eigen::Index i = 0; i < mean_.size(); ++i) {
     if (!std::isfinite(mean_[i]) || !std::isfinite(scale_[i]) || !(scale_[i] > 0.0)) {
@@ -42,7 +43,8 @@ Normalizer::Normalizer(Eigen::VectorXd mean, Eigen::VectorXd scale, Eigen::Vecto
 }
 
 Normalizer Normalizer::fit(const Eigen::MatrixXd& data) {
-  if (data.cols() == 0) throw InvalidArgument("Normalizer::fit: no samples; give at least one column");
+  if (data.cols() == 0)
+    throw InvalidArgument("Normalizer::fit: no samples; give at least one column");
   if (!data.allFinite()) throw InvalidArgument("Normalizer::fit: the data has a non-finite entry");
   const Eigen::VectorXd mean = data.rowwise().mean();
   Eigen::VectorXd scale(data.rows()), active(data.rows());

@@ -10,7 +10,8 @@
 
 namespace handcentric::policy {
 
-inline void write_normalizers(ByteWriter& out, const Normalizer& actions, const Normalizer& observations) {
+inline void write_normalizers(ByteWriter& out, const Normalizer& actions,
+                              const Normalizer& observations) {
   out.doubles(actions.mean());
   out.doubles(actions.scale());
   out.doubles(actions.active());

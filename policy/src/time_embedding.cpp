@@ -8,12 +8,14 @@
 
 namespace handcentric::policy {
 
-int time_feature_count(int dimension) { return dimension == 0 ? 1 : dimension; }
+int time_feature_count(int dimension) {
+  return dimension == 0 ? 1 : dimension;
+}
 
 void time_features(double t, int dimension, Eigen::Ref<Eigen::VectorXf> out) {
   if (out.size() != time_feature_count(dimension)) {
-    throw InvalidArgument("time_features: output of length " + std::to_string(out.size()) + ", expected " +
-                          std::to_string(time_feature_count(dimension)));
+    throw InvalidArgument("time_features: output of length " + std::to_string(out.size()) +
+                          ", expected " + std::to_string(time_feature_count(dimension)));
   }
   if (dimension == 0) {
     out[0] = static_cast<float>(t);

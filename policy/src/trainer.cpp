@@ -14,7 +14,9 @@
 namespace handcentric::policy {
 
 int training_budget(long long samples) {
-  if (samples < 1) throw InvalidArgument("training_budget: no training samples (got " + std::to_string(samples) + ")");
+  if (samples < 1)
+    throw InvalidArgument("training_budget: no training samples (got " + std::to_string(samples) +
+                          ")");
   const double steps = kBudgetStepsPerSample * static_cast<double>(samples);
   return static_cast<int>(std::clamp(std::llround(steps), static_cast<long long>(kBudgetMinSteps),
                                      static_cast<long long>(kBudgetMaxSteps)));
@@ -26,7 +28,8 @@ double learning_rate_at(const PolicyConfig& config, int step) {
                           std::to_string(config.steps));
   }
   switch (config.lr_schedule) {
-    case LearningRateSchedule::constant: return config.learning_rate;
+    case LearningRateSchedule::constant:
+      return config.learning_rate;
     case LearningRateSchedule::cosine: {
       const double progress = static_cast<double>(step - 1) / config.steps;  // [0, 1)
       return config.learning_rate * 0.5 * (1.0 + std::cos(std::numbers::pi * progress));
@@ -35,19 +38,21 @@ double learning_rate_at(const PolicyConfig& config, int step) {
   return config.learning_rate;
 }
 
-LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes, std::uint64_t seed,
-                           const ProgressCallback& progress, int report_every) {
+LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes,
+                           std::uint64_t seed, const ProgressCallback& progress, int report_every) {
   config.validate();
   const auto representation = make_representation(config.representation);
-  return train_policy(config, encode_scenes(*representation, scenes, config.history_length, config.chunk_length),
-                      seed, progress, report_every);
+  return train_policy(
+      config, encode_scenes(*representation, scenes, config.history_length, config.chunk_length),
+      seed, progress, report_every);
 }
 
 LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64_t seed,
                            const ProgressCallback& progress, int report_every) {
   config.validate();
   std::shared_ptr<const Representation> representation = make_representation(config.representation);
-  if (data.size() == 0) throw InvalidScene("no training samples: give at least one demonstration step");
+  if (data.size() == 0)
+    throw InvalidScene("no training samples: give at least one demonstration step");
   if (config.steps == 0) {
     config.steps = training_budget(c8::augmentation_copies(config.head) * data.size());
   }
@@ -62,8 +67,9 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
   const Eigen::MatrixXf actions = data.actions.cast<float>();
   const Eigen::MatrixXf observations = data.observations.cast<float>();
   if (!actions.allFinite() || !observations.allFinite()) {
-    throw InvalidScene("the training data has a value beyond the float32 range (|x| > 3.4e38): express poses and "
-                       "points in metres and radians");
+    throw InvalidScene(
+        "the training data has a value beyond the float32 range (|x| > 3.4e38): express poses and "
+        "points in metres and radians");
   }
   Eigen::MatrixXf batch_actions(actions.rows(), config.batch_size);
   Eigen::MatrixXf batch_observations(observations.rows(), config.batch_size);
@@ -82,19 +88,22 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
     head->set_learning_rate(learning_rate);
     const double loss = head->train_step(batch_actions, batch_observations, rng);
     if (!std::isfinite(loss)) {
-      throw InvalidArgument("training diverged at step " + std::to_string(step) + " (loss " + std::to_string(loss) +
-                            ", learning rate " + std::to_string(learning_rate) +
+      throw InvalidArgument("training diverged at step " + std::to_string(step) + " (loss " +
+                            std::to_string(loss) + ", learning rate " +
+                            std::to_string(learning_rate) +
                             "): lower the learning rate or keep gradient clipping on");
     }
     loss_sum += loss;
     ++loss_count;
     if (progress && (step % std::max(report_every, 1) == 0 || step == config.steps)) {
-      const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       TrainingProgress report;
       report.step = step;
       report.steps = config.steps;
       report.loss = loss_sum / loss_count;
-      report.samples_per_second = seconds > 0.0 ? static_cast<double>(step) * config.batch_size / seconds : 0.0;
+      report.samples_per_second =
+          seconds > 0.0 ? static_cast<double>(step) * config.batch_size / seconds : 0.0;
       report.eta_seconds = seconds / step * (config.steps - step);
       progress(report);
       loss_sum = 0.0;

@@ -22,9 +22,9 @@ bool has_symbols(const GiNaC::ex& value) {
 
 void require_same_shape(const GiNaC::matrix& lhs, const GiNaC::matrix& rhs) {
   if (lhs.rows() != rhs.rows() || lhs.cols() != rhs.cols()) {
-    throw InvalidArgument("certificate: the two sides have shapes " + std::to_string(lhs.rows()) + "x" +
-                          std::to_string(lhs.cols()) + " and " + std::to_string(rhs.rows()) + "x" +
-                          std::to_string(rhs.cols()) + "; a claim must compare equal shapes");
+    throw InvalidArgument("certificate: the two sides have shapes " + std::to_string(lhs.rows()) +
+                          "x" + std::to_string(lhs.cols()) + " and " + std::to_string(rhs.rows()) +
+                          "x" + std::to_string(rhs.cols()) + "; a claim must compare equal shapes");
   }
 }
 
@@ -161,9 +161,10 @@ CertificateResult certify_counterexample(const Side& lhs, const Side& rhs, const
   const auto shown = [](const GiNaC::matrix& m) {
     return m.cols() == 1 ? column_text(m) : matrix_text(m);
   };
-  const std::string both = text.inputs + "; " + text.lhs_name + " = " + shown(left_simplified) + ", " +
-                           text.rhs_name + " = " + shown(right_simplified);
-  if (differing < 0) return {false, both, "both sides are equal at this witness: not a counterexample"};
+  const std::string both = text.inputs + "; " + text.lhs_name + " = " + shown(left_simplified) +
+                           ", " + text.rhs_name + " = " + shown(right_simplified);
+  if (differing < 0)
+    return {false, both, "both sides are equal at this witness: not a counterexample"};
   return {true, both, "entry " + std::to_string(differing) + " of the two sides certainly differs"};
 }
 

@@ -20,8 +20,8 @@ std::string section_title(ClaimSection section) {
   return "?";
 }
 
-Claim identity_claim(std::string id, std::string statement, ClaimSection section, Side lhs, Side rhs,
-                     Group group, std::string note) {
+Claim identity_claim(std::string id, std::string statement, ClaimSection section, Side lhs,
+                     Side rhs, Group group, std::string note) {
   Claim claim{std::move(id),
               std::move(statement),
               ClaimKind::identity,
@@ -52,7 +52,8 @@ Claim counterexample_claim(std::string id, std::string statement, ClaimSection s
               Group::rigid_motions,
               std::move(witness),
               std::move(inputs)};
-  claim.certify = [lhs = claim.lhs, rhs = claim.rhs, witness = claim.witness, inputs = claim.inputs] {
+  claim.certify = [lhs = claim.lhs, rhs = claim.rhs, witness = claim.witness,
+                   inputs = claim.inputs] {
     return certify_counterexample(lhs, rhs, witness, inputs);
   };
   return claim;

@@ -12,8 +12,9 @@ namespace {
 constexpr ClaimSection kSection = ClaimSection::counterexamples;
 
 Flow with_noise(GiNaC::matrix (*f)(const ExactScene&, const GiNaC::matrix&)) {
-  return
-      [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) { return f(scene, eps); };
+  return [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) {
+    return f(scene, eps);
+  };
 }
 
 Flow ignoring_noise(GiNaC::matrix (*f)(const ExactScene&)) {
@@ -21,7 +22,9 @@ Flow ignoring_noise(GiNaC::matrix (*f)(const ExactScene&)) {
 }
 
 // The 3-4-5 rotation about z: cos = 3/5, sin = 4/5 (q = (2, 0, 0, 1)).
-GiNaC::matrix rotation_345() { return rational_rotation(2, 0, 0, 1); }
+GiNaC::matrix rotation_345() {
+  return rational_rotation(2, 0, 0, 1);
+}
 
 // A witness with T_0, T_k and eps, and its description.
 struct Witness {
@@ -43,16 +46,18 @@ Witness witness(const ExactPose& g, const ExactPose& world_T_hand0, const ExactP
 
 Claim invariance_counterexample(std::string id, std::string statement, const Flow& flow,
                                 const Witness& w, std::string note = "") {
-  return counterexample_claim(std::move(id), std::move(statement), kSection, moved(flow), unmoved(flow),
-                              w.instance, WitnessText(w.inputs, "f(T~ scene)", "f(scene)"),
-                              std::move(note));
+  return counterexample_claim(std::move(id), std::move(statement), kSection, moved(flow),
+                              unmoved(flow), w.instance,
+                              WitnessText(w.inputs, "f(T~ scene)", "f(scene)"), std::move(note));
 }
 
 // eq. (13): certified on the matrices R~ R_k != R_k, both of angle below pi (tr R > -1).
 Claim eq13_claim() {
-  const Witness w = witness(rotation_pose(rotation_345()), ExactPose{}, ExactPose{}, column(0, 0, 0));
+  const Witness w =
+      witness(rotation_pose(rotation_345()), ExactPose{}, ExactPose{}, column(0, 0, 0));
   Claim claim = invariance_counterexample(
-      "A.1 eq. (13)", "The absolute rotation flow r(R_k) - eps is not invariant under global rotations.",
+      "A.1 eq. (13)",
+      "The absolute rotation flow r(R_k) - eps is not invariant under global rotations.",
       ignoring_noise(flows::absolute_rotation_matrix), w,
       "A rotation vector is transcendental in general, so this is certified on the exact matrices: "
       "R~ R_k != R_k, and both have angle below pi (trace > -1, checked exactly). r is injective "
@@ -96,7 +101,8 @@ std::vector<Claim> counterexample_claims() {
       "A.1 eq. (11), translations",
       "The absolute translation flow p_k - eps is not invariant under global translations.",
       with_noise(flows::absolute_translation),
-      witness(translation_pose(column(0, 1, 0)), ExactPose{}, translation_pose(column(1, 0, 0)), zero)));
+      witness(translation_pose(column(0, 1, 0)), ExactPose{}, translation_pose(column(1, 0, 0)),
+              zero)));
   claims.push_back(invariance_counterexample(
       "A.1 eq. (11), rotations",
       "The absolute translation flow p_k - eps is not invariant under global rotations.",
@@ -113,7 +119,8 @@ std::vector<Claim> counterexample_claims() {
       "The relative_diff rotation flow r(R_k) - r(R_0) - eps (App. A.2 eq. (14)) is not invariant "
       "under global rotations.",
       with_noise(flows::relative_diff_rotation),
-      witness(rotation_pose(quarter_turn(0, 1)), ExactPose{}, rotation_pose(quarter_turn(2, 1)), zero),
+      witness(rotation_pose(quarter_turn(0, 1)), ExactPose{}, rotation_pose(quarter_turn(2, 1)),
+              zero),
       "Exact rotation vectors: every rotation involved is a product of quarter turns with angle "
       "pi/2 or 2 pi/3, whose r(.) is exact in Q(sqrt(3), pi)."));
   claims.push_back(invariance_counterexample(
@@ -128,7 +135,8 @@ std::vector<Claim> counterexample_claims() {
       "(pointwise, fixed eps).",
       with_noise(flows::actionflow_translation),
       witness(rotate_345, ExactPose{}, ExactPose{}, column(1, 0, 0)),
-      "Pointwise: the same eps before and after. In distribution it is rotation-invariant (item 3)."));
+      "Pointwise: the same eps before and after. In distribution it is rotation-invariant (item "
+      "3)."));
   claims.push_back(third_person_claim());
   return claims;
 }

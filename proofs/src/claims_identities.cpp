@@ -16,8 +16,9 @@ Flow ignoring_noise(GiNaC::matrix (*f)(const ExactScene&)) {
 }
 
 Flow with_noise(GiNaC::matrix (*f)(const ExactScene&, const GiNaC::matrix&)) {
-  return
-      [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) { return f(scene, eps); };
+  return [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) {
+    return f(scene, eps);
+  };
 }
 
 // Lemma 1 / eq. (8): the inner policy's action Ra_k is invariant, so it is one generic pose that
@@ -33,14 +34,16 @@ Claim lemma1_claim() {
   };
   return identity_claim(
       "Sec. 3.1 Lemma 1, eq. (8)",
-      "If the hand-centric policy is invariant, the outer action a_k = T_0 Ra_k is SE(3)-equivariant: "
+      "If the hand-centric policy is invariant, the outer action a_k = T_0 Ra_k is "
+      "SE(3)-equivariant: "
       "moving the scene by T~ gives (T~ T_0) Ra_k = T~ a_k.",
       kSection, outer_of_moved_scene, moved_outer_action, Group::rigid_motions,
       "Ra_k is a generic pose that does not depend on T~ (the invariance assumed by Lemma 1); "
       "the identity is on all 12 entries of the pose.");
 }
 
-// eq. (11) as printed: R~ p_k + p~ - eps = T~ o (p_k - eps) + R~ eps - eps, with T~ o v = R~ v + p~.
+// eq. (11) as printed: R~ p_k + p~ - eps = T~ o (p_k - eps) + R~ eps - eps,
+// with T~ o v = R~ v + p~.
 Claim eq11_printed_claim() {
   Side printed_right = [](const Instance& x) {
     const GiNaC::matrix flow = flows::absolute_translation(x.scene, x.eps);
@@ -65,8 +68,9 @@ std::vector<Claim> identity_claims() {
       unmoved(ignoring_noise(flows::hand_centric_proprioception)), Group::rigid_motions,
       "All 12 entries of the pose, with T~, T_0 and T_{-h} generic."));
   claims.push_back(identity_claim(
-      "A.3 eq. (23)", "The hand-centric translation flow R_0^T (p_k - p_0) - eps is SE(3)-invariant.",
-      kSection, moved(with_noise(flows::hand_centric_translation)),
+      "A.3 eq. (23)",
+      "The hand-centric translation flow R_0^T (p_k - p_0) - eps is SE(3)-invariant.", kSection,
+      moved(with_noise(flows::hand_centric_translation)),
       unmoved(with_noise(flows::hand_centric_translation)), Group::rigid_motions));
   claims.push_back(identity_claim(
       "A.3 eq. (26)",
@@ -78,9 +82,9 @@ std::vector<Claim> identity_claims() {
       "is unchanged too."));
   claims.push_back(identity_claim(
       "A.2 eq. (16), translations",
-      "The relative translation flow p_k - p_0 - eps is invariant under global translations.", kSection,
-      moved(with_noise(flows::relative_translation)), unmoved(with_noise(flows::relative_translation)),
-      Group::translations));
+      "The relative translation flow p_k - p_0 - eps is invariant under global translations.",
+      kSection, moved(with_noise(flows::relative_translation)),
+      unmoved(with_noise(flows::relative_translation)), Group::translations));
   claims.push_back(lemma1_claim());
   claims.push_back(identity_claim(
       "Sec. 3.2 Lemma 2 with eq. (9)",

@@ -10,7 +10,9 @@ namespace {
 
 constexpr ClaimSection kSection = ClaimSection::paper_findings;
 
-const ExactPose& hand_k(const Instance& x) { return x.scene.chunk.front(); }
+const ExactPose& hand_k(const Instance& x) {
+  return x.scene.chunk.front();
+}
 
 // ActionFlow's target on the moved scene, exactly: (R~ R_k)^T (R~ p_k + p~ - eps).
 GiNaC::matrix moved_actionflow(const Instance& x) {
@@ -28,7 +30,8 @@ Instance actionflow_witness(const ExactPose& g, const ExactPose& world_T_handk,
 }
 
 std::string actionflow_inputs(const Instance& x) {
-  return "T~ = " + pose_text(x.g) + ", T_k = " + pose_text(hand_k(x)) + ", eps = " + column_text(x.eps);
+  return "T~ = " + pose_text(x.g) + ", T_k = " + pose_text(hand_k(x)) +
+         ", eps = " + column_text(x.eps);
 }
 
 // eq. (28) with the path x_t of eq. (27): R_k^T (p_k - x_t) / (1 - t), x_t = t v + (1 - t) eps.
@@ -44,23 +47,25 @@ std::vector<Claim> eq27_claims() {
   Side with_r_as_printed = [](const Instance& x) {
     return eq28_with_path(x, exact_rotation_vector(hand_k(x).R));
   };
-  Instance w =
-      actionflow_witness(ExactPose{}, ExactPose{quarter_turn(2, 1), column(1, 0, 0)}, column(0, 0, 0));
+  Instance w = actionflow_witness(ExactPose{}, ExactPose{quarter_turn(2, 1), column(1, 0, 0)},
+                                  column(0, 0, 0));
   w.t = GiNaC::numeric(1, 2);
   return {
-      identity_claim("A.4 eqs. (27)-(29), path on p",
-                     "With the path x_t = t p_k + (1 - t) eps, eq. (28) R_k^T (p_k - x_t) / (1 - t) "
-                     "equals eq. (29) R_k^T (p_k - eps).",
-                     kSection, with_p, eq29, Group::rigid_motions,
-                     "For every t != 1 (the factor (1 - t) cancels)."),
-      counterexample_claim("A.4 eq. (27) as printed",
-                           "With eq. (27) as printed, x_t = t r_k + (1 - t) eps (the rotation vector), "
-                           "eq. (28) does not give eq. (29): the printed r is a typo for p.",
-                           kSection, with_r_as_printed, eq29, w,
-                           WitnessText(actionflow_inputs(w) + ", t = 1/2, r_k = r(R_k) = (0, 0, pi/2)",
-                                       "eq. (28) on the printed path", "eq. (29)"),
-                           "Found: the paper prints 't W r_Rk' in eq. (27) where W p_Rk is meant; "
-                           "eq. (29) follows only from the path on p (previous claim)."),
+      identity_claim(
+          "A.4 eqs. (27)-(29), path on p",
+          "With the path x_t = t p_k + (1 - t) eps, eq. (28) R_k^T (p_k - x_t) / (1 - t) "
+          "equals eq. (29) R_k^T (p_k - eps).",
+          kSection, with_p, eq29, Group::rigid_motions,
+          "For every t != 1 (the factor (1 - t) cancels)."),
+      counterexample_claim(
+          "A.4 eq. (27) as printed",
+          "With eq. (27) as printed, x_t = t r_k + (1 - t) eps (the rotation vector), "
+          "eq. (28) does not give eq. (29): the printed r is a typo for p.",
+          kSection, with_r_as_printed, eq29, w,
+          WitnessText(actionflow_inputs(w) + ", t = 1/2, r_k = r(R_k) = (0, 0, pi/2)",
+                      "eq. (28) on the printed path", "eq. (29)"),
+          "Found: the paper prints 't W r_Rk' in eq. (27) where W p_Rk is meant; "
+          "eq. (29) follows only from the path on p (previous claim)."),
   };
 }
 
@@ -90,14 +95,16 @@ std::vector<Claim> eq30_claims() {
   const Instance w = actionflow_witness(ExactPose{rational_rotation(2, 0, 0, 1), column(1, 0, 0)},
                                         ExactPose{}, column(0, 0, 0));
   return {
-      identity_claim("A.4 eq. (30), first expression",
-                     "The first expression of eq. (30), (R~ R_k)^T (R~ p_k + p~ - eps), is ActionFlow's "
-                     "flow on the moved scene.",
-                     kSection, moved_actionflow, first_printed, Group::rigid_motions),
-      identity_claim("A.4 eq. (30), middle: p_k and eps terms",
-                     "In eq. (30)'s middle expression R_k^T (p_k + R~ p~ - R~^T eps), the p_k and eps "
-                     "terms are right: (R~ R_k)^T (R~ p_k - eps) = R_k^T (p_k - R~^T eps).",
-                     kSection, exact_pk_and_eps_terms, printed_pk_and_eps_terms, Group::rigid_motions),
+      identity_claim(
+          "A.4 eq. (30), first expression",
+          "The first expression of eq. (30), (R~ R_k)^T (R~ p_k + p~ - eps), is ActionFlow's "
+          "flow on the moved scene.",
+          kSection, moved_actionflow, first_printed, Group::rigid_motions),
+      identity_claim(
+          "A.4 eq. (30), middle: p_k and eps terms",
+          "In eq. (30)'s middle expression R_k^T (p_k + R~ p~ - R~^T eps), the p_k and eps "
+          "terms are right: (R~ R_k)^T (R~ p_k - eps) = R_k^T (p_k - R~^T eps).",
+          kSection, exact_pk_and_eps_terms, printed_pk_and_eps_terms, Group::rigid_motions),
       counterexample_claim(
           "A.4 eq. (30), middle: p~ term as printed",
           "In eq. (30)'s middle expression the p~ term is wrong as printed: "
@@ -106,10 +113,11 @@ std::vector<Claim> eq30_claims() {
           WitnessText(actionflow_inputs(w), "exact (R~ R_k)^T p~", "printed R_k^T R~ p~"),
           "Found: the paper prints R~ p~ where R~^T p~ is meant. The conclusion of "
           "eq. (30) (not invariant) still holds: item 2."),
-      identity_claim("A.4 eq. (30), middle corrected",
-                     "With R~^T p~, the middle expression R_k^T (p_k + R~^T p~ - R~^T eps) equals the "
-                     "moved flow exactly.",
-                     kSection, moved_actionflow, corrected_middle, Group::rigid_motions),
+      identity_claim(
+          "A.4 eq. (30), middle corrected",
+          "With R~^T p~, the middle expression R_k^T (p_k + R~^T p~ - R~^T eps) equals the "
+          "moved flow exactly.",
+          kSection, moved_actionflow, corrected_middle, Group::rigid_motions),
   };
 }
 
@@ -132,7 +140,8 @@ std::vector<Claim> actionflow_distribution_claims() {
   Side unmoved_mean = [](const Instance& x) {
     return flows::actionflow_translation(x.scene, column(0, 0, 0));
   };
-  const Instance w = actionflow_witness(translation_pose(column(1, 0, 0)), ExactPose{}, column(0, 0, 0));
+  const Instance w =
+      actionflow_witness(translation_pose(column(1, 0, 0)), ExactPose{}, column(0, 0, 0));
   return {
       identity_claim(
           "Sec. 5 vs A.4, rotations in distribution",
@@ -144,13 +153,14 @@ std::vector<Claim> actionflow_distribution_claims() {
           "in distribution, App. A.4 (depends on rotations) pointwise for a fixed eps "
           "(item 2). The sampled counterpart is `handcentric audit --json`, mode "
           "\"distribution\", for the actionflow target."),
-      counterexample_claim("Sec. 5 vs A.4, translations in distribution",
-                           "ActionFlow's translation flow is not translation-invariant even in "
-                           "distribution: its mean R_k^T p_k (the target at eps = 0) moves.",
-                           kSection, moved_mean, unmoved_mean, w,
-                           WitnessText(actionflow_inputs(w), "mean on T~ scene", "mean on scene"),
-                           "The target is affine in eps and E[eps] = 0, so its mean is the target at "
-                           "eps = 0; different means, different laws. Sec. 5 says so too."),
+      counterexample_claim(
+          "Sec. 5 vs A.4, translations in distribution",
+          "ActionFlow's translation flow is not translation-invariant even in "
+          "distribution: its mean R_k^T p_k (the target at eps = 0) moves.",
+          kSection, moved_mean, unmoved_mean, w,
+          WitnessText(actionflow_inputs(w), "mean on T~ scene", "mean on scene"),
+          "The target is affine in eps and E[eps] = 0, so its mean is the target at "
+          "eps = 0; different means, different laws. Sec. 5 says so too."),
   };
 }
 

@@ -17,13 +17,17 @@ GiNaC::matrix stack(const GiNaC::matrix& top, const GiNaC::matrix& bottom) {
   return out;
 }
 
-GiNaC::matrix identity3() { return GiNaC::matrix{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}; }
+GiNaC::matrix identity3() {
+  return GiNaC::matrix{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+}
 
 ExactPose ExactPose::operator*(const ExactPose& other) const {
   return ExactPose{R.mul(other.R), R.mul(other.p).add(p)};
 }
 
-GiNaC::matrix ExactPose::operator*(const GiNaC::matrix& point) const { return R.mul(point).add(p); }
+GiNaC::matrix ExactPose::operator*(const GiNaC::matrix& point) const {
+  return R.mul(point).add(p);
+}
 
 ExactPose ExactPose::inverse() const {
   const GiNaC::matrix Rt = R.transpose();
@@ -77,11 +81,13 @@ std::string canonical_text(const GiNaC::ex& value) {
   const GiNaC::ex expanded = GiNaC::expand(value);
   std::vector<std::pair<std::string, GiNaC::numeric>> terms;
   if (GiNaC::is_a<GiNaC::add>(expanded)) {
-    for (std::size_t i = 0; i < expanded.nops(); ++i) terms.push_back(canonical_term(expanded.op(i)));
+    for (std::size_t i = 0; i < expanded.nops(); ++i)
+      terms.push_back(canonical_term(expanded.op(i)));
   } else {
     terms.push_back(canonical_term(expanded));
   }
-  std::sort(terms.begin(), terms.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(terms.begin(), terms.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   std::string out;
   for (const auto& [key, coefficient] : terms) {
     const bool negative = coefficient < 0;
@@ -123,7 +129,8 @@ std::string pose_text(const ExactPose& pose) {
   std::ostringstream out;
   bool identity = true;
   for (unsigned i = 0; i < 3; ++i) {
-    for (unsigned j = 0; j < 3; ++j) identity = identity && (pose.R(i, j) - (i == j ? 1 : 0)).is_zero();
+    for (unsigned j = 0; j < 3; ++j)
+      identity = identity && (pose.R(i, j) - (i == j ? 1 : 0)).is_zero();
   }
   out << "[";
   if (identity) {
@@ -135,9 +142,13 @@ std::string pose_text(const ExactPose& pose) {
   return out.str();
 }
 
-ExactPose translation_pose(const GiNaC::matrix& p) { return ExactPose{identity3(), p}; }
+ExactPose translation_pose(const GiNaC::matrix& p) {
+  return ExactPose{identity3(), p};
+}
 
-ExactPose rotation_pose(const GiNaC::matrix& R) { return ExactPose{R, column(0, 0, 0)}; }
+ExactPose rotation_pose(const GiNaC::matrix& R) {
+  return ExactPose{R, column(0, 0, 0)};
+}
 
 ExactScene operator*(const ExactPose& g, const ExactScene& scene) {
   ExactScene out = scene;

@@ -21,7 +21,8 @@ const ExactPose& hand_past(const ExactScene& scene) {
 }
 
 const ExactPose& hand_k(const ExactScene& scene) {
-  if (scene.chunk.empty()) throw InvalidScene("exact scene has an empty chunk; put T_k in chunk[0]");
+  if (scene.chunk.empty())
+    throw InvalidScene("exact scene has an empty chunk; put T_k in chunk[0]");
   return scene.chunk.front();
 }
 
@@ -31,7 +32,9 @@ GiNaC::matrix absolute_translation(const ExactScene& scene, const GiNaC::matrix&
   return hand_k(scene).p.sub(eps);
 }
 
-GiNaC::matrix absolute_rotation_matrix(const ExactScene& scene) { return hand_k(scene).R; }
+GiNaC::matrix absolute_rotation_matrix(const ExactScene& scene) {
+  return hand_k(scene).R;
+}
 
 GiNaC::matrix relative_translation(const ExactScene& scene, const GiNaC::matrix& eps) {
   return hand_k(scene).p.sub(hand0(scene).p).sub(eps);

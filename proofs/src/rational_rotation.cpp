@@ -86,10 +86,12 @@ GiNaC::matrix exact_rotation_vector(const GiNaC::matrix& R) {
                           " has no exact angle here; use a rotation with cos(angle) in "
                           "{1, 1/2, 0, -1/2} (angle pi is refused: r(R) is not unique there)");
   }
-  const GiNaC::ex sin_phi = GiNaC::sqrt(GiNaC::ex(1) - cos_phi * cos_phi);  // > 0 for phi in (0, pi)
+  const GiNaC::ex sin_phi =
+      GiNaC::sqrt(GiNaC::ex(1) - cos_phi * cos_phi);  // > 0 for phi in (0, pi)
   // r = phi / (2 sin phi) * vee(R - R^T), the axis-angle vector of Euler's theorem.
   const GiNaC::ex scale = phi / (2 * sin_phi);
-  return column(GiNaC::normal(scale * (R(2, 1) - R(1, 2))), GiNaC::normal(scale * (R(0, 2) - R(2, 0))),
+  return column(GiNaC::normal(scale * (R(2, 1) - R(1, 2))),
+                GiNaC::normal(scale * (R(0, 2) - R(2, 0))),
                 GiNaC::normal(scale * (R(1, 0) - R(0, 1))));
 }
 

@@ -38,7 +38,8 @@ std::string report_text(const std::vector<ClaimOutcome>& outcomes) {
     out << "\n== " << section_title(section) << " ==\n";
     for (const ClaimOutcome& outcome : outcomes) {
       if (outcome.section != section) continue;
-      out << "\n[" << verdict(outcome) << "] " << outcome.id << "  (" << kind_name(outcome.kind) << ")\n"
+      out << "\n[" << verdict(outcome) << "] " << outcome.id << "  (" << kind_name(outcome.kind)
+          << ")\n"
           << "  " << outcome.statement << "\n";
       if (!outcome.result.witness.empty()) out << "  witness: " << outcome.result.witness << "\n";
       if (!outcome.note.empty()) out << "  note: " << outcome.note << "\n";
@@ -52,16 +53,16 @@ std::string report_text(const std::vector<ClaimOutcome>& outcomes) {
 std::string report_json(const std::vector<ClaimOutcome>& outcomes) {
   nlohmann::ordered_json claims = nlohmann::ordered_json::array();
   for (const ClaimOutcome& outcome : outcomes) {
-    claims.push_back(
-        {{"id", outcome.id},
-         {"statement", outcome.statement},
-         {"kind", kind_name(outcome.kind)},
-         {"verified", outcome.result.verified},
-         {"witness", outcome.result.witness.empty() ? nlohmann::ordered_json(nullptr)
-                                                    : nlohmann::ordered_json(outcome.result.witness)},
-         {"section", section_title(outcome.section)},
-         {"note", outcome.note},
-         {"detail", outcome.result.detail}});
+    claims.push_back({{"id", outcome.id},
+                      {"statement", outcome.statement},
+                      {"kind", kind_name(outcome.kind)},
+                      {"verified", outcome.result.verified},
+                      {"witness", outcome.result.witness.empty()
+                                      ? nlohmann::ordered_json(nullptr)
+                                      : nlohmann::ordered_json(outcome.result.witness)},
+                      {"section", section_title(outcome.section)},
+                      {"note", outcome.note},
+                      {"detail", outcome.result.detail}});
   }
   const nlohmann::ordered_json document = {
       {"claims", claims}, {"verified", count_verified(outcomes)}, {"total", outcomes.size()}};
@@ -89,10 +90,12 @@ std::string report_markdown(const std::vector<ClaimOutcome>& outcomes) {
          "in each note). The C++ implementation in `core/` computes the same formulas in floating "
          "point; the `proofs` test suite cross-checks the two on rational scenes, and "
          "`handcentric audit` property-tests the implementation.\n\n"
-      << "**" << count_verified(outcomes) << "/" << outcomes.size() << " certificates verified.**\n\n"
+      << "**" << count_verified(outcomes) << "/" << outcomes.size()
+      << " certificates verified.**\n\n"
       << "| claim | kind | verdict |\n|---|---|---|\n";
   for (const ClaimOutcome& outcome : outcomes) {
-    out << "| " << outcome.id << " | " << kind_name(outcome.kind) << " | " << verdict(outcome) << " |\n";
+    out << "| " << outcome.id << " | " << kind_name(outcome.kind) << " | " << verdict(outcome)
+        << " |\n";
   }
   for (const ClaimSection section : kSections) {
     out << "\n## " << section_title(section) << "\n";

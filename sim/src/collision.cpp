@@ -13,8 +13,10 @@ namespace {
 
 b2PolygonShape box_shape(const Box& box) {
   b2PolygonShape shape;
-  shape.SetAsBox(static_cast<float>(0.5 * (box.x1 - box.x0)), static_cast<float>(0.5 * (box.y1 - box.y0)),
-                 b2Vec2(static_cast<float>(0.5 * (box.x0 + box.x1)), static_cast<float>(0.5 * (box.y0 + box.y1))),
+  shape.SetAsBox(static_cast<float>(0.5 * (box.x1 - box.x0)),
+                 static_cast<float>(0.5 * (box.y1 - box.y0)),
+                 b2Vec2(static_cast<float>(0.5 * (box.x0 + box.x1)),
+                        static_cast<float>(0.5 * (box.y0 + box.y1))),
                  0.0f);
   return shape;
 }
@@ -31,7 +33,8 @@ RigidTransform interpolate_planar(const RigidTransform& from, const RigidTransfo
   const Eigen::Vector3d a = planar_coordinates(from);
   const Eigen::Vector3d b = planar_coordinates(to);
   const double dtheta = wrap_angle(b(0) - a(0));
-  return RigidTransform::planar(a(0) + s * dtheta, a(1) + s * (b(1) - a(1)), a(2) + s * (b(2) - a(2)));
+  return RigidTransform::planar(a(0) + s * dtheta, a(1) + s * (b(1) - a(1)),
+                                a(2) + s * (b(2) - a(2)));
 }
 
 CollisionChecker::CollisionChecker(const PegHoleGeometry& geometry) : geometry_(geometry) {
@@ -70,13 +73,16 @@ bool CollisionChecker::motion_collides(const RigidTransform& hole_T_hand_from,
   const Eigen::Vector3d a = planar_coordinates(hole_T_hand_from);
   const Eigen::Vector3d b = planar_coordinates(hole_T_hand_to);
   // v bounds the speed (per unit of s) of every peg point along the motion
-  const double speed = std::hypot(b(1) - a(1), b(2) - a(2)) + geometry_.peg_radius() * std::abs(wrap_angle(b(0) - a(0)));
-  const double finest = 0.25 * geometry_.clearance;  // never move a peg point more than c/4 unchecked
+  const double speed = std::hypot(b(1) - a(1), b(2) - a(2)) +
+                       geometry_.peg_radius() * std::abs(wrap_angle(b(0) - a(0)));
+  const double finest =
+      0.25 * geometry_.clearance;  // never move a peg point more than c/4 unchecked
   double s = 0.0;
   while (true) {
-    const RigidTransform pose = s == 0.0   ? hole_T_hand_from
-                                : s >= 1.0 ? hole_T_hand_to
-                                           : interpolate_planar(hole_T_hand_from, hole_T_hand_to, s);
+    const RigidTransform pose = s == 0.0 ? hole_T_hand_from
+                                : s >= 1.0
+                                    ? hole_T_hand_to
+                                    : interpolate_planar(hole_T_hand_from, hole_T_hand_to, s);
     const double d = distance(pose);
     if (d <= kContactDistance) return true;
     if (s >= 1.0 || speed == 0.0) return false;

@@ -39,22 +39,26 @@ json pose_to_json(const RigidTransform& pose) {
   throw InvalidDemoFile("demo file '" + path + "', " + where + ": " + what);
 }
 
-RigidTransform pose_from_json(const json& value, const std::string& path, const std::string& where, bool planar) {
+RigidTransform pose_from_json(const json& value, const std::string& path, const std::string& where,
+                              bool planar) {
   if (!value.is_array() || value.size() != 3) {
-    fail(path, where, "a pose must be a 3x4 matrix [[r00, r01, r02, x], [..], [..]], got " + value.dump());
+    fail(path, where,
+         "a pose must be a 3x4 matrix [[r00, r01, r02, x], [..], [..]], got " + value.dump());
   }
   Eigen::Matrix4d M = Eigen::Matrix4d::Identity();
   for (int r = 0; r < 3; ++r) {
     const json& row = value[static_cast<std::size_t>(r)];
     if (!row.is_array() || row.size() != 4) {
-      fail(path, where, "row " + std::to_string(r) + " of a pose must hold 4 numbers, got " + row.dump());
+      fail(path, where,
+           "row " + std::to_string(r) + " of a pose must hold 4 numbers, got " + row.dump());
     }
     for (int c = 0; c < 4; ++c) {
       const json& entry = row[static_cast<std::size_t>(c)];
       // JSON has no NaN: nlohmann writes NaN and infinity as null
       if (!entry.is_number()) {
-        fail(path, where, "entry (" + std::to_string(r) + ", " + std::to_string(c) +
-                              ") is not a finite number: " + entry.dump());
+        fail(path, where,
+             "entry (" + std::to_string(r) + ", " + std::to_string(c) +
+                 ") is not a finite number: " + entry.dump());
       }
       M(r, c) = entry.get<double>();
     }
@@ -66,17 +70,20 @@ RigidTransform pose_from_json(const json& value, const std::string& path, const 
     fail(path, where, std::string("not a rigid transform: ") + e.what());
   }
   if (planar && !is_planar(pose)) {
-    fail(path, where, "not a planar pose (rotation about z, z = 0): " + format_matrix(M.topRows<3>()) +
-                          "; the 2D task uses RigidTransform::planar(theta, x, y)");
+    fail(path, where,
+         "not a planar pose (rotation about z, z = 0): " + format_matrix(M.topRows<3>()) +
+             "; the 2D task uses RigidTransform::planar(theta, x, y)");
   }
   return pose;
 }
 
 void check_demo(const DemoFileTask& task, const DemoRecord& demo, std::size_t index) {
   const std::string where = "demo " + std::to_string(index + 1);
-  if (demo.world_T_hand.empty()) throw InvalidArgument(where + " has no hand pose; a demo needs at least one");
+  if (demo.world_T_hand.empty())
+    throw InvalidArgument(where + " has no hand pose; a demo needs at least one");
   if (!task.planar) return;
-  if (!is_planar(demo.world_T_object)) throw InvalidArgument(where + ": " + task.object_key + " is not planar");
+  if (!is_planar(demo.world_T_object))
+    throw InvalidArgument(where + ": " + task.object_key + " is not planar");
   for (std::size_t t = 0; t < demo.world_T_hand.size(); ++t) {
     if (!is_planar(demo.world_T_hand[t])) {
       throw InvalidArgument(where + ": world_T_hand[" + std::to_string(t) + "] is not planar");
@@ -100,8 +107,10 @@ bool read_line(std::istream& in, std::string& line, bool& newline, const DemoFil
       return true;
     }
     if (line.size() == limits.max_line_bytes) {
-      fail(path, where, "the line is longer than " + std::to_string(limits.max_line_bytes) +
-                            " bytes, the limit for one demo: this is not a demo file of this task, or it is damaged");
+      fail(path, where,
+           "the line is longer than " + std::to_string(limits.max_line_bytes) +
+               " bytes, the limit for one demo: this is not a demo file of this task, or it is "
+               "damaged");
     }
     line.push_back(static_cast<char>(c));
   }
@@ -115,8 +124,9 @@ json parse_line(const std::string& line, const DemoFileLimits& limits, const std
     // `depth` counts the containers around the one that opens
     if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
         depth >= limits.max_json_depth) {
-      fail(path, where, "JSON nested deeper than " + std::to_string(limits.max_json_depth) +
-                            " levels (a demo record has 4): this is not a demo file of this task");
+      fail(path, where,
+           "JSON nested deeper than " + std::to_string(limits.max_json_depth) +
+               " levels (a demo record has 4): this is not a demo file of this task");
     }
     return true;
   };
@@ -128,7 +138,10 @@ json parse_line(const std::string& line, const DemoFileLimits& limits, const std
 void save_demo_records(const std::string& path, const DemoFileTask& task, double clearance,
                        const std::vector<DemoRecord>& demos) {
   std::ostringstream out;
-  json header = {{"format", kFormat}, {"version", kVersion}, {"task", task.name}, {"count", demos.size()},
+  json header = {{"format", kFormat},
+                 {"version", kVersion},
+                 {"task", task.name},
+                 {"count", demos.size()},
                  {task.clearance_key, clearance}};
   out << header.dump() << "\n";
   for (std::size_t i = 0; i < demos.size(); ++i) {
@@ -146,8 +159,8 @@ void save_demo_records(const std::string& path, const DemoFileTask& task, double
 namespace {
 
 // The one reader of demo files, from a file or from memory; `path` names the source in errors.
-std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& path, const DemoFileTask& task,
-                                          const DemoFileLimits& limits) {
+std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& path,
+                                          const DemoFileTask& task, const DemoFileLimits& limits) {
   std::string line;
   bool newline = false;
   if (!read_line(in, line, newline, limits, path, "line 1 (header)")) {
@@ -163,32 +176,41 @@ std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& p
   if (!header.is_object() || !header.contains("format") || header["format"] != kFormat) {
     fail(path, "line 1 (header)", std::string("expected {\"format\": \"") + kFormat + "\", ...}");
   }
-  if (!header.contains("version") || !header["version"].is_number_integer() || header["version"] != kVersion) {
-    fail(path, "line 1 (header)", "unsupported version " + (header.contains("version") ? header["version"].dump() : "(none)") +
-                                      "; this build reads version " + std::to_string(kVersion));
+  if (!header.contains("version") || !header["version"].is_number_integer() ||
+      header["version"] != kVersion) {
+    fail(path, "line 1 (header)",
+         "unsupported version " +
+             (header.contains("version") ? header["version"].dump() : "(none)") +
+             "; this build reads version " + std::to_string(kVersion));
   }
   // A header without a task is the 2D task's: files written before the 3D task existed.
-  const std::string file_task =
-      !header.contains("task") ? "peg2d" : header["task"].is_string() ? header["task"].get<std::string>() : header["task"].dump();
+  const std::string file_task = !header.contains("task")     ? "peg2d"
+                                : header["task"].is_string() ? header["task"].get<std::string>()
+                                                             : header["task"].dump();
   if (file_task != task.name) {
-    fail(path, "line 1 (header)", "a demo file of task '" + file_task + "', not '" + task.name +
-                                      "': use a " + task.name + " demo file here (" + file_task + " files go with --task " + file_task + ")");
+    fail(path, "line 1 (header)",
+         "a demo file of task '" + file_task + "', not '" + task.name + "': use a " + task.name +
+             " demo file here (" + file_task + " files go with --task " + file_task + ")");
   }
   if (!header.contains("count") || !header["count"].is_number_unsigned()) {
     fail(path, "line 1 (header)", "\"count\" must be a non-negative integer");
   }
   const auto count = header["count"].get<std::uint64_t>();
   if (count > limits.max_demos) {
-    fail(path, "line 1 (header)", "the header announces " + std::to_string(count) + " demos, more than the limit of " +
-                                      std::to_string(limits.max_demos) + ": split the data set, or fix the count");
+    fail(path, "line 1 (header)",
+         "the header announces " + std::to_string(count) + " demos, more than the limit of " +
+             std::to_string(limits.max_demos) + ": split the data set, or fix the count");
   }
   std::vector<DemoRecord> demos;
   std::size_t poses = 0;
   for (std::size_t record = 1; record <= count; ++record) {
-    const std::string where = "record " + std::to_string(record) + " (line " + std::to_string(record + 1) + ")";
+    const std::string where =
+        "record " + std::to_string(record) + " (line " + std::to_string(record + 1) + ")";
     if (!read_line(in, line, newline, limits, path, where)) {
-      fail(path, where, "missing: the header promises " + std::to_string(count) + " demos but the file ends after " +
-                            std::to_string(record - 1) + " (truncated file?)");
+      fail(path, where,
+           "missing: the header promises " + std::to_string(count) +
+               " demos but the file ends after " + std::to_string(record - 1) +
+               " (truncated file?)");
     }
     if (!newline) fail(path, where, "the line has no final newline (truncated file?)");
     json value;
@@ -198,31 +220,37 @@ std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& p
       fail(path, where, "not valid JSON (truncated or corrupted line)");
     }
     if (!value.is_object() || !value.contains(task.object_key) || !value.contains("world_T_hand")) {
-      fail(path, where, "expected {\"" + task.object_key + "\": pose, \"world_T_hand\": [pose, ...]}");
+      fail(path, where,
+           "expected {\"" + task.object_key + "\": pose, \"world_T_hand\": [pose, ...]}");
     }
     DemoRecord demo;
-    demo.world_T_object = pose_from_json(value[task.object_key], path, where + ", " + task.object_key, task.planar);
+    demo.world_T_object =
+        pose_from_json(value[task.object_key], path, where + ", " + task.object_key, task.planar);
     const json& hands = value["world_T_hand"];
-    if (!hands.is_array() || hands.empty()) fail(path, where, "world_T_hand must be a non-empty array of poses");
+    if (!hands.is_array() || hands.empty())
+      fail(path, where, "world_T_hand must be a non-empty array of poses");
     if (hands.size() > limits.max_poses_per_demo) {
-      fail(path, where, "a demo of " + std::to_string(hands.size()) + " poses, more than the limit of " +
-                            std::to_string(limits.max_poses_per_demo) + " for one demo");
+      fail(path, where,
+           "a demo of " + std::to_string(hands.size()) + " poses, more than the limit of " +
+               std::to_string(limits.max_poses_per_demo) + " for one demo");
     }
     poses += hands.size();
     if (poses > limits.max_poses) {
-      fail(path, where, "the demos so far hold " + std::to_string(poses) + " poses, more than the limit of " +
-                            std::to_string(limits.max_poses) + " for one file: split the data set");
+      fail(path, where,
+           "the demos so far hold " + std::to_string(poses) + " poses, more than the limit of " +
+               std::to_string(limits.max_poses) + " for one file: split the data set");
     }
     demo.world_T_hand.reserve(hands.size());
     for (std::size_t t = 0; t < hands.size(); ++t) {
-      demo.world_T_hand.push_back(
-          pose_from_json(hands[t], path, where + ", world_T_hand[" + std::to_string(t) + "]", task.planar));
+      demo.world_T_hand.push_back(pose_from_json(
+          hands[t], path, where + ", world_T_hand[" + std::to_string(t) + "]", task.planar));
     }
     demos.push_back(std::move(demo));
   }
-  if (read_line(in, line, newline, limits, path, "line " + std::to_string(count + 2)) && !line.empty()) {
-    fail(path, "line " + std::to_string(count + 2), "extra data after the " + std::to_string(count) +
-                                                         " demos the header promises");
+  if (read_line(in, line, newline, limits, path, "line " + std::to_string(count + 2)) &&
+      !line.empty()) {
+    fail(path, "line " + std::to_string(count + 2),
+         "extra data after the " + std::to_string(count) + " demos the header promises");
   }
   return demos;
 }
@@ -232,7 +260,9 @@ std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& p
 std::vector<DemoRecord> load_demo_records(const std::string& path, const DemoFileTask& task,
                                           const DemoFileLimits& limits) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidDemoFile("cannot open demo file '" + path + "'; check the path (make one with `handcentric demos`)");
+  if (!in)
+    throw InvalidDemoFile("cannot open demo file '" + path +
+                          "'; check the path (make one with `handcentric demos`)");
   return read_demo_records(in, path, task, limits);
 }
 

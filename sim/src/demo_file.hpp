@@ -16,9 +16,9 @@ namespace handcentric::sim::detail {
 
 /// What differs between the tasks' files.
 struct DemoFileTask {
-  std::string name;        ///< "peg2d" (also a header without "task") or "insert3d"
-  std::string object_key;  ///< the record's object pose: "world_T_hole" or "world_T_slot"
-  bool planar = false;     ///< every pose must be planar (the 2D task)
+  std::string name;           ///< "peg2d" (also a header without "task") or "insert3d"
+  std::string object_key;     ///< the record's object pose: "world_T_hole" or "world_T_slot"
+  bool planar = false;        ///< every pose must be planar (the 2D task)
   std::string clearance_key;  ///< the header's clearance entry
 };
 
@@ -46,13 +46,15 @@ std::vector<DemoRecord> parse_demo_records(const std::string& bytes, const std::
 /// the start), chunk T_{t+1}..T_{t+K} (the last pose repeated after the end), hand_points =
 /// points_at(T_t). Throws InvalidArgument for H < 0, K < 1 or an empty demo.
 template <typename PointsAt>
-std::vector<Scene> demo_training_scenes(const std::vector<RigidTransform>& world_T_hand, int H, int K,
-                                        const PointsAt& points_at) {
+std::vector<Scene> demo_training_scenes(const std::vector<RigidTransform>& world_T_hand, int H,
+                                        int K, const PointsAt& points_at) {
   if (H < 0) throw InvalidArgument("history length H must be >= 0, got " + std::to_string(H));
   if (K < 1) throw InvalidArgument("chunk length K must be >= 1, got " + std::to_string(K));
   if (world_T_hand.empty()) throw InvalidArgument("training_scenes: the demo has no hand pose");
   const int T = static_cast<int>(world_T_hand.size());
-  const auto pose = [&](int t) { return world_T_hand[static_cast<std::size_t>(std::clamp(t, 0, T - 1))]; };
+  const auto pose = [&](int t) {
+    return world_T_hand[static_cast<std::size_t>(std::clamp(t, 0, T - 1))];
+  };
   std::vector<Scene> scenes;
   scenes.reserve(static_cast<std::size_t>(T));
   for (int t = 0; t < T; ++t) {
@@ -68,9 +70,11 @@ std::vector<Scene> demo_training_scenes(const std::vector<RigidTransform>& world
 /// The training scenes of the first `max_demos` demos (0: all), demo after demo, from
 /// scenes_of(demo). Throws InvalidArgument for max_demos < 0 or more than demos.size().
 template <typename DemoType, typename ScenesOf>
-std::vector<Scene> demos_training_scenes(const std::vector<DemoType>& demos, int max_demos, const ScenesOf& scenes_of) {
+std::vector<Scene> demos_training_scenes(const std::vector<DemoType>& demos, int max_demos,
+                                         const ScenesOf& scenes_of) {
   if (max_demos < 0) {
-    throw InvalidArgument("the number of demos to train on must be >= 0 (0 = all), got " + std::to_string(max_demos));
+    throw InvalidArgument("the number of demos to train on must be >= 0 (0 = all), got " +
+                          std::to_string(max_demos));
   }
   if (max_demos > static_cast<int>(demos.size())) {
     throw InvalidArgument("asked to train on " + std::to_string(max_demos) + " demos but only " +

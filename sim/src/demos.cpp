@@ -18,7 +18,8 @@ const detail::DemoFileTask kPeg2d{"peg2d", "world_T_hole", true, "clearance"};
 
 }  // namespace
 
-void save_demos(const std::string& path, const std::vector<Demo>& demos, const PegHoleGeometry& geometry) {
+void save_demos(const std::string& path, const std::vector<Demo>& demos,
+                const PegHoleGeometry& geometry) {
   geometry.validate();
   std::vector<detail::DemoRecord> records;
   records.reserve(demos.size());
@@ -31,7 +32,8 @@ namespace {
 std::vector<Demo> to_demos(std::vector<detail::DemoRecord> records) {
   std::vector<Demo> demos;
   demos.reserve(records.size());
-  for (detail::DemoRecord& record : records) demos.push_back({record.world_T_object, std::move(record.world_T_hand)});
+  for (detail::DemoRecord& record : records)
+    demos.push_back({record.world_T_object, std::move(record.world_T_hand)});
   return demos;
 }
 
@@ -41,7 +43,8 @@ std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limi
   return to_demos(detail::load_demo_records(path, kPeg2d, limits));
 }
 
-std::vector<Demo> parse_demos(const std::string& bytes, const std::string& source, const DemoFileLimits& limits) {
+std::vector<Demo> parse_demos(const std::string& bytes, const std::string& source,
+                              const DemoFileLimits& limits) {
   return to_demos(detail::parse_demo_records(bytes, source, kPeg2d, limits));
 }
 
@@ -50,23 +53,28 @@ std::vector<Eigen::Vector3d> eye_in_hand_points(const RigidTransform& world_T_ho
                                                 const PegHoleGeometry& geometry) {
   const RigidTransform hand_T_hole = world_T_hand.inverse_compose(world_T_hole);
   std::vector<Eigen::Vector3d> points;
-  for (const Eigen::Vector3d& hole_p_corner : geometry.opening_corners()) points.push_back(hand_T_hole * hole_p_corner);
+  for (const Eigen::Vector3d& hole_p_corner : geometry.opening_corners())
+    points.push_back(hand_T_hole * hole_p_corner);
   return points;
 }
 
-std::vector<Scene> training_scenes(const Demo& demo, int H, int K, const PegHoleGeometry& geometry) {
-  return detail::demo_training_scenes(demo.world_T_hand, H, K, [&](const RigidTransform& world_T_hand) {
-    return eye_in_hand_points(demo.world_T_hole, world_T_hand, geometry);
-  });
+std::vector<Scene> training_scenes(const Demo& demo, int H, int K,
+                                   const PegHoleGeometry& geometry) {
+  return detail::demo_training_scenes(
+      demo.world_T_hand, H, K, [&](const RigidTransform& world_T_hand) {
+        return eye_in_hand_points(demo.world_T_hole, world_T_hand, geometry);
+      });
 }
 
 std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K, int max_demos,
                                    const PegHoleGeometry& geometry) {
-  return detail::demos_training_scenes(demos, max_demos, [&](const Demo& demo) { return training_scenes(demo, H, K, geometry); });
+  return detail::demos_training_scenes(
+      demos, max_demos, [&](const Demo& demo) { return training_scenes(demo, H, K, geometry); });
 }
 
 Demo mirrored_about_hole_axis(const Demo& demo) {
-  if (demo.world_T_hand.empty()) throw InvalidArgument("mirrored_about_hole_axis: the demo has no hand pose");
+  if (demo.world_T_hand.empty())
+    throw InvalidArgument("mirrored_about_hole_axis: the demo has no hand pose");
   Demo mirrored;
   mirrored.world_T_hole = demo.world_T_hole;
   mirrored.world_T_hand.reserve(demo.world_T_hand.size());
@@ -75,11 +83,13 @@ Demo mirrored_about_hole_axis(const Demo& demo) {
     const Eigen::Matrix3d& R = hole_T_hand.rotation().matrix();
     const Eigen::Vector3d& p = hole_T_hand.translation();
     if (std::abs(p.z()) > 1e-9 || std::abs(R(2, 2) - 1.0) > 1e-9) {
-      throw InvalidArgument("mirrored_about_hole_axis: a hand pose is not planar in its hole's frame (z = " +
-                            std::to_string(p.z()) + "): only planar demos can be mirrored");
+      throw InvalidArgument(
+          "mirrored_about_hole_axis: a hand pose is not planar in its hole's frame (z = " +
+          std::to_string(p.z()) + "): only planar demos can be mirrored");
     }
     const double theta = std::atan2(R(1, 0), R(0, 0));
-    mirrored.world_T_hand.push_back(demo.world_T_hole * RigidTransform::planar(-theta, -p.x(), p.y()));
+    mirrored.world_T_hand.push_back(demo.world_T_hole *
+                                    RigidTransform::planar(-theta, -p.x(), p.y()));
   }
   return mirrored;
 }
@@ -92,24 +102,29 @@ std::vector<Demo> with_mirrored_demos(const std::vector<Demo>& demos) {
 }
 
 void TrainingData::validate() const {
-  const auto refuse = [](const std::string& what) { throw InvalidArgument("training data: " + what); };
+  const auto refuse = [](const std::string& what) {
+    throw InvalidArgument("training data: " + what);
+  };
   if (perturbed_copies < 0 || perturbed_copies > 64) {
     refuse("perturbed_copies must be in [0, 64], got " + std::to_string(perturbed_copies));
   }
-  if (!(offset_cm >= 0.0 && offset_cm <= 10.0)) refuse("offset_cm must be in [0, 10], got " + std::to_string(offset_cm));
+  if (!(offset_cm >= 0.0 && offset_cm <= 10.0))
+    refuse("offset_cm must be in [0, 10], got " + std::to_string(offset_cm));
   if (!(offset_deg >= 0.0 && offset_deg <= 90.0)) {
     refuse("offset_deg must be in [0, 90], got " + std::to_string(offset_deg));
   }
-  if (recovery_steps < 1) refuse("recovery_steps must be >= 1, got " + std::to_string(recovery_steps));
+  if (recovery_steps < 1)
+    refuse("recovery_steps must be >= 1, got " + std::to_string(recovery_steps));
 }
 
 std::string TrainingData::to_text() const {
   char text[256];
-  std::snprintf(text, sizeof text,
-                "mirror=%d\nperturbed_copies=%d\noffset_cm=%.17g\noffset_deg=%.17g\nrecovery_steps=%d\n"
-                "perturbation_seed=%llu\n",
-                mirror ? 1 : 0, perturbed_copies, offset_cm, offset_deg, recovery_steps,
-                static_cast<unsigned long long>(perturbation_seed));
+  std::snprintf(
+      text, sizeof text,
+      "mirror=%d\nperturbed_copies=%d\noffset_cm=%.17g\noffset_deg=%.17g\nrecovery_steps=%d\n"
+      "perturbation_seed=%llu\n",
+      mirror ? 1 : 0, perturbed_copies, offset_cm, offset_deg, recovery_steps,
+      static_cast<unsigned long long>(perturbation_seed));
   return text;
 }
 
@@ -121,27 +136,31 @@ struct PlanarPose {
 
 PlanarPose planar_parameters(const RigidTransform& hole_T_hand) {
   const Eigen::Matrix3d& R = hole_T_hand.rotation().matrix();
-  return {std::atan2(R(1, 0), R(0, 0)), hole_T_hand.translation().x(), hole_T_hand.translation().y()};
+  return {std::atan2(R(1, 0), R(0, 0)), hole_T_hand.translation().x(),
+          hole_T_hand.translation().y()};
 }
 
 // The perturbed copies of demo's samples (TrainingData::perturbed_copies): sample t of copy c
 // draws its offset from stream (seed, (demo_index, t, c)), so the copies do not depend on how
 // many others were dropped.
-void append_perturbed_scenes(const Demo& demo, std::uint64_t demo_index, int H, int K, const TrainingData& data,
-                             const CollisionChecker& checker, const PegHoleGeometry& geometry,
-                             std::vector<Scene>& scenes) {
+void append_perturbed_scenes(const Demo& demo, std::uint64_t demo_index, int H, int K,
+                             const TrainingData& data, const CollisionChecker& checker,
+                             const PegHoleGeometry& geometry, std::vector<Scene>& scenes) {
   const int T = static_cast<int>(demo.world_T_hand.size());
   std::vector<RigidTransform> hole_T_hand;
   hole_T_hand.reserve(demo.world_T_hand.size());
   for (const RigidTransform& world_T_hand : demo.world_T_hand) {
     hole_T_hand.push_back(demo.world_T_hole.inverse_compose(world_T_hand));
   }
-  const auto pose = [&](int t) { return hole_T_hand[static_cast<std::size_t>(std::clamp(t, 0, T - 1))]; };
+  const auto pose = [&](int t) {
+    return hole_T_hand[static_cast<std::size_t>(std::clamp(t, 0, T - 1))];
+  };
   const double offset_rad = data.offset_deg * std::numbers::pi / 180.0;
   for (int t = 0; t < T; ++t) {
     for (int c = 0; c < data.perturbed_copies; ++c) {
-      const std::uint64_t index = (demo_index * 1'000'003ull + static_cast<std::uint64_t>(t)) * 65ull +
-                                  static_cast<std::uint64_t>(c);
+      const std::uint64_t index =
+          (demo_index * 1'000'003ull + static_cast<std::uint64_t>(t)) * 65ull +
+          static_cast<std::uint64_t>(c);
       std::mt19937_64 rng(stream_seed(data.perturbation_seed, index));
       std::uniform_real_distribution<double> unit(-1.0, 1.0);
       const double d_theta = offset_rad * unit(rng);
@@ -161,9 +180,11 @@ void append_perturbed_scenes(const Demo& demo, std::uint64_t demo_index, int H, 
       Scene scene;
       scene.world_T_hand_history.push_back(demo.world_T_hole * moved(0));
       // The past as the demo had it: the perturbation happened at t.
-      for (int h = 1; h <= H; ++h) scene.world_T_hand_history.push_back(demo.world_T_hole * pose(t - h));
+      for (int h = 1; h <= H; ++h)
+        scene.world_T_hand_history.push_back(demo.world_T_hole * pose(t - h));
       for (int k = 1; k <= K; ++k) scene.world_T_hand_chunk.push_back(demo.world_T_hole * moved(k));
-      scene.hand_points = eye_in_hand_points(demo.world_T_hole, scene.world_T_hand_history.front(), geometry);
+      scene.hand_points =
+          eye_in_hand_points(demo.world_T_hole, scene.world_T_hand_history.front(), geometry);
       scenes.push_back(std::move(scene));
     }
   }
@@ -188,7 +209,8 @@ std::vector<Scene> training_scenes(const std::vector<Demo>& demos, int H, int K,
     for (std::size_t i = 0; i < used; ++i) {
       append_perturbed_scenes(demos[i], 2 * i, H, K, data, checker, geometry, scenes);
       if (data.mirror) {
-        append_perturbed_scenes(mirrored_about_hole_axis(demos[i]), 2 * i + 1, H, K, data, checker, geometry, scenes);
+        append_perturbed_scenes(mirrored_about_hole_axis(demos[i]), 2 * i + 1, H, K, data, checker,
+                                geometry, scenes);
       }
     }
   }

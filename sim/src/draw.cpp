@@ -14,11 +14,15 @@
 namespace handcentric::sim {
 namespace {
 
-constexpr int kMargin = 30;  // pixels around the content
+constexpr int kMargin = 30;   // pixels around the content
 constexpr int kCaption = 36;  // pixels of caption band at the top
 
-cv::Scalar rgb(int r, int g, int b) { return cv::Scalar(b, g, r); }  // OpenCV stores BGR
-cv::Scalar rgb(const std::uint8_t (&c)[3]) { return rgb(c[0], c[1], c[2]); }
+cv::Scalar rgb(int r, int g, int b) {
+  return cv::Scalar(b, g, r);
+}  // OpenCV stores BGR
+cv::Scalar rgb(const std::uint8_t (&c)[3]) {
+  return rgb(c[0], c[1], c[2]);
+}
 
 /// World (cm, y up) to pixels: fits a bounding box into the canvas below the caption.
 class View {
@@ -30,8 +34,9 @@ class View {
     cy_ = 0.5 * (y0 + y1);
   }
   cv::Point px(const Eigen::Vector3d& p) const {
-    return cv::Point(static_cast<int>(std::lround(0.5 * size_ + scale_ * (p.x() - cx_))),
-                     static_cast<int>(std::lround(0.5 * (size_ + kCaption) - scale_ * (p.y() - cy_))));
+    return cv::Point(
+        static_cast<int>(std::lround(0.5 * size_ + scale_ * (p.x() - cx_))),
+        static_cast<int>(std::lround(0.5 * (size_ + kCaption) - scale_ * (p.y() - cy_))));
   }
   double scale() const { return scale_; }
 
@@ -40,23 +45,28 @@ class View {
   double scale_, cx_, cy_;
 };
 
-std::vector<cv::Point> outline(const View& view, const RigidTransform& world_T_frame, const Box& box) {
-  const Eigen::Vector3d corners[4] = {{box.x0, box.y0, 0}, {box.x1, box.y0, 0}, {box.x1, box.y1, 0}, {box.x0, box.y1, 0}};
+std::vector<cv::Point> outline(const View& view, const RigidTransform& world_T_frame,
+                               const Box& box) {
+  const Eigen::Vector3d corners[4] = {
+      {box.x0, box.y0, 0}, {box.x1, box.y0, 0}, {box.x1, box.y1, 0}, {box.x0, box.y1, 0}};
   std::vector<cv::Point> points;
   for (const auto& c : corners) points.push_back(view.px(world_T_frame * c));
   return points;
 }
 
 /// Bounding box of the hole and the given hand poses (with the peg's reach).
-View fit(const std::vector<RigidTransform>& world_T_holes, const std::vector<RigidTransform>& world_T_hands,
-         const PegHoleGeometry& geometry, int size) {
+View fit(const std::vector<RigidTransform>& world_T_holes,
+         const std::vector<RigidTransform>& world_T_hands, const PegHoleGeometry& geometry,
+         int size) {
   double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
   const auto grow = [&](const Eigen::Vector3d& p) {
-    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
+    x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()),
+    y1 = std::max(y1, p.y());
   };
   for (const RigidTransform& T : world_T_holes) {
     for (const Box& wall : geometry.hole_walls()) {
-      for (const double x : {wall.x0, wall.x1}) for (const double y : {wall.y0, wall.y1}) grow(T * Eigen::Vector3d(x, y, 0));
+      for (const double x : {wall.x0, wall.x1})
+        for (const double y : {wall.y0, wall.y1}) grow(T * Eigen::Vector3d(x, y, 0));
     }
   }
   for (const RigidTransform& T : world_T_hands) {
@@ -66,26 +76,30 @@ View fit(const std::vector<RigidTransform>& world_T_holes, const std::vector<Rig
   return View(x0 - pad, x1 + pad, y0 - pad, y1 + pad, size);
 }
 
-void draw_hole(cv::Mat& canvas, const View& view, const RigidTransform& world_T_hole, const PegHoleGeometry& geometry) {
+void draw_hole(cv::Mat& canvas, const View& view, const RigidTransform& world_T_hole,
+               const PegHoleGeometry& geometry) {
   for (const Box& wall : geometry.hole_walls()) {
     const auto poly = outline(view, world_T_hole, wall);
     cv::fillConvexPoly(canvas, poly, rgb(150, 150, 150), cv::LINE_AA);
     cv::polylines(canvas, poly, true, rgb(90, 90, 90), 1, cv::LINE_AA);
   }
   // the hole's +y axis, out of the opening
-  cv::line(canvas, view.px(world_T_hole * Eigen::Vector3d(0, 0, 0)), view.px(world_T_hole * Eigen::Vector3d(0, 3, 0)),
-           rgb(120, 120, 120), 1, cv::LINE_AA);
+  cv::line(canvas, view.px(world_T_hole * Eigen::Vector3d(0, 0, 0)),
+           view.px(world_T_hole * Eigen::Vector3d(0, 3, 0)), rgb(120, 120, 120), 1, cv::LINE_AA);
   for (const Eigen::Vector3d& corner : geometry.opening_corners()) {
-    cv::circle(canvas, view.px(world_T_hole * corner), 4, rgb(255, 140, 0), cv::FILLED, cv::LINE_AA);
+    cv::circle(canvas, view.px(world_T_hole * corner), 4, rgb(255, 140, 0), cv::FILLED,
+               cv::LINE_AA);
   }
 }
 
 void caption(cv::Mat& canvas, const std::string& text) {
-  cv::putText(canvas, text, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.6, rgb(20, 20, 20), 1, cv::LINE_AA);
+  cv::putText(canvas, text, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.6, rgb(20, 20, 20), 1,
+              cv::LINE_AA);
 }
 
 void check_size(int size) {
-  if (size < 64 || size > 4096) throw InvalidArgument("image size must be in [64, 4096] pixels, got " + std::to_string(size));
+  if (size < 64 || size > 4096)
+    throw InvalidArgument("image size must be in [64, 4096] pixels, got " + std::to_string(size));
 }
 
 Image to_image(const cv::Mat& bgr) {
@@ -98,7 +112,9 @@ Image to_image(const cv::Mat& bgr) {
   return image;
 }
 
-cv::Mat blank(int size) { return cv::Mat(size, size, CV_8UC3, cv::Scalar(255, 255, 255)); }
+cv::Mat blank(int size) {
+  return cv::Mat(size, size, CV_8UC3, cv::Scalar(255, 255, 255));
+}
 
 std::string fmt(const char* format, double a) {
   char buffer[64];
@@ -111,7 +127,8 @@ std::string fmt(const char* format, double a) {
 int Image::count_pixels(std::uint8_t r, std::uint8_t g, std::uint8_t b, int tolerance) const {
   int count = 0;
   for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) {
-    if (std::abs(rgb[i] - r) <= tolerance && std::abs(rgb[i + 1] - g) <= tolerance && std::abs(rgb[i + 2] - b) <= tolerance) {
+    if (std::abs(rgb[i] - r) <= tolerance && std::abs(rgb[i + 1] - g) <= tolerance &&
+        std::abs(rgb[i + 2] - b) <= tolerance) {
       ++count;
     }
   }
@@ -123,11 +140,14 @@ Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry, int si
   cv::Mat canvas = blank(size);
   const View view = fit({scene.world_T_hole}, {scene.world_T_hand_start}, geometry, size);
   draw_hole(canvas, view, scene.world_T_hole, geometry);
-  cv::polylines(canvas, outline(view, scene.world_T_hand_start, geometry.peg_in_hand()), true, rgb(30, 90, 220), 2, cv::LINE_AA);
-  cv::circle(canvas, view.px(scene.world_T_hand_start * Eigen::Vector3d::Zero()), 3, rgb(30, 90, 220), cv::FILLED);
+  cv::polylines(canvas, outline(view, scene.world_T_hand_start, geometry.peg_in_hand()), true,
+                rgb(30, 90, 220), 2, cv::LINE_AA);
+  cv::circle(canvas, view.px(scene.world_T_hand_start * Eigen::Vector3d::Zero()), 3,
+             rgb(30, 90, 220), cv::FILLED);
   const Eigen::Vector3d q = planar_coordinates(scene.world_T_hole);
-  caption(canvas, "scene: hole at (" + fmt("%.1f", q(1)) + ", " + fmt("%.1f", q(2)) + ") cm, angle " +
-                      fmt("%.1f", q(0) * 180.0 / 3.14159265358979) + " deg; peg start in blue");
+  caption(canvas, "scene: hole at (" + fmt("%.1f", q(1)) + ", " + fmt("%.1f", q(2)) +
+                      ") cm, angle " + fmt("%.1f", q(0) * 180.0 / 3.14159265358979) +
+                      " deg; peg start in blue");
   return to_image(canvas);
 }
 
@@ -138,7 +158,8 @@ Image draw_demos(const std::vector<Demo>& demos, const PegHoleGeometry& geometry
   std::vector<RigidTransform> all;
   for (const Demo& demo : demos) {
     std::vector<RigidTransform> path;
-    for (const RigidTransform& world_T_hand : demo.world_T_hand) path.push_back(demo.world_T_hole.inverse_compose(world_T_hand));
+    for (const RigidTransform& world_T_hand : demo.world_T_hand)
+      path.push_back(demo.world_T_hole.inverse_compose(world_T_hand));
     all.insert(all.end(), path.begin(), path.end());
     hole_T_hands.push_back(std::move(path));
   }
@@ -151,43 +172,52 @@ Image draw_demos(const std::vector<Demo>& demos, const PegHoleGeometry& geometry
     const cv::Scalar colour(c[0], c[1], c[2]);
     const auto& path = hole_T_hands[d];
     for (std::size_t t = 0; t < path.size(); t += 6) {
-      cv::polylines(canvas, outline(view, path[t], geometry.peg_in_hand()), true, colour, 1, cv::LINE_AA);
+      cv::polylines(canvas, outline(view, path[t], geometry.peg_in_hand()), true, colour, 1,
+                    cv::LINE_AA);
     }
     std::vector<cv::Point> line;
     for (const RigidTransform& T : path) line.push_back(view.px(T * Eigen::Vector3d::Zero()));
     cv::polylines(canvas, line, false, colour, 2, cv::LINE_AA);
   }
   draw_hole(canvas, view, RigidTransform(), geometry);
-  caption(canvas, std::to_string(demos.size()) + " demos in the hole frame: hand paths, peg every 6 steps");
+  caption(canvas,
+          std::to_string(demos.size()) + " demos in the hole frame: hand paths, peg every 6 steps");
   return to_image(canvas);
 }
 
-Image draw_rollout(const TaskScene& scene, const Rollout& rollout, const PegHoleGeometry& geometry, int size) {
+Image draw_rollout(const TaskScene& scene, const Rollout& rollout, const PegHoleGeometry& geometry,
+                   int size) {
   check_size(size);
   cv::Mat canvas = blank(size);
   const View view = fit({scene.world_T_hole}, rollout.world_T_hand, geometry, size);
   draw_hole(canvas, view, scene.world_T_hole, geometry);
   const std::size_t n = rollout.world_T_hand.size();
   for (std::size_t t = 0; t < n; ++t) {
-    const double f = n > 1 ? static_cast<double>(t) / static_cast<double>(n - 1) : 1.0;  // light to dark blue
-    const cv::Scalar colour = rgb(static_cast<int>(190 - 160 * f), static_cast<int>(210 - 130 * f), 245 - static_cast<int>(40 * f));
-    cv::polylines(canvas, outline(view, rollout.world_T_hand[t], geometry.peg_in_hand()), true, colour, 1, cv::LINE_AA);
+    const double f =
+        n > 1 ? static_cast<double>(t) / static_cast<double>(n - 1) : 1.0;  // light to dark blue
+    const cv::Scalar colour = rgb(static_cast<int>(190 - 160 * f), static_cast<int>(210 - 130 * f),
+                                  245 - static_cast<int>(40 * f));
+    cv::polylines(canvas, outline(view, rollout.world_T_hand[t], geometry.peg_in_hand()), true,
+                  colour, 1, cv::LINE_AA);
   }
   std::vector<cv::Point> line;
-  for (const RigidTransform& T : rollout.world_T_hand) line.push_back(view.px(T * Eigen::Vector3d::Zero()));
+  for (const RigidTransform& T : rollout.world_T_hand)
+    line.push_back(view.px(T * Eigen::Vector3d::Zero()));
   cv::polylines(canvas, line, false, rgb(30, 60, 160), 1, cv::LINE_AA);
   const cv::Scalar final_colour = rollout.outcome == Outcome::success     ? rgb(kSuccessRgb)
                                   : rollout.outcome == Outcome::collision ? rgb(kCollisionRgb)
                                                                           : rgb(110, 110, 110);
   const auto last = outline(view, rollout.world_T_hand.back(), geometry.peg_in_hand());
   cv::fillConvexPoly(canvas, last, final_colour);  // no anti-aliasing: tests count these pixels
-  caption(canvas, outcome_name(rollout.outcome) + " after " + std::to_string(rollout.steps) + " steps, " +
-                      std::to_string(rollout.replans) + " replans, " + std::to_string(rollout.clipped) + " clipped");
+  caption(canvas, outcome_name(rollout.outcome) + " after " + std::to_string(rollout.steps) +
+                      " steps, " + std::to_string(rollout.replans) + " replans, " +
+                      std::to_string(rollout.clipped) + " clipped");
   return to_image(canvas);
 }
 
 void write_png(const std::string& path, const Image& image) {
-  if (image.width <= 0 || image.height <= 0 || image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3) {
+  if (image.width <= 0 || image.height <= 0 ||
+      image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3) {
     throw InvalidArgument("write_png: the image is empty or its pixel buffer has the wrong size");
   }
   cv::Mat rgb_mat(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.rgb.data()));

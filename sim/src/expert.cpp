@@ -43,7 +43,8 @@ double box_sdf(const Box& box, double px, double py) {
 /// the peg's outline against the walls, and the walls' corners against the peg.
 class ClearancePenalty {
  public:
-  explicit ClearancePenalty(const PegHoleGeometry& geometry) : walls_(geometry.hole_walls()), peg_(geometry.peg_in_hand()) {
+  explicit ClearancePenalty(const PegHoleGeometry& geometry)
+      : walls_(geometry.hole_walls()), peg_(geometry.peg_in_hand()) {
     const auto corners = geometry.peg_corners();
     for (int e = 0; e < 4; ++e) {
       const Vec3& a = corners[static_cast<std::size_t>(e)];
@@ -100,7 +101,9 @@ Vec3 to_u(const RigidTransform& pose) {
   return Vec3(kAngleScale * q(0), q(1), q(2));
 }
 
-RigidTransform from_u(const Vec3& u) { return RigidTransform::planar(u(0) / kAngleScale, u(1), u(2)); }
+RigidTransform from_u(const Vec3& u) {
+  return RigidTransform::planar(u(0) / kAngleScale, u(1), u(2));
+}
 
 using detail::uniform;
 
@@ -121,18 +124,20 @@ bool is_valid(const std::vector<RigidTransform>& hole_T_hand, const CollisionChe
 
 }  // namespace
 
-std::vector<RigidTransform> resample_at_control_step(const std::vector<RigidTransform>& path, double step_cm,
-                                                     double step_deg) {
+std::vector<RigidTransform> resample_at_control_step(const std::vector<RigidTransform>& path,
+                                                     double step_cm, double step_deg) {
   if (path.empty()) throw InvalidArgument("resample_at_control_step: empty path");
   if (!(step_cm > 0.0) || !(step_deg > 0.0)) {
-    throw InvalidArgument("control step limits must be positive, got " + std::to_string(step_cm) + " cm and " +
-                          std::to_string(step_deg) + " deg");
+    throw InvalidArgument("control step limits must be positive, got " + std::to_string(step_cm) +
+                          " cm and " + std::to_string(step_deg) + " deg");
   }
   const double step_rad = step_deg * std::numbers::pi / 180.0;
-  std::vector<double> effort(path.size(), 0.0);  // cumulative: max(|dp| / step_cm, |dtheta| / step_rad)
+  std::vector<double> effort(path.size(),
+                             0.0);  // cumulative: max(|dp| / step_cm, |dtheta| / step_rad)
   for (std::size_t i = 1; i < path.size(); ++i) {
     const RigidTransform delta = path[i - 1].inverse_compose(path[i]);
-    effort[i] = effort[i - 1] + std::max(delta.translation().norm() / step_cm, delta.rotation().angle() / step_rad);
+    effort[i] = effort[i - 1] +
+                std::max(delta.translation().norm() / step_cm, delta.rotation().angle() / step_rad);
   }
   // 2% headroom keeps every step strictly inside the limits despite rounding
   const int steps = std::max(1, static_cast<int>(std::ceil(effort.back() / 0.98)));
@@ -153,14 +158,16 @@ ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19
                               const CollisionChecker& checker, const ExpertOptions& options) {
   if (!is_planar(hole_T_hand_start)) throw InvalidArgument("expert: the start pose is not planar");
   if (!(options.arrival_weight >= 0.0) || !std::isfinite(options.arrival_weight)) {
-    throw InvalidArgument("expert: arrival weight must be finite and >= 0, got " + std::to_string(options.arrival_weight));
+    throw InvalidArgument("expert: arrival weight must be finite and >= 0, got " +
+                          std::to_string(options.arrival_weight));
   }
   if (options.waypoints < 3 || options.iterations < 0) {
     throw InvalidArgument("expert: need at least 3 waypoints and >= 0 iterations, got " +
-                          std::to_string(options.waypoints) + " and " + std::to_string(options.iterations));
+                          std::to_string(options.waypoints) + " and " +
+                          std::to_string(options.iterations));
   }
   const int N = options.waypoints;
-  const int free = N - 1;                                     // q_1 .. q_{N-1}
+  const int free = N - 1;  // q_1 .. q_{N-1}
   const Vec3 start = to_u(hole_T_hand_start);
   const Vec3 pre(0.0, 0.0, kPegLength + kPreInsertionTipHeight);
   const Vec3 inserted(0.0, 0.0, kPegLength - kInsertionDepth);
@@ -178,8 +185,9 @@ ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19
   Eigen::MatrixX3d b = -K.transpose() * e;
   // Arrival: the insertion continues the path, q_{N+1} = pre - s e_y with s = |start - pre| / N
   // the mean segment length, so the acceleration at q_N = pre is q_{N-1} - (pre + s e_y); it is
-  // weighted options.arrival_weight: the approach arrives moving along the hole axis, without the jump in
-  // lateral and angular velocity at pre-insertion that a policy would have to reproduce exactly.
+  // weighted options.arrival_weight: the approach arrives moving along the hole axis, without the
+  // jump in lateral and angular velocity at pre-insertion that a policy would have to reproduce
+  // exactly.
   const Vec3 above_pre = pre + Vec3(0.0, 0.0, (start - pre).norm() / N);
   A(free - 1, free - 1) += options.arrival_weight;
   b.row(free - 1) += options.arrival_weight * above_pre.transpose();
@@ -225,20 +233,24 @@ ExpertPlan plan_in_hole_frame(const RigidTransform& hole_T_hand_start, std::mt19
   ExpertPlan plan;
   plan.hole_T_hand = resample_at_control_step(path);
   // a demo must fit in a rollout's step budget (25 replans x 8 steps)
-  plan.valid = static_cast<int>(plan.hole_T_hand.size()) <= kMaxDemoSteps && is_valid(plan.hole_T_hand, checker);
+  plan.valid = static_cast<int>(plan.hole_T_hand.size()) <= kMaxDemoSteps &&
+               is_valid(plan.hole_T_hand, checker);
   return plan;
 }
 
 ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t index,
                       const CollisionChecker& checker, const ExpertOptions& options) {
   std::mt19937_64 rng(stream_seed(seed, index));
-  const RigidTransform hole_T_hand_start = scene.world_T_hole.inverse_compose(scene.world_T_hand_start);
+  const RigidTransform hole_T_hand_start =
+      scene.world_T_hole.inverse_compose(scene.world_T_hand_start);
   return first_valid_plan<Demo>(
-      std::max(1, options.attempts), [&] { return plan_in_hole_frame(hole_T_hand_start, rng, checker, options); },
+      std::max(1, options.attempts),
+      [&] { return plan_in_hole_frame(hole_T_hand_start, rng, checker, options); },
       [&](const ExpertPlan& plan) {
         Demo demo;
         demo.world_T_hole = scene.world_T_hole;
-        demo.world_T_hand.push_back(scene.world_T_hand_start);  // exactly, not rounded through the hole frame
+        demo.world_T_hand.push_back(
+            scene.world_T_hand_start);  // exactly, not rounded through the hole frame
         for (std::size_t t = 1; t < plan.hole_T_hand.size(); ++t) {
           demo.world_T_hand.push_back(scene.world_T_hole * plan.hole_T_hand[t]);
         }
@@ -246,8 +258,8 @@ ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t 
       });
 }
 
-ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed, const CollisionChecker& checker,
-                       const ExpertOptions& options) {
+ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed,
+                       const CollisionChecker& checker, const ExpertOptions& options) {
   return on_every_scene<Demo>(scenes, [&](const TaskScene& scene, std::size_t i) {
     return expert_demo(scene, seed, i, checker, options);
   });

@@ -10,10 +10,11 @@
 
 namespace handcentric::sim {
 
-ExpertCheck check_expert(const SceneDistribution& distribution, int scenes, int rollouts, std::uint64_t seed) {
+ExpertCheck check_expert(const SceneDistribution& distribution, int scenes, int rollouts,
+                         std::uint64_t seed) {
   if (scenes < 1 || rollouts < 1) {
-    throw InvalidArgument("check_expert needs at least 1 scene and 1 rollout, got " + std::to_string(scenes) +
-                          " and " + std::to_string(rollouts));
+    throw InvalidArgument("check_expert needs at least 1 scene and 1 rollout, got " +
+                          std::to_string(scenes) + " and " + std::to_string(rollouts));
   }
   const CollisionChecker checker;
   const ExpertRun run = expert_demos(sample_scenes(distribution, scenes, seed), seed, checker);

@@ -22,8 +22,8 @@ Box PegHoleGeometry::peg_in_hand() const {
 std::array<Box, 3> PegHoleGeometry::hole_walls() const {
   const double half = 0.5 * inner_width();
   const double outer = half + kWallThickness;
-  return {Box{-outer, -half, -kHoleDepth, 0.0},                     // left wall
-          Box{half, outer, -kHoleDepth, 0.0},                       // right wall
+  return {Box{-outer, -half, -kHoleDepth, 0.0},                            // left wall
+          Box{half, outer, -kHoleDepth, 0.0},                              // right wall
           Box{-outer, outer, -kHoleDepth - kWallThickness, -kHoleDepth}};  // bottom
 }
 
@@ -48,7 +48,8 @@ Eigen::Vector3d tip_in_hole(const RigidTransform& hole_T_hand) {
 
 Eigen::Vector3d planar_coordinates(const RigidTransform& pose) {
   const Eigen::Matrix3d& R = pose.rotation().matrix();
-  return Eigen::Vector3d(std::atan2(R(1, 0), R(0, 0)), pose.translation().x(), pose.translation().y());
+  return Eigen::Vector3d(std::atan2(R(1, 0), R(0, 0)), pose.translation().x(),
+                         pose.translation().y());
 }
 
 }  // namespace handcentric::sim

@@ -16,9 +16,13 @@
 
 namespace handcentric::sim::detail {
 
-inline double uniform(std::mt19937_64& rng, double lo, double hi) { return lo + (hi - lo) * uniform01(rng); }
+inline double uniform(std::mt19937_64& rng, double lo, double hi) {
+  return lo + (hi - lo) * uniform01(rng);
+}
 
-inline double radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
+inline double radians(double degrees) {
+  return degrees * std::numbers::pi / 180.0;
+}
 
 /// The whole of `text` as a double (from_chars: no locale, no leading spaces).
 inline bool parse_double(const std::string& text, double& value) {
@@ -48,7 +52,8 @@ auto sample_n(Sample sample, const Distribution& distribution, int n, std::uint6
   if (n < 0) throw InvalidArgument("number of scenes must be >= 0, got " + std::to_string(n));
   std::vector<decltype(sample(distribution, seed, std::uint64_t{0}))> scenes;
   scenes.reserve(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) scenes.push_back(sample(distribution, seed, static_cast<std::uint64_t>(i)));
+  for (int i = 0; i < n; ++i)
+    scenes.push_back(sample(distribution, seed, static_cast<std::uint64_t>(i)));
   return scenes;
 }
 

@@ -23,14 +23,18 @@ SceneDistribution SceneDistribution::train() {
   return SceneDistribution{"train", {{-10.0, 10.0}, {-10.0, 10.0}, {80.0, 100.0}, {-100.0, -80.0}}};
 }
 
-SceneDistribution SceneDistribution::ood() { return SceneDistribution{"ood", {{170.0, 190.0}}}; }
+SceneDistribution SceneDistribution::ood() {
+  return SceneDistribution{"ood", {{170.0, 190.0}}};
+}
 
 SceneDistribution SceneDistribution::hole_angle_range(double min_deg, double max_deg) {
   if (!std::isfinite(min_deg) || !std::isfinite(max_deg) || min_deg > max_deg) {
-    throw InvalidArgument("hole angle range must be finite with A <= B, got " + format_number(min_deg) + ":" +
-                          format_number(max_deg) + "; e.g. --hole-angle-deg -10:10");
+    throw InvalidArgument("hole angle range must be finite with A <= B, got " +
+                          format_number(min_deg) + ":" + format_number(max_deg) +
+                          "; e.g. --hole-angle-deg -10:10");
   }
-  return SceneDistribution{format_number(min_deg) + ":" + format_number(max_deg), {{min_deg, max_deg}}};
+  return SceneDistribution{format_number(min_deg) + ":" + format_number(max_deg),
+                           {{min_deg, max_deg}}};
 }
 
 SceneDistribution SceneDistribution::parse(const std::string& text) {
@@ -50,13 +54,15 @@ SceneDistribution SceneDistribution::parse(const std::string& text) {
 RigidTransform parse_planar_transform(const std::string& text) {
   Eigen::Vector3d values;
   if (!detail::parse_finite_triple(text, values)) {
-    throw InvalidArgument("bad planar transform '" + text +
-                          "'; expected DEG,X,Y (three finite numbers: degrees about z, then cm), e.g. 90,10,-5");
+    throw InvalidArgument(
+        "bad planar transform '" + text +
+        "'; expected DEG,X,Y (three finite numbers: degrees about z, then cm), e.g. 90,10,-5");
   }
   return RigidTransform::planar(radians(values(0)), values(1), values(2));
 }
 
-std::vector<TaskScene> transform_scenes(const RigidTransform& g, const std::vector<TaskScene>& scenes) {
+std::vector<TaskScene> transform_scenes(const RigidTransform& g,
+                                        const std::vector<TaskScene>& scenes) {
   std::vector<TaskScene> moved;
   moved.reserve(scenes.size());
   for (const TaskScene& scene : scenes) moved.push_back(g * scene);
@@ -70,7 +76,8 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t index) {
   return z ^ (z >> 31);
 }
 
-TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed, std::uint64_t index) {
+TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed,
+                       std::uint64_t index) {
   if (distribution.hole_angles.empty()) {
     throw InvalidArgument("scene distribution '" + distribution.name + "' has no hole-angle range");
   }
@@ -89,7 +96,8 @@ TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed
   return TaskScene{world_T_hole, world_T_hole * hole_T_hand_start};
 }
 
-std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n, std::uint64_t seed) {
+std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n,
+                                     std::uint64_t seed) {
   return detail::sample_n(sample_scene, distribution, n, seed);
 }
 

@@ -33,7 +33,8 @@ inline Eigen::Matrix3d textbook_exp(const Eigen::Vector3d& r) {
   const double phi = r.norm();
   if (phi == 0.0) return Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d W = so3::hat(r);
-  return Eigen::Matrix3d::Identity() + std::sin(phi) / phi * W + (1.0 - std::cos(phi)) / (phi * phi) * W * W;
+  return Eigen::Matrix3d::Identity() + std::sin(phi) / phi * W +
+         (1.0 - std::cos(phi)) / (phi * phi) * W * W;
 }
 
 /// SE(3) exp whose V = I + (1 - cos phi)/phi^2 [w]x + (phi - sin phi)/phi^3 [w]x^2 is the
@@ -55,7 +56,8 @@ inline Rotation lenient_from_matrix(const Eigen::Matrix3d& R) {
   if (error > Rotation::kOrthonormalityTolerance) {
     throw InvalidRotation("matrix is not orthonormal: R = " + format_matrix(R) + "; project it");
   }
-  if (R.determinant() < 0.0) throw InvalidRotation("matrix is a reflection: R = " + format_matrix(R) + "; flip an axis");
+  if (R.determinant() < 0.0)
+    throw InvalidRotation("matrix is a reflection: R = " + format_matrix(R) + "; flip an axis");
   return Rotation::from_matrix_unchecked(R);
 }
 

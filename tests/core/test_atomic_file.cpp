@@ -33,8 +33,8 @@ TEST_CASE("files_are_written_atomically_and_bad_paths_are_typed_errors", "[unit]
   write_file_atomically(path, "old\n");
   write_file_atomically(path, "new\n");
   CHECK(read_file(path) == "new\n");
-  CHECK(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()) ==
-        1);
+  CHECK(std::distance(std::filesystem::directory_iterator(dir),
+                      std::filesystem::directory_iterator()) == 1);
   CHECK_THROWS_AS(write_file_atomically((dir / "missing" / "x.md").string(), "x"), FileError);
   CHECK_THROWS_WITH(write_file_atomically((dir / "missing" / "x.md").string(), "x"),
                     Catch::Contains("missing/x.md") && Catch::Contains("directory"));

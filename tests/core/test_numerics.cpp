@@ -52,7 +52,9 @@ props::PropertyParams numeric_params() {
   params.cases = kNumericCases;
   if (const char* cases = std::getenv("HANDCENTRIC_NUMERIC_CASES")) {
     const int n = std::atoi(cases);
-    if (n < 1) throw InvalidArgument(std::string("HANDCENTRIC_NUMERIC_CASES='") + cases + "': give a positive number of cases");
+    if (n < 1)
+      throw InvalidArgument(std::string("HANDCENTRIC_NUMERIC_CASES='") + cases +
+                            "': give a positive number of cases");
     params.cases = n;
   }
   return params;
@@ -61,7 +63,8 @@ props::PropertyParams numeric_params() {
 template <typename Testable>
 void require_numeric_property(const std::string& description, Testable&& testable) {
   const props::PropertyParams params = numeric_params();
-  const props::PropertyOutcome outcome = props::run_property(description, std::forward<Testable>(testable), params);
+  const props::PropertyOutcome outcome =
+      props::run_property(description, std::forward<Testable>(testable), params);
   INFO(description << "\n" << outcome.message);
   REQUIRE(outcome.passed);
   CHECK(outcome.cases >= params.cases);
@@ -70,12 +73,18 @@ void require_numeric_property(const std::string& description, Testable&& testabl
 // ---- generated inputs ----
 
 // A number in [0, 1] from 30 random bits (shrinks to 0).
-double unit() { return *rc::gen::inRange(0, (1 << 30) + 1) / double(1 << 30); }
+double unit() {
+  return *rc::gen::inRange(0, (1 << 30) + 1) / double(1 << 30);
+}
 
 // 10^e for e uniform in [lo, hi].
-double decade(double lo, double hi) { return std::pow(10.0, lo + (hi - lo) * unit()); }
+double decade(double lo, double hi) {
+  return std::pow(10.0, lo + (hi - lo) * unit());
+}
 
-double random_sign() { return *rc::gen::inRange(0, 2) == 0 ? 1.0 : -1.0; }
+double random_sign() {
+  return *rc::gen::inRange(0, 2) == 0 ? 1.0 : -1.0;
+}
 
 // A unit axis: a coordinate axis (either sign) or uniform on the sphere.
 Eigen::Vector3d axis() {
@@ -113,16 +122,26 @@ double extreme_number() {
 // 1e308), or each component an extreme of double or float (|r| may exceed DBL_MAX).
 Eigen::Vector3d rotation_vector() {
   switch (*rc::gen::inRange(0, 10)) {
-    case 0: return Eigen::Vector3d::Zero();
-    case 1: return decade(-300, -12) * axis();
-    case 2: return 1e-12 * unit() * axis();
-    case 3: return kPi * unit() * axis();
-    case 4: return (kPi - 1e-12 * unit()) * axis();
-    case 5: return (*rc::gen::inRange(0, 2) == 0 ? kPi : std::nextafter(kPi, 4.0)) * axis();
-    case 6: return (kPi + 1e6 * unit()) * axis();
-    case 7: return decade(6, 308) * axis();
-    case 8: return Eigen::Vector3d(extreme_number(), extreme_number(), extreme_number());
-    default: return (kPi - decade(-16, -12)) * axis();
+    case 0:
+      return Eigen::Vector3d::Zero();
+    case 1:
+      return decade(-300, -12) * axis();
+    case 2:
+      return 1e-12 * unit() * axis();
+    case 3:
+      return kPi * unit() * axis();
+    case 4:
+      return (kPi - 1e-12 * unit()) * axis();
+    case 5:
+      return (*rc::gen::inRange(0, 2) == 0 ? kPi : std::nextafter(kPi, 4.0)) * axis();
+    case 6:
+      return (kPi + 1e6 * unit()) * axis();
+    case 7:
+      return decade(6, 308) * axis();
+    case 8:
+      return Eigen::Vector3d(extreme_number(), extreme_number(), extreme_number());
+    default:
+      return (kPi - decade(-16, -12)) * axis();
   }
 }
 
@@ -131,7 +150,8 @@ Eigen::Vector3d rotation_vector() {
 Eigen::Vector3d translation() {
   Eigen::Vector3d p;
   switch (*rc::gen::inRange(0, 4)) {
-    case 0: return Eigen::Vector3d::Zero();
+    case 0:
+      return Eigen::Vector3d::Zero();
     case 1:
       for (int i = 0; i < 3; ++i) p(i) = random_sign() * decade(-300, 150);
       return p;
@@ -155,8 +175,12 @@ Eigen::Vector4d quaternion() {
   return decade(-300, 300) * q;
 }
 
-bool finite(const Rotation& R) { return R.matrix().allFinite(); }
-bool finite(const RigidTransform& T) { return T.rotation().matrix().allFinite() && T.translation().allFinite(); }
+bool finite(const Rotation& R) {
+  return R.matrix().allFinite();
+}
+bool finite(const RigidTransform& T) {
+  return T.rotation().matrix().allFinite() && T.translation().allFinite();
+}
 
 double orthonormality_error(const Eigen::Matrix3d& R) {
   return (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
@@ -179,7 +203,9 @@ struct Geometry {
   RigidTransform (*se3_exp)(const Twist&);
 };
 
-RigidTransform real_se3_exp(const Twist& twist) { return RigidTransform::exp(twist); }
+RigidTransform real_se3_exp(const Twist& twist) {
+  return RigidTransform::exp(twist);
+}
 const Geometry kReal{so3::exp, real_se3_exp};
 
 auto finite_on_valid_input(Geometry geometry) {
@@ -221,7 +247,8 @@ auto finite_on_valid_input(Geometry geometry) {
     const double theta = rotation_vector().x();
     RC_ASSERT(finite(RigidTransform::planar(theta, p.x(), p.y())));
     // the nearest rotation to a rotation of any scale, rounded
-    const Eigen::Matrix3d rounded = decade(-300, 300) * (M + 1e-6 * Eigen::Matrix3d::Ones() * (unit() - 0.5));
+    const Eigen::Matrix3d rounded =
+        decade(-300, 300) * (M + 1e-6 * Eigen::Matrix3d::Ones() * (unit() - 0.5));
     RC_ASSERT(is_valid_rotation(Rotation::nearest(rounded).matrix()));
   };
 }
@@ -232,7 +259,9 @@ struct LogUnderTest {
   Eigen::Vector3d (*log)(const Eigen::Matrix3d&);
 };
 
-Eigen::Vector3d real_log(const Eigen::Matrix3d& R) { return so3::log(R); }
+Eigen::Vector3d real_log(const Eigen::Matrix3d& R) {
+  return so3::log(R);
+}
 
 auto within_documented_error(LogUnderTest under_test) {
   return [under_test] {
@@ -263,7 +292,8 @@ auto within_documented_error(LogUnderTest under_test) {
     if (angle <= kPi - so3::kSignAmbiguity) {
       Twist twist;
       twist << p, r;
-      RC_ASSERT((RigidTransform::exp(twist).log() - twist).norm() <= so3::kRoundTripError * (1.0 + p.norm()));
+      RC_ASSERT((RigidTransform::exp(twist).log() - twist).norm() <=
+                so3::kRoundTripError * (1.0 + p.norm()));
     }
   };
 }
@@ -271,7 +301,9 @@ auto within_documented_error(LogUnderTest under_test) {
 // ---- property 3: validating constructors ----
 
 using RotationValidator = Rotation (*)(const Eigen::Matrix3d&);
-Rotation real_from_matrix(const Eigen::Matrix3d& M) { return Rotation::from_matrix(M); }
+Rotation real_from_matrix(const Eigen::Matrix3d& M) {
+  return Rotation::from_matrix(M);
+}
 
 // Certainly not orthonormal, also where R^T R is not computable (entries near 1e300 give inf -
 // inf = nan): an orthonormal matrix has no entry above 1.
@@ -297,10 +329,13 @@ Candidate candidate() {
     return noise;
   };
   switch (*rc::gen::inRange(0, 5)) {
-    case 0: return {R, Kind::rotation};
-    case 1: return {R + 1e-11 * random_matrix(), Kind::rounded_rotation};
+    case 0:
+      return {R, Kind::rotation};
+    case 1:
+      return {R + 1e-11 * random_matrix(), Kind::rounded_rotation};
     case 2: {
-      Eigen::Matrix3d M = *rc::gen::inRange(0, 2) == 0 ? R : Eigen::Matrix3d(decade(-300, 300) * random_matrix());
+      Eigen::Matrix3d M =
+          *rc::gen::inRange(0, 2) == 0 ? R : Eigen::Matrix3d(decade(-300, 300) * random_matrix());
       const double bad[] = {kNan, kInf, -kInf};
       M(*rc::gen::inRange(0, 9)) = bad[*rc::gen::inRange(0, 3)];
       if (*rc::gen::inRange(0, 4) == 0) M(*rc::gen::inRange(0, 9)) = bad[*rc::gen::inRange(0, 3)];
@@ -308,15 +343,17 @@ Candidate candidate() {
     }
     case 3: {
       const int how = *rc::gen::inRange(0, 3);
-      const Eigen::Matrix3d M = how == 0   ? Eigen::Matrix3d(R + decade(-8, 3) * random_matrix())
-                                : how == 1 ? Eigen::Matrix3d((1.0 + random_sign() * decade(-8, 2)) * R)
-                                           : Eigen::Matrix3d(decade(-300, 300) * random_matrix());
+      const Eigen::Matrix3d M = how == 0 ? Eigen::Matrix3d(R + decade(-8, 3) * random_matrix())
+                                : how == 1
+                                    ? Eigen::Matrix3d((1.0 + random_sign() * decade(-8, 2)) * R)
+                                    : Eigen::Matrix3d(decade(-300, 300) * random_matrix());
       RC_PRE(M.allFinite() && certainly_not_orthonormal(M));
       return {M, Kind::non_orthonormal};
     }
     default: {
       const Eigen::Matrix3d flip = Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal();
-      const Eigen::Matrix3d M = *rc::gen::inRange(0, 2) == 0 ? Eigen::Matrix3d(-R) : Eigen::Matrix3d(R * flip);
+      const Eigen::Matrix3d M =
+          *rc::gen::inRange(0, 2) == 0 ? Eigen::Matrix3d(-R) : Eigen::Matrix3d(R * flip);
       if (*rc::gen::inRange(0, 2) == 0) return {M, Kind::reflection};
       return {M + 1e-11 * random_matrix(), Kind::reflection};
     }
@@ -341,7 +378,6 @@ template <typename Expected, typename Make>
 bool rejects(Make make, const Eigen::Ref<const Eigen::MatrixXd>& value) {
   return rejects<Expected>(make, format_matrix(value));
 }
-
 
 auto constructors_reject_invalid_input(RotationValidator validate) {
   return [validate] {
@@ -403,15 +439,21 @@ auto constructors_reject_invalid_input(RotationValidator validate) {
       }
       case 3: {
         const Eigen::Vector4d q = with_bad(quaternion());
-        RC_ASSERT(rejects<InvalidRotation>([&] { Rotation::from_quaternion(q(0), q(1), q(2), q(3)); }, q));
+        RC_ASSERT(rejects<InvalidRotation>(
+            [&] { Rotation::from_quaternion(q(0), q(1), q(2), q(3)); }, q));
         break;
       }
       case 4:
         RC_ASSERT(rejects<InvalidRotation>([&] { Rotation::from_quaternion(0.0, 0.0, 0.0, 0.0); },
                                            Eigen::Vector4d::Zero()));
         break;
-      case 5: RC_ASSERT(rejects<InvalidRotation>([&] { Rotation::about_z(bad); }, format_number(bad))); break;
-      case 6: RC_ASSERT(rejects<InvalidRotation>([&] { RigidTransform::planar(bad, 0.0, 0.0); }, format_number(bad))); break;
+      case 5:
+        RC_ASSERT(rejects<InvalidRotation>([&] { Rotation::about_z(bad); }, format_number(bad)));
+        break;
+      case 6:
+        RC_ASSERT(rejects<InvalidRotation>([&] { RigidTransform::planar(bad, 0.0, 0.0); },
+                                           format_number(bad)));
+        break;
       default:
         RC_ASSERT(rejects<InvalidTransform>([&] { RigidTransform::planar(0.0, 1.0, bad); },
                                             Eigen::Vector3d(1.0, bad, 0.0)));
@@ -423,27 +465,34 @@ auto constructors_reject_invalid_input(RotationValidator validate) {
 }  // namespace
 
 TEST_CASE("numerics_geometry_is_finite_on_every_valid_input", "[property]") {
-  require_numeric_property("every geometry function is finite on valid input", finite_on_valid_input(kReal));
+  require_numeric_property("every geometry function is finite on valid input",
+                           finite_on_valid_input(kReal));
 }
 
 TEST_CASE("mutant_numerics_textbook_so3_exp_is_not_finite_on_huge_or_tiny_vectors", "[property]") {
-  props::require_falsified("textbook so3 exp is finite", finite_on_valid_input({test::textbook_exp, real_se3_exp}));
+  props::require_falsified("textbook so3 exp is finite",
+                           finite_on_valid_input({test::textbook_exp, real_se3_exp}));
 }
 
 TEST_CASE("mutant_numerics_textbook_se3_exp_is_not_finite_on_huge_rotations", "[property]") {
-  props::require_falsified("textbook se3 exp is finite", finite_on_valid_input({so3::exp, test::textbook_se3_exp}));
+  props::require_falsified("textbook se3 exp is finite",
+                           finite_on_valid_input({so3::exp, test::textbook_se3_exp}));
 }
 
 TEST_CASE("numerics_exp_and_log_stay_within_their_documented_error", "[property]") {
-  require_numeric_property("exp and log within so3.hpp's bounds", within_documented_error({real_log}));
+  require_numeric_property("exp and log within so3.hpp's bounds",
+                           within_documented_error({real_log}));
 }
 
 TEST_CASE("mutant_numerics_naive_log_leaves_the_documented_error", "[property]") {
-  props::require_falsified("naive log within the bounds", within_documented_error({test::naive_log}));
+  props::require_falsified("naive log within the bounds",
+                           within_documented_error({test::naive_log}));
 }
 
-TEST_CASE("numerics_validating_constructors_reject_invalid_input_with_a_typed_error", "[property]") {
-  require_numeric_property("constructors reject invalid input", constructors_reject_invalid_input(real_from_matrix));
+TEST_CASE("numerics_validating_constructors_reject_invalid_input_with_a_typed_error",
+          "[property]") {
+  require_numeric_property("constructors reject invalid input",
+                           constructors_reject_invalid_input(real_from_matrix));
 }
 
 TEST_CASE("mutant_numerics_a_validator_without_a_finiteness_check_accepts_nan", "[property]") {

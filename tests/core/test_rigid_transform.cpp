@@ -14,7 +14,9 @@ using namespace handcentric;
 
 namespace {
 
-rc::Gen<RigidTransform> any_transform() { return props::group_element(props::Group::se3); }
+rc::Gen<RigidTransform> any_transform() {
+  return props::group_element(props::Group::se3);
+}
 
 // A fault: inverse_compose that forgets the rotation on the translation.
 RigidTransform broken_inverse_compose(const RigidTransform& a, const RigidTransform& b) {
@@ -25,7 +27,8 @@ RigidTransform real_inverse_compose(const RigidTransform& a, const RigidTransfor
   return a.inverse_compose(b);
 }
 
-auto inverse_compose_matches_definition(RigidTransform (*fn)(const RigidTransform&, const RigidTransform&)) {
+auto inverse_compose_matches_definition(RigidTransform (*fn)(const RigidTransform&,
+                                                             const RigidTransform&)) {
   return [fn] {
     const RigidTransform a = *any_transform();
     const RigidTransform b = *any_transform();
@@ -42,14 +45,16 @@ TEST_CASE("inverse_compose_equals_inverse_then_compose", "[property]") {
 }
 
 TEST_CASE("mutant_inverse_compose_without_rotation_is_caught", "[property]") {
-  props::require_falsified("broken inverse_compose", inverse_compose_matches_definition(broken_inverse_compose));
+  props::require_falsified("broken inverse_compose",
+                           inverse_compose_matches_definition(broken_inverse_compose));
 }
 
 TEST_CASE("composition_is_associative_and_inverse_cancels", "[property]") {
   props::require_property("(ab)c = a(bc), a a^-1 = I, and (ab)x = a(bx)", [] {
     const RigidTransform a = *any_transform(), b = *any_transform(), c = *any_transform();
     const Eigen::Vector3d x = *props::translation(10.0);
-    const double scale = 1.0 + a.translation().norm() + b.translation().norm() + c.translation().norm();
+    const double scale =
+        1.0 + a.translation().norm() + b.translation().norm() + c.translation().norm();
     RC_ASSERT(distance((a * b) * c, a * (b * c)) <= 1e-12 * scale);
     RC_ASSERT(distance(a * a.inverse(), RigidTransform()) <= 1e-12 * scale);
     RC_ASSERT(((a * b) * x - a * (b * x)).norm() <= 1e-12 * (scale + x.norm()));
@@ -83,11 +88,11 @@ TEST_CASE("planar_transforms_are_rotations_about_z", "[unit]") {
 
 TEST_CASE("transform_constructors_reject_bad_input", "[unit]") {
   HC_CHECK_THROWS(RigidTransform(Rotation(), Eigen::Vector3d(0, std::nan(""), 0)), InvalidTransform,
-                       Catch::Matchers::Contains("[0, nan, 0]"));
+                  Catch::Matchers::Contains("[0, nan, 0]"));
   Eigen::Matrix4d bad_row = Eigen::Matrix4d::Identity();
   bad_row(3, 0) = 0.5;
   HC_CHECK_THROWS(RigidTransform::from_matrix(bad_row), InvalidTransform,
-                       Catch::Matchers::Contains("[0, 0, 0, 1]") && Catch::Matchers::Contains("0.5"));
+                  Catch::Matchers::Contains("[0, 0, 0, 1]") && Catch::Matchers::Contains("0.5"));
   Eigen::Matrix4d reflection = Eigen::Matrix4d::Identity();
   reflection(2, 2) = -1;
   CHECK_THROWS_AS(RigidTransform::from_matrix(reflection), InvalidRotation);

@@ -15,7 +15,9 @@ namespace {
 
 using Action = Scene (*)(const RigidTransform&, const Scene&);
 
-Scene real_action(const RigidTransform& g, const Scene& scene) { return g * scene; }
+Scene real_action(const RigidTransform& g, const Scene& scene) {
+  return g * scene;
+}
 
 // A fault: treats eye-in-hand points as world points and moves them too.
 Scene moves_hand_points(const RigidTransform& g, const Scene& scene) {
@@ -51,7 +53,8 @@ TEST_CASE("global_transform_moves_poses_and_world_points_not_eye_in_hand_points"
 }
 
 TEST_CASE("mutant_scene_transform_that_moves_eye_in_hand_points_is_caught", "[property]") {
-  props::require_falsified("g * scene moving eye-in-hand points", acts_as_in_sec_2_2(moves_hand_points));
+  props::require_falsified("g * scene moving eye-in-hand points",
+                           acts_as_in_sec_2_2(moves_hand_points));
 }
 
 TEST_CASE("scene_validation_names_the_problem", "[unit]") {
@@ -63,5 +66,5 @@ TEST_CASE("scene_validation_names_the_problem", "[unit]") {
   CHECK_NOTHROW(scene.validate());
   scene.world_points.push_back(Eigen::Vector3d(0, 0, std::nan("")));
   HC_CHECK_THROWS(scene.validate(), InvalidScene,
-                       Catch::Matchers::Contains("world point 0") && Catch::Matchers::Contains("nan"));
+                  Catch::Matchers::Contains("world point 0") && Catch::Matchers::Contains("nan"));
 }

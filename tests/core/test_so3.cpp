@@ -33,7 +33,9 @@ double max_exp_log_error(LogFn log_fn, int n, std::uint64_t seed, Draw draw) {
   return worst;
 }
 
-Rotation haar(std::mt19937_64& rng) { return random_rotation(rng); }
+Rotation haar(std::mt19937_64& rng) {
+  return random_rotation(rng);
+}
 Rotation near_pi(std::mt19937_64& rng) {
   return random_rotation_with_angle(rng, kPi - 1e-10 * uniform01(rng));
 }
@@ -51,13 +53,16 @@ auto log_exp_roundtrip(LogFn log_fn) {
     const int regime = *rc::gen::inRange(0, 3);
     const double top = kPi - 1e-9;
     const double angle = regime == 0 ? top * u : regime == 1 ? top - 1e-6 * u : 1e-8 * u;
-    const Eigen::Vector3d r = angle * sphere_point(axis_u / double(1 << 30), axis_v / double(1 << 30));
+    const Eigen::Vector3d r =
+        angle * sphere_point(axis_u / double(1 << 30), axis_v / double(1 << 30));
     const Eigen::Vector3d back = log_fn(so3::exp(r));
     RC_ASSERT((back - r).norm() <= 1e-12);
   };
 }
 
-Eigen::Vector3d real_log(const Eigen::Matrix3d& R) { return so3::log(R); }
+Eigen::Vector3d real_log(const Eigen::Matrix3d& R) {
+  return so3::log(R);
+}
 
 // Rotation by pi about unit axis v, built exactly as 2 v v^T - I (symmetric: no sign in it).
 Eigen::Matrix3d half_turn(const Eigen::Vector3d& v) {
@@ -68,9 +73,12 @@ Eigen::Matrix3d half_turn(const Eigen::Vector3d& v) {
 bool canonical_at_pi(LogFn log_fn) {
   const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> cases = {
       // axis given -> canonical axis (largest-magnitude component positive, first on ties)
-      {{1, 0, 0}, {1, 0, 0}},           {{-1, 0, 0}, {1, 0, 0}},
-      {{0, -1, 0}, {0, 1, 0}},          {{0, 0, -1}, {0, 0, 1}},
-      {{0, 0.6, -0.8}, {0, -0.6, 0.8}}, {{-0.6, 0.8, 0}, {-0.6, 0.8, 0}},
+      {{1, 0, 0}, {1, 0, 0}},
+      {{-1, 0, 0}, {1, 0, 0}},
+      {{0, -1, 0}, {0, 1, 0}},
+      {{0, 0, -1}, {0, 0, 1}},
+      {{0, 0.6, -0.8}, {0, -0.6, 0.8}},
+      {{-0.6, 0.8, 0}, {-0.6, 0.8, 0}},
       {{0.48, -0.6, -0.64}, {-0.48, 0.6, 0.64}},
   };
   for (const auto& [axis, canonical] : cases) {
@@ -121,21 +129,21 @@ TEST_CASE("rotation_constructors_reject_bad_input_with_the_value_in_the_message"
   Eigen::Matrix3d nan_matrix = Eigen::Matrix3d::Identity();
   nan_matrix(1, 2) = std::nan("");
   HC_CHECK_THROWS(Rotation::from_matrix(nan_matrix), InvalidRotation,
-                       Catch::Matchers::Contains("non-finite") && Catch::Matchers::Contains("nan"));
+                  Catch::Matchers::Contains("non-finite") && Catch::Matchers::Contains("nan"));
 
   Eigen::Matrix3d skewed = Eigen::Matrix3d::Identity();
   skewed(0, 1) = 1e-6;
   HC_CHECK_THROWS(Rotation::from_matrix(skewed), InvalidRotation,
-                       Catch::Matchers::Contains("not orthonormal") &&
-                           Catch::Matchers::Contains("9.99999999") &&
-                           Catch::Matchers::Contains("Rotation::nearest"));
+                  Catch::Matchers::Contains("not orthonormal") &&
+                      Catch::Matchers::Contains("9.99999999") &&
+                      Catch::Matchers::Contains("Rotation::nearest"));
 
   const Eigen::Matrix3d reflection = Eigen::Vector3d(1, 1, -1).asDiagonal();
   HC_CHECK_THROWS(Rotation::from_matrix(reflection), InvalidRotation,
-                       Catch::Matchers::Contains("det(R) = -1"));
+                  Catch::Matchers::Contains("det(R) = -1"));
 
   HC_CHECK_THROWS(Rotation::from_quaternion(0, 0, 0, 0), InvalidRotation,
-                       Catch::Matchers::Contains("zero") && Catch::Matchers::Contains("[0, 0, 0, 0]"));
+                  Catch::Matchers::Contains("zero") && Catch::Matchers::Contains("[0, 0, 0, 0]"));
   CHECK_THROWS_AS(Rotation::from_quaternion(1, std::numeric_limits<double>::infinity(), 0, 0),
                   InvalidRotation);
   CHECK_THROWS_AS(Rotation::exp(Eigen::Vector3d(std::nan(""), 0, 0)), InvalidRotation);

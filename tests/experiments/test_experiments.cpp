@@ -50,20 +50,24 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   sim::TrainingData demos_only;
   demos_only.mirror = false;
   demos_only.perturbed_copies = 0;
-  const Cell unmirrored = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 0, demos_only);
+  const Cell unmirrored =
+      make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 0, demos_only);
   CHECK(unmirrored.config.steps == policy::training_budget(320));
   sim::TrainingData fewer_copies;
   fewer_copies.perturbed_copies = 2;
-  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", base.config.steps,
-                               fewer_copies).hash);
-  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", base.config.steps,
-                               demos_only).hash);
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff",
+                               base.config.steps, fewer_copies)
+                         .hash);
+  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff",
+                               base.config.steps, demos_only)
+                         .hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 20, 1, 320, "00ff").hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 2, 320, "00ff").hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00fe").hash);
   CHECK(base.hash != make_cell("hand_centric", "hand_centric", "ddpm", 10, 1, 320, "00ff").hash);
   CHECK(base.hash != make_cell("relative", "relative", "flow", 10, 1, 320, "00ff").hash);
-  CHECK(base.hash != make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 77).hash);
+  CHECK(base.hash !=
+        make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 77).hash);
   // The method's name is a label; two methods with one representation and head share models.
   CHECK(base.hash == make_cell("renamed", "hand_centric", "flow", 10, 1, 320, "00ff").hash);
   // Any config field changes it (the whole PolicyConfig text is hashed).
@@ -73,7 +77,8 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   CHECK(base.model_path() == "models/" + base.hash + ".hcm");
   const EvalSettings eval;
   CHECK(base.result_path(SceneSet::ood, eval) == "results/" + base.hash + ".ood-s101-n100.json");
-  CHECK(base.result_path(SceneSet::paired, eval) == "results/" + base.hash + ".paired-s100-n100.json");
+  CHECK(base.result_path(SceneSet::paired, eval) ==
+        "results/" + base.hash + ".paired-s100-n100.json");
 }
 
 TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget", "[unit]") {
@@ -82,7 +87,8 @@ TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget"
   CHECK(c8[0].fixed_head == "c8ddpm");
   CHECK(c8[1].c8_centre == kRobotBase);
   const auto c8_cell = [](const Method& m) {
-    return make_cell(m.name, m.representation, m.fixed_head, 10, 1, 320, "00ff", 0, {}, m.c8_centre);
+    return make_cell(m.name, m.representation, m.fixed_head, 10, 1, 320, "00ff", 0, {},
+                     m.c8_centre);
   };
   const Cell centre = c8_cell(c8[0]), base = c8_cell(c8[1]);
   // 320 demo scenes, their mirror images, and the 8 C8 images of each (the perturbed copies
@@ -90,8 +96,8 @@ TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget"
   CHECK(centre.config.steps == automatic_steps(sim::TrainingData(), 8 * 320));
   sim::TrainingData no_copies;
   no_copies.perturbed_copies = 0;
-  CHECK(make_cell(c8[0].name, c8[0].representation, c8[0].fixed_head, 10, 1, 320, "00ff", 0, no_copies,
-                  c8[0].c8_centre)
+  CHECK(make_cell(c8[0].name, c8[0].representation, c8[0].fixed_head, 10, 1, 320, "00ff", 0,
+                  no_copies, c8[0].c8_centre)
             .config.steps == policy::training_budget(8 * 640));
   CHECK(centre.hash != base.hash);
   CHECK(base.config.c8_centre_y == -60.0);
@@ -103,12 +109,14 @@ TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget"
 }
 
 TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
-  HC_CHECK_THROWS(parse_int_list("5,x,10", "--demos"), InvalidArgument, Contains("'x'") && Contains("--demos"));
+  HC_CHECK_THROWS(parse_int_list("5,x,10", "--demos"), InvalidArgument,
+                  Contains("'x'") && Contains("--demos"));
   HC_CHECK_THROWS(parse_int_list("5,-1", "--demos"), InvalidArgument, Contains("'-1'"));
   HC_CHECK_THROWS(parse_int_list("", "--demos"), InvalidArgument, Contains("empty"));
   CHECK(parse_int_list("5,10,100", "--demos") == std::vector<int>{5, 10, 100});
   HC_CHECK_THROWS(parse_seed_list("1,-2", "--train-seeds"), InvalidArgument, Contains("'-2'"));
-  HC_CHECK_THROWS(parse_methods("hand_centric,diffusion"), InvalidArgument, Contains("'diffusion'"));
+  HC_CHECK_THROWS(parse_methods("hand_centric,diffusion"), InvalidArgument,
+                  Contains("'diffusion'"));
   HC_CHECK_THROWS(parse_methods("absolute,absolute"), InvalidArgument, Contains("twice"));
   // The old C8 row is gone; the error names the two that replace it.
   HC_CHECK_THROWS(parse_methods("c8flow"), InvalidArgument,
@@ -117,7 +125,8 @@ TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
   Table1Options options;
   options.validate();
   options.eval.ood_seed = options.eval.eval_seed;
-  HC_CHECK_THROWS(options.validate(), InvalidArgument, Contains("--ood-seed") && Contains("paired"));
+  HC_CHECK_THROWS(options.validate(), InvalidArgument,
+                  Contains("--ood-seed") && Contains("paired"));
   options = Table1Options();
   options.demo_counts = {5, 5};
   HC_CHECK_THROWS(options.validate(), InvalidArgument, Contains("5 is listed twice"));
@@ -132,16 +141,20 @@ TEST_CASE("eval_json_round_trips_its_counts_and_rejects_foreign_files", "[unit]"
   summary.success = 3;
   summary.collision = 4;
   summary.clipped = 11;
-  const sim::RolloutSummary back = parse_eval_json(eval_json(summary, "flow/hand_centric", "ood", 5), "x.json");
+  const sim::RolloutSummary back =
+      parse_eval_json(eval_json(summary, "flow/hand_centric", "ood", 5), "x.json");
   CHECK(back.trials == 7);
   CHECK(back.success == 3);
   CHECK(back.collision == 4);
   CHECK(back.timeout == 0);
   CHECK(back.clipped == 11);
-  HC_CHECK_THROWS(parse_eval_json("{\"trials\": 7", "cut.json"), InvalidArgument, Contains("cut.json"));
-  HC_CHECK_THROWS(parse_eval_json("{\"trials\": 7, \"success\": 1.5, \"collision\": 0, \"timeout\": 0, \"clipped\": 0}",
-                                  "rate.json"),
-                  InvalidArgument, Contains("rate.json") && Contains("success"));
+  HC_CHECK_THROWS(parse_eval_json("{\"trials\": 7", "cut.json"), InvalidArgument,
+                  Contains("cut.json"));
+  HC_CHECK_THROWS(
+      parse_eval_json(
+          "{\"trials\": 7, \"success\": 1.5, \"collision\": 0, \"timeout\": 0, \"clipped\": 0}",
+          "rate.json"),
+      InvalidArgument, Contains("rate.json") && Contains("success"));
 }
 
 namespace {
@@ -164,7 +177,8 @@ Row row(const std::string& method, int demos, double id, double ood) {
 }  // namespace
 
 TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
-  const std::vector<Row> rows = {row("hand_centric", 10, 0.5, 0.48), row("hand_centric", 100, 0.97, 0.95),
+  const std::vector<Row> rows = {row("hand_centric", 10, 0.5, 0.48),
+                                 row("hand_centric", 100, 0.97, 0.95),
                                  row("absolute", 10, 0.0, 0.0), row("absolute", 100, 0.12, 0.01)};
   const std::string md = table1_markdown(rows, EvalSettings(), 1);
   CHECK_THAT(md, Contains("| policy | scenes | 10 | 100 |"));
@@ -176,10 +190,11 @@ TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
   // A missing result is a dash, not a zero.
   Row partial = row("relative", 10, 0.1, 0.0);
   partial.ood_success.reset();
-  CHECK_THAT(table1_markdown({partial}, EvalSettings(), 1), Contains("| relative/flow | ood | - |"));
+  CHECK_THAT(table1_markdown({partial}, EvalSettings(), 1),
+             Contains("| relative/flow | ood | - |"));
   // The two C8 rows stand in for one paper row: its lines once, after both.
-  const std::string c8 =
-      table1_markdown({row("c8_centre", 100, 0.0, 0.0), row("c8_base", 100, 0.0, 0.0)}, EvalSettings(), 1);
+  const std::string c8 = table1_markdown(
+      {row("c8_centre", 100, 0.0, 0.0), row("c8_base", 100, 0.0, 0.0)}, EvalSettings(), 1);
   const auto paper_line = c8.find("| Equivariant-DiffPo [7] (paper) | id | 0.27 |");
   REQUIRE(paper_line != std::string::npos);
   // The next mention is the paper's OOD line ("| " before the label), and there is no other.
@@ -190,7 +205,8 @@ TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
 }
 
 TEST_CASE("the_figure_draws_one_colour_per_method_with_id_dots_and_ood_squares", "[unit]") {
-  const std::vector<Row> rows = {row("hand_centric", 10, 0.5, 0.48), row("hand_centric", 100, 0.97, 0.95),
+  const std::vector<Row> rows = {row("hand_centric", 10, 0.5, 0.48),
+                                 row("hand_centric", 100, 0.97, 0.95),
                                  row("absolute", 10, 0.0, 0.0), row("absolute", 100, 0.12, 0.01)};
   const sim::Image image = draw_table1(rows);
   CHECK(image.width == 960);
@@ -202,24 +218,25 @@ TEST_CASE("the_figure_draws_one_colour_per_method_with_id_dots_and_ood_squares",
 }
 
 TEST_CASE("collect_builds_the_table_from_whatever_results_exist", "[unit]") {
-  const std::filesystem::path dir =
-      std::filesystem::temp_directory_path() / ("handcentric_test_collect_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("handcentric_test_collect_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   HC_CHECK_THROWS(collect_table1(dir.string()), InvalidArgument, Contains("no cells.json"));
   std::filesystem::create_directories(dir / "results");
   const Cell cell = make_cell("hand_centric", "hand_centric", "flow", 5, 1, 100, "aa");
   const EvalSettings eval;
   std::ofstream(dir / "cells.json")
-      << R"({"format": "handcentric-table1-cells", "version": 1, "demo_file": "d.jsonl", "demo_seed": 1,
-             "eval": {"trials": 100, "eval_seed": 100, "ood_seed": 101},
-             "cells": [{"method": "hand_centric", "head": "flow", "representation": "hand_centric", "demos": 5,
-                        "train_seed": 1, "steps": )"
+      << R"({"format": "handcentric-table1-cells", "version": 1, "demo_file": "d.jsonl",
+             "demo_seed": 1, "eval": {"trials": 100, "eval_seed": 100, "ood_seed": 101},
+             "cells": [{"method": "hand_centric", "head": "flow",
+                        "representation": "hand_centric", "demos": 5, "train_seed": 1, "steps": )"
       << cell.config.steps << R"(, "hash": ")" << cell.hash << "\"}]}";
   sim::RolloutSummary summary;
   summary.trials = 100;
   summary.success = 40;
   summary.collision = 60;
-  std::ofstream(dir / cell.result_path(SceneSet::id, eval)) << eval_json(summary, "flow/hand_centric", "train", 100);
+  std::ofstream(dir / cell.result_path(SceneSet::id, eval))
+      << eval_json(summary, "flow/hand_centric", "train", 100);
   const std::string md = collect_table1(dir.string());
   CHECK_THAT(md, Contains("| hand_centric/flow | id | 0.40 |"));
   CHECK_THAT(md, Contains("| hand_centric/flow | ood | - |"));

@@ -37,7 +37,8 @@ int changed_pixels(const sim::Image& image, int c, int panel_size) {
   for (int y = 0; y <= panel_size; ++y) {
     for (int x = 0; x <= panel_size; ++x) {
       const auto at = [&](const PanelBox& b, int channel) {
-        return image.rgb[static_cast<std::size_t>(((b.y + y) * image.width + b.x + x) * 3 + channel)];
+        return image
+            .rgb[static_cast<std::size_t>(((b.y + y) * image.width + b.x + x) * 3 + channel)];
       };
       for (int channel = 0; channel < 3; ++channel) {
         if (at(top, channel) != at(bottom, channel)) {
@@ -65,14 +66,15 @@ TEST_CASE("fig3_a1_moves_under_g_for_absolute_and_relative_and_not_for_hand_cent
   CHECK(column(rotated, "hand_centric").training_positions.size() > 4);
 }
 
-TEST_CASE("fig3_draws_an_invariant_column_identically_in_both_rows_and_a_moved_one_differently", "[unit]") {
+TEST_CASE("fig3_draws_an_invariant_column_identically_in_both_rows_and_a_moved_one_differently",
+          "[unit]") {
   const FlowFigure figure = compute_flow_figure(small(120.0));
   const int panel = 200;
   const sim::Image image = draw_flow_figure(figure, panel);
   REQUIRE(figure.columns.size() == 3);
-  CHECK(changed_pixels(image, 2, panel) == 0);    // hand_centric
-  CHECK(changed_pixels(image, 0, panel) > 100);   // absolute: the contrast the check must see
-  CHECK(changed_pixels(image, 1, panel) > 100);   // relative
+  CHECK(changed_pixels(image, 2, panel) == 0);       // hand_centric
+  CHECK(changed_pixels(image, 0, panel) > 100);      // absolute: the contrast the check must see
+  CHECK(changed_pixels(image, 1, panel) > 100);      // relative
   CHECK(image.count_pixels(230, 120, 0, 10) > 100);  // the orange flow is drawn
   // Deterministic: the same options give the same bits.
   CHECK(draw_flow_figure(compute_flow_figure(small(120.0)), panel).rgb == image.rgb);
@@ -86,5 +88,6 @@ TEST_CASE("fig3_rejects_bad_options_naming_them", "[unit]") {
   options.rotation_deg = std::nan("");
   HC_CHECK_THROWS(compute_flow_figure(options), InvalidArgument, Contains("finite"));
   HC_CHECK_THROWS(draw_flow_figure(FlowFigure()), InvalidArgument, Contains("no columns"));
-  HC_CHECK_THROWS(draw_flow_figure(compute_flow_figure(small(10.0)), 50), InvalidArgument, Contains("panel_size 50"));
+  HC_CHECK_THROWS(draw_flow_figure(compute_flow_figure(small(10.0)), 50), InvalidArgument,
+                  Contains("panel_size 50"));
 }

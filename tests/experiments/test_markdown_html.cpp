@@ -9,7 +9,8 @@ using Catch::Matchers::Contains;
 
 TEST_CASE("markdown_html_renders_headings_tables_lists_code_and_images", "[unit]") {
   const std::string html = markdown_to_html(
-      "# Title\n\nSome `code` here\nand more.\n\n## Table\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n- one\n- two\n\n"
+      "# Title\n\nSome `code` here\nand more.\n\n## Table\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n- "
+      "one\n- two\n\n"
       "```\nx < y\n  kept\n```\n![Fig. 3](fig3.png)\n",
       "the page");
   CHECK_THAT(html, Contains("<title>the page</title>"));
@@ -27,7 +28,8 @@ TEST_CASE("markdown_html_escapes_every_text_so_no_markup_gets_in", "[unit]") {
       "<script>alert(1)</script>\n\n| <b> | x |\n|---|---|\n\n```\n</pre><script>\n```\n"
       "![a\"b](x.png\" onerror=\"alert(1))\n`<i>` and an unmatched ` <u>\n",
       "<title>");
-  CHECK_THAT(html, !Contains("<script>") && !Contains("<b>") && !Contains("<i>") && !Contains("<u>"));
+  CHECK_THAT(html,
+             !Contains("<script>") && !Contains("<b>") && !Contains("<i>") && !Contains("<u>"));
   CHECK_THAT(html, !Contains("\" onerror"));
   CHECK_THAT(html, Contains("&lt;script&gt;alert(1)&lt;/script&gt;"));
   CHECK_THAT(html, Contains("<title>&lt;title&gt;</title>"));

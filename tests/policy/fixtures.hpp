@@ -11,7 +11,8 @@
 namespace handcentric::test {
 
 /// A 2-layer, 32-wide network, batch 64, K = 4, H = 2, sampling from the whole distribution.
-inline policy::PolicyConfig small_config(policy::HeadKind head, const std::string& representation, int steps) {
+inline policy::PolicyConfig small_config(policy::HeadKind head, const std::string& representation,
+                                         int steps) {
   policy::PolicyConfig config;
   config.head = head;
   config.representation = representation;

@@ -30,9 +30,10 @@ auto action_matches_scene_transform(int hand_points) {
     const RigidTransform g = RigidTransform::planar(k * std::numbers::pi / 4.0, 0.0, 0.0);
     const AbsoluteRepresentation absolute;
     const Eigen::Matrix3d R = c8::rotation(k);
-    RC_ASSERT((absolute.encode_actions(g * scene) - c8::act_on_actions(R, absolute.encode_actions(scene)))
-                  .cwiseAbs()
-                  .maxCoeff() < 1e-9);
+    RC_ASSERT(
+        (absolute.encode_actions(g * scene) - c8::act_on_actions(R, absolute.encode_actions(scene)))
+            .cwiseAbs()
+            .maxCoeff() < 1e-9);
     RC_ASSERT((absolute.encode_observation(g * scene) -
                c8::act_on_observation(R, absolute.encode_observation(scene), 2, hand_points))
                   .cwiseAbs()
@@ -45,13 +46,15 @@ auto action_matches_scene_transform(int hand_points) {
 TEST_CASE("c8_action_on_absolute_vectors_is_the_scene_transform", "[property]") {
   props::require_property("encode(g scene) = g encode(scene)", action_matches_scene_transform(2));
   // Planted fault: eye-in-hand points rotated as if they were world points.
-  props::require_falsified("hand points treated as world points", action_matches_scene_transform(0));
+  props::require_falsified("hand points treated as world points",
+                           action_matches_scene_transform(0));
 }
 
 TEST_CASE("c8_rotations_compose_exactly", "[unit]") {
   for (int j = 0; j < 8; ++j) {
     for (int k = 0; k < 8; ++k) {
-      CHECK((c8::rotation(j) * c8::rotation(k) - c8::rotation(j + k)).cwiseAbs().maxCoeff() < 1e-15);
+      CHECK((c8::rotation(j) * c8::rotation(k) - c8::rotation(j + k)).cwiseAbs().maxCoeff() <
+            1e-15);
     }
   }
 }
@@ -68,13 +71,16 @@ TEST_CASE("c8_velocity_push_forward_matches_finite_differences", "[unit]") {
     a.segment<3>(3) *= 2.5;  // a rotation vector of angle up to ~2.5 * sqrt(3) > pi/2
     const Eigen::Matrix3d R = c8::rotation(1 + trial % 7);
     const double h = 1e-6;
-    const Eigen::VectorXd numeric = (c8::act_on_actions(R, a + h * v) - c8::act_on_actions(R, a - h * v)) / (2 * h);
-    if (a.segment<3>(3).norm() > 3.0 || a.segment<3>(9).norm() > 3.0) continue;  // keep away from |r| = pi
+    const Eigen::VectorXd numeric =
+        (c8::act_on_actions(R, a + h * v) - c8::act_on_actions(R, a - h * v)) / (2 * h);
+    if (a.segment<3>(3).norm() > 3.0 || a.segment<3>(9).norm() > 3.0)
+      continue;  // keep away from |r| = pi
     worst = std::max(worst, (numeric - c8::push_velocity(R, a, v)).cwiseAbs().maxCoeff());
     // Planted fault: rotating the rotation-vector velocity like a translation.
     Eigen::VectorXd naive = v;
     for (int i = 0; i < 12; i += 3) naive.segment<3>(i) = R * v.segment<3>(i);
-    worst_without_jacobians = std::max(worst_without_jacobians, (numeric - naive).cwiseAbs().maxCoeff());
+    worst_without_jacobians =
+        std::max(worst_without_jacobians, (numeric - naive).cwiseAbs().maxCoeff());
   }
   CHECK(worst < 1e-6);
   CHECK(worst_without_jacobians > 1e-2);
@@ -90,12 +96,14 @@ std::shared_ptr<const LearnedPolicy> trained_c8() {
 }
 
 // F(g x, g o) = g_* F(x, o) at x, o from a random scene (rotation vectors inside the ball).
-auto field_equivariant(std::shared_ptr<const LearnedPolicy> policy, props::Group group, bool symmetrized) {
+auto field_equivariant(std::shared_ptr<const LearnedPolicy> policy, props::Group group,
+                       bool symmetrized) {
   return [policy, group, symmetrized] {
     const Scene scene = random_c8_scene(*rc::gen::arbitrary<std::uint64_t>());
     const double t = *rc::gen::inRange(0, 10) / 10.0;
     const AbsoluteRepresentation absolute;
-    const Eigen::VectorXd x = absolute.encode_actions(scene), o = absolute.encode_observation(scene);
+    const Eigen::VectorXd x = absolute.encode_actions(scene),
+                          o = absolute.encode_observation(scene);
     const RigidTransform g = *props::group_element(group);
     const Eigen::VectorXd x_moved = absolute.encode_actions(g * scene);
     const Eigen::VectorXd o_moved = absolute.encode_observation(g * scene);
@@ -111,8 +119,11 @@ auto field_equivariant(std::shared_ptr<const LearnedPolicy> policy, props::Group
 
 TEST_CASE("c8flow_field_is_c8_equivariant_but_not_translation_equivariant", "[property]") {
   const auto policy = trained_c8();
-  props::require_property("F(g x, g o) = g_* F(x, o), g in C8", field_equivariant(policy, props::Group::c8, true));
-  props::require_falsified("F under translations", field_equivariant(policy, props::Group::translation, true));
+  props::require_property("F(g x, g o) = g_* F(x, o), g in C8",
+                          field_equivariant(policy, props::Group::c8, true));
+  props::require_falsified("F under translations",
+                           field_equivariant(policy, props::Group::translation, true));
   // Planted fault: the network's field without the frame average.
-  props::require_falsified("f without averaging, g in C8", field_equivariant(policy, props::Group::c8, false));
+  props::require_falsified("f without averaging, g in C8",
+                           field_equivariant(policy, props::Group::c8, false));
 }

@@ -45,14 +45,17 @@ std::shared_ptr<const LearnedPolicy> trained(HeadKind head, const std::string& r
 class LeaksWorldPosition final : public Representation {
  public:
   std::string name() const override { return "hand_centric"; }
-  Eigen::VectorXd encode_actions(const Scene& scene) const override { return inner_.encode_actions(scene); }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    return inner_.encode_actions(scene);
+  }
   Eigen::VectorXd encode_observation(const Scene& scene) const override {
     const Eigen::VectorXd o = inner_.encode_observation(scene);
     Eigen::VectorXd leaky(o.size() + 3);
     leaky << o, scene.world_T_hand0().translation();
     return leaky;
   }
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a, const RigidTransform& T0) const override {
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
+                                             const RigidTransform& T0) const override {
     return inner_.decode_actions(a, T0);
   }
 
@@ -64,16 +67,19 @@ class LeaksWorldPosition final : public Representation {
 
 TEST_CASE("trained_hand_centric_policies_are_se3_equivariant_for_every_head", "[property]") {
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae}) {
-    props::require_property(to_string(head) + "/hand_centric: act(g o) = g act(o)",
-                            outer_policy_equivariant(trained(head, "hand_centric"), props::Group::se3));
+    props::require_property(
+        to_string(head) + "/hand_centric: act(g o) = g act(o)",
+        outer_policy_equivariant(trained(head, "hand_centric"), props::Group::se3));
   }
 }
 
 TEST_CASE("mutant_absolute_and_leaky_policies_are_not_se3_equivariant", "[property]") {
-  props::require_falsified("flow/absolute under se3",
-                           outer_policy_equivariant(trained(HeadKind::flow, "absolute"), props::Group::se3));
-  props::require_falsified("flow/relative under rotations",
-                           outer_policy_equivariant(trained(HeadKind::flow, "relative"), props::Group::rotation));
+  props::require_falsified(
+      "flow/absolute under se3",
+      outer_policy_equivariant(trained(HeadKind::flow, "absolute"), props::Group::se3));
+  props::require_falsified(
+      "flow/relative under rotations",
+      outer_policy_equivariant(trained(HeadKind::flow, "relative"), props::Group::rotation));
   // The leak: train on the leaky encoding, then act through it.
   const LeaksWorldPosition leaky;
   const std::vector<Scene> scenes = test::small_scenes(64, 21);
@@ -81,8 +87,8 @@ TEST_CASE("mutant_absolute_and_leaky_policies_are_not_se3_equivariant", "[proper
   Dataset data = encode_scenes(leaky, scenes, 2, 4);
   data.hand_points = 2;
   const LearnedPolicy honest_head = train_policy(config, data, 5);
-  const auto policy = std::make_shared<LearnedPolicy>(honest_head.config(), std::make_shared<LeaksWorldPosition>(),
-                                                      honest_head.shared_head());
+  const auto policy = std::make_shared<LearnedPolicy>(
+      honest_head.config(), std::make_shared<LeaksWorldPosition>(), honest_head.shared_head());
   props::require_falsified("flow/hand_centric + leaked world position under se3",
                            outer_policy_equivariant(policy, props::Group::se3));
 }
@@ -102,11 +108,13 @@ TEST_CASE("normalized_hand_centric_vectors_stay_se3_invariant", "[property]") {
       Eigen::MatrixXf after = representation.encode_observation(g * scene).cast<float>();
       normalizer.normalize(before);
       normalizer.normalize(after);
-      RC_ASSERT((after - before).cwiseAbs().maxCoeff() <= 1e-4f * (1.0f + before.cwiseAbs().maxCoeff()));
+      RC_ASSERT((after - before).cwiseAbs().maxCoeff() <=
+                1e-4f * (1.0f + before.cwiseAbs().maxCoeff()));
     };
   };
   props::require_property("normalized hand_centric observation under se3", invariant(hand_centric));
-  props::require_falsified("normalized absolute observation under se3", invariant(AbsoluteRepresentation()));
+  props::require_falsified("normalized absolute observation under se3",
+                           invariant(AbsoluteRepresentation()));
 }
 
 TEST_CASE("trained_hand_centric_policy_passes_the_props_equivariance_check", "[property]") {
@@ -120,11 +128,13 @@ TEST_CASE("trained_hand_centric_policy_passes_the_props_equivariance_check", "[p
   options.shape.min_history = options.shape.max_history = 2;
   options.shape.min_hand_points = options.shape.max_hand_points = 2;
   options.shape.max_world_points = 0;
-  const props::Verdict verdict = props::check_equivariance(*trained(HeadKind::flow, "hand_centric"), props::Group::se3, options);
+  const props::Verdict verdict = props::check_equivariance(*trained(HeadKind::flow, "hand_centric"),
+                                                           props::Group::se3, options);
   INFO("largest error " << verdict.max_error);
   CHECK(verdict.max_error <= kEquivarianceTolerance);
   // Planted fault: the same check on an absolute policy finds a witness.
-  const props::Verdict absolute = props::check_equivariance(*trained(HeadKind::flow, "absolute"), props::Group::se3, options);
+  const props::Verdict absolute =
+      props::check_equivariance(*trained(HeadKind::flow, "absolute"), props::Group::se3, options);
   CHECK_FALSE(absolute.invariant);
   CHECK(absolute.max_error > kEquivarianceTolerance);
   CHECK(absolute.witness.has_value());

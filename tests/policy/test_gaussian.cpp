@@ -16,7 +16,8 @@ TEST_CASE("box_muller_pairs_match_the_formula_in_double", "[unit]") {
   // Including the extremes of both 24-bit fields; `skip` plants a fault in the reference (the
   // pair taken from the next draw), which the check must catch.
   std::mt19937_64 rng(17);
-  std::vector<std::uint64_t> bits(71);  // one more than the most pairs: the shifted reference reads i + 1
+  std::vector<std::uint64_t> bits(
+      71);  // one more than the most pairs: the shifted reference reads i + 1
   for (std::uint64_t& b : bits) b = rng();
   bits[0] = 0;                             // u1 = 2^-24 (the largest radius), u2 = 0
   bits[1] = ~std::uint64_t{0};             // u1 = 1 (radius 0), u2 = 1 - 2^-24
@@ -52,6 +53,7 @@ TEST_CASE("fill_standard_normal_is_seeded_and_column_by_column", "[unit]") {
   std::vector<float> pairs(20);
   box_muller_pairs(10, bits.data(), pairs.data());
   for (int j = 0; j < 4; ++j) {
-    for (int i = 0; i < 7; ++i) CHECK(outer(i, j) == (i < 5 ? pairs[static_cast<std::size_t>(i + 5 * j)] : 99.0f));
+    for (int i = 0; i < 7; ++i)
+      CHECK(outer(i, j) == (i < 5 ? pairs[static_cast<std::size_t>(i + 5 * j)] : 99.0f));
   }
 }

@@ -59,7 +59,8 @@ TEST_CASE("flow_and_ddpm_heads_learn_both_modes_of_a_two_mode_target", "[unit]")
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm}) {
     INFO(to_string(head));
     const ModeCounts counts = sample_modes(train_policy(toy_config(head, 1500), data, 1), 0.25);
-    INFO(counts.near_first << " near (-1, 0.5), " << counts.near_second << " near (1, -0.5), " << counts.far << " far");
+    INFO(counts.near_first << " near (-1, 0.5), " << counts.near_second << " near (1, -0.5), "
+                           << counts.far << " far");
     CHECK(learned_both_modes(counts));
   }
 }
@@ -79,8 +80,8 @@ namespace {
 // Trains on two scenes (one chunk per observation) and returns (final loss, max distance of a
 // sampled chunk to its demo). Two, not one: with one scene every dimension is constant and the
 // heads reproduce it exactly without learning anything (normalizer.hpp, active = 0).
-std::pair<double, double> overfit_one_chunk(HeadKind head, int steps,
-                                            LearningRateSchedule schedule = LearningRateSchedule::constant) {
+std::pair<double, double> overfit_one_chunk(
+    HeadKind head, int steps, LearningRateSchedule schedule = LearningRateSchedule::constant) {
   const std::vector<Scene> scenes = test::small_scenes(2, 17);
   double last_loss = 0.0;
   PolicyConfig config = test::small_config(head, "hand_centric", steps);
@@ -88,8 +89,7 @@ std::pair<double, double> overfit_one_chunk(HeadKind head, int steps,
   config.learning_rate = 1e-2;
   config.lr_schedule = schedule;
   const LearnedPolicy policy = train_policy(
-      config, scenes, 3,
-      [&](const TrainingProgress& p) { last_loss = p.loss; }, 100);
+      config, scenes, 3, [&](const TrainingProgress& p) { last_loss = p.loss; }, 100);
   double worst = 0.0;
   for (const Scene& scene : scenes) {
     for (std::uint64_t seed = 0; seed < 5; ++seed) {
@@ -136,7 +136,8 @@ TEST_CASE("constant_action_dimensions_are_reproduced_exactly", "[unit]") {
   }
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm}) {
     INFO(to_string(head));
-    const LearnedPolicy policy = train_policy(test::small_config(head, "hand_centric", 20), scenes, 2);
+    const LearnedPolicy policy =
+        train_policy(test::small_config(head, "hand_centric", 20), scenes, 2);
     const Eigen::VectorXd a = policy.action_vector(scenes[3], 7);
     for (Eigen::Index k = 0; k < a.size() / 6; ++k) {
       CHECK(std::abs(a[6 * k + 2]) < 1e-6);  // z
@@ -155,7 +156,8 @@ TEST_CASE("training_is_deterministic_bit_for_bit", "[unit]") {
   const std::vector<Scene> scenes = test::small_scenes(20, 4);
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow}) {
     INFO(to_string(head));
-    const PolicyConfig config = test::small_config(head, head == HeadKind::c8flow ? "absolute" : "hand_centric", 30);
+    const PolicyConfig config =
+        test::small_config(head, head == HeadKind::c8flow ? "absolute" : "hand_centric", 30);
     const std::string a = serialize_model(train_policy(config, scenes, 8));
     const std::string b = serialize_model(train_policy(config, scenes, 8));
     CHECK(a == b);
@@ -167,29 +169,33 @@ TEST_CASE("training_is_deterministic_bit_for_bit", "[unit]") {
 TEST_CASE("bad_training_input_is_a_typed_error", "[unit]") {
   const std::vector<Scene> scenes = test::small_scenes(3, 4);
   PolicyConfig config = test::small_config(HeadKind::flow, "hand_centric", 1);
-  HC_CHECK_THROWS(train_policy(config, std::vector<Scene>{}, 1), InvalidScene, Catch::Contains("no training scenes"));
+  HC_CHECK_THROWS(train_policy(config, std::vector<Scene>{}, 1), InvalidScene,
+                  Catch::Contains("no training scenes"));
   config.chunk_length = 5;
   HC_CHECK_THROWS(train_policy(config, scenes, 1), InvalidScene, Catch::Contains("K = 4"));
   config = test::small_config(HeadKind::flow, "polar", 1);
   HC_CHECK_THROWS(train_policy(config, scenes, 1), InvalidArgument, Catch::Contains("polar"));
   config = test::small_config(HeadKind::c8flow, "hand_centric", 1);
-  HC_CHECK_THROWS(train_policy(config, scenes, 1), InvalidArgument, Catch::Contains("--repr absolute"));
+  HC_CHECK_THROWS(train_policy(config, scenes, 1), InvalidArgument,
+                  Catch::Contains("--repr absolute"));
   config = test::small_config(HeadKind::flow, "hand_centric", 1);
   config.learning_rate = -1.0;
-  HC_CHECK_THROWS(train_policy(config, scenes, 1), InvalidArgument, Catch::Contains("learning_rate"));
+  HC_CHECK_THROWS(train_policy(config, scenes, 1), InvalidArgument,
+                  Catch::Contains("learning_rate"));
   std::vector<Scene> mixed = scenes;
   mixed[2].hand_points.pop_back();
-  HC_CHECK_THROWS(train_policy(test::small_config(HeadKind::flow, "hand_centric", 1), mixed, 1), InvalidScene,
-                  Catch::Contains("training scene 2"));
-  const LearnedPolicy policy = train_policy(test::small_config(HeadKind::flow, "hand_centric", 1), scenes, 1);
+  HC_CHECK_THROWS(train_policy(test::small_config(HeadKind::flow, "hand_centric", 1), mixed, 1),
+                  InvalidScene, Catch::Contains("training scene 2"));
+  const LearnedPolicy policy =
+      train_policy(test::small_config(HeadKind::flow, "hand_centric", 1), scenes, 1);
   Scene wrong = scenes[0];
   wrong.world_T_hand_history.pop_back();
   HC_CHECK_THROWS(policy.act(wrong, 1), InvalidScene, Catch::Contains("trained with H = 2"));
   HC_CHECK_THROWS(parse_head("gan"), InvalidArgument, Catch::Contains("flow, ddpm, cvae, c8flow"));
   Dataset huge = test::two_mode_data(16, 1);
   huge.actions(0, 3) = 1e39;  // finite in double, inf in float32
-  HC_CHECK_THROWS(train_policy(test::small_config(HeadKind::flow, "absolute", 1), huge, 1), InvalidScene,
-                  Catch::Contains("float32 range"));
+  HC_CHECK_THROWS(train_policy(test::small_config(HeadKind::flow, "absolute", 1), huge, 1),
+                  InvalidScene, Catch::Contains("float32 range"));
 }
 
 TEST_CASE("cosine_learning_rate_decays_from_the_peak_towards_zero", "[unit]") {
@@ -204,22 +210,27 @@ TEST_CASE("cosine_learning_rate_decays_from_the_peak_towards_zero", "[unit]") {
   CHECK(learning_rate_at(config, 501) == Approx(1e-3).epsilon(1e-12));  // half way: half the peak
   CHECK(learning_rate_at(config, 1000) > 0.0);
   CHECK(learning_rate_at(config, 1000) < 2e-3 * 1e-5);  // ~ lr pi^2 / (4 steps^2)
-  for (int step = 2; step <= 1000; ++step) CHECK(learning_rate_at(config, step) < learning_rate_at(config, step - 1));
+  for (int step = 2; step <= 1000; ++step)
+    CHECK(learning_rate_at(config, step) < learning_rate_at(config, step - 1));
   HC_CHECK_THROWS(learning_rate_at(config, 0), InvalidArgument, Catch::Contains("outside 1..1000"));
-  HC_CHECK_THROWS(learning_rate_at(config, 1001), InvalidArgument, Catch::Contains("outside 1..1000"));
+  HC_CHECK_THROWS(learning_rate_at(config, 1001), InvalidArgument,
+                  Catch::Contains("outside 1..1000"));
   HC_CHECK_THROWS(parse_schedule("linear"), InvalidArgument, Catch::Contains("constant or cosine"));
   // stored in model files
   CHECK(PolicyConfig::from_text(config.to_text()).lr_schedule == LearningRateSchedule::cosine);
-  HC_CHECK_THROWS(PolicyConfig::from_text("lr_schedule=step\n"), InvalidArgument, Catch::Contains("'step'"));
+  HC_CHECK_THROWS(PolicyConfig::from_text("lr_schedule=step\n"), InvalidArgument,
+                  Catch::Contains("'step'"));
 }
 
 TEST_CASE("the_trainer_applies_the_learning_rate_schedule_to_every_head", "[unit]") {
   // A trainer that ignored config.lr_schedule would give the constant schedule's weights bit
-  // for bit (the same actions); and decaying the rate must let the one-chunk fit settle lower than a constant rate.
+  // for bit (the same actions); and decaying the rate must let the one-chunk fit settle lower than
+  // a constant rate.
   const std::vector<Scene> scenes = test::small_scenes(20, 4);
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow}) {
     INFO(to_string(head));
-    PolicyConfig config = test::small_config(head, head == HeadKind::c8flow ? "absolute" : "hand_centric", 30);
+    PolicyConfig config =
+        test::small_config(head, head == HeadKind::c8flow ? "absolute" : "hand_centric", 30);
     config.lr_schedule = LearningRateSchedule::constant;
     // the sampled actions, not the model files (those also store the schedule's name)
     const Eigen::VectorXd constant = train_policy(config, scenes, 8).action_vector(scenes[0], 1);
@@ -229,9 +240,9 @@ TEST_CASE("the_trainer_applies_the_learning_rate_schedule_to_every_head", "[unit
   const auto [constant_loss, constant_distance] = overfit_one_chunk(HeadKind::flow, 2000);
   const auto [cosine_loss, cosine_distance] =
       overfit_one_chunk(HeadKind::flow, 2000, LearningRateSchedule::cosine);
-  INFO("flow, one chunk, 2000 steps: constant loss " << constant_loss << ", distance " << constant_distance
-                                                       << "; cosine loss " << cosine_loss << ", distance "
-                                                       << cosine_distance);
+  INFO("flow, one chunk, 2000 steps: constant loss "
+       << constant_loss << ", distance " << constant_distance << "; cosine loss " << cosine_loss
+       << ", distance " << cosine_distance);
   CHECK(cosine_loss < constant_loss);
   CHECK(cosine_distance < constant_distance);
 }
@@ -270,7 +281,9 @@ TEST_CASE("noise_scale_0_samples_the_most_likely_chunk_and_1_a_random_one", "[un
   for (const HeadKind kind : {HeadKind::flow, HeadKind::c8flow}) {
     config = test::small_config(kind, kind == HeadKind::c8flow ? "absolute" : "hand_centric", 30);
     const LearnedPolicy random_draw = train_policy(config, scenes, 2);
-    CHECK((random_draw.action_vector(scenes[0], 1) - random_draw.action_vector(scenes[0], 2)).norm() > 1e-6);
+    CHECK(
+        (random_draw.action_vector(scenes[0], 1) - random_draw.action_vector(scenes[0], 2)).norm() >
+        1e-6);
     config.noise_scale = 0.0;
     const LearnedPolicy mode = train_policy(config, scenes, 2);
     // The same chunk for every noise seed: the flow integrated from the prior's mode.
@@ -280,7 +293,8 @@ TEST_CASE("noise_scale_0_samples_the_most_likely_chunk_and_1_a_random_one", "[un
 
 TEST_CASE("a_model_file_loads_with_other_sampling_settings_and_checks_them", "[unit]") {
   const std::vector<Scene> scenes = test::small_scenes(6, 13);
-  const std::string bytes = serialize_model(train_policy(test::small_config(HeadKind::flow, "hand_centric", 5), scenes, 1));
+  const std::string bytes = serialize_model(
+      train_policy(test::small_config(HeadKind::flow, "hand_centric", 5), scenes, 1));
   SamplingOverrides overrides;
   overrides.noise_scale = 0.0;
   overrides.execute = 2;
@@ -291,5 +305,6 @@ TEST_CASE("a_model_file_loads_with_other_sampling_settings_and_checks_them", "[u
   CHECK(changed.config().euler_steps == 3);
   CHECK(deserialize_model(bytes, "m.hcm").config().noise_scale == 1.0);  // the stored value
   overrides.execute = 0;
-  HC_CHECK_THROWS(deserialize_model(bytes, "m.hcm", overrides), InvalidArgument, Catch::Contains("execute = 0"));
+  HC_CHECK_THROWS(deserialize_model(bytes, "m.hcm", overrides), InvalidArgument,
+                  Catch::Contains("execute = 0"));
 }

@@ -3,8 +3,9 @@
 // the three orientations Mlp uses and the fourth, with biases, every edge of the blocking
 // (partial tiles, k beyond one k block, n beyond one column block, strides, k = 0), the narrow
 // products of sampling (n <= 16) with unaligned columns, the SiLU kernels, the squared norm
-// and Adam. Then the whole Mlp per named kernel set (kernels.hpp) against MlpT<double>. The checks are seen failing on planted faults.
-// Under ASan, the masked accesses ASan cannot see are checked lane by lane (kernels/asan_lanes.hpp).
+// and Adam. Then the whole Mlp per named kernel set (kernels.hpp) against MlpT<double>. The checks
+// are seen failing on planted faults. Under ASan, the masked accesses ASan cannot see are checked
+// lane by lane (kernels/asan_lanes.hpp).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -83,7 +84,8 @@ struct Problem {
   float A(int i, int p) const { return op_a == Op::none ? a[i + p * lda] : a[p + i * lda]; }
   float B(int p, int j) const { return op_b == Op::none ? b[p + j * ldb] : b[j + p * ldb]; }
   kernels::Gemm gemm() {
-    return {op_a, op_b, m, n, k, a.data(), lda, b.data(), ldb, bias ? row_bias.data() : nullptr, c.data(), ldc};
+    return {op_a,     op_b, m, n, k, a.data(), lda, b.data(), ldb, bias ? row_bias.data() : nullptr,
+            c.data(), ldc};
   }
 };
 
@@ -116,11 +118,32 @@ struct Shape {
 // Edges of the blocking of both vector sets (MR 32 / 16, NR 12 / 6, KC 256, NC 384) and the
 // network's own shapes (57 -> 256 -> 256 -> 24 at batch 256 and 1).
 const std::vector<Shape> kShapes = {
-    {1, 1, 1},    {3, 2, 5},     {16, 6, 7},    {17, 7, 9},    {32, 12, 16},  {33, 13, 31},
-    {31, 11, 257}, {24, 256, 256}, {256, 256, 57}, {256, 57, 256}, {57, 256, 256}, {40, 400, 20},
-    {256, 1, 256}, {24, 1, 256},  {300, 1, 57},  {7, 1, 3},     {400, 1, 5},   {5, 3, 0},
+    {1, 1, 1},
+    {3, 2, 5},
+    {16, 6, 7},
+    {17, 7, 9},
+    {32, 12, 16},
+    {33, 13, 31},
+    {31, 11, 257},
+    {24, 256, 256},
+    {256, 256, 57},
+    {256, 57, 256},
+    {57, 256, 256},
+    {40, 400, 20},
+    {256, 1, 256},
+    {24, 1, 256},
+    {300, 1, 57},
+    {7, 1, 3},
+    {400, 1, 5},
+    {5, 3, 0},
     // the narrow kernel (n <= 16: groups of up to 8 columns, 24 / N vectors of rows)
-    {50, 3, 20},   {100, 4, 33},  {70, 5, 9},    {260, 8, 40},  {33, 9, 17},   {400, 16, 5},  {17, 15, 64}};
+    {50, 3, 20},
+    {100, 4, 33},
+    {70, 5, 9},
+    {260, 8, 40},
+    {33, 9, 17},
+    {400, 16, 5},
+    {17, 15, 64}};
 
 }  // namespace
 
@@ -135,8 +158,8 @@ TEST_CASE("every_kernel_set_multiplies_like_the_double_reference", "[unit]") {
             const bool bias = (shape.m + shape.k + pad) % 2 == 0;
             Problem problem(op_a, op_b, shape.m, shape.n, shape.k, pad, bias, rng);
             set->gemm(problem.gemm());
-            INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a) << " op_b "
-                      << int(op_b) << " pad " << pad << " bias " << bias);
+            INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a)
+                      << " op_b " << int(op_b) << " pad " << pad << " bias " << bias);
             CHECK(gemm_error(problem) <= 1.0);
           }
         }
@@ -163,9 +186,11 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
 // The epilogues on every path of the product (blocked, narrow, k = 0): C against the double
 // reference Z followed by SiLU, or by the product with SiLU'(z) = s + a (1 - s) from given s and
 // a (leading dimension lds, unlike C's). Returns the worst error over C in units of the bound;
-// `skip_epilogue` plants a fault in the reference (the epilogue left out), which the check must catch.
-double epilogue_error(Problem& problem, kernels::Epilogue epilogue, int lds, const std::vector<float>& s_in,
-                      const std::vector<float>& a_in, const std::vector<float>& s_out, bool skip_epilogue = false) {
+// `skip_epilogue` plants a fault in the reference (the epilogue left out), which the check must
+// catch.
+double epilogue_error(Problem& problem, kernels::Epilogue epilogue, int lds,
+                      const std::vector<float>& s_in, const std::vector<float>& a_in,
+                      const std::vector<float>& s_out, bool skip_epilogue = false) {
   double worst = 0.0;
   for (int j = 0; j < problem.n; ++j) {
     for (int i = 0; i < problem.m; ++i) {
@@ -179,13 +204,17 @@ double epilogue_error(Problem& problem, kernels::Epilogue epilogue, int lds, con
       if (!skip_epilogue && epilogue == kernels::Epilogue::silu) {
         const double sigmoid = 1.0 / (1.0 + std::exp(-z));
         expected = z * sigmoid;
-        bound = bound * 1.1 + 1e-6 * std::abs(expected) + 1e-30;  // SiLU' <= 1.1, plus the sigmoid's error
-        if (!s_out.empty()) worst = std::max(worst, std::abs(s_out[at_s] - sigmoid) / (bound + 1e-6 * sigmoid));
+        bound = bound * 1.1 + 1e-6 * std::abs(expected) +
+                1e-30;  // SiLU' <= 1.1, plus the sigmoid's error
+        if (!s_out.empty())
+          worst = std::max(worst, std::abs(s_out[at_s] - sigmoid) / (bound + 1e-6 * sigmoid));
       } else if (!skip_epilogue && epilogue == kernels::Epilogue::silu_derivative) {
         const double derivative = s_in[at_s] + a_in[at_s] * (1.0 - s_in[at_s]);
-        const double terms = std::abs(s_in[at_s]) + std::abs(a_in[at_s] * (1.0 - s_in[at_s]));  // float rounds these
+        const double terms =
+            std::abs(s_in[at_s]) + std::abs(a_in[at_s] * (1.0 - s_in[at_s]));  // float rounds these
         expected = z * derivative;
-        bound = bound * std::abs(derivative) + 4.0 * 6e-8 * (std::abs(z) * terms + std::abs(expected)) + 1e-30;
+        bound = bound * std::abs(derivative) +
+                4.0 * 6e-8 * (std::abs(z) * terms + std::abs(expected)) + 1e-30;
       }
       worst = std::max(worst, std::abs(problem.c[at] - expected) / bound);
     }
@@ -199,7 +228,8 @@ TEST_CASE("every_kernel_set_applies_the_silu_epilogues_on_every_path", "[unit]")
     INFO("target " << name);
     for (const Shape& shape : kShapes) {
       for (Op op_a : {Op::none, Op::transpose}) {
-        for (kernels::Epilogue epilogue : {kernels::Epilogue::silu, kernels::Epilogue::silu_derivative}) {
+        for (kernels::Epilogue epilogue :
+             {kernels::Epilogue::silu, kernels::Epilogue::silu_derivative}) {
           for (bool keep_sigmoid : {false, true}) {
             if (epilogue == kernels::Epilogue::silu_derivative && !keep_sigmoid) continue;
             Problem problem(op_a, Op::none, shape.m, shape.n, shape.k, 3, true, rng);
@@ -219,12 +249,14 @@ TEST_CASE("every_kernel_set_applies_the_silu_epilogues_on_every_path", "[unit]")
               gemm.sigmoid = s_out.data();
             }
             set->gemm(gemm);
-            const std::vector<float>& kept = epilogue == kernels::Epilogue::silu && keep_sigmoid ? s_out : std::vector<float>{};
-            INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a) << " epilogue "
-                      << int(epilogue) << " keep_sigmoid " << keep_sigmoid);
+            const std::vector<float>& kept =
+                epilogue == kernels::Epilogue::silu && keep_sigmoid ? s_out : std::vector<float>{};
+            INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a)
+                      << " epilogue " << int(epilogue) << " keep_sigmoid " << keep_sigmoid);
             CHECK(epilogue_error(problem, epilogue, lds, s_in, a_in, kept) <= 1.0);
             if (shape.m * shape.n >= 4) {  // planted fault: a reference without the epilogue
-              CHECK(epilogue_error(problem, epilogue, lds, s_in, a_in, kept, /*skip_epilogue=*/true) > 1.0);
+              CHECK(epilogue_error(problem, epilogue, lds, s_in, a_in, kept,
+                                   /*skip_epilogue=*/true) > 1.0);
             }
           }
         }
@@ -247,7 +279,8 @@ TEST_CASE("narrow_products_read_columns_at_every_offset_from_a_cache_line", "[un
         const int ldc = m + 32;
         std::vector<float> y(static_cast<std::size_t>(ldc) * n, 7.0f);
         const float* a = storage.data() + offset;
-        set->gemm({Op::none, Op::none, m, n, k, a, lda, x.data(), k, bias.data(), y.data() + 16, ldc});
+        set->gemm(
+            {Op::none, Op::none, m, n, k, a, lda, x.data(), k, bias.data(), y.data() + 16, ldc});
         double worst = 0.0;
         for (int j = 0; j < n; ++j) {
           for (int i = 0; i < m; ++i) {
@@ -256,7 +289,8 @@ TEST_CASE("narrow_products_read_columns_at_every_offset_from_a_cache_line", "[un
               sum += static_cast<double>(a[i + p * lda]) * x[p + j * k];
               magnitude += std::abs(static_cast<double>(a[i + p * lda]) * x[p + j * k]);
             }
-            worst = std::max(worst, std::abs(y[16 + i + j * ldc] - sum) / (4.0 * k * 6e-8 * magnitude));
+            worst =
+                std::max(worst, std::abs(y[16 + i + j * ldc] - sum) / (4.0 * k * 6e-8 * magnitude));
           }
           // Nothing written outside C: the masked lanes stay untouched.
           for (int i = 0; i < 16; ++i) CHECK(y[i + j * ldc] == 7.0f);
@@ -278,7 +312,7 @@ TEST_CASE("every_kernel_set_computes_silu_norm_and_adam_like_the_reference", "[u
       std::vector<float> z = random_floats(n, rng);
       for (float& v : z) v *= 20.0f;  // both tails of the sigmoid
       if (n > 3) {
-        z[0] = 95.0f;  // past the exp clamp: sigmoid 1, SiLU z
+        z[0] = 95.0f;   // past the exp clamp: sigmoid 1, SiLU z
         z[1] = -95.0f;  // sigmoid ~0, SiLU ~0, never NaN
         z[2] = 0.0f;
       }
@@ -303,8 +337,8 @@ TEST_CASE("every_kernel_set_computes_silu_norm_and_adam_like_the_reference", "[u
       for (float v : delta0) norm += static_cast<double>(v) * v;
       CHECK(std::abs(set.squared_norm(n, delta0.data()) - norm) <= 1e-12 * norm);
 
-      std::vector<float> p = random_floats(n, rng), g = random_floats(n, rng), m = random_floats(n, rng),
-                         v = random_floats(n, rng);
+      std::vector<float> p = random_floats(n, rng), g = random_floats(n, rng),
+                         m = random_floats(n, rng), v = random_floats(n, rng);
       for (float& x : v) x = std::abs(x);
       const std::vector<float> p0 = p, m0 = m, v0 = v;
       kernels::AdamUpdate update;
@@ -338,9 +372,10 @@ TEST_CASE("mlp_on_every_kernel_set_matches_the_double_network", "[unit]") {
   // with the same parameters in float on each kernel set and in double (Eigen).
   KernelSetGuard guard;
   std::mt19937_64 rng(15);
-  for (const auto& [widths, activation] : {std::pair{std::vector<int>{57, 256, 256, 24}, Activation::silu},
-                                           std::pair{std::vector<int>{5, 33, 17, 3}, Activation::silu},
-                                           std::pair{std::vector<int>{9, 40, 24, 6}, Activation::relu}}) {
+  for (const auto& [widths, activation] :
+       {std::pair{std::vector<int>{57, 256, 256, 24}, Activation::silu},
+        std::pair{std::vector<int>{5, 33, 17, 3}, Activation::silu},
+        std::pair{std::vector<int>{9, 40, 24, 6}, Activation::relu}}) {
     MlpT<double> reference(widths, activation);
     reference.initialize(rng);
     Eigen::MatrixXd input(widths.front(), 37), d_output(widths.back(), 37);
@@ -349,14 +384,16 @@ TEST_CASE("mlp_on_every_kernel_set_matches_the_double_network", "[unit]") {
     const Eigen::MatrixXd output = reference.forward(input);
     const Eigen::MatrixXd d_input = reference.backward(d_output);
     for (KernelIsa isa : supported_sets()) {
-      INFO("kernel set " << to_string(isa) << ", input width " << widths.front() << ", " << to_string(activation));
+      INFO("kernel set " << to_string(isa) << ", input width " << widths.front() << ", "
+                         << to_string(activation));
       set_kernel_isa(isa);
       Mlp net(widths, activation);
       net.parameters() = reference.parameters().cast<float>();
       const Eigen::MatrixXf out = net.forward(input.cast<float>());
       const Eigen::MatrixXf din = net.backward(d_output.cast<float>());
       const auto relative = [](const auto& x, const Eigen::MatrixXd& y) {
-        return (x.template cast<double>() - y).cwiseAbs().maxCoeff() / (1.0 + y.cwiseAbs().maxCoeff());
+        return (x.template cast<double>() - y).cwiseAbs().maxCoeff() /
+               (1.0 + y.cwiseAbs().maxCoeff());
       };
       CHECK(relative(out, output) < 1e-5);
       CHECK(relative(din, d_input) < 1e-5);
@@ -373,7 +410,8 @@ TEST_CASE("kernel_sets_are_named_chosen_and_refused_with_typed_errors", "[unit]"
   for (KernelIsa isa : {KernelIsa::generic, KernelIsa::avx2, KernelIsa::avx512}) {
     CHECK(parse_kernel_isa(to_string(isa)) == isa);
   }
-  HC_CHECK_THROWS(parse_kernel_isa("sse9"), InvalidArgument, Catch::Contains("'sse9'") && Catch::Contains("avx512"));
+  HC_CHECK_THROWS(parse_kernel_isa("sse9"), InvalidArgument,
+                  Catch::Contains("'sse9'") && Catch::Contains("avx512"));
   CHECK(kernel_isa_supported(KernelIsa::generic));
   CHECK(kernel_isa_supported(best_kernel_isa()));
   // The best named set is Highway's dynamic choice, the first of the targets tested above.
@@ -400,7 +438,8 @@ TEST_CASE("training_is_bit_for_bit_repeatable_on_each_kernel_set", "[unit]") {
       Adam adam(net.parameter_count(), AdamOptions{1e-3, 0.9, 0.999, 1e-8, 0.0});
       Eigen::MatrixXf input(9, 50), d_output(4, 50);
       for (int step = 0; step < 5; ++step) {
-        for (Eigen::Index i = 0; i < input.size(); ++i) input(i) = static_cast<float>(uniform01(rng));
+        for (Eigen::Index i = 0; i < input.size(); ++i)
+          input(i) = static_cast<float>(uniform01(rng));
         d_output = net.forward(input) * 0.1f;
         net.backward_parameters(d_output);
         adam.step(net.parameters(), net.gradient());
@@ -419,11 +458,13 @@ TEST_CASE("masked_kernel_accesses_are_checked_lane_by_lane_under_asan", "[unit]"
 #if defined(__SANITIZE_ADDRESS__) || defined(HANDCENTRIC_ASAN)
   std::vector<float> five(5, 1.0f);
   const float* x = five.data();
-  CHECK(kernels::poisoned_lane(x, 0x1F, sizeof(float)) == nullptr);       // lanes 0..4: the buffer
-  CHECK(kernels::poisoned_lane(x, 0x3F, sizeof(float)) == x + 5);         // a tail one lane too long
-  CHECK(kernels::poisoned_lane(x - 1, 0x3E, sizeof(float)) == nullptr);   // a shifted head: lane 0 is off
-  CHECK(kernels::poisoned_lane(x - 1, 0x3F, sizeof(float)) == x - 1);     // ... unless it is on
-  CHECK(kernels::poisoned_lane(x, 0x21, sizeof(float)) == x + 5);         // lanes between are skipped, not the last
+  CHECK(kernels::poisoned_lane(x, 0x1F, sizeof(float)) == nullptr);  // lanes 0..4: the buffer
+  CHECK(kernels::poisoned_lane(x, 0x3F, sizeof(float)) == x + 5);    // a tail one lane too long
+  CHECK(kernels::poisoned_lane(x - 1, 0x3E, sizeof(float)) ==
+        nullptr);  // a shifted head: lane 0 is off
+  CHECK(kernels::poisoned_lane(x - 1, 0x3F, sizeof(float)) == x - 1);  // ... unless it is on
+  CHECK(kernels::poisoned_lane(x, 0x21, sizeof(float)) ==
+        x + 5);  // lanes between are skipped, not the last
 #else
   std::vector<float> five(5, 1.0f);
   CHECK(kernels::poisoned_lane(five.data(), 0xFFFF, sizeof(float)) == nullptr);

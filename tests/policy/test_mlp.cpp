@@ -44,7 +44,9 @@ GradientErrors gradient_errors(MlpD& net, MlpD& numeric_net, const Eigen::Matrix
   if (fault) fault(analytic);
   const double h = 1e-6;
   GradientErrors errors;
-  const auto loss_at = [&](const Eigen::MatrixXd& x) { return probe_loss(numeric_net.forward(x), weights); };
+  const auto loss_at = [&](const Eigen::MatrixXd& x) {
+    return probe_loss(numeric_net.forward(x), weights);
+  };
   numeric_net.parameters() = net.parameters();
   for (Eigen::Index i = 0; i < net.parameter_count(); ++i) {
     const double saved = numeric_net.parameters()[i];
@@ -54,7 +56,8 @@ GradientErrors gradient_errors(MlpD& net, MlpD& numeric_net, const Eigen::Matrix
     const double minus = loss_at(input);
     numeric_net.parameters()[i] = saved;
     const double numeric = (plus - minus) / (2 * h);
-    errors.parameters = std::max(errors.parameters, std::abs(analytic[i] - numeric) / (1.0 + std::abs(numeric)));
+    errors.parameters =
+        std::max(errors.parameters, std::abs(analytic[i] - numeric) / (1.0 + std::abs(numeric)));
   }
   for (Eigen::Index i = 0; i < input.size(); ++i) {
     Eigen::MatrixXd x = input;
@@ -63,7 +66,8 @@ GradientErrors gradient_errors(MlpD& net, MlpD& numeric_net, const Eigen::Matrix
     x(i) -= 2 * h;
     const double minus = loss_at(x);
     const double numeric = (plus - minus) / (2 * h);
-    errors.input = std::max(errors.input, std::abs(d_input(i) - numeric) / (1.0 + std::abs(numeric)));
+    errors.input =
+        std::max(errors.input, std::abs(d_input(i) - numeric) / (1.0 + std::abs(numeric)));
   }
   return errors;
 }
@@ -78,8 +82,10 @@ Problem make_problem(Activation activation, std::uint64_t seed) {
   Problem problem{MlpD({5, 7, 6, 3}, activation), Eigen::MatrixXd(5, 4), Eigen::MatrixXd(3, 4)};
   problem.net.initialize(rng);
   // Inputs away from 0 so that no ReLU pre-activation sits within h of its kink.
-  for (Eigen::Index i = 0; i < problem.input.size(); ++i) problem.input(i) = 2.0 * uniform01(rng) - 1.0;
-  for (Eigen::Index i = 0; i < problem.weights.size(); ++i) problem.weights(i) = 2.0 * uniform01(rng) - 1.0;
+  for (Eigen::Index i = 0; i < problem.input.size(); ++i)
+    problem.input(i) = 2.0 * uniform01(rng) - 1.0;
+  for (Eigen::Index i = 0; i < problem.weights.size(); ++i)
+    problem.weights(i) = 2.0 * uniform01(rng) - 1.0;
   return problem;
 }
 
@@ -128,7 +134,9 @@ TEST_CASE("mse_and_kl_gradients_match_finite_differences", "[unit]") {
     Eigen::MatrixXd plus = pred, minus = pred;
     plus(i) += h;
     minus(i) -= h;
-    const double numeric = (mse_loss<double>(plus, target, scratch_a) - mse_loss<double>(minus, target, scratch_a)) / (2 * h);
+    const double numeric =
+        (mse_loss<double>(plus, target, scratch_a) - mse_loss<double>(minus, target, scratch_a)) /
+        (2 * h);
     worst = std::max(worst, std::abs(numeric - d_pred(i)));
   }
   for (Eigen::Index i = 0; i < mu.size(); ++i) {
@@ -136,19 +144,23 @@ TEST_CASE("mse_and_kl_gradients_match_finite_differences", "[unit]") {
     plus(i) += h;
     minus(i) -= h;
     double numeric = (gaussian_kl_loss<double>(plus, log_var, 0.3, scratch_a, scratch_b) -
-                      gaussian_kl_loss<double>(minus, log_var, 0.3, scratch_a, scratch_b)) / (2 * h);
+                      gaussian_kl_loss<double>(minus, log_var, 0.3, scratch_a, scratch_b)) /
+                     (2 * h);
     worst = std::max(worst, std::abs(numeric - d_mu(i)));
     plus = log_var;
     minus = log_var;
     plus(i) += h;
     minus(i) -= h;
     numeric = (gaussian_kl_loss<double>(mu, plus, 0.3, scratch_a, scratch_b) -
-               gaussian_kl_loss<double>(mu, minus, 0.3, scratch_a, scratch_b)) / (2 * h);
+               gaussian_kl_loss<double>(mu, minus, 0.3, scratch_a, scratch_b)) /
+              (2 * h);
     worst = std::max(worst, std::abs(numeric - d_log_var(i)));
   }
   CHECK(worst < kGradientTolerance);
   // Planted fault: the gradient of the mean absolute error is not that of the MSE.
-  CHECK((d_pred - (pred - target).cwiseSign() / static_cast<double>(pred.size())).cwiseAbs().maxCoeff() > 1e-3);
+  CHECK((d_pred - (pred - target).cwiseSign() / static_cast<double>(pred.size()))
+            .cwiseAbs()
+            .maxCoeff() > 1e-3);
 }
 
 TEST_CASE("adam_minimizes_a_quadratic_and_clipping_bounds_the_norm", "[unit]") {
@@ -191,13 +203,15 @@ TEST_CASE("mlp_rejects_bad_shapes", "[unit]") {
   HC_CHECK_THROWS(MlpD({5}, Activation::silu), InvalidArgument, Catch::Contains("at least"));
   HC_CHECK_THROWS(MlpD({5, 0, 2}, Activation::silu), InvalidArgument, Catch::Contains("is 0"));
   MlpD net({5, 3}, Activation::silu);
-  HC_CHECK_THROWS(net.forward(Eigen::MatrixXd::Zero(4, 2)), InvalidArgument, Catch::Contains("expected 5"));
+  HC_CHECK_THROWS(net.forward(Eigen::MatrixXd::Zero(4, 2)), InvalidArgument,
+                  Catch::Contains("expected 5"));
 }
 
 TEST_CASE("cvae_loss_gradients_match_finite_differences_through_the_reparameterization", "[unit]") {
   std::mt19937_64 rng(5);
   const int da = 3, dobs = 2, Z = 2, batch = 4;
-  MlpD encoder({da + dobs, 6, 2 * Z}, Activation::silu), decoder({Z + dobs, 6, da}, Activation::silu);
+  MlpD encoder({da + dobs, 6, 2 * Z}, Activation::silu),
+      decoder({Z + dobs, 6, da}, Activation::silu);
   encoder.initialize(rng);
   decoder.initialize(rng);
   Eigen::MatrixXd a(da, batch), o(dobs, batch), noise(Z, batch);
@@ -205,9 +219,12 @@ TEST_CASE("cvae_loss_gradients_match_finite_differences_through_the_reparameteri
     for (Eigen::Index i = 0; i < m->size(); ++i) (*m)(i) = 2.0 * uniform01(rng) - 1.0;
   }
   CvaeBuffers<double> buffers;
-  const auto loss = [&](MlpD& e, MlpD& d) { return cvae_loss_and_gradients<double>(e, d, a, o, noise, 0.3, buffers); };
+  const auto loss = [&](MlpD& e, MlpD& d) {
+    return cvae_loss_and_gradients<double>(e, d, a, o, noise, 0.3, buffers);
+  };
   loss(encoder, decoder);
-  const Eigen::VectorXd encoder_gradient = encoder.gradient(), decoder_gradient = decoder.gradient();
+  const Eigen::VectorXd encoder_gradient = encoder.gradient(),
+                        decoder_gradient = decoder.gradient();
   const double h = 1e-6;
   const auto worst_error = [&](MlpD& net, const Eigen::VectorXd& analytic) {
     double worst = 0.0;
@@ -225,7 +242,8 @@ TEST_CASE("cvae_loss_gradients_match_finite_differences_through_the_reparameteri
   };
   CHECK(worst_error(encoder, encoder_gradient) < kGradientTolerance);
   CHECK(worst_error(decoder, decoder_gradient) < kGradientTolerance);
-  // Planted fault: the encoder gradient off by a factor of 2 (as a dropped factor of the MSE would be).
+  // Planted fault: the encoder gradient off by a factor of 2 (as a dropped factor of the MSE would
+  // be).
   Eigen::VectorXd wrong = encoder_gradient;
   wrong *= 0.5;
   CHECK(worst_error(encoder, wrong) > 1e-3);

@@ -19,8 +19,8 @@ using namespace handcentric::policy;
 namespace {
 
 const LearnedPolicy& small_policy() {
-  static const LearnedPolicy policy =
-      train_policy(test::small_config(HeadKind::flow, "hand_centric", 20), test::small_scenes(16, 2), 3);
+  static const LearnedPolicy policy = train_policy(
+      test::small_config(HeadKind::flow, "hand_centric", 20), test::small_scenes(16, 2), 3);
   return policy;
 }
 
@@ -42,7 +42,8 @@ TEST_CASE("saved_models_load_and_act_identically", "[unit]") {
     INFO(to_string(head));
     const std::vector<Scene> scenes = test::small_scenes(16, 2);
     const std::string representation = head == HeadKind::c8flow ? "absolute" : "hand_centric";
-    const LearnedPolicy policy = train_policy(test::small_config(head, representation, 20), scenes, 3);
+    const LearnedPolicy policy =
+        train_policy(test::small_config(head, representation, 20), scenes, 3);
     const std::string path = temporary_path("roundtrip.model");
     save_model(policy, path);
     const LearnedPolicy loaded = load_model(path);
@@ -56,8 +57,8 @@ TEST_CASE("saved_models_load_and_act_identically", "[unit]") {
 TEST_CASE("damaged_model_files_are_typed_errors", "[unit]") {
   const std::string bytes = serialize_model(small_policy());
   CHECK_NOTHROW(deserialize_model(bytes, "intact.model"));  // the positive control
-  for (std::size_t length : {std::size_t{0}, std::size_t{5}, std::size_t{19}, std::size_t{40}, bytes.size() / 2,
-                             bytes.size() - 1}) {
+  for (std::size_t length : {std::size_t{0}, std::size_t{5}, std::size_t{19}, std::size_t{40},
+                             bytes.size() / 2, bytes.size() - 1}) {
     INFO("truncated to " << length);
     HC_CHECK_THROWS(deserialize_model(bytes.substr(0, length), "cut.model"), InvalidModelFile,
                     Catch::Contains("cut.model"));
@@ -68,7 +69,8 @@ TEST_CASE("damaged_model_files_are_typed_errors", "[unit]") {
     damaged[position] = static_cast<char>(damaged[position] ^ 0x5a);
     CHECK_THROWS_AS(deserialize_model(damaged, "flipped.model"), InvalidModelFile);
   }
-  HC_CHECK_THROWS(deserialize_model(bytes + "x", "long.model"), InvalidModelFile, Catch::Contains("appended"));
+  HC_CHECK_THROWS(deserialize_model(bytes + "x", "long.model"), InvalidModelFile,
+                  Catch::Contains("appended"));
   HC_CHECK_THROWS(deserialize_model("{\"demos\": []}", "demos.json"), InvalidModelFile,
                   Catch::Contains("not a handcentric model"));
   std::string version = bytes;
@@ -89,7 +91,8 @@ TEST_CASE("damaged_model_files_are_typed_errors", "[unit]") {
 }
 
 TEST_CASE("missing_or_unwritable_model_paths_are_typed_errors", "[unit]") {
-  HC_CHECK_THROWS(load_model("/nonexistent/dir/x.model"), InvalidModelFile, Catch::Contains("no such model file"));
+  HC_CHECK_THROWS(load_model("/nonexistent/dir/x.model"), InvalidModelFile,
+                  Catch::Contains("no such model file"));
   HC_CHECK_THROWS(save_model(small_policy(), "/nonexistent/dir/x.model"), FileError,
                   Catch::Contains("/nonexistent/dir/x.model"));
 }

@@ -58,7 +58,9 @@ PolicyConfig trained_like() {
   return config;
 }
 
-void write(const std::string& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
+void write(const std::string& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
 
 // What load_model(path) throws, run in a child: "<type>: <message>".
 test::ChildRun load_in_child(const std::string& path) {
@@ -75,7 +77,8 @@ test::ChildRun load_in_child(const std::string& path) {
 // `handcentric eval --model path` must exit 1 with one line on stderr matching `what`, within
 // the memory limit.
 void check_cli_refuses(const std::string& path, const std::string& what) {
-  test::check_cli_refuses({HANDCENTRIC_CLI, "eval", "--model", path, "--dist", "train", "--trials", "1"}, path, what);
+  test::check_cli_refuses(
+      {HANDCENTRIC_CLI, "eval", "--model", path, "--dist", "train", "--trials", "1"}, path, what);
 }
 
 }  // namespace
@@ -93,19 +96,22 @@ TEST_CASE("parameter_count_is_what_every_head_stores", "[unit]") {
     const std::size_t float_vectors = kind == HeadKind::cvae ? 2 : 1;
     const std::size_t normalizers = 8 * (5 + 3 * 24 + 2 * 24);
     const std::size_t extra = kind == HeadKind::ddpm ? 8 : 0;
-    CHECK(stored.bytes().size() == normalizers + 8 * float_vectors + sizeof(float) * parameter_count(config) + extra);
+    CHECK(stored.bytes().size() ==
+          normalizers + 8 * float_vectors + sizeof(float) * parameter_count(config) + extra);
   }
 }
 
 TEST_CASE("a_model_file_over_256_MiB_is_refused_from_its_size_before_it_is_read", "[unit]") {
   // 2 GiB, sparse: a real model's header, then holes that read as zeros.
   const std::string path = test::limits_temp_path("huge.model");
-  write(path, serialize_model(train_policy(test::small_config(HeadKind::flow, "hand_centric", 2), test::small_scenes(4, 1), 1)));
+  write(path, serialize_model(train_policy(test::small_config(HeadKind::flow, "hand_centric", 2),
+                                           test::small_scenes(4, 1), 1)));
   std::filesystem::resize_file(path, std::uintmax_t{2} << 30);
   const test::ChildRun run = load_in_child(path);
   INFO(run.out);
   CHECK(run.exit_code == 0);
-  CHECK_THAT(run.out, Contains("InvalidModelFile") && Contains(std::to_string(std::uint64_t{2} << 30) + " bytes") &&
+  CHECK_THAT(run.out, Contains("InvalidModelFile") &&
+                          Contains(std::to_string(std::uint64_t{2} << 30) + " bytes") &&
                           Contains(std::to_string(kMaxModelFileBytes)));
   CHECK(run.peak_bytes < test::kPeakMemoryLimitBytes);
   check_cli_refuses(path, "more than the 268435456");
@@ -124,7 +130,8 @@ TEST_CASE("a_model_config_describing_3e11_parameters_is_refused_before_allocatin
   const test::ChildRun run = load_in_child(path);
   INFO(run.out);
   CHECK(run.exit_code == 0);
-  CHECK_THAT(run.out, Contains("InvalidModelFile") && Contains(std::to_string(parameter_count(config)) + " parameters") &&
+  CHECK_THAT(run.out, Contains("InvalidModelFile") &&
+                          Contains(std::to_string(parameter_count(config)) + " parameters") &&
                           Contains("only 1024 bytes follow"));
   CHECK(run.peak_bytes < test::kPeakMemoryLimitBytes);
   check_cli_refuses(path, "parameters");
@@ -149,16 +156,18 @@ TEST_CASE("a_model_config_with_a_1e12_parameter_layer_is_refused_before_allocati
   const test::ChildRun run = load_in_child(path);
   INFO(run.out);
   CHECK(run.exit_code == 0);
-  CHECK_THAT(run.out, Contains("InvalidModelFile") && Contains("observation_dimension = 2000000000") &&
-                          Contains("0..1048576"));
+  CHECK_THAT(run.out, Contains("InvalidModelFile") &&
+                          Contains("observation_dimension = 2000000000") && Contains("0..1048576"));
   CHECK(run.peak_bytes < test::kPeakMemoryLimitBytes);
   check_cli_refuses(path, "observation_dimension = 2000000000");
   std::filesystem::remove(path);
 }
 
 TEST_CASE("a_weight_array_claiming_1e12_entries_is_refused_before_allocating", "[unit]") {
-  // A real model whose stored parameter count is rewritten to 1e12 (the config still says 24x32...).
-  const LearnedPolicy policy = train_policy(test::small_config(HeadKind::flow, "hand_centric", 2), test::small_scenes(4, 1), 1);
+  // A real model whose stored parameter count is rewritten to 1e12 (the config still says
+  // 24x32...).
+  const LearnedPolicy policy = train_policy(test::small_config(HeadKind::flow, "hand_centric", 2),
+                                            test::small_scenes(4, 1), 1);
   std::string bytes = serialize_model(policy);
   // the weights are the last array: its u64 length sits 8 + 4 * n bytes before the checksum
   const std::uint64_t n = parameter_count(policy.config());

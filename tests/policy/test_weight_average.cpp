@@ -21,7 +21,8 @@ namespace {
 
 // The average of `iterates` by the documented formula, with the warm-up or (planted fault)
 // without it.
-Eigen::VectorXf expected_average(const std::vector<Eigen::VectorXf>& iterates, double decay, bool warm_up = true) {
+Eigen::VectorXf expected_average(const std::vector<Eigen::VectorXf>& iterates, double decay,
+                                 bool warm_up = true) {
   Eigen::VectorXf average = iterates.front();
   for (std::size_t i = 1; i < iterates.size(); ++i) {
     const double t = static_cast<double>(i + 1);
@@ -53,13 +54,15 @@ Eigen::VectorXf trailing_weights(const Head& head) {
 
 TEST_CASE("weight_average_follows_its_formula_with_the_warm_up", "[unit]") {
   std::vector<Eigen::VectorXf> iterates;
-  for (int t = 0; t < 40; ++t) iterates.push_back(Eigen::VectorXf::Constant(3, static_cast<float>(t * t) * 0.01f));
+  for (int t = 0; t < 40; ++t)
+    iterates.push_back(Eigen::VectorXf::Constant(3, static_cast<float>(t * t) * 0.01f));
   WeightAverage average(0.95);
   for (const Eigen::VectorXf& theta : iterates) average.update(theta);
   CHECK(average.updates() == 40);
   CHECK((average.average() - expected_average(iterates, 0.95)).cwiseAbs().maxCoeff() < 1e-6f);
   // Planted fault: the same check against an average without the warm-up fails.
-  CHECK((average.average() - expected_average(iterates, 0.95, false)).cwiseAbs().maxCoeff() > 1e-3f);
+  CHECK((average.average() - expected_average(iterates, 0.95, false)).cwiseAbs().maxCoeff() >
+        1e-3f);
 
   WeightAverage off(0.0);
   off.update(iterates.back());

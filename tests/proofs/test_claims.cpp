@@ -31,8 +31,9 @@ const Claim& claim(const std::string& id) {
 }
 
 Flow with_noise(GiNaC::matrix (*f)(const ExactScene&, const GiNaC::matrix&)) {
-  return
-      [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) { return f(scene, eps); };
+  return [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) {
+    return f(scene, eps);
+  };
 }
 
 Flow ignoring_noise(GiNaC::matrix (*f)(const ExactScene&)) {
@@ -43,8 +44,11 @@ bool identity_holds(const Flow& flow, Group group) {
   return certify_identity(moved(flow), unmoved(flow), generic_instance(group)).verified;
 }
 
-// A small integer in [-2, 2] from the seeded generator (no std::*_distribution: same bits everywhere).
-long small(std::mt19937_64& rng) { return static_cast<long>(rng() % 5) - 2; }
+// A small integer in [-2, 2] from the seeded generator (no std::*_distribution: same bits
+// everywhere).
+long small(std::mt19937_64& rng) {
+  return static_cast<long>(rng() % 5) - 2;
+}
 
 ExactPose random_rational_pose(std::mt19937_64& rng) {
   long q[4] = {small(rng), small(rng), small(rng), small(rng)};
@@ -53,7 +57,8 @@ ExactPose random_rational_pose(std::mt19937_64& rng) {
                    column(small(rng), small(rng), small(rng))};
 }
 
-// `count` seeded exact witnesses: T~, T_0, T_{-h}, T_k random rational poses, rational points and eps.
+// `count` seeded exact witnesses: T~, T_0, T_{-h}, T_k random rational poses, rational points and
+// eps.
 std::vector<Instance> rational_witnesses(std::uint64_t seed, int count) {
   std::mt19937_64 rng(seed);
   std::vector<Instance> witnesses;
@@ -74,7 +79,8 @@ std::vector<Instance> rational_witnesses(std::uint64_t seed, int count) {
 int verified_counterexamples(const Flow& flow, const std::vector<Instance>& witnesses) {
   int verified = 0;
   for (const Instance& w : witnesses) {
-    verified += certify_counterexample(moved(flow), unmoved(flow), w, "seeded witness").verified ? 1 : 0;
+    verified +=
+        certify_counterexample(moved(flow), unmoved(flow), w, "seeded witness").verified ? 1 : 0;
   }
   return verified;
 }
@@ -135,8 +141,10 @@ TEST_CASE("mutant_claim_that_relative_is_rotation_invariant_fails_the_identity_c
 TEST_CASE("mutant_counterexamples_for_hand_centric_never_verify", "[proofs]") {
   const std::vector<Instance> witnesses = rational_witnesses(20261122, 25);
   CHECK(verified_counterexamples(with_noise(flows::hand_centric_translation), witnesses) == 0);
-  CHECK(verified_counterexamples(ignoring_noise(flows::hand_centric_rotation_matrix), witnesses) == 0);
-  CHECK(verified_counterexamples(ignoring_noise(flows::hand_centric_proprioception), witnesses) == 0);
+  CHECK(verified_counterexamples(ignoring_noise(flows::hand_centric_rotation_matrix), witnesses) ==
+        0);
+  CHECK(verified_counterexamples(ignoring_noise(flows::hand_centric_proprioception), witnesses) ==
+        0);
   CHECK(verified_counterexamples(ignoring_noise(flows::inner_policy_input), witnesses) == 0);
   // The same witnesses do break the representations that are not invariant.
   CHECK(verified_counterexamples(with_noise(flows::relative_translation), witnesses) > 20);
@@ -204,9 +212,9 @@ TEST_CASE("mutant_claims_fail_every_certificate", "[proofs]") {
 
 TEST_CASE("counterexample_with_a_symbolic_witness_is_a_typed_error", "[proofs]") {
   const Flow flow = with_noise(flows::absolute_translation);
-  CHECK_THROWS_AS(
-      certify_counterexample(moved(flow), unmoved(flow), generic_instance(Group::translations), "w"),
-      InvalidArgument);
+  CHECK_THROWS_AS(certify_counterexample(moved(flow), unmoved(flow),
+                                         generic_instance(Group::translations), "w"),
+                  InvalidArgument);
   // A claim whose certificate throws is reported as not verified, with the error.
   Claim broken = claim("A.1 eq. (11), translations");
   broken.certify = [flow] {

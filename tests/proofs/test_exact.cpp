@@ -86,7 +86,8 @@ TEST_CASE("generic_quaternion_rotation_is_orthonormal_identically", "[proofs]") 
 }
 
 TEST_CASE("rational_rotations_match_core_quaternion_convention", "[proofs]") {
-  for (const auto& q : std::vector<std::array<long, 4>>{{2, 1, 0, 0}, {1, 1, 1, 1}, {3, -1, 2, 5}}) {
+  for (const auto& q :
+       std::vector<std::array<long, 4>>{{2, 1, 0, 0}, {1, 1, 1, 1}, {3, -1, 2, 5}}) {
     const Eigen::Matrix3d exact = to_double(rational_rotation(q[0], q[1], q[2], q[3]));
     const Eigen::Matrix3d core =
         Rotation::from_quaternion(static_cast<double>(q[0]), static_cast<double>(q[1]),
@@ -107,8 +108,8 @@ TEST_CASE("angle_below_pi_is_decided_exactly_from_the_trace", "[proofs]") {
 }
 
 TEST_CASE("exact_rotation_vectors_match_core_log_on_the_cube_rotations", "[proofs]") {
-  CHECK(disagreements_with_core_log([](const GiNaC::matrix& R) { return exact_rotation_vector(R); }) ==
-        0);
+  CHECK(disagreements_with_core_log(
+            [](const GiNaC::matrix& R) { return exact_rotation_vector(R); }) == 0);
   const GiNaC::matrix r = exact_rotation_vector(quarter_turn(0, 1).mul(quarter_turn(2, 1)));
   CHECK(GiNaC::normal(r(0, 0) - 2 * GiNaC::Pi / (3 * GiNaC::sqrt(GiNaC::ex(3)))).is_zero());
   // Planted fault: r with the opposite sign (vee(R^T - R)) disagrees with core.
@@ -119,8 +120,8 @@ TEST_CASE("exact_rotation_vectors_match_core_log_on_the_cube_rotations", "[proof
 TEST_CASE("exact_constructors_reject_bad_input_naming_the_value", "[proofs]") {
   HC_CHECK_THROWS(rational_rotation(0, 0, 0, 0), InvalidRotation, Catch::Contains("(0, 0, 0, 0)"));
   HC_CHECK_THROWS(quarter_turn(3, 1), InvalidArgument, Catch::Contains("axis 3"));
-  HC_CHECK_THROWS(exact_rotation_vector(GiNaC::matrix{{2, 0, 0}, {0, 1, 0}, {0, 0, 1}}), InvalidRotation,
-                  Catch::Contains("[[2, 0, 0], [0, 1, 0], [0, 0, 1]]"));
+  HC_CHECK_THROWS(exact_rotation_vector(GiNaC::matrix{{2, 0, 0}, {0, 1, 0}, {0, 0, 1}}),
+                  InvalidRotation, Catch::Contains("[[2, 0, 0], [0, 1, 0], [0, 0, 1]]"));
   HC_CHECK_THROWS(exact_rotation_vector(rational_rotation(2, 0, 0, 1)), InvalidArgument,
                   Catch::Contains("3/5"));
   HC_CHECK_THROWS(exact_rotation_vector(quarter_turn(2, 2)), InvalidArgument,  // angle pi

@@ -72,4 +72,3 @@ TEST_CASE("committed_claims_report_is_up_to_date", "[proofs]") {
   // Planted fault: a report with one failed certificate differs from the committed one.
   CHECK(read_file(committed) != report_markdown(with_first_failed()));
 }
-

@@ -334,9 +334,9 @@ TEST_CASE("audit_model_finds_a_trained_hand_centric_policy_equivariant_and_an_ab
 TEST_CASE("an_endless_plugin_line_is_refused_in_bounded_memory", "[unit]") {
   // 200 MB on one line: refused at 64 MiB, the audit's peak memory (GNU time's %M, KiB) far
   // below 512 MB. A generous timeout: a loaded machine must not turn this into "no answer".
-  const auto result = test::run_command("/usr/bin/time -f 'peak %M' " + test::cli() +
-                                        " audit --exec \"head -c 200000000 /dev/zero | tr '\\\\0' x\"" +
-                                        " --timeout 120 --cases 5");
+  const auto result = test::run_command(
+      "/usr/bin/time -f 'peak %M' " + test::cli() +
+      " audit --exec \"head -c 200000000 /dev/zero | tr '\\\\0' x\"" + " --timeout 120 --cases 5");
   CHECK(result.exit_code == 1);
   CHECK_THAT(result.err, Contains("longer than 64 MiB"));
   const std::size_t at = result.err.rfind("peak ");

@@ -123,9 +123,10 @@ TEST_CASE("subprocess_reads_with_a_deadline_and_sees_a_closed_stdout", "[unit]")
 TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
   using props::RequestKind;
   const std::string who = "plug-in 'x'";
-  const auto hello = props::parse_reply(
-      R"({"id": 0, "hello": {"protocol": 2, "extra_poses": ["start"], "scalars": ["gripper"], "decode": true}})",
-      0, RequestKind::encode, who, true);
+  const auto hello =
+      props::parse_reply(R"({"id": 0, "hello": {"protocol": 2, "extra_poses": ["start"], )"
+                         R"("scalars": ["gripper"], "decode": true}})",
+                         0, RequestKind::encode, who, true);
   REQUIRE(hello.hello.has_value());
   CHECK(hello.hello->extra_pose_names == std::vector<std::string>{"start"});
   CHECK(hello.hello->scalar_names == std::vector<std::string>{"gripper"});
@@ -202,6 +203,7 @@ TEST_CASE("plugin_replies_are_bounded_in_length_and_nesting", "[unit]") {
   CHECK_THROWS_WITH(props::parse_reply(deep, 0, props::RequestKind::encode, "plug-in 'x'", false),
                     Contains("nested deeper than"));
   // Brackets inside strings do not count.
-  CHECK_THROWS_WITH(props::parse_reply(in_string, 0, props::RequestKind::encode, "plug-in 'x'", false),
-                    Contains("without \"actions\""));
+  CHECK_THROWS_WITH(
+      props::parse_reply(in_string, 0, props::RequestKind::encode, "plug-in 'x'", false),
+      Contains("without \"actions\""));
 }

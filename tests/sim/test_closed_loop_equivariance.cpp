@@ -28,11 +28,13 @@ policy::LearnedPolicy trained_policy(const std::string& representation) {
   config.steps = 300;
   config.batch_size = 64;
   config.history_length = 2;  // what sim::rollout observes by default (RolloutOptions::history)
-  return policy::train_policy(config, sim::training_scenes(run.demos, config.history_length, config.chunk_length), 5);
+  return policy::train_policy(
+      config, sim::training_scenes(run.demos, config.history_length, config.chunk_length), 5);
 }
 
 // Largest |g T_t - T'_t| over the two rollouts' common steps (cm + Frobenius of the rotation).
-double trajectory_gap(const sim::Rollout& original, const sim::Rollout& moved, const RigidTransform& g) {
+double trajectory_gap(const sim::Rollout& original, const sim::Rollout& moved,
+                      const RigidTransform& g) {
   double worst = 0.0;
   const std::size_t n = std::min(original.world_T_hand.size(), moved.world_T_hand.size());
   for (std::size_t t = 0; t < n; ++t) {
@@ -51,7 +53,8 @@ double worst_gap(const ChunkPolicy& policy, bool& same_outcomes) {
   for (std::size_t i = 0; i < scenes.size(); ++i) {
     const sim::Rollout original = sim::rollout(policy, scenes[i], checker, 3 + i);
     const sim::Rollout moved = sim::rollout(policy, g * scenes[i], checker, 3 + i);
-    same_outcomes = same_outcomes && original.outcome == moved.outcome && original.steps == moved.steps;
+    same_outcomes =
+        same_outcomes && original.outcome == moved.outcome && original.steps == moved.steps;
     worst = std::max(worst, trajectory_gap(original, moved, g));
   }
   return worst;

@@ -25,23 +25,28 @@ bool continuous(const CollisionChecker& checker, const RigidTransform& a, const 
 // poses are caught; the free insertion down the axis is not flagged.
 bool catches_motions_through_walls(MotionCheck check) {
   const CollisionChecker checker;
-  const RigidTransform inside = RigidTransform::planar(0.0, 0.0, 4.0);     // tip 4 deep, centred
-  const RigidTransform far_right = RigidTransform::planar(0.0, 20.0, 4.0); // well right of the right wall
-  const RigidTransform above_left = RigidTransform::planar(0.0, -3.5, 8.3); // tip 0.3 above the left wall
-  if (checker.collides(inside) || checker.collides(far_right) || checker.collides(above_left)) return false;
+  const RigidTransform inside = RigidTransform::planar(0.0, 0.0, 4.0);  // tip 4 deep, centred
+  const RigidTransform far_right =
+      RigidTransform::planar(0.0, 20.0, 4.0);  // well right of the right wall
+  const RigidTransform above_left =
+      RigidTransform::planar(0.0, -3.5, 8.3);  // tip 0.3 above the left wall
+  if (checker.collides(inside) || checker.collides(far_right) || checker.collides(above_left))
+    return false;
   // straight through the right wall (2 thick) in one 20 cm command
   if (!check(checker, inside, far_right)) return false;
   // diagonally into the hole from above the left wall: the peg's corner cuts the wall's top corner
   if (!check(checker, above_left, inside)) return false;
   // the free insertion is free
-  return !check(checker, RigidTransform::planar(0.0, 0.0, 9.0), RigidTransform::planar(0.0, 0.0, 2.5));
+  return !check(checker, RigidTransform::planar(0.0, 0.0, 9.0),
+                RigidTransform::planar(0.0, 0.0, 2.5));
 }
 
 }  // namespace
 
 TEST_CASE("a_centred_peg_in_the_hole_does_not_collide", "[unit]") {
   const CollisionChecker checker;
-  for (const double y : {9.0, 8.0, 5.0, 2.5, 2.01}) {  // tip 1 above, at the opening, 3 / 5.5 / 5.99 deep
+  for (const double y :
+       {9.0, 8.0, 5.0, 2.5, 2.01}) {  // tip 1 above, at the opening, 3 / 5.5 / 5.99 deep
     INFO("hand at y = " << y);
     CHECK_FALSE(checker.collides(RigidTransform::planar(0.0, 0.0, y)));
   }
@@ -66,7 +71,8 @@ TEST_CASE("a_peg_tilted_by_the_angle_that_closes_the_gap_collides", "[unit]") {
   REQUIRE(phi_star > 0.0);
   CHECK(checker.collides(RigidTransform::planar(1.05 * phi_star, 0.0, 4.0)));
   CHECK_FALSE(checker.collides(RigidTransform::planar(0.95 * phi_star, 0.0, 4.0)));
-  CHECK(checker.collides(RigidTransform::planar(-1.05 * phi_star, 0.0, 4.0)));  // and to the left wall
+  CHECK(checker.collides(
+      RigidTransform::planar(-1.05 * phi_star, 0.0, 4.0)));  // and to the left wall
   CHECK_FALSE(checker.collides(RigidTransform::planar(-0.95 * phi_star, 0.0, 4.0)));
 }
 
@@ -92,18 +98,23 @@ TEST_CASE("mutant_endpoint_only_motion_check_is_caught", "[unit]") {
 }
 
 TEST_CASE("mutant_fixed_four_sample_motion_check_is_caught", "[unit]") {
-  CHECK_FALSE(catches_motions_through_walls(testing::four_samples<CollisionChecker, interpolate_planar>));
+  CHECK_FALSE(
+      catches_motions_through_walls(testing::four_samples<CollisionChecker, interpolate_planar>));
 }
 
-TEST_CASE("continuous_check_steps_by_the_clearance_and_never_coarser_than_c_over_4_near_walls", "[unit]") {
+TEST_CASE("continuous_check_steps_by_the_clearance_and_never_coarser_than_c_over_4_near_walls",
+          "[unit]") {
   // A long free motion far above the hole: conservative advancement takes big steps there...
   const CollisionChecker checker;
   const std::uint64_t before = checker.queries();
-  CHECK_FALSE(checker.motion_collides(RigidTransform::planar(0.0, -20.0, 30.0), RigidTransform::planar(0.0, 20.0, 30.0)));
+  CHECK_FALSE(checker.motion_collides(RigidTransform::planar(0.0, -20.0, 30.0),
+                                      RigidTransform::planar(0.0, 20.0, 30.0)));
   const std::uint64_t far_queries = checker.queries() - before;
-  // ...and 0.01 from a wall (shifted by 0.04) it takes at least one query per c/4 = 0.025 of travel.
+  // ...and 0.01 from a wall (shifted by 0.04) it takes at least one query per c/4 = 0.025 of
+  // travel.
   const std::uint64_t mid = checker.queries();
-  CHECK_FALSE(checker.motion_collides(RigidTransform::planar(0.0, 0.04, 7.5), RigidTransform::planar(0.0, 0.04, 7.0)));
+  CHECK_FALSE(checker.motion_collides(RigidTransform::planar(0.0, 0.04, 7.5),
+                                      RigidTransform::planar(0.0, 0.04, 7.0)));
   const std::uint64_t near_queries = (checker.queries() - mid) / 3;  // 3 walls per query point
   CHECK(near_queries >= 0.5 / 0.025);
   CHECK(far_queries / 3 < 40);
@@ -120,7 +131,8 @@ TEST_CASE("interpolation_takes_the_short_way_round", "[unit]") {
 TEST_CASE("a_bad_clearance_is_rejected_with_the_value_and_the_fix", "[unit]") {
   PegHoleGeometry geometry;
   geometry.clearance = -0.1;
-  CHECK_THROWS_WITH(CollisionChecker{geometry}, Catch::Matchers::Contains("-0.1") && Catch::Matchers::Contains("0.1"));
+  CHECK_THROWS_WITH(CollisionChecker{geometry},
+                    Catch::Matchers::Contains("-0.1") && Catch::Matchers::Contains("0.1"));
   geometry.clearance = std::nan("");
   CHECK_THROWS_AS(CollisionChecker{geometry}, InvalidArgument);
 }

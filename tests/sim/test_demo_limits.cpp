@@ -22,9 +22,11 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-const std::string kHeaderOfOne = R"({"clearance":0.1,"count":1,"format":"handcentric-demos","version":1})";
+const std::string kHeaderOfOne =
+    R"({"clearance":0.1,"count":1,"format":"handcentric-demos","version":1})";
 const std::string kPose = "[[1,0,0,0],[0,1,0,5],[0,0,1,0]]";
-const std::string kRecordStart = R"({"world_T_hole":[[1,0,0,0],[0,1,0,0],[0,0,1,0]],"world_T_hand":[)";
+const std::string kRecordStart =
+    R"({"world_T_hole":[[1,0,0,0],[0,1,0,0],[0,0,1,0]],"world_T_hand":[)";
 
 // A record of `poses` poses (one line, with its newline).
 std::string record_of(std::size_t poses) {
@@ -34,10 +36,13 @@ std::string record_of(std::size_t poses) {
   return line + "]}\n";
 }
 
-void write(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+void write(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
 
 // What load_demos(path, limits) throws, run in a child: "<type>: <message>".
-test::ChildRun load_in_child(const std::string& path, const DemoFileLimits& limits = DemoFileLimits()) {
+test::ChildRun load_in_child(const std::string& path,
+                             const DemoFileLimits& limits = DemoFileLimits()) {
   return test::run_in_child([&] {
     try {
       return "loaded " + std::to_string(load_demos(path, limits).size());
@@ -57,7 +62,9 @@ void check_refused(const test::ChildRun& run, const std::string& where, const st
 // `handcentric render --demos path` exits 1 with one line on stderr naming `what`, within the
 // memory limit.
 void check_cli_refuses(const std::string& path, const std::string& what) {
-  test::check_cli_refuses({HANDCENTRIC_CLI, "render", "--demos", path, "--out", test::limits_temp_path("never.png")}, path, what);
+  test::check_cli_refuses(
+      {HANDCENTRIC_CLI, "render", "--demos", path, "--out", test::limits_temp_path("never.png")},
+      path, what);
 }
 
 }  // namespace
@@ -94,16 +101,19 @@ TEST_CASE("json_nested_deeper_than_the_limit_is_refused", "[unit]") {
   check_refused(load_in_child(path), "record 1 (line 2)", "nested deeper than 8 levels");
   check_cli_refuses(path, "nested deeper than 8 levels");
   // the header too
-  write(path, R"({"format":"handcentric-demos","version":1,"count":1,"x":)" + std::string(depth, '[') +
-                  std::string(depth, ']') + "}\n");
+  write(path, R"({"format":"handcentric-demos","version":1,"count":1,"x":)" +
+                  std::string(depth, '[') + std::string(depth, ']') + "}\n");
   check_refused(load_in_child(path), "line 1 (header)", "nested deeper than 8 levels");
   std::filesystem::remove(path);
 }
 
 TEST_CASE("a_header_announcing_a_billion_demos_is_refused_before_any_record", "[unit]") {
   const std::string path = test::limits_temp_path("billion.jsonl");
-  write(path, R"({"clearance":0.1,"count":1000000000,"format":"handcentric-demos","version":1})" "\n" + record_of(1));
-  check_refused(load_in_child(path), "line 1 (header)", "1000000000 demos, more than the limit of 100000");
+  write(path, R"({"clearance":0.1,"count":1000000000,"format":"handcentric-demos","version":1})"
+              "\n" +
+                  record_of(1));
+  check_refused(load_in_child(path), "line 1 (header)",
+                "1000000000 demos, more than the limit of 100000");
   check_cli_refuses(path, "1000000000 demos");
   std::filesystem::remove(path);
 }
@@ -112,7 +122,8 @@ TEST_CASE("a_demo_of_more_poses_than_the_limit_is_refused", "[unit]") {
   // 10001 poses: a 330 KB line, within the line limit.
   const std::string path = test::limits_temp_path("many_poses.jsonl");
   write(path, kHeaderOfOne + "\n" + record_of(10'001));
-  check_refused(load_in_child(path), "record 1 (line 2)", "a demo of 10001 poses, more than the limit of 10000");
+  check_refused(load_in_child(path), "record 1 (line 2)",
+                "a demo of 10001 poses, more than the limit of 10000");
   check_cli_refuses(path, "10001 poses");
   // exactly at the limit it loads
   write(path, kHeaderOfOne + "\n" + record_of(10'000));
@@ -131,24 +142,31 @@ TEST_CASE("demo_files_over_each_limit_are_refused_and_files_at_it_load", "[unit]
   const std::string path = test::limits_temp_path("small_limits.jsonl");
   const auto file = [](std::size_t count, const std::vector<std::size_t>& poses) {
     std::string text = R"({"clearance":0.1,"count":)" + std::to_string(count) +
-                       R"(,"format":"handcentric-demos","version":1})" "\n";
+                       R"(,"format":"handcentric-demos","version":1})"
+                       "\n";
     for (std::size_t n : poses) text += record_of(n);
     return text;
   };
   write(path, file(3, {2, 2, 2}));
   CHECK(load_in_child(path, limits).out == "loaded 3");
   write(path, file(4, {1, 1, 1, 1}));
-  check_refused(load_in_child(path, limits), "line 1 (header)", "4 demos, more than the limit of 3");
+  check_refused(load_in_child(path, limits), "line 1 (header)",
+                "4 demos, more than the limit of 3");
   write(path, file(1, {5}));
-  check_refused(load_in_child(path, limits), "record 1", "a demo of 5 poses, more than the limit of 4");
+  check_refused(load_in_child(path, limits), "record 1",
+                "a demo of 5 poses, more than the limit of 4");
   write(path, file(2, {4, 3}));
-  check_refused(load_in_child(path, limits), "record 2", "7 poses, more than the limit of 6 for one file");
-  write(path, kHeaderOfOne + "\n" + R"({"world_T_hole":[[[[1]]]],"world_T_hand":[]})" "\n");
+  check_refused(load_in_child(path, limits), "record 2",
+                "7 poses, more than the limit of 6 for one file");
+  write(path, kHeaderOfOne + "\n" +
+                  R"({"world_T_hole":[[[[1]]]],"world_T_hand":[]})"
+                  "\n");
   check_refused(load_in_child(path, limits), "record 1", "nested deeper than 4 levels");
   limits.max_line_bytes = record_of(2).size() - 1;  // the line without its newline fits exactly
   write(path, file(1, {2}));
   CHECK(load_in_child(path, limits).out == "loaded 1");
   limits.max_line_bytes -= 1;
-  check_refused(load_in_child(path, limits), "record 1", "longer than " + std::to_string(limits.max_line_bytes));
+  check_refused(load_in_child(path, limits), "record 1",
+                "longer than " + std::to_string(limits.max_line_bytes));
   std::filesystem::remove(path);
 }

@@ -39,8 +39,9 @@ TEST_CASE("a_successful_rollout_is_drawn_green_and_a_collision_red", "[unit]") {
 }
 
 TEST_CASE("drawings_are_written_as_png_atomically", "[unit]") {
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("handcentric_test_draw_" + std::to_string(::getpid()) + ".png")).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("handcentric_test_draw_" + std::to_string(::getpid()) + ".png"))
+                               .string();
   const TaskScene scene = sample_scene(SceneDistribution::train(), 1, 0);
   write_png(path, draw_scene(scene, PegHoleGeometry(), 200));
   std::ifstream in(path, std::ios::binary);

@@ -38,7 +38,8 @@ class NanRightOf final : public ChunkPolicy {
   NanRightOf(double line, bool throws) : line_(line), throws_(throws) {}
   std::string name() const override { return "nan_right_of_line"; }
   std::vector<RigidTransform> act(const Scene& observation, std::uint64_t seed) const override {
-    if (observation.world_T_hand0().translation().x() <= line_) return HoldPolicy().act(observation, seed);
+    if (observation.world_T_hand0().translation().x() <= line_)
+      return HoldPolicy().act(observation, seed);
     if (throws_) throw NonFiniteAction("the planted network diverged");
     const double nan = std::numeric_limits<double>::quiet_NaN();
     return {RigidTransform::unchecked(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0.0, 0.0))};
@@ -49,7 +50,9 @@ class NanRightOf final : public ChunkPolicy {
   bool throws_;
 };
 
-std::vector<TaskScene> scenes() { return sample_scenes(SceneDistribution::train(), 12, 5); }
+std::vector<TaskScene> scenes() {
+  return sample_scenes(SceneDistribution::train(), 12, 5);
+}
 
 // The median start x of the scenes: about half of them are right of it.
 double median_start_x(const std::vector<TaskScene>& all) {
@@ -134,23 +137,27 @@ TEST_CASE("a_policy_returning_nan_on_some_scenes_makes_those_trials_invalid_not_
     CHECK(summary.success + summary.collision == 0);
     CHECK(summary.first_invalid_scene == first_right);
     CHECK_THAT(summary.first_invalid_reason, Contains("nan_right_of_line") && Contains("replan 0"));
-    CHECK_THAT(summary.first_invalid_reason, Contains(throws ? "the planted network diverged" : "non-finite pose"));
+    CHECK_THAT(summary.first_invalid_reason,
+               Contains(throws ? "the planted network diverged" : "non-finite pose"));
 
     RolloutOptions strict;
     strict.stop_on_invalid = true;
     CHECK_THROWS_AS(evaluate(NanRightOf(line, throws), all, checker, 1, strict), NonFiniteAction);
-    CHECK_THROWS_WITH(evaluate(NanRightOf(line, throws), all, checker, 1, strict),
-                      Contains("scene " + std::to_string(first_right) + ": ") && Contains("nan_right_of_line"));
+    CHECK_THROWS_WITH(
+        evaluate(NanRightOf(line, throws), all, checker, 1, strict),
+        Contains("scene " + std::to_string(first_right) + ": ") && Contains("nan_right_of_line"));
   }
 }
 
-TEST_CASE("eval_counts_a_diverging_model_as_invalid_trials_and_strict_stops_at_the_first", "[unit]") {
+TEST_CASE("eval_counts_a_diverging_model_as_invalid_trials_and_strict_stops_at_the_first",
+          "[unit]") {
   // The model diverges where the left corner is right of the hand by more than on the median
   // scene; eval through the command line must count what evaluate() counts in process.
   const auto all = scenes();
   std::vector<double> corner_x;
   for (const TaskScene& scene : all) {
-    corner_x.push_back(observation(scene.world_T_hole, {scene.world_T_hand_start}, 0).hand_points[0].x());
+    corner_x.push_back(
+        observation(scene.world_T_hole, {scene.world_T_hand_start}, 0).hand_points[0].x());
   }
   std::sort(corner_x.begin(), corner_x.end());
   const std::string path = temp_path("diverging.model");
@@ -160,12 +167,13 @@ TEST_CASE("eval_counts_a_diverging_model_as_invalid_trials_and_strict_stops_at_t
   RolloutOptions options;
   options.history = 0;
   const RolloutSummary expected = evaluate(model, all, CollisionChecker(), 5, options);
-  INFO("invalid " << expected.invalid << " of " << expected.trials << ", first: scene " << expected.first_invalid_scene);
+  INFO("invalid " << expected.invalid << " of " << expected.trials << ", first: scene "
+                  << expected.first_invalid_scene);
   REQUIRE(expected.invalid > 0);
   REQUIRE(expected.invalid < expected.trials);
 
-  const std::vector<std::string> eval = {HANDCENTRIC_CLI, "eval",   "--model", path,    "--dist",
-                                         "train",         "--trials", "12",    "--seed", "5"};
+  const std::vector<std::string> eval = {HANDCENTRIC_CLI, "eval",     "--model", path,     "--dist",
+                                         "train",         "--trials", "12",      "--seed", "5"};
   std::vector<std::string> json_eval = eval;
   json_eval.push_back("--json");
   const test::ChildRun run = test::run_program(json_eval);
@@ -179,9 +187,11 @@ TEST_CASE("eval_counts_a_diverging_model_as_invalid_trials_and_strict_stops_at_t
         Approx(12));
   // one warning line naming the first such scene
   CHECK(std::count(run.err.begin(), run.err.end(), '\n') == 1);
-  CHECK_THAT(run.err, Contains("handcentric: warning: " + std::to_string(expected.invalid) + " of 12 trials invalid") &&
-                          Contains("scene " + std::to_string(expected.first_invalid_scene) + ", ") &&
-                          Contains("flow/hand_centric") && Contains("--strict"));
+  CHECK_THAT(run.err,
+             Contains("handcentric: warning: " + std::to_string(expected.invalid) +
+                      " of 12 trials invalid") &&
+                 Contains("scene " + std::to_string(expected.first_invalid_scene) + ", ") &&
+                 Contains("flow/hand_centric") && Contains("--strict"));
 
   std::vector<std::string> strict = eval;
   strict.push_back("--strict");
@@ -190,7 +200,8 @@ TEST_CASE("eval_counts_a_diverging_model_as_invalid_trials_and_strict_stops_at_t
   CHECK(stopped.exit_code == 1);
   CHECK(stopped.out.empty());
   CHECK(std::count(stopped.err.begin(), stopped.err.end(), '\n') == 1);
-  CHECK_THAT(stopped.err, Contains("handcentric: error: scene " + std::to_string(expected.first_invalid_scene) + ": ") &&
+  CHECK_THAT(stopped.err, Contains("handcentric: error: scene " +
+                                   std::to_string(expected.first_invalid_scene) + ": ") &&
                               Contains("non-finite"));
   std::filesystem::remove(path);
 }

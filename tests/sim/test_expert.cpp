@@ -16,19 +16,23 @@ using namespace handcentric::sim;
 
 namespace {
 
-using DemoMaker = std::vector<RigidTransform> (*)(const TaskScene&, std::uint64_t index, const CollisionChecker&);
+using DemoMaker = std::vector<RigidTransform> (*)(const TaskScene&, std::uint64_t index,
+                                                  const CollisionChecker&);
 
-std::vector<RigidTransform> real_expert(const TaskScene& scene, std::uint64_t index, const CollisionChecker& checker) {
+std::vector<RigidTransform> real_expert(const TaskScene& scene, std::uint64_t index,
+                                        const CollisionChecker& checker) {
   const ExpertRun run = expert_demo(scene, 9, index, checker);
   return run.demos.empty() ? std::vector<RigidTransform>{} : run.demos.front().world_T_hand;
 }
 
 // A planted fault: plans in a frame at the hole's position but aligned with the world axes.
-std::vector<RigidTransform> world_axes_expert(const TaskScene& scene, std::uint64_t index, const CollisionChecker& checker) {
+std::vector<RigidTransform> world_axes_expert(const TaskScene& scene, std::uint64_t index,
+                                              const CollisionChecker& checker) {
   const Eigen::Vector3d& p = scene.world_T_hole.translation();
   const RigidTransform world_T_frame = RigidTransform::planar(0.0, p.x(), p.y());
   std::mt19937_64 rng(stream_seed(9, index));
-  const ExpertPlan plan = plan_in_hole_frame(world_T_frame.inverse_compose(scene.world_T_hand_start), rng, checker);
+  const ExpertPlan plan =
+      plan_in_hole_frame(world_T_frame.inverse_compose(scene.world_T_hand_start), rng, checker);
   std::vector<RigidTransform> out;
   for (const auto& frame_T_hand : plan.hole_T_hand) out.push_back(world_T_frame * frame_T_hand);
   return out;
@@ -41,12 +45,16 @@ double equivariance_error(DemoMaker make, int n) {
   double worst = 0.0;
   const auto scenes = sample_scenes(SceneDistribution::train(), n, 4);
   for (int i = 0; i < n; ++i) {
-    const RigidTransform g = RigidTransform::planar(2.0 * std::numbers::pi * uniform01(rng), 100.0 * uniform01(rng) - 50.0,
-                                                    100.0 * uniform01(rng) - 50.0);
-    const auto demo = make(scenes[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), checker);
-    const auto moved = make(g * scenes[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), checker);
+    const RigidTransform g =
+        RigidTransform::planar(2.0 * std::numbers::pi * uniform01(rng),
+                               100.0 * uniform01(rng) - 50.0, 100.0 * uniform01(rng) - 50.0);
+    const auto demo =
+        make(scenes[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), checker);
+    const auto moved =
+        make(g * scenes[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), checker);
     if (demo.size() != moved.size()) return INFINITY;
-    for (std::size_t t = 0; t < demo.size(); ++t) worst = std::max(worst, distance(moved[t], g * demo[t]));
+    for (std::size_t t = 0; t < demo.size(); ++t)
+      worst = std::max(worst, distance(moved[t], g * demo[t]));
   }
   return worst;
 }
@@ -57,8 +65,9 @@ TEST_CASE("expert_solves_at_least_99_percent_of_train_and_ood_scenes", "[experim
   const CollisionChecker checker;
   for (const auto& distribution : {SceneDistribution::train(), SceneDistribution::ood()}) {
     const ExpertRun run = expert_demos(sample_scenes(distribution, 300, 1), 1, checker);
-    WARN(distribution.name << ": solved " << run.solved_rate() << ", discard rate " << run.discard_rate() << " ("
-                           << run.discarded << " of " << run.solutions << " solutions)");
+    WARN(distribution.name << ": solved " << run.solved_rate() << ", discard rate "
+                           << run.discard_rate() << " (" << run.discarded << " of " << run.solutions
+                           << " solutions)");
     CHECK(run.solved_rate() >= 0.99);
     CHECK(run.demos.size() == static_cast<std::size_t>(run.scenes - run.unsolved));
   }
@@ -78,8 +87,9 @@ TEST_CASE("expert_demos_are_collision_free_inserted_and_within_the_step_limits",
       const RigidTransform step = demo.world_T_hand[t].inverse_compose(demo.world_T_hand[t + 1]);
       CHECK(step.translation().norm() <= kMaxStepCm);
       CHECK(step.rotation().angle() <= kMaxStepDeg * std::numbers::pi / 180.0);
-      CHECK_FALSE(checker.motion_collides(demo.world_T_hole.inverse_compose(demo.world_T_hand[t]),
-                                          demo.world_T_hole.inverse_compose(demo.world_T_hand[t + 1])));
+      CHECK_FALSE(
+          checker.motion_collides(demo.world_T_hole.inverse_compose(demo.world_T_hand[t]),
+                                  demo.world_T_hole.inverse_compose(demo.world_T_hand[t + 1])));
     }
     CHECK(is_inserted(demo.world_T_hole.inverse_compose(demo.world_T_hand.back())));
   }
@@ -114,8 +124,9 @@ TEST_CASE("the_same_seed_gives_the_same_demos_bit_for_bit", "[unit]") {
 }
 
 TEST_CASE("resampling_keeps_the_ends_and_the_step_limits", "[unit]") {
-  const std::vector<RigidTransform> path = {RigidTransform::planar(0.7, 3.0, 15.0), RigidTransform::planar(-0.2, -2.0, 10.0),
-                                            RigidTransform::planar(0.0, 0.0, 9.0), RigidTransform::planar(0.0, 0.0, 2.5)};
+  const std::vector<RigidTransform> path = {
+      RigidTransform::planar(0.7, 3.0, 15.0), RigidTransform::planar(-0.2, -2.0, 10.0),
+      RigidTransform::planar(0.0, 0.0, 9.0), RigidTransform::planar(0.0, 0.0, 2.5)};
   const auto steps = resample_at_control_step(path);
   CHECK(steps.front().matrix() == path.front().matrix());
   CHECK(steps.back().matrix() == path.back().matrix());
@@ -124,7 +135,8 @@ TEST_CASE("resampling_keeps_the_ends_and_the_step_limits", "[unit]") {
     CHECK(step.translation().norm() <= kMaxStepCm);
     CHECK(step.rotation().angle() <= kMaxStepDeg * std::numbers::pi / 180.0);
   }
-  CHECK(steps.size() >= 2 + static_cast<std::size_t>((std::hypot(5.0, 5.0) + 2.0 + 6.5) / kMaxStepCm) - 2);
+  CHECK(steps.size() >=
+        2 + static_cast<std::size_t>((std::hypot(5.0, 5.0) + 2.0 + 6.5) / kMaxStepCm) - 2);
   CHECK_THROWS_AS(resample_at_control_step({}), InvalidArgument);
   CHECK_THROWS_AS(resample_at_control_step(path, 0.0), InvalidArgument);
 }
@@ -138,14 +150,16 @@ TEST_CASE("without_the_collision_term_invalid_solutions_are_discarded_and_counte
   const auto scenes = sample_scenes(SceneDistribution::train(), 200, 12);
   const ExpertRun raw = expert_demos(scenes, 12, checker, no_collision_term);
   const ExpertRun optimized = expert_demos(scenes, 12, checker);
-  WARN("discard rate without the collision term " << raw.discard_rate() << ", with it " << optimized.discard_rate());
+  WARN("discard rate without the collision term " << raw.discard_rate() << ", with it "
+                                                  << optimized.discard_rate());
   CHECK(raw.discarded > 0);
   CHECK(raw.solutions == raw.discarded + static_cast<int>(raw.demos.size()));
   CHECK(optimized.discarded < raw.discarded);
   for (const Demo& demo : raw.demos) {  // whatever survived is valid
     for (std::size_t t = 0; t + 1 < demo.world_T_hand.size(); ++t) {
-      REQUIRE_FALSE(checker.motion_collides(demo.world_T_hole.inverse_compose(demo.world_T_hand[t]),
-                                            demo.world_T_hole.inverse_compose(demo.world_T_hand[t + 1])));
+      REQUIRE_FALSE(
+          checker.motion_collides(demo.world_T_hole.inverse_compose(demo.world_T_hand[t]),
+                                  demo.world_T_hole.inverse_compose(demo.world_T_hand[t + 1])));
     }
   }
 }
@@ -156,13 +170,16 @@ namespace {
 // before the hand first stands on the hole axis upright (the start of the straight insertion).
 std::pair<double, double> arrival_jump(const ExpertOptions& options) {
   const CollisionChecker checker;
-  const ExpertRun run = expert_demos(sample_scenes(SceneDistribution::train(), 60, 21), 21, checker, options);
+  const ExpertRun run =
+      expert_demos(sample_scenes(SceneDistribution::train(), 60, 21), 21, checker, options);
   std::vector<double> lateral, angular;
   for (const Demo& demo : run.demos) {
     for (std::size_t t = 1; t < demo.world_T_hand.size(); ++t) {
-      const Eigen::Vector3d q = planar_coordinates(demo.world_T_hole.inverse_compose(demo.world_T_hand[t]));
+      const Eigen::Vector3d q =
+          planar_coordinates(demo.world_T_hole.inverse_compose(demo.world_T_hand[t]));
       if (std::abs(q(0)) > 1e-9 || std::abs(q(1)) > 1e-9) continue;
-      const Eigen::Vector3d before = planar_coordinates(demo.world_T_hole.inverse_compose(demo.world_T_hand[t - 1]));
+      const Eigen::Vector3d before =
+          planar_coordinates(demo.world_T_hole.inverse_compose(demo.world_T_hand[t - 1]));
       lateral.push_back(std::abs(before(1)));
       angular.push_back(std::abs(before(0)) * 180.0 / std::numbers::pi);
       break;
@@ -194,6 +211,7 @@ TEST_CASE("mutant_approach_without_the_arrival_term_turns_down_in_one_step", "[u
   ExpertOptions negative;
   negative.arrival_weight = -1.0;
   std::mt19937_64 rng(1);
-  CHECK_THROWS_AS(plan_in_hole_frame(RigidTransform::planar(0.0, 0.0, 15.0), rng, CollisionChecker(), negative),
-                  InvalidArgument);
+  CHECK_THROWS_AS(
+      plan_in_hole_frame(RigidTransform::planar(0.0, 0.0, 15.0), rng, CollisionChecker(), negative),
+      InvalidArgument);
 }

@@ -20,15 +20,18 @@ namespace {
 constexpr double kImageTolerance = 1e-9;
 
 /// The hand 1 cm above the opening, upright and centred: where the insertion starts.
-const RigidTransform kSlotTHandPreInsertion = RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, kBladeLength + 1.0));
+const RigidTransform kSlotTHandPreInsertion =
+    RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, kBladeLength + 1.0));
 
 double largest_difference(const DepthImage& a, const DepthImage& b) {
   double worst = 0.0;
-  for (std::size_t i = 0; i < a.values.size(); ++i) worst = std::max(worst, std::abs(a.values[i] - b.values[i]));
+  for (std::size_t i = 0; i < a.values.size(); ++i)
+    worst = std::max(worst, std::abs(a.values[i] - b.values[i]));
   return worst;
 }
 
-using Renderer = DepthImage (*)(const RigidTransform& world_T_hand, const RigidTransform& world_T_slot);
+using Renderer = DepthImage (*)(const RigidTransform& world_T_hand,
+                                const RigidTransform& world_T_slot);
 
 DepthImage hand_camera(const RigidTransform& world_T_hand, const RigidTransform& world_T_slot) {
   return render_depth(BladeSlotGeometry(), DepthCamera(), world_T_hand, world_T_slot);
@@ -37,7 +40,8 @@ DepthImage hand_camera(const RigidTransform& world_T_hand, const RigidTransform&
 // A planted fault: the camera fixed in the world, 80 cm above the origin looking down, instead
 // of on the hand.
 DepthImage world_camera(const RigidTransform&, const RigidTransform& world_T_slot) {
-  return render_depth(BladeSlotGeometry(), DepthCamera(), RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, 80.0)),
+  return render_depth(BladeSlotGeometry(), DepthCamera(),
+                      RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, 80.0)),
                       world_T_slot);
 }
 
@@ -52,7 +56,8 @@ auto image_is_invariant(Renderer render) {
     const RigidTransform world_T_hand =
         *rc::gen::element(0, 1) == 0
             ? scene.world_T_hand_start
-            : scene.world_T_slot * RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, kBladeLength + 1.0 - depth));
+            : scene.world_T_slot * RigidTransform::from_translation(
+                                       Eigen::Vector3d(0.0, 0.0, kBladeLength + 1.0 - depth));
     const RigidTransform g = *props::group_element(props::Group::se3);
     const DepthImage original = render(world_T_hand, scene.world_T_slot);
     const DepthImage moved = render(g * world_T_hand, g * scene.world_T_slot);
@@ -68,13 +73,15 @@ auto image_is_invariant(Renderer render) {
 }  // namespace
 
 TEST_CASE("insert3d_hand_camera_depth_image_is_se3_invariant", "[property]") {
-  props::require_property("depth(g * scene) = depth(scene) within 1e-9", image_is_invariant(hand_camera));
+  props::require_property("depth(g * scene) = depth(scene) within 1e-9",
+                          image_is_invariant(hand_camera));
 }
 
 TEST_CASE("mutant_insert3d_world_fixed_camera_is_not_se3_invariant", "[property]") {
-  const props::PropertyOutcome outcome =
-      props::require_falsified("a world-fixed camera's depth image under se3", image_is_invariant(world_camera));
-  CHECK_THAT(outcome.message, Catch::Matchers::Contains("largest_difference"));  // the invariance failed
+  const props::PropertyOutcome outcome = props::require_falsified(
+      "a world-fixed camera's depth image under se3", image_is_invariant(world_camera));
+  CHECK_THAT(outcome.message,
+             Catch::Matchers::Contains("largest_difference"));  // the invariance failed
 }
 
 TEST_CASE("insert3d_the_hand_camera_sees_the_slot_at_pre_insertion", "[unit]") {
@@ -93,12 +100,14 @@ TEST_CASE("insert3d_the_hand_camera_sees_the_slot_at_pre_insertion", "[unit]") {
   const Eigen::Vector3d ray = slot_T_camera.rotation() * Eigen::Vector3d(0.5 / f, 0.5 / f, 1.0);
   const double t = -slot_T_camera.translation().z() / ray.z();
   const Eigen::Vector3d hit = slot_T_camera.translation() + t * ray;
-  REQUIRE((hit.x() > geometry.inner_half_x() && hit.x() < geometry.inner_half_x() + kSlotWallThickness));
+  REQUIRE((hit.x() > geometry.inner_half_x() &&
+           hit.x() < geometry.inner_half_x() + kSlotWallThickness));
   CHECK(std::abs(image.at(12, 16) - t) < 1e-12);
   // The slot's gap: a pixel whose ray enters the opening reads deeper than the block's top.
-  const double deepest = *std::max_element(image.values.begin(), image.values.end(), [&](double a, double b) {
-    return (a < camera.max_range ? a : 0.0) < (b < camera.max_range ? b : 0.0);
-  });
+  const double deepest =
+      *std::max_element(image.values.begin(), image.values.end(), [&](double a, double b) {
+        return (a < camera.max_range ? a : 0.0) < (b < camera.max_range ? b : 0.0);
+      });
   CHECK(deepest > t + 1.0);
 }
 
@@ -123,21 +132,25 @@ TEST_CASE("insert3d_ray_box_hits_from_outside_inside_and_misses", "[unit]") {
   CHECK(ray_box_hit(Eigen::Vector3d(0.0, 0.0, 2.5), Eigen::Vector3d(0.0, 0.0, 1.0), box) == 0.0);
   CHECK(ray_box_hit(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.0, 0.0, -1.0), box) < 0.0);
   CHECK(ray_box_hit(Eigen::Vector3d(2.0, 0.0, 0.0), Eigen::Vector3d(0.0, 0.0, 1.0), box) < 0.0);
-  CHECK(ray_box_hit(Eigen::Vector3d(-5.0, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 1.0), box) < 0.0);  // passes beside
-  CHECK(ray_box_hit(Eigen::Vector3d(-3.5, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 1.0), box) == Approx(2.5));  // enters x = -1
-  CHECK(ray_box_hit(Eigen::Vector3d(-3.5, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 1.0).normalized(), box) ==
-        Approx(2.5 * std::sqrt(2.0)));
+  CHECK(ray_box_hit(Eigen::Vector3d(-5.0, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 1.0), box) <
+        0.0);  // passes beside
+  CHECK(ray_box_hit(Eigen::Vector3d(-3.5, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 1.0), box) ==
+        Approx(2.5));  // enters x = -1
+  CHECK(ray_box_hit(Eigen::Vector3d(-3.5, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 1.0).normalized(),
+                    box) == Approx(2.5 * std::sqrt(2.0)));
 }
 
 TEST_CASE("insert3d_a_bad_camera_is_rejected_with_the_value_and_the_fix", "[unit]") {
   const BladeSlotGeometry geometry;
   DepthCamera camera;
   camera.width = 0;
-  CHECK_THROWS_WITH(render_depth(geometry, camera, RigidTransform()), Catch::Matchers::Contains("0 x 24") &&
-                                                                          Catch::Matchers::Contains("e.g. 32 x 24"));
+  CHECK_THROWS_WITH(
+      render_depth(geometry, camera, RigidTransform()),
+      Catch::Matchers::Contains("0 x 24") && Catch::Matchers::Contains("e.g. 32 x 24"));
   camera = DepthCamera();
   camera.horizontal_fov_deg = 180.0;
-  CHECK_THROWS_WITH(render_depth(geometry, camera, RigidTransform()), Catch::Matchers::Contains("180"));
+  CHECK_THROWS_WITH(render_depth(geometry, camera, RigidTransform()),
+                    Catch::Matchers::Contains("180"));
   camera = DepthCamera();
   camera.max_range = std::nan("");
   CHECK_THROWS_AS(render_depth(geometry, camera, RigidTransform()), InvalidArgument);

@@ -13,7 +13,9 @@ using namespace handcentric::sim::insert3d;
 
 namespace {
 
-RigidTransform at(double x, double y, double z) { return RigidTransform::from_translation(Eigen::Vector3d(x, y, z)); }
+RigidTransform at(double x, double y, double z) {
+  return RigidTransform::from_translation(Eigen::Vector3d(x, y, z));
+}
 
 /// The hand at (0, 0, z) turned by `angle` about its own axis `axis` (unit).
 RigidTransform tilted(const Eigen::Vector3d& axis, double angle, double z) {
@@ -31,12 +33,14 @@ bool continuous(const CollisionChecker& checker, const RigidTransform& a, const 
 // block are not flagged.
 bool catches_motions_through_walls(MotionCheck check) {
   const CollisionChecker checker;
-  const RigidTransform inside = at(0.0, 0.0, 4.0);       // tip 4 deep, centred
-  const RigidTransform far_right = at(20.0, 0.0, 4.0);   // well beyond the +x plate
-  const RigidTransform far_back = at(0.0, 20.0, 4.0);    // well beyond the +y end wall
-  if (checker.collides(inside) || checker.collides(far_right) || checker.collides(far_back)) return false;
-  if (!check(checker, inside, far_right)) return false;  // through the +x plate in one 20 cm command
-  if (!check(checker, inside, far_back)) return false;   // through the +y end wall
+  const RigidTransform inside = at(0.0, 0.0, 4.0);      // tip 4 deep, centred
+  const RigidTransform far_right = at(20.0, 0.0, 4.0);  // well beyond the +x plate
+  const RigidTransform far_back = at(0.0, 20.0, 4.0);   // well beyond the +y end wall
+  if (checker.collides(inside) || checker.collides(far_right) || checker.collides(far_back))
+    return false;
+  if (!check(checker, inside, far_right))
+    return false;                                       // through the +x plate in one 20 cm command
+  if (!check(checker, inside, far_back)) return false;  // through the +y end wall
   // sweeping across the block's top with the tip 0.001 below it: free at x = -10, 0, +10
   const double low = kBladeLength - 0.001;
   if (checker.collides(at(-10.0, 0.0, low)) || checker.collides(at(0.0, 0.0, low))) return false;
@@ -51,17 +55,19 @@ bool catches_motions_through_walls(MotionCheck check) {
 
 TEST_CASE("insert3d_a_centred_blade_in_the_slot_does_not_collide", "[unit]") {
   const CollisionChecker checker;
-  for (const double z : {9.0, 8.0, 5.0, 2.5, 2.01}) {  // tip 1 above, at the opening, 3 / 5.5 / 5.99 deep
+  for (const double z :
+       {9.0, 8.0, 5.0, 2.5, 2.01}) {  // tip 1 above, at the opening, 3 / 5.5 / 5.99 deep
     INFO("hand at z = " << z);
     CHECK_FALSE(checker.collides(at(0.0, 0.0, z)));
   }
   // the clearance, 0.1 per side, seen by FCL to 1e-9
   CHECK(std::abs(checker.distance(at(0.0, 0.0, 4.0)) - 0.1) < 1e-9);
   CHECK(std::abs(checker.distance(at(0.0, 0.0, 2.01)) - 0.01) < 1e-9);  // the bottom is nearer
-  CHECK(checker.collides(at(0.0, 0.0, 2.0 - 1e-3)));                     // tip into the bottom
+  CHECK(checker.collides(at(0.0, 0.0, 2.0 - 1e-3)));                    // tip into the bottom
 }
 
-TEST_CASE("insert3d_a_blade_shifted_by_more_than_the_clearance_collides_and_by_less_does_not", "[unit]") {
+TEST_CASE("insert3d_a_blade_shifted_by_more_than_the_clearance_collides_and_by_less_does_not",
+          "[unit]") {
   const CollisionChecker checker;
   for (const double sign : {-1.0, 1.0}) {
     CHECK(checker.collides(at(sign * 0.11, 0.0, 4.0)));  // into a plate
@@ -85,7 +91,8 @@ TEST_CASE("insert3d_a_blade_tilted_by_the_angle_that_closes_the_gap_collides", "
     double half_gap;
   } cases[] = {{Eigen::Vector3d::UnitY(), 0.2, 0.3}, {Eigen::Vector3d::UnitX(), 2.0, 2.1}};
   for (const auto& c : cases) {
-    const double phi_star = std::asin(c.half_gap / std::hypot(c.half_size, 8.0)) - std::atan2(c.half_size, 8.0);
+    const double phi_star =
+        std::asin(c.half_gap / std::hypot(c.half_size, 8.0)) - std::atan2(c.half_size, 8.0);
     REQUIRE(phi_star > 0.0);
     INFO("axis " << c.axis.transpose() << ", phi* = " << phi_star);
     for (const double sign : {-1.0, 1.0}) {
@@ -107,7 +114,8 @@ TEST_CASE("mutant_insert3d_fixed_four_sample_motion_check_is_caught", "[unit]") 
   CHECK_FALSE(catches_motions_through_walls(testing::four_samples<CollisionChecker, interpolate>));
 }
 
-TEST_CASE("insert3d_advancement_takes_big_steps_far_from_the_block_and_small_ones_near_it", "[unit]") {
+TEST_CASE("insert3d_advancement_takes_big_steps_far_from_the_block_and_small_ones_near_it",
+          "[unit]") {
   const CollisionChecker checker;
   const std::uint64_t before = checker.queries();
   CHECK_FALSE(checker.motion_collides(at(-20.0, 0.0, 30.0), at(20.0, 0.0, 30.0)));
@@ -120,9 +128,12 @@ TEST_CASE("insert3d_advancement_takes_big_steps_far_from_the_block_and_small_one
 }
 
 TEST_CASE("insert3d_interpolation_commutes_with_global_transforms_and_hits_both_ends", "[unit]") {
-  const RigidTransform a(Rotation::exp(Eigen::Vector3d(0.3, -2.0, 1.0)), Eigen::Vector3d(1.0, 2.0, 3.0));
-  const RigidTransform b(Rotation::exp(Eigen::Vector3d(-1.0, 0.5, 2.5)), Eigen::Vector3d(-4.0, 0.0, 7.0));
-  const RigidTransform g(Rotation::exp(Eigen::Vector3d(2.0, 1.0, -0.5)), Eigen::Vector3d(30.0, -20.0, 5.0));
+  const RigidTransform a(Rotation::exp(Eigen::Vector3d(0.3, -2.0, 1.0)),
+                         Eigen::Vector3d(1.0, 2.0, 3.0));
+  const RigidTransform b(Rotation::exp(Eigen::Vector3d(-1.0, 0.5, 2.5)),
+                         Eigen::Vector3d(-4.0, 0.0, 7.0));
+  const RigidTransform g(Rotation::exp(Eigen::Vector3d(2.0, 1.0, -0.5)),
+                         Eigen::Vector3d(30.0, -20.0, 5.0));
   CHECK(distance(interpolate(a, b, 0.0), a) < 1e-12);
   CHECK(distance(interpolate(a, b, 1.0), b) < 1e-12);
   for (const double s : {0.1, 0.5, 0.9}) {
@@ -133,7 +144,8 @@ TEST_CASE("insert3d_interpolation_commutes_with_global_transforms_and_hits_both_
 TEST_CASE("insert3d_a_bad_clearance_is_rejected_with_the_value_and_the_fix", "[unit]") {
   BladeSlotGeometry geometry;
   geometry.clearance_per_side = -0.1;
-  CHECK_THROWS_WITH(CollisionChecker{geometry}, Catch::Matchers::Contains("-0.1") && Catch::Matchers::Contains("e.g. 0.1"));
+  CHECK_THROWS_WITH(CollisionChecker{geometry},
+                    Catch::Matchers::Contains("-0.1") && Catch::Matchers::Contains("e.g. 0.1"));
   geometry.clearance_per_side = std::nan("");
   CHECK_THROWS_AS(CollisionChecker{geometry}, InvalidArgument);
   geometry.clearance_per_side = 2.0;

@@ -54,8 +54,9 @@ TEST_CASE("insert3d_demo_files_round_trip_bit_for_bit_and_record_their_task", "[
 TEST_CASE("insert3d_and_2d_demo_files_are_not_mixed_up", "[unit]") {
   const std::string path3d = temp_path("mix3d.jsonl");
   save_demos(path3d, some_demos(1));
-  CHECK_THROWS_WITH(sim::load_demos(path3d), Catch::Matchers::Contains("task 'insert3d', not 'peg2d'") &&
-                                                 Catch::Matchers::Contains("--task insert3d"));
+  CHECK_THROWS_WITH(sim::load_demos(path3d),
+                    Catch::Matchers::Contains("task 'insert3d', not 'peg2d'") &&
+                        Catch::Matchers::Contains("--task insert3d"));
   const std::string path2d = temp_path("mix2d.jsonl");
   sim::save_demos(path2d, {sim::Demo{RigidTransform(), {RigidTransform::planar(0.1, 1.0, 2.0)}}});
   CHECK_THAT(first_line(path2d), Catch::Matchers::Contains("\"task\":\"peg2d\""));
@@ -64,7 +65,8 @@ TEST_CASE("insert3d_and_2d_demo_files_are_not_mixed_up", "[unit]") {
   // a 2D file written before files named their task is still a 2D file
   {
     std::ofstream out(path2d);
-    out << R"({"clearance":0.1,"count":0,"format":"handcentric-demos","version":1})" << "\n";
+    out << R"({"clearance":0.1,"count":0,"format":"handcentric-demos","version":1})"
+        << "\n";
   }
   CHECK(sim::load_demos(path2d).empty());
   CHECK_THROWS_WITH(load_demos(path2d), Catch::Matchers::Contains("task 'peg2d'"));
@@ -81,7 +83,8 @@ TEST_CASE("insert3d_training_scenes_see_the_four_opening_corners", "[unit]") {
   REQUIRE(last.hand_points.size() == 4u);
   REQUIRE(last.history_length() == 2);
   REQUIRE(last.chunk_length() == 16);
-  const auto corners = opening_corners_in_hand(geometry, last.world_T_hand0(), demos[1].world_T_slot);
+  const auto corners =
+      opening_corners_in_hand(geometry, last.world_T_hand0(), demos[1].world_T_slot);
   for (std::size_t k = 0; k < 4; ++k) CHECK((last.hand_points[k] - corners[k]).norm() == 0.0);
   CHECK_THROWS_AS(training_scenes(demos, 0, 16, 3), InvalidArgument);
 }

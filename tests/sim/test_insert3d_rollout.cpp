@@ -21,7 +21,8 @@ class WorldDown final : public ChunkPolicy {
   std::vector<RigidTransform> act(const Scene& observation, std::uint64_t) const override {
     std::vector<RigidTransform> chunk;
     for (int k = 1; k <= 16; ++k) {
-      chunk.push_back(RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -0.49 * k)) * observation.world_T_hand0());
+      chunk.push_back(RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -0.49 * k)) *
+                      observation.world_T_hand0());
     }
     return chunk;
   }
@@ -32,7 +33,8 @@ class Jump final : public ChunkPolicy {
  public:
   std::string name() const override { return "jump"; }
   std::vector<RigidTransform> act(const Scene& observation, std::uint64_t) const override {
-    return {observation.world_T_hand0() * RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -10.0))};
+    return {observation.world_T_hand0() *
+            RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -10.0))};
   }
 };
 
@@ -80,14 +82,16 @@ TEST_CASE("insert3d_closed_loop_expert_inserts_on_train_ood_and_random_se3_scene
 }
 
 TEST_CASE("insert3d_closed_loop_rollouts_are_se3_equivariant", "[property]") {
-  const auto outcome = props::run_property("rollout(g * scene) = g * rollout(scene)",
-                                           rollouts_are_equivariant(std::make_shared<ClosedLoopExpert>()), rollout_params());
+  const auto outcome = props::run_property(
+      "rollout(g * scene) = g * rollout(scene)",
+      rollouts_are_equivariant(std::make_shared<ClosedLoopExpert>()), rollout_params());
   INFO(outcome.message);
   REQUIRE(outcome.passed);
 }
 
 TEST_CASE("mutant_insert3d_a_policy_moving_along_world_axes_is_not_equivariant", "[property]") {
-  const auto outcome = props::run_property("world-down rollouts under se3", rollouts_are_equivariant(std::make_shared<WorldDown>()),
+  const auto outcome = props::run_property("world-down rollouts under se3",
+                                           rollouts_are_equivariant(std::make_shared<WorldDown>()),
                                            rollout_params(), props::Expect::failure);
   CHECK_FALSE(outcome.passed);
 }
@@ -103,7 +107,8 @@ TEST_CASE("insert3d_the_slot_is_read_back_from_the_four_corners", "[unit]") {
 
 TEST_CASE("insert3d_commands_beyond_the_step_limits_are_clipped_and_counted", "[unit]") {
   const CollisionChecker checker;
-  const TaskScene scene{RigidTransform(), RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, 20.0))};
+  const TaskScene scene{RigidTransform(),
+                        RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, 20.0))};
   RolloutOptions options;
   options.max_replans = 3;
   const Rollout result = rollout(Jump(), scene, 1, checker, options);
@@ -112,5 +117,6 @@ TEST_CASE("insert3d_commands_beyond_the_step_limits_are_clipped_and_counted", "[
   CHECK(std::abs(result.world_T_hand[1].translation().z() - (20.0 - kMaxStepCm)) < 1e-12);
   CHECK(result.outcome == Outcome::timeout);
   options.execute = 0;
-  CHECK_THROWS_WITH(rollout(Jump(), scene, 1, checker, options), Catch::Matchers::Contains("got 0"));
+  CHECK_THROWS_WITH(rollout(Jump(), scene, 1, checker, options),
+                    Catch::Matchers::Contains("got 0"));
 }

@@ -12,7 +12,9 @@ using namespace handcentric::sim::insert3d;
 
 namespace {
 
-double degrees(double radians) { return radians * 180.0 / std::numbers::pi; }
+double degrees(double radians) {
+  return radians * 180.0 / std::numbers::pi;
+}
 
 /// The angle (deg) between a frame's +z and world +z.
 double tilt_deg(const RigidTransform& world_T_frame) {
@@ -23,16 +25,19 @@ using Sampler = TaskScene (*)(const SceneDistribution&, std::uint64_t, std::uint
 
 // A planted fault: the start kept at the slot's position but in world axes (not turned with
 // the slot), so non-train starts are not transformed train starts.
-TaskScene start_in_world_axes(const SceneDistribution& distribution, std::uint64_t seed, std::uint64_t index) {
+TaskScene start_in_world_axes(const SceneDistribution& distribution, std::uint64_t seed,
+                              std::uint64_t index) {
   TaskScene scene = sample_scene(distribution, seed, index);
   const RigidTransform slot_T_hand = scene.world_T_slot.inverse_compose(scene.world_T_hand_start);
-  scene.world_T_hand_start = RigidTransform::from_translation(scene.world_T_slot.translation()) * slot_T_hand;
+  scene.world_T_hand_start =
+      RigidTransform::from_translation(scene.world_T_slot.translation()) * slot_T_hand;
   return scene;
 }
 
-/// Claim: scene i of `distribution` = g_i * train scene i, g_i = world_T_slot * world_T_slot_train^-1;
-/// returns the largest pose error over n scenes.
-double is_a_global_transform_of_train(Sampler sample, const SceneDistribution& distribution, int n) {
+/// Claim: scene i of `distribution` = g_i * train scene i, g_i = world_T_slot *
+/// world_T_slot_train^-1; returns the largest pose error over n scenes.
+double is_a_global_transform_of_train(Sampler sample, const SceneDistribution& distribution,
+                                      int n) {
   double worst = 0.0;
   for (int i = 0; i < n; ++i) {
     const TaskScene train = sample(SceneDistribution::train(), 7, static_cast<std::uint64_t>(i));
@@ -50,13 +55,15 @@ const SceneDistribution kRotated = SceneDistribution::rotate(Eigen::Vector3d(30.
 }  // namespace
 
 TEST_CASE("insert3d_every_non_train_scene_is_a_global_transform_of_a_train_scene", "[property]") {
-  for (const SceneDistribution& distribution : {SceneDistribution::ood(), SceneDistribution::random_se3(), kRotated}) {
+  for (const SceneDistribution& distribution :
+       {SceneDistribution::ood(), SceneDistribution::random_se3(), kRotated}) {
     INFO(distribution.name());
     CHECK(is_a_global_transform_of_train(sample_scene, distribution, 500) < 1e-11);
   }
   // the fixed rotation is exactly that rotation, about the world origin
   for (int i = 0; i < 20; ++i) {
-    const TaskScene train = sample_scene(SceneDistribution::train(), 7, static_cast<std::uint64_t>(i));
+    const TaskScene train =
+        sample_scene(SceneDistribution::train(), 7, static_cast<std::uint64_t>(i));
     const TaskScene rotated = sample_scene(kRotated, 7, static_cast<std::uint64_t>(i));
     const RigidTransform g(rotation_from_xyz_deg(kRotated.rotate_deg), Eigen::Vector3d::Zero());
     CHECK(distance(g * train.world_T_slot, rotated.world_T_slot) < 1e-12);
@@ -64,7 +71,8 @@ TEST_CASE("insert3d_every_non_train_scene_is_a_global_transform_of_a_train_scene
 }
 
 TEST_CASE("mutant_insert3d_start_drawn_in_world_axes_is_caught", "[property]") {
-  for (const SceneDistribution& distribution : {SceneDistribution::ood(), SceneDistribution::random_se3(), kRotated}) {
+  for (const SceneDistribution& distribution :
+       {SceneDistribution::ood(), SceneDistribution::random_se3(), kRotated}) {
     INFO(distribution.name());
     CHECK(is_a_global_transform_of_train(start_in_world_axes, distribution, 500) > 1.0);
   }
@@ -78,7 +86,8 @@ TEST_CASE("insert3d_scenes_respect_the_stated_ranges", "[property]") {
     const Eigen::Vector3d& p = slot_T_hand.translation();
     CHECK((std::abs(p.x()) <= kStartMaxAbsXY && std::abs(p.y()) <= kStartMaxAbsXY));
     CHECK((p.z() >= kStartMinZ && p.z() <= kStartMaxZ));
-    CHECK(tilt_deg(slot_T_hand) <= kStartMaxTiltDeg + 1e-9);  // the blade's axis within 25 deg of the slot's
+    CHECK(tilt_deg(slot_T_hand) <=
+          kStartMaxTiltDeg + 1e-9);  // the blade's axis within 25 deg of the slot's
     CHECK(tilt_deg(scene.world_T_slot) <= kSlotMaxTiltDeg + 1e-9);
     const Eigen::Vector3d& slot = scene.world_T_slot.translation();
     CHECK((std::abs(slot.x()) <= kWorkspaceHalfWidth && std::abs(slot.y()) <= kWorkspaceHalfWidth));
@@ -102,7 +111,8 @@ TEST_CASE("insert3d_scenes_respect_the_stated_ranges", "[property]") {
 
 TEST_CASE("insert3d_the_same_seed_gives_the_same_scenes_bit_for_bit", "[unit]") {
   for (const SceneDistribution& distribution :
-       {SceneDistribution::train(), SceneDistribution::ood(), SceneDistribution::random_se3(), kRotated}) {
+       {SceneDistribution::train(), SceneDistribution::ood(), SceneDistribution::random_se3(),
+        kRotated}) {
     INFO(distribution.name());
     const auto a = sample_scenes(distribution, 30, 11);
     const auto b = sample_scenes(distribution, 30, 11);
@@ -115,7 +125,8 @@ TEST_CASE("insert3d_the_same_seed_gives_the_same_scenes_bit_for_bit", "[unit]") 
     }
     CHECK(differ == 30);
     // scene i does not depend on how many scenes are drawn
-    CHECK(sample_scene(distribution, 11, 29).world_T_hand_start.matrix() == a[29].world_T_hand_start.matrix());
+    CHECK(sample_scene(distribution, 11, 29).world_T_hand_start.matrix() ==
+          a[29].world_T_hand_start.matrix());
   }
 }
 
@@ -128,13 +139,16 @@ TEST_CASE("insert3d_xyz_euler_angles_turn_about_x_then_y_then_z_of_the_turned_fr
 }
 
 TEST_CASE("insert3d_bad_distribution_names_and_rotations_are_rejected_with_the_forms", "[unit]") {
-  CHECK_THROWS_WITH(SceneDistribution::parse("sideways"), Catch::Matchers::Contains("sideways") &&
-                                                              Catch::Matchers::Contains("random-se3"));
+  CHECK_THROWS_WITH(
+      SceneDistribution::parse("sideways"),
+      Catch::Matchers::Contains("sideways") && Catch::Matchers::Contains("random-se3"));
   for (const char* bad : {"90,0", "90,0,0,1", "a,b,c", "90,nan,0", "", "90,,0"}) {
     INFO(bad);
-    CHECK_THROWS_WITH(SceneDistribution::parse_rotate_deg(bad), Catch::Matchers::Contains("RX,RY,RZ"));
+    CHECK_THROWS_WITH(SceneDistribution::parse_rotate_deg(bad),
+                      Catch::Matchers::Contains("RX,RY,RZ"));
   }
   CHECK(SceneDistribution::parse_rotate_deg("90,0,45").name() == "rotate 90,0,45");
-  CHECK_THROWS_AS(SceneDistribution::rotate(Eigen::Vector3d(0.0, std::nan(""), 0.0)), InvalidArgument);
+  CHECK_THROWS_AS(SceneDistribution::rotate(Eigen::Vector3d(0.0, std::nan(""), 0.0)),
+                  InvalidArgument);
   CHECK_THROWS_AS(sample_scenes(SceneDistribution::train(), -1, 1), InvalidArgument);
 }

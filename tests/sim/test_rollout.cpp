@@ -25,7 +25,9 @@ class JumpPolicy final : public ChunkPolicy {
  public:
   explicit JumpPolicy(RigidTransform target) : target_(target) {}
   std::string name() const override { return "jump"; }
-  std::vector<RigidTransform> act(const Scene&, std::uint64_t) const override { return {16, target_}; }
+  std::vector<RigidTransform> act(const Scene&, std::uint64_t) const override {
+    return {16, target_};
+  }
 
  private:
   RigidTransform target_;
@@ -48,7 +50,8 @@ class WorldDownPolicy final : public ChunkPolicy {
   std::string name() const override { return "world_down"; }
   std::vector<RigidTransform> act(const Scene& o, std::uint64_t) const override {
     std::vector<RigidTransform> chunk;
-    for (int k = 1; k <= kChunkLength; ++k) chunk.push_back(RigidTransform::planar(0, 0, -0.5 * k) * o.world_T_hand0());
+    for (int k = 1; k <= kChunkLength; ++k)
+      chunk.push_back(RigidTransform::planar(0, 0, -0.5 * k) * o.world_T_hand0());
     return chunk;
   }
 };
@@ -61,12 +64,14 @@ double policy_equivariance_error(const ChunkPolicy& policy, int n) {
   for (int i = 0; i < n; ++i) {
     const TaskScene& scene = scenes[static_cast<std::size_t>(i)];
     const Scene o = observation(scene.world_T_hole, {scene.world_T_hand_start}, 2);
-    const RigidTransform g = RigidTransform::planar(2.0 * std::numbers::pi * uniform01(rng), 100.0 * uniform01(rng) - 50.0,
-                                                    100.0 * uniform01(rng) - 50.0);
+    const RigidTransform g =
+        RigidTransform::planar(2.0 * std::numbers::pi * uniform01(rng),
+                               100.0 * uniform01(rng) - 50.0, 100.0 * uniform01(rng) - 50.0);
     const auto chunk = policy.act(o, 5);
     const auto moved = policy.act(g * o, 5);
     if (chunk.size() != moved.size()) return INFINITY;
-    for (std::size_t k = 0; k < chunk.size(); ++k) worst = std::max(worst, distance(moved[k], g * chunk[k]));
+    for (std::size_t k = 0; k < chunk.size(); ++k)
+      worst = std::max(worst, distance(moved[k], g * chunk[k]));
   }
   return worst;
 }
@@ -78,8 +83,8 @@ TEST_CASE("the_closed_loop_expert_succeeds_on_train_and_ood_scenes", "[experimen
   const ExpertPolicy expert;
   for (const auto& distribution : {SceneDistribution::train(), SceneDistribution::ood()}) {
     const RolloutSummary summary = evaluate(expert, sample_scenes(distribution, 40, 3), checker, 3);
-    INFO(distribution.name << ": " << summary.success << " successes, " << summary.collision << " collisions, "
-                           << summary.timeout << " timeouts");
+    INFO(distribution.name << ": " << summary.success << " successes, " << summary.collision
+                           << " collisions, " << summary.timeout << " timeouts");
     CHECK(summary.success >= 0.99 * summary.trials);
     CHECK(summary.clipped == 0);
   }
@@ -107,9 +112,11 @@ TEST_CASE("scripted_policies_give_each_outcome", "[unit]") {
   CHECK(down.outcome == Outcome::success);
   CHECK(down.steps == static_cast<int>(std::ceil((15.1 - 8.0 + 5.0) / 0.5)));
   // off the axis by 3 cm: lands on the wall
-  CHECK(rollout(StraightPolicy(), scene_at(0.0, 3.0, 15.0), checker, 1).outcome == Outcome::collision);
+  CHECK(rollout(StraightPolicy(), scene_at(0.0, 3.0, 15.0), checker, 1).outcome ==
+        Outcome::collision);
   // tilted by 2 degrees: the gap closes inside the hole
-  CHECK(rollout(StraightPolicy(), scene_at(2.0 * std::numbers::pi / 180.0, 0.0, 15.0), checker, 1).outcome == Outcome::collision);
+  CHECK(rollout(StraightPolicy(), scene_at(2.0 * std::numbers::pi / 180.0, 0.0, 15.0), checker, 1)
+            .outcome == Outcome::collision);
   // holding still: timeout after 25 replans of 8 steps
   const Rollout hold = rollout(HoldPolicy(), scene_at(0.0, 0.0, 15.0), checker, 1);
   CHECK(hold.outcome == Outcome::timeout);
@@ -139,20 +146,24 @@ TEST_CASE("commands_beyond_the_step_limits_are_clipped_and_counted", "[unit]") {
 TEST_CASE("a_policy_returning_garbage_is_a_typed_error_naming_it", "[unit]") {
   const CollisionChecker checker;
   const TaskScene scene = scene_at(0.0, 0.0, 15.0);
-  CHECK_THROWS_WITH(rollout(BrokenPolicy({}), scene, checker, 1), Catch::Matchers::Contains("broken") &&
-                                                                     Catch::Matchers::Contains("empty chunk"));
+  CHECK_THROWS_WITH(
+      rollout(BrokenPolicy({}), scene, checker, 1),
+      Catch::Matchers::Contains("broken") && Catch::Matchers::Contains("empty chunk"));
   // a non-finite pose ends the rollout as invalid, or is an error with stop_on_invalid
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  const RigidTransform bad = RigidTransform::unchecked(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0));
+  const RigidTransform bad =
+      RigidTransform::unchecked(Eigen::Matrix3d::Identity(), Eigen::Vector3d(nan, 0, 0));
   const Rollout r = rollout(BrokenPolicy({bad}), scene, checker, 1);
   CHECK(r.outcome == Outcome::invalid);
   CHECK(outcome_name(r.outcome) == "invalid");
-  CHECK_THAT(r.invalid_reason, Catch::Matchers::Contains("broken") && Catch::Matchers::Contains("non-finite") &&
+  CHECK_THAT(r.invalid_reason, Catch::Matchers::Contains("broken") &&
+                                   Catch::Matchers::Contains("non-finite") &&
                                    Catch::Matchers::Contains("replan 0"));
   RolloutOptions strict;
   strict.stop_on_invalid = true;
   CHECK_THROWS_AS(rollout(BrokenPolicy({bad}), scene, checker, 1, strict), NonFiniteAction);
-  CHECK_THROWS_WITH(rollout(BrokenPolicy({bad}), scene, checker, 1, strict), Catch::Matchers::Contains("non-finite"));
+  CHECK_THROWS_WITH(rollout(BrokenPolicy({bad}), scene, checker, 1, strict),
+                    Catch::Matchers::Contains("non-finite"));
   RolloutOptions options;
   options.execute = 0;
   CHECK_THROWS_AS(rollout(HoldPolicy(), scene, checker, 1, options), InvalidArgument);
@@ -162,7 +173,8 @@ TEST_CASE("the_observation_holds_h_past_poses_and_the_opening_corners", "[unit]"
   const TaskScene scene = scene_at(0.3, 1.0, 14.0);
   const Scene o = observation(scene.world_T_hole, {scene.world_T_hand_start}, 2);
   REQUIRE(o.world_T_hand_history.size() == 3u);
-  for (const auto& T : o.world_T_hand_history) CHECK(T.matrix() == scene.world_T_hand_start.matrix());
+  for (const auto& T : o.world_T_hand_history)
+    CHECK(T.matrix() == scene.world_T_hand_start.matrix());
   CHECK(o.world_T_hand_chunk.empty());
   const RigidTransform hand_T_hole = hand_T_hole_from_observation(o);
   CHECK(distance(scene.world_T_hand_start * hand_T_hole, scene.world_T_hole) < 1e-12);
@@ -186,6 +198,8 @@ TEST_CASE("the_same_seed_gives_the_same_rollout_bit_for_bit", "[unit]") {
   const Rollout a = rollout(ExpertPolicy(), scene, checker, 5);
   const Rollout b = rollout(ExpertPolicy(), scene, checker, 5);
   REQUIRE(a.world_T_hand.size() == b.world_T_hand.size());
-  for (std::size_t t = 0; t < a.world_T_hand.size(); ++t) CHECK(a.world_T_hand[t].matrix() == b.world_T_hand[t].matrix());
-  CHECK_THROWS_WITH(make_scripted_policy("oracle"), Catch::Matchers::Contains("oracle") && Catch::Matchers::Contains("expert"));
+  for (std::size_t t = 0; t < a.world_T_hand.size(); ++t)
+    CHECK(a.world_T_hand[t].matrix() == b.world_T_hand[t].matrix());
+  CHECK_THROWS_WITH(make_scripted_policy("oracle"),
+                    Catch::Matchers::Contains("oracle") && Catch::Matchers::Contains("expert"));
 }

@@ -13,7 +13,9 @@ using namespace handcentric::sim;
 
 namespace {
 
-double degrees(double radians) { return radians * 180.0 / std::numbers::pi; }
+double degrees(double radians) {
+  return radians * 180.0 / std::numbers::pi;
+}
 
 /// The angle in (-180, 180] of a hole angle in degrees.
 double wrap_deg(double deg) {
@@ -25,7 +27,8 @@ using Sampler = TaskScene (*)(const SceneDistribution&, std::uint64_t, std::uint
 
 // A planted fault: draws the start in the world frame (around the hole's position, not turned
 // with it), so OOD starts are not transformed train starts.
-TaskScene start_in_world_frame(const SceneDistribution& distribution, std::uint64_t seed, std::uint64_t index) {
+TaskScene start_in_world_frame(const SceneDistribution& distribution, std::uint64_t seed,
+                               std::uint64_t index) {
   TaskScene scene = sample_scene(distribution, seed, index);
   const RigidTransform hole_T_hand = scene.world_T_hole.inverse_compose(scene.world_T_hand_start);
   const Eigen::Vector3d& p = scene.world_T_hole.translation();
@@ -62,24 +65,30 @@ TEST_CASE("scenes_respect_the_issue_ranges", "[property]") {
   int up = 0, sideways_plus = 0, sideways_minus = 0;
   const int n = 2000;
   for (const auto& scene : sample_scenes(SceneDistribution::train(), n, 3)) {
-    const Eigen::Vector3d rel = planar_coordinates(scene.world_T_hole.inverse_compose(scene.world_T_hand_start));
+    const Eigen::Vector3d rel =
+        planar_coordinates(scene.world_T_hole.inverse_compose(scene.world_T_hand_start));
     CHECK(std::abs(rel(1)) <= kStartMaxAbsX);
     CHECK((rel(2) >= kStartMinY && rel(2) <= kStartMaxY));
     CHECK(std::abs(degrees(rel(0))) <= kStartMaxAbsAngleDeg + 1e-9);
     const Eigen::Vector3d hole = planar_coordinates(scene.world_T_hole);
     CHECK((std::abs(hole(1)) <= kWorkspaceHalfWidth && std::abs(hole(2)) <= kWorkspaceHalfWidth));
     const double angle = degrees(hole(0));
-    if (std::abs(angle) <= 10.0 + 1e-9) ++up;
-    else if (std::abs(angle - 90.0) <= 10.0 + 1e-9) ++sideways_plus;
-    else if (std::abs(angle + 90.0) <= 10.0 + 1e-9) ++sideways_minus;
-    else FAIL("train hole angle " << angle << " deg is outside up / sideways");
+    if (std::abs(angle) <= 10.0 + 1e-9)
+      ++up;
+    else if (std::abs(angle - 90.0) <= 10.0 + 1e-9)
+      ++sideways_plus;
+    else if (std::abs(angle + 90.0) <= 10.0 + 1e-9)
+      ++sideways_minus;
+    else
+      FAIL("train hole angle " << angle << " deg is outside up / sideways");
   }
   // half up, a quarter each side: 4 sigma of a binomial
   CHECK(std::abs(up - n / 2) < 4.0 * std::sqrt(n * 0.25));
   CHECK(std::abs(sideways_plus - n / 4) < 4.0 * std::sqrt(n * 0.1875));
   CHECK(std::abs(sideways_minus - n / 4) < 4.0 * std::sqrt(n * 0.1875));
   for (const auto& scene : sample_scenes(SceneDistribution::ood(), 500, 3)) {
-    CHECK(std::abs(std::abs(wrap_deg(degrees(planar_coordinates(scene.world_T_hole)(0)))) - 180.0) <= 10.0 + 1e-9);
+    CHECK(std::abs(std::abs(wrap_deg(degrees(planar_coordinates(scene.world_T_hole)(0)))) -
+                   180.0) <= 10.0 + 1e-9);
   }
   for (const auto& scene : sample_scenes(SceneDistribution::parse("30:45"), 500, 3)) {
     const double angle = degrees(planar_coordinates(scene.world_T_hole)(0));
@@ -99,12 +108,13 @@ TEST_CASE("the_same_seed_gives_the_same_scenes_bit_for_bit", "[unit]") {
   }
   CHECK(differ == 50);
   // scene i does not depend on how many scenes are drawn
-  CHECK(sample_scene(SceneDistribution::train(), 11, 49).world_T_hole.matrix() == a[49].world_T_hole.matrix());
+  CHECK(sample_scene(SceneDistribution::train(), 11, 49).world_T_hole.matrix() ==
+        a[49].world_T_hole.matrix());
 }
 
 TEST_CASE("bad_distribution_names_are_rejected_with_the_forms", "[unit]") {
-  CHECK_THROWS_WITH(SceneDistribution::parse("sideways"), Catch::Matchers::Contains("sideways") &&
-                                                              Catch::Matchers::Contains("A:B"));
+  CHECK_THROWS_WITH(SceneDistribution::parse("sideways"),
+                    Catch::Matchers::Contains("sideways") && Catch::Matchers::Contains("A:B"));
   CHECK_THROWS_AS(SceneDistribution::parse("10:-10"), InvalidArgument);
   CHECK_THROWS_AS(SceneDistribution::parse("nan:3"), InvalidArgument);
   CHECK_THROWS_AS(SceneDistribution::parse("1:2:3"), InvalidArgument);

@@ -34,11 +34,11 @@ inline std::string limits_temp_path(const std::string& name) {
 constexpr long kPeakMemoryLimitBytes = 512L << 20;
 
 struct ChildRun {
-  int exit_code = -1;  ///< exit status; -1 when a signal ended the child
-  int signal = 0;      ///< the signal that ended it, 0 if none
-  std::string out;     ///< stdout (run_program) or what the function returned (run_in_child)
-  std::string err;     ///< stderr (run_program)
-  long peak_bytes = 0; ///< ru_maxrss of the child
+  int exit_code = -1;   ///< exit status; -1 when a signal ended the child
+  int signal = 0;       ///< the signal that ended it, 0 if none
+  std::string out;      ///< stdout (run_program) or what the function returned (run_in_child)
+  std::string err;      ///< stderr (run_program)
+  long peak_bytes = 0;  ///< ru_maxrss of the child
 };
 
 namespace detail {

@@ -12,7 +12,8 @@ bool endpoints_only(const Checker& checker, const RigidTransform& a, const Rigid
 }
 
 /// A fixed subdivision into 4 pieces, whatever the motion's length.
-template <typename Checker, RigidTransform (*Interpolate)(const RigidTransform&, const RigidTransform&, double)>
+template <typename Checker,
+          RigidTransform (*Interpolate)(const RigidTransform&, const RigidTransform&, double)>
 bool four_samples(const Checker& checker, const RigidTransform& a, const RigidTransform& b) {
   for (int i = 0; i <= 4; ++i) {
     if (checker.collides(Interpolate(a, b, i / 4.0))) return true;

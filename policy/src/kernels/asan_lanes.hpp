@@ -21,7 +21,8 @@ inline const void* poisoned_lane(const void* base, std::uint64_t mask, std::size
 #if defined(__SANITIZE_ADDRESS__) || defined(HANDCENTRIC_ASAN)
   for (int i = 0; mask != 0; ++i, mask >>= 1) {
     if ((mask & 1u) == 0) continue;
-    void* lane = const_cast<char*>(static_cast<const char*>(base) + static_cast<std::ptrdiff_t>(i) * lane_bytes);
+    void* lane = const_cast<char*>(static_cast<const char*>(base) +
+                                   static_cast<std::ptrdiff_t>(i) * lane_bytes);
     if (void* bad = __asan_region_is_poisoned(lane, lane_bytes)) return bad;
   }
 #else
@@ -31,11 +32,13 @@ inline const void* poisoned_lane(const void* base, std::uint64_t mask, std::size
 }
 
 /// ASan's report (an abort with halt_on_error) when a lane `mask` enables is poisoned.
-inline void check_lanes(const void* base, std::uint64_t mask, std::size_t lane_bytes, bool is_write) {
+inline void check_lanes(const void* base, std::uint64_t mask, std::size_t lane_bytes,
+                        bool is_write) {
 #if defined(__SANITIZE_ADDRESS__) || defined(HANDCENTRIC_ASAN)
   if (const void* bad = poisoned_lane(base, mask, lane_bytes)) {
-    __asan_report_error(__builtin_return_address(0), __builtin_frame_address(0), __builtin_frame_address(0),
-                        const_cast<void*>(bad), is_write ? 1 : 0, lane_bytes);
+    __asan_report_error(__builtin_return_address(0), __builtin_frame_address(0),
+                        __builtin_frame_address(0), const_cast<void*>(bad), is_write ? 1 : 0,
+                        lane_bytes);
   }
 #else
   (void)base, (void)mask, (void)lane_bytes, (void)is_write;

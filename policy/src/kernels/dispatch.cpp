@@ -14,9 +14,12 @@ namespace handcentric::policy {
 
 std::string to_string(KernelIsa isa) {
   switch (isa) {
-    case KernelIsa::generic: return "generic";
-    case KernelIsa::avx2: return "avx2";
-    case KernelIsa::avx512: return "avx512";
+    case KernelIsa::generic:
+      return "generic";
+    case KernelIsa::avx2:
+      return "avx2";
+    case KernelIsa::avx512:
+      return "avx512";
   }
   return "unknown";
 }
@@ -47,11 +50,15 @@ std::int64_t target_of(KernelIsa isa) {
 
 }  // namespace
 
-bool kernel_isa_supported(KernelIsa isa) { return target_of(isa) != 0; }
+bool kernel_isa_supported(KernelIsa isa) {
+  return target_of(isa) != 0;
+}
 
 KernelIsa best_kernel_isa() {
   const std::int64_t best = kernels::best_kernels().target;
-  return best == HWY_AVX3 ? KernelIsa::avx512 : best == HWY_AVX2 ? KernelIsa::avx2 : KernelIsa::generic;
+  return best == HWY_AVX3   ? KernelIsa::avx512
+         : best == HWY_AVX2 ? KernelIsa::avx2
+                            : KernelIsa::generic;
 }
 
 namespace {
@@ -61,8 +68,9 @@ std::mutex g_isa_mutex;
 
 void require_supported(KernelIsa isa, const std::string& origin) {
   if (!kernel_isa_supported(isa)) {
-    throw InvalidArgument(origin + " asks for the " + to_string(isa) + " kernels, which this CPU (or this build) " +
-                          "cannot run: use " + to_string(best_kernel_isa()) + " or generic");
+    throw InvalidArgument(origin + " asks for the " + to_string(isa) +
+                          " kernels, which this CPU (or this build) " + "cannot run: use " +
+                          to_string(best_kernel_isa()) + " or generic");
   }
 }
 
@@ -99,7 +107,8 @@ bool trivial_gemm(const Gemm& g) {
   if (g.m <= 0 || g.n <= 0) return true;
   if (g.k > 0) return false;
   for (int j = 0; j < g.n; ++j) {  // the empty product: C = bias 1^T
-    for (int i = 0; i < g.m; ++i) g.c[i + static_cast<long>(j) * g.ldc] = g.row_bias ? g.row_bias[i] : 0.0f;
+    for (int i = 0; i < g.m; ++i)
+      g.c[i + static_cast<long>(j) * g.ldc] = g.row_bias ? g.row_bias[i] : 0.0f;
   }
   return true;
 }
@@ -132,7 +141,9 @@ const KernelSet& kernels_for(KernelIsa isa) {
   return *sets[static_cast<std::size_t>(isa)];
 }
 
-const KernelSet& active() { return kernels_for(kernel_isa()); }
+const KernelSet& active() {
+  return kernels_for(kernel_isa());
+}
 
 }  // namespace kernels
 }  // namespace handcentric::policy

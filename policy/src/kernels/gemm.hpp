@@ -19,7 +19,8 @@
 
 namespace handcentric::policy::kernels {
 
-/// Panels of MR rows of op(A)(i0 : i0 + mc, p0 : p0 + kc) into `out` (ceil(mc / MR) * kc * MR floats).
+/// Panels of MR rows of op(A)(i0 : i0 + mc, p0 : p0 + kc) into `out` (ceil(mc / MR) * kc * MR
+/// floats).
 template <int MR>
 void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out) {
   for (int panel = 0; panel < mc; panel += MR) {
@@ -135,7 +136,8 @@ void blocked_gemm(const Gemm& g) {
         for (int jr = 0; jr < nc; jr += NR) {
           const int cols = std::min(NR, nc - jr);
           const long j = j0 + jr;
-          const float* b_in_place = g.op_b == Op::none ? g.b + p0 + j * g.ldb : g.b + j + static_cast<long>(p0) * g.ldb;
+          const float* b_in_place =
+              g.op_b == Op::none ? g.b + p0 + j * g.ldb : g.b + j + static_cast<long>(p0) * g.ldb;
           for (int ir = 0; ir < mc; ir += MR) {
             const int rows = std::min(MR, mc - ir);
             const float* a_panel = buffers.a.data() + static_cast<long>(ir / MR) * kc * MR;
@@ -151,22 +153,28 @@ void blocked_gemm(const Gemm& g) {
             float* c = g.c + (i0 + ir) + j * g.ldc;
             float* target = c;
             int ld_target = g.ldc;
-            if (rows < MR || cols < NR) {  // an edge tile: computed in `tile`, the valid part copied
+            if (rows < MR ||
+                cols < NR) {  // an edge tile: computed in `tile`, the valid part copied
               target = tile;
               ld_target = MR;
               if (accumulate) {
-                for (int jj = 0; jj < cols; ++jj) std::copy(c + jj * g.ldc, c + jj * g.ldc + rows, tile + jj * MR);
+                for (int jj = 0; jj < cols; ++jj)
+                  std::copy(c + jj * g.ldc, c + jj * g.ldc + rows, tile + jj * MR);
               }
             }
             if (cols < NR) {
-              Kernel::template tile<BLayout::packed>(kc, a_panel, buffers.b.data(), NR, target, ld_target, accumulate, bias);
+              Kernel::template tile<BLayout::packed>(kc, a_panel, buffers.b.data(), NR, target,
+                                                     ld_target, accumulate, bias);
             } else if (g.op_b == Op::none) {
-              Kernel::template tile<BLayout::columns>(kc, a_panel, b_in_place, g.ldb, target, ld_target, accumulate, bias);
+              Kernel::template tile<BLayout::columns>(kc, a_panel, b_in_place, g.ldb, target,
+                                                      ld_target, accumulate, bias);
             } else {
-              Kernel::template tile<BLayout::rows>(kc, a_panel, b_in_place, g.ldb, target, ld_target, accumulate, bias);
+              Kernel::template tile<BLayout::rows>(kc, a_panel, b_in_place, g.ldb, target,
+                                                   ld_target, accumulate, bias);
             }
             if (target == tile) {
-              for (int jj = 0; jj < cols; ++jj) std::copy(tile + jj * MR, tile + jj * MR + rows, c + jj * g.ldc);
+              for (int jj = 0; jj < cols; ++jj)
+                std::copy(tile + jj * MR, tile + jj * MR + rows, c + jj * g.ldc);
             }
           }
           if (p0 + kc == g.k) {  // this mc x cols block of C is complete and still in L1
@@ -189,13 +197,16 @@ void blocked_gemm(const Gemm& g) {
 // past the end (masked lanes are neither read nor written). Needs shift + rows <= lanes V.
 // Kernel provides kNarrowLanes (floats per vector), kNarrowAccumulators (N V <= it),
 // kNarrowGroup (columns per pass), kAlignedHeads (whether to shift the heads at all) and
-//   template <int N, int V> narrow_block(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc).
+//   template <int N, int V>
+//   narrow_block(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc).
 constexpr int kNarrowMax = 16;
 
 template <typename Kernel, int N, int... V>
-void narrow_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* b, long b_step,
-                 long b_stride, const float* bias, float* c, long ldc, std::integer_sequence<int, V...>) {
-  ((vectors == V + 1 ? Kernel::template narrow_block<N, V + 1>(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc)
+void narrow_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* b,
+                 long b_step, long b_stride, const float* bias, float* c, long ldc,
+                 std::integer_sequence<int, V...>) {
+  ((vectors == V + 1 ? Kernel::template narrow_block<N, V + 1>(shift, rows, k, a, lda, b, b_step,
+                                                               b_stride, bias, c, ldc)
                      : void()),
    ...);
 }
@@ -214,9 +225,11 @@ void narrow_columns(const Gemm& g, int j0) {
   for (int i0 = 0; i0 < g.m; i0 += block_rows) {
     const int rows = std::min(block_rows, g.m - i0);
     const int block_shift = i0 == 0 ? shift : 0;  // later blocks start on a boundary
-    narrow_rows<Kernel, N>((block_shift + rows + kLanes - 1) / kLanes, block_shift, rows, g.k, g.a + i0, g.lda,
-                           g.b + j0 * b_stride, b_step, b_stride, g.row_bias ? g.row_bias + i0 : nullptr,
-                           g.c + i0 + static_cast<long>(j0) * g.ldc, g.ldc, std::make_integer_sequence<int, kVectors>{});
+    narrow_rows<Kernel, N>((block_shift + rows + kLanes - 1) / kLanes, block_shift, rows, g.k,
+                           g.a + i0, g.lda, g.b + j0 * b_stride, b_step, b_stride,
+                           g.row_bias ? g.row_bias + i0 : nullptr,
+                           g.c + i0 + static_cast<long>(j0) * g.ldc, g.ldc,
+                           std::make_integer_sequence<int, kVectors>{});
   }
 }
 
@@ -230,7 +243,8 @@ template <typename Kernel>
 void narrow_gemm(const Gemm& g) {
   constexpr int kGroup = Kernel::kNarrowGroup;
   for (int j0 = 0; j0 < g.n; j0 += kGroup) {
-    narrow_dispatch<Kernel>(g, j0, std::min(kGroup, g.n - j0), std::make_integer_sequence<int, kGroup>{});
+    narrow_dispatch<Kernel>(g, j0, std::min(kGroup, g.n - j0),
+                            std::make_integer_sequence<int, kGroup>{});
   }
 }
 

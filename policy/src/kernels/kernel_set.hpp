@@ -58,10 +58,12 @@ struct SiluFunctions {
 /// Applies problem.epilogue to rows [i0, i0 + rows) of columns [j0, j0 + cols) of C with one
 /// set's SiLU functions (Epilogue::silu: `forward` when problem.sigmoid is set, else
 /// `in_place`; Epilogue::silu_derivative: `backward`).
-void apply_epilogue(const Gemm& problem, int i0, int rows, int j0, int cols, const SiluFunctions& silu);
+void apply_epilogue(const Gemm& problem, int i0, int rows, int j0, int cols,
+                    const SiluFunctions& silu);
 
 /// Adam's update of n parameters (adam.hpp) from g = gradient_scale gradient:
-/// m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g^2, p = decay p - step_size m / (sqrt(v) inv_sqrt_bias2 + eps).
+/// m = b1 m + (1 - b1) g, v = b2 v + (1 - b2) g^2,
+/// p = decay p - step_size m / (sqrt(v) inv_sqrt_bias2 + eps).
 struct AdamUpdate {
   std::ptrdiff_t n = 0;
   float* parameters = nullptr;

@@ -22,8 +22,13 @@ HWY_BEFORE_NAMESPACE();
 namespace handcentric::policy::kernels::HWY_NAMESPACE {
 
 const KernelSet* TargetKernels() {
-  static constexpr KernelSet kSet{vector_gemm<GemmKernel>, SiluForward, SiluBackward, SiluInPlace,
-                                  SquaredNorm,             Adam,        HWY_TARGET};
+  static constexpr KernelSet kSet{vector_gemm<GemmKernel>,
+                                  SiluForward,
+                                  SiluBackward,
+                                  SiluInPlace,
+                                  SquaredNorm,
+                                  Adam,
+                                  HWY_TARGET};
   return &kSet;
 }
 
@@ -35,11 +40,17 @@ namespace handcentric::policy::kernels {
 
 HWY_EXPORT(TargetKernels);
 
-std::vector<std::int64_t> available_targets() { return hwy::SupportedAndGeneratedTargets(); }
+std::vector<std::int64_t> available_targets() {
+  return hwy::SupportedAndGeneratedTargets();
+}
 
-std::string target_name(std::int64_t target) { return hwy::TargetName(target); }
+std::string target_name(std::int64_t target) {
+  return hwy::TargetName(target);
+}
 
-const KernelSet& best_kernels() { return *HWY_DYNAMIC_DISPATCH(TargetKernels)(); }
+const KernelSet& best_kernels() {
+  return *HWY_DYNAMIC_DISPATCH(TargetKernels)();
+}
 
 const KernelSet& kernels_of_target(std::int64_t target) {
 #if (HWY_TARGETS & (HWY_TARGETS - 1)) == 0  // one target: HWY_EXPORT's table has one entry

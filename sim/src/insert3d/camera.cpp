@@ -22,16 +22,18 @@ RigidTransform DepthCamera::default_mount() {
 
 void DepthCamera::validate() const {
   if (width < 1 || width > 4096 || height < 1 || height > 4096) {
-    throw InvalidArgument("depth camera size must be 1..4096 pixels each way, got " + std::to_string(width) + " x " +
-                          std::to_string(height) + "; e.g. 32 x 24");
+    throw InvalidArgument("depth camera size must be 1..4096 pixels each way, got " +
+                          std::to_string(width) + " x " + std::to_string(height) +
+                          "; e.g. 32 x 24");
   }
-  if (!std::isfinite(horizontal_fov_deg) || horizontal_fov_deg <= 0.0 || horizontal_fov_deg >= 170.0) {
+  if (!std::isfinite(horizontal_fov_deg) || horizontal_fov_deg <= 0.0 ||
+      horizontal_fov_deg >= 170.0) {
     throw InvalidArgument("depth camera horizontal field of view must be in (0, 170) deg, got " +
                           format_number(horizontal_fov_deg) + "; e.g. 70");
   }
   if (!std::isfinite(max_range) || max_range <= 0.0) {
-    throw InvalidArgument("depth camera max_range must be a positive number of cm, got " + format_number(max_range) +
-                          "; e.g. 60");
+    throw InvalidArgument("depth camera max_range must be a positive number of cm, got " +
+                          format_number(max_range) + "; e.g. 60");
   }
 }
 
@@ -39,7 +41,8 @@ double DepthCamera::focal_length() const {
   return 0.5 * width / std::tan(0.5 * horizontal_fov_deg * std::numbers::pi / 180.0);
 }
 
-double ray_box_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Box3& box) {
+double ray_box_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                   const Box3& box) {
   double t_near = 0.0;
   double t_far = std::numeric_limits<double>::infinity();
   for (int axis = 0; axis < 3; ++axis) {
@@ -57,7 +60,8 @@ double ray_box_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& directi
   return t_near;
 }
 
-DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera, const RigidTransform& hand_T_slot) {
+DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera,
+                        const RigidTransform& hand_T_slot) {
   geometry.validate();
   camera.validate();
   // Each box is hit in its own frame: the block's in the slot frame, the blade in the hand frame.
@@ -67,17 +71,21 @@ DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& ca
   const Box3 blade = geometry.blade_in_hand();
   const double f = camera.focal_length();
   DepthImage image{camera.width, camera.height, {}};
-  image.values.resize(static_cast<std::size_t>(camera.width) * static_cast<std::size_t>(camera.height));
+  image.values.resize(static_cast<std::size_t>(camera.width) *
+                      static_cast<std::size_t>(camera.height));
   for (int row = 0; row < camera.height; ++row) {
     for (int col = 0; col < camera.width; ++col) {
-      const Eigen::Vector3d camera_ray((col + 0.5 - 0.5 * camera.width) / f, (row + 0.5 - 0.5 * camera.height) / f, 1.0);
+      const Eigen::Vector3d camera_ray((col + 0.5 - 0.5 * camera.width) / f,
+                                       (row + 0.5 - 0.5 * camera.height) / f, 1.0);
       double depth = camera.max_range;
       const auto nearest = [&depth](double t) {
         if (t >= 0.0) depth = std::min(depth, t);
       };
       const Eigen::Vector3d slot_ray = slot_T_camera.rotation() * camera_ray;
-      for (const Box3& wall : walls) nearest(ray_box_hit(slot_T_camera.translation(), slot_ray, wall));
-      nearest(ray_box_hit(hand_T_camera.translation(), hand_T_camera.rotation() * camera_ray, blade));
+      for (const Box3& wall : walls)
+        nearest(ray_box_hit(slot_T_camera.translation(), slot_ray, wall));
+      nearest(
+          ray_box_hit(hand_T_camera.translation(), hand_T_camera.rotation() * camera_ray, blade));
       image.values[static_cast<std::size_t>(row * camera.width + col)] = depth;
     }
   }

@@ -19,9 +19,10 @@ struct CollisionChecker::Shapes {
 
   explicit Shapes(const BladeSlotGeometry& geometry)
       : blade(geometry.blade_in_hand().size()),
-        walls{fcl::Boxd(geometry.slot_walls()[0].size()), fcl::Boxd(geometry.slot_walls()[1].size()),
-              fcl::Boxd(geometry.slot_walls()[2].size()), fcl::Boxd(geometry.slot_walls()[3].size()),
-              fcl::Boxd(geometry.slot_walls()[4].size())} {
+        walls{
+            fcl::Boxd(geometry.slot_walls()[0].size()), fcl::Boxd(geometry.slot_walls()[1].size()),
+            fcl::Boxd(geometry.slot_walls()[2].size()), fcl::Boxd(geometry.slot_walls()[3].size()),
+            fcl::Boxd(geometry.slot_walls()[4].size())} {
     hand_T_blade_centre = fcl::Transform3d::Identity();
     hand_T_blade_centre.translation() = geometry.blade_in_hand().centre();
     const auto boxes = geometry.slot_walls();
@@ -57,14 +58,15 @@ double CollisionChecker::distance(const RigidTransform& slot_T_hand) const {
   for (std::size_t i = 0; i < shapes_->walls.size(); ++i) {
     fcl::CollisionRequestd collision_request;
     fcl::CollisionResultd collision_result;
-    fcl::collide(&shapes_->blade, slot_T_blade, &shapes_->walls[i], shapes_->slot_T_wall_centre[i], collision_request,
-                 collision_result);
+    fcl::collide(&shapes_->blade, slot_T_blade, &shapes_->walls[i], shapes_->slot_T_wall_centre[i],
+                 collision_request, collision_result);
     if (collision_result.isCollision()) return 0.0;
     // FCL's own GJK in double (GST_INDEP), iterated to 1e-12: libccd's default stops at 1e-6.
     fcl::DistanceRequestd distance_request(false, false, 0.0, 0.0, 1e-12, fcl::GST_INDEP);
     fcl::DistanceResultd distance_result;
-    const double d = fcl::distance(&shapes_->blade, slot_T_blade, &shapes_->walls[i], shapes_->slot_T_wall_centre[i],
-                                   distance_request, distance_result);
+    const double d =
+        fcl::distance(&shapes_->blade, slot_T_blade, &shapes_->walls[i],
+                      shapes_->slot_T_wall_centre[i], distance_request, distance_result);
     nearest = std::min(nearest, std::max(d, 0.0));
   }
   return nearest;
@@ -74,7 +76,8 @@ bool CollisionChecker::collides(const RigidTransform& slot_T_hand) const {
   return distance(slot_T_hand) <= kContactDistance;
 }
 
-bool CollisionChecker::motion_collides(const RigidTransform& slot_T_hand_from, const RigidTransform& slot_T_hand_to) const {
+bool CollisionChecker::motion_collides(const RigidTransform& slot_T_hand_from,
+                                       const RigidTransform& slot_T_hand_to) const {
   const Eigen::Vector3d omega =
       so3::log(slot_T_hand_from.rotation().inverse_compose(slot_T_hand_to.rotation()).matrix());
   const double speed = (slot_T_hand_to.translation() - slot_T_hand_from.translation()).norm() +

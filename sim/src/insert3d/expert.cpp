@@ -21,13 +21,15 @@ constexpr double kStepCm = 0.98 * kMaxStepCm;
 const double kStepAngle = 0.98 * radians(kMaxStepDeg);
 
 RigidTransform pre_insertion() {
-  return RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, kBladeLength + kPreInsertionTipHeight));
+  return RigidTransform::from_translation(
+      Eigen::Vector3d(0.0, 0.0, kBladeLength + kPreInsertionTipHeight));
 }
 
 /// The approach curve of expert.hpp, step 1.
 class Approach {
  public:
-  Approach(const RigidTransform& slot_T_hand_start, const Eigen::Vector3d& via, const Eigen::Vector3d& wiggle)
+  Approach(const RigidTransform& slot_T_hand_start, const Eigen::Vector3d& via,
+           const Eigen::Vector3d& wiggle)
       : start_(slot_T_hand_start),
         via_(via),
         wiggle_(wiggle),
@@ -38,10 +40,12 @@ class Approach {
     const Eigen::Vector3d p3 = pre_insertion().translation();
     const Eigen::Vector3d p2 = p3 + Eigen::Vector3d(0.0, 0.0, kArrivalLift);
     const double r = 1.0 - s;
-    const Eigen::Vector3d p = r * r * r * p0 + 3.0 * r * r * s * via_ + 3.0 * r * s * s * p2 + s * s * s * p3;
+    const Eigen::Vector3d p =
+        r * r * r * p0 + 3.0 * r * r * s * via_ + 3.0 * r * s * s * p2 + s * s * s * p3;
     const double eased = s * s * (3.0 - 2.0 * s);
     const double bump = 16.0 * s * s * r * r;
-    const Eigen::Matrix3d R = start_.rotation().matrix() * so3::exp(eased * turn_) * so3::exp(bump * wiggle_);
+    const Eigen::Matrix3d R =
+        start_.rotation().matrix() * so3::exp(eased * turn_) * so3::exp(bump * wiggle_);
     return RigidTransform::unchecked(R, p);
   }
 
@@ -77,7 +81,8 @@ std::vector<RigidTransform> resample(const Path& path) {
 
 void ExpertOptions::validate() const {
   if (attempts < 1) {
-    throw InvalidArgument("expert attempts per scene must be >= 1, got " + std::to_string(attempts) + "; e.g. 8");
+    throw InvalidArgument("expert attempts per scene must be >= 1, got " +
+                          std::to_string(attempts) + "; e.g. 8");
   }
 }
 
@@ -89,8 +94,9 @@ ExpertPlan plan_in_slot_frame(const RigidTransform& slot_T_hand_start, std::mt19
   Eigen::Vector3d wiggle = Eigen::Vector3d::Zero();
   if (options.random_via) {
     const double u = uniform(rng, 0.3, 0.7);
-    via = (1.0 - u) * p0 + u * p3 +
-          Eigen::Vector3d(uniform(rng, -3.0, 3.0), uniform(rng, -3.0, 3.0), uniform(rng, -1.0, 3.0));
+    via =
+        (1.0 - u) * p0 + u * p3 +
+        Eigen::Vector3d(uniform(rng, -3.0, 3.0), uniform(rng, -3.0, 3.0), uniform(rng, -1.0, 3.0));
     wiggle = radians(uniform(rng, 0.0, 15.0)) * sphere_point(uniform01(rng), uniform01(rng));
   }
   const Approach approach(slot_T_hand_start, via, wiggle);
@@ -116,11 +122,14 @@ ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t 
                       const CollisionChecker& checker, const ExpertOptions& options) {
   options.validate();
   std::mt19937_64 rng(stream_seed(seed, index));
-  const RigidTransform slot_T_hand_start = scene.world_T_slot.inverse_compose(scene.world_T_hand_start);
+  const RigidTransform slot_T_hand_start =
+      scene.world_T_slot.inverse_compose(scene.world_T_hand_start);
   return first_valid_plan<Demo>(
-      options.attempts, [&] { return plan_in_slot_frame(slot_T_hand_start, rng, checker, options); },
+      options.attempts,
+      [&] { return plan_in_slot_frame(slot_T_hand_start, rng, checker, options); },
       [&](const ExpertPlan& plan) {
-        Demo demo{scene.world_T_slot, {scene.world_T_hand_start}};  // the start exactly, not rounded through the slot
+        Demo demo{scene.world_T_slot,
+                  {scene.world_T_hand_start}};  // the start exactly, not rounded through the slot
         demo.world_T_hand.reserve(plan.slot_T_hand.size());
         for (std::size_t t = 1; t < plan.slot_T_hand.size(); ++t) {
           demo.world_T_hand.push_back(scene.world_T_slot * plan.slot_T_hand[t]);
@@ -129,8 +138,8 @@ ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t 
       });
 }
 
-ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed, const CollisionChecker& checker,
-                       const ExpertOptions& options) {
+ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed,
+                       const CollisionChecker& checker, const ExpertOptions& options) {
   return on_every_scene<Demo>(scenes, [&](const TaskScene& scene, std::size_t i) {
     return expert_demo(scene, seed, i, checker, options);
   });

@@ -8,9 +8,11 @@
 namespace handcentric::sim::insert3d {
 
 void BladeSlotGeometry::validate() const {
-  if (!std::isfinite(clearance_per_side) || clearance_per_side <= 0.0 || clearance_per_side > kMaxClearancePerSide) {
-    throw InvalidArgument("blade-slot clearance per side must be in (0, " + format_number(kMaxClearancePerSide) +
-                          "] cm, got " + format_number(clearance_per_side) + "; e.g. 0.1");
+  if (!std::isfinite(clearance_per_side) || clearance_per_side <= 0.0 ||
+      clearance_per_side > kMaxClearancePerSide) {
+    throw InvalidArgument("blade-slot clearance per side must be in (0, " +
+                          format_number(kMaxClearancePerSide) + "] cm, got " +
+                          format_number(clearance_per_side) + "; e.g. 0.1");
   }
 }
 
@@ -25,19 +27,22 @@ std::array<Box3, 5> BladeSlotGeometry::slot_walls() const {
   const double t = kSlotWallThickness;
   const double outer_y = hy + t;
   return {
-      Box3{Eigen::Vector3d(-hx - t, -outer_y, -kSlotDepth), Eigen::Vector3d(-hx, outer_y, 0.0)},  // plate -x
-      Box3{Eigen::Vector3d(hx, -outer_y, -kSlotDepth), Eigen::Vector3d(hx + t, outer_y, 0.0)},    // plate +x
-      Box3{Eigen::Vector3d(-hx, -outer_y, -kSlotDepth), Eigen::Vector3d(hx, -hy, 0.0)},           // end -y
-      Box3{Eigen::Vector3d(-hx, hy, -kSlotDepth), Eigen::Vector3d(hx, outer_y, 0.0)},             // end +y
-      Box3{Eigen::Vector3d(-hx - t, -outer_y, -kSlotDepth - t), Eigen::Vector3d(hx + t, outer_y, -kSlotDepth)},  // bottom
+      Box3{Eigen::Vector3d(-hx - t, -outer_y, -kSlotDepth),
+           Eigen::Vector3d(-hx, outer_y, 0.0)},  // plate -x
+      Box3{Eigen::Vector3d(hx, -outer_y, -kSlotDepth),
+           Eigen::Vector3d(hx + t, outer_y, 0.0)},                                       // plate +x
+      Box3{Eigen::Vector3d(-hx, -outer_y, -kSlotDepth), Eigen::Vector3d(hx, -hy, 0.0)},  // end -y
+      Box3{Eigen::Vector3d(-hx, hy, -kSlotDepth), Eigen::Vector3d(hx, outer_y, 0.0)},    // end +y
+      Box3{Eigen::Vector3d(-hx - t, -outer_y, -kSlotDepth - t),
+           Eigen::Vector3d(hx + t, outer_y, -kSlotDepth)},  // bottom
   };
 }
 
 std::array<Eigen::Vector3d, 4> BladeSlotGeometry::opening_corners() const {
   const double hx = inner_half_x();
   const double hy = inner_half_y();
-  return {Eigen::Vector3d(-hx, -hy, 0.0), Eigen::Vector3d(hx, -hy, 0.0), Eigen::Vector3d(hx, hy, 0.0),
-          Eigen::Vector3d(-hx, hy, 0.0)};
+  return {Eigen::Vector3d(-hx, -hy, 0.0), Eigen::Vector3d(hx, -hy, 0.0),
+          Eigen::Vector3d(hx, hy, 0.0), Eigen::Vector3d(-hx, hy, 0.0)};
 }
 
 std::array<Eigen::Vector3d, 8> BladeSlotGeometry::blade_corners() const {

@@ -54,17 +54,21 @@ SceneDistribution SceneDistribution::parse(const std::string& name) {
 SceneDistribution SceneDistribution::parse_rotate_deg(const std::string& text) {
   Eigen::Vector3d values;
   if (!detail::parse_finite_triple(text, values)) {
-    throw InvalidArgument("bad rotation '" + text +
-                          "'; expected RX,RY,RZ (three finite XYZ Euler angles in degrees), e.g. 90,0,45");
+    throw InvalidArgument(
+        "bad rotation '" + text +
+        "'; expected RX,RY,RZ (three finite XYZ Euler angles in degrees), e.g. 90,0,45");
   }
   return rotate(values);
 }
 
 std::string SceneDistribution::name() const {
   switch (kind) {
-    case Kind::train: return "train";
-    case Kind::ood: return "ood";
-    case Kind::random_se3: return "random-se3";
+    case Kind::train:
+      return "train";
+    case Kind::ood:
+      return "ood";
+    case Kind::random_se3:
+      return "random-se3";
     case Kind::rotate:
       return "rotate " + format_number(rotate_deg.x()) + "," + format_number(rotate_deg.y()) + "," +
              format_number(rotate_deg.z());
@@ -72,13 +76,15 @@ std::string SceneDistribution::name() const {
   return "?";
 }
 
-TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed, std::uint64_t index) {
+TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed,
+                       std::uint64_t index) {
   std::mt19937_64 rng(stream_seed(seed, index));
   // the start relative to the slot first, so it does not depend on the distribution
   const double x = uniform(rng, -kStartMaxAbsXY, kStartMaxAbsXY);
   const double y = uniform(rng, -kStartMaxAbsXY, kStartMaxAbsXY);
   const double z = uniform(rng, kStartMinZ, kStartMaxZ);
-  const Rotation yaw = Rotation::about_z(radians(uniform(rng, -kStartMaxAbsYawDeg, kStartMaxAbsYawDeg)));
+  const Rotation yaw =
+      Rotation::about_z(radians(uniform(rng, -kStartMaxAbsYawDeg, kStartMaxAbsYawDeg)));
   const Rotation slot_R_hand = random_tilt(rng, kStartMaxTiltDeg) * yaw;
   const RigidTransform slot_T_hand_start(slot_R_hand, Eigen::Vector3d(x, y, z));
   // the slot as in train, then turned on its side for ood
@@ -89,8 +95,8 @@ TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed
                                      uniform(rng, 0.0, kWorkspaceMaxHeight));
   const double side_yaw = uniform(rng, 0.0, 2.0 * std::numbers::pi);
   if (distribution.kind == SceneDistribution::Kind::ood) {
-    world_R_slot = Rotation::about_z(side_yaw) * Rotation::exp(0.5 * std::numbers::pi * Eigen::Vector3d::UnitY()) *
-                   world_R_slot;
+    world_R_slot = Rotation::about_z(side_yaw) *
+                   Rotation::exp(0.5 * std::numbers::pi * Eigen::Vector3d::UnitY()) * world_R_slot;
   }
   const RigidTransform world_T_slot(world_R_slot, world_p_slot);
   const TaskScene scene{world_T_slot, world_T_slot * slot_T_hand_start};
@@ -101,12 +107,15 @@ TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed
     case SceneDistribution::Kind::random_se3:
       return random_transform(rng, kRandomTranslationHalfWidth) * scene;
     case SceneDistribution::Kind::rotate:
-      return RigidTransform(rotation_from_xyz_deg(distribution.rotate_deg), Eigen::Vector3d::Zero()) * scene;
+      return RigidTransform(rotation_from_xyz_deg(distribution.rotate_deg),
+                            Eigen::Vector3d::Zero()) *
+             scene;
   }
   return scene;
 }
 
-std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n, std::uint64_t seed) {
+std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n,
+                                     std::uint64_t seed) {
   return detail::sample_n(sample_scene, distribution, n, seed);
 }
 

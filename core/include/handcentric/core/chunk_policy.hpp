@@ -20,7 +20,8 @@ class ChunkPolicy {
   /// The world-frame chunk T_1..T_K for `observation` (its history and points; its chunk is
   /// ignored and may be empty). Same observation and same `noise_seed`, same chunk, bit for bit.
   /// Equivariance (eq. 4) means act(g * o, s) = g * act(o, s) for every rigid g.
-  virtual std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const = 0;
+  virtual std::vector<RigidTransform> act(const Scene& observation,
+                                          std::uint64_t noise_seed) const = 0;
 };
 
 }  // namespace handcentric

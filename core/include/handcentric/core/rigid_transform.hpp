@@ -14,7 +14,8 @@
 // to 1e150 in magnitude, so that sums and products of two stay far from overflow, and any finite
 // rotation vector omega (exp wraps it). Accuracy, with so3.hpp's constants:
 //   - |exp(log(T)) - T| (distance below) <= so3::kRoundTripError * (1 + |p|);
-//   - |log(exp(xi)) - xi| <= so3::kRoundTripError * (1 + |rho|) when |omega| <= pi - so3::kSignAmbiguity.
+//   - |log(exp(xi)) - xi| <= so3::kRoundTripError * (1 + |rho|)
+//     when |omega| <= pi - so3::kSignAmbiguity.
 #include <Eigen/Core>
 
 #include "handcentric/core/rotation.hpp"

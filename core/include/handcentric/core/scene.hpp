@@ -10,8 +10,8 @@
 //   scalars                 named numbers no transform changes (a gripper's width)
 //
 // A global rigid transform g acts as in Sec. 2.2: g * scene moves every pose (T -> g T) and
-// every world point (x -> g x), and leaves the eye-in-hand points and the scalars alone, because the camera,
-// the hand and the objects move together (the proposition behind Lemma 2).
+// every world point (x -> g x), and leaves the eye-in-hand points and the scalars alone, because
+// the camera, the hand and the objects move together (the proposition behind Lemma 2).
 #include <Eigen/Core>
 #include <string>
 #include <utility>

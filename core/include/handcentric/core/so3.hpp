@@ -43,7 +43,8 @@ Eigen::Matrix3d exp(const Eigen::Vector3d& rotation_vector);
 
 /// The unit axis u of a finite r != 0 and half its angle, |r| / 2, computed without overflow or
 /// underflow for every finite r (|r| itself may exceed DBL_MAX). For r = 0: the x axis and 0.
-Eigen::Vector3d unit_axis_and_half_angle(const Eigen::Vector3d& rotation_vector, double& half_angle);
+Eigen::Vector3d unit_axis_and_half_angle(const Eigen::Vector3d& rotation_vector,
+                                         double& half_angle);
 
 /// The rotation vector r(R), angle in [0, pi]. No validation: R must be a rotation matrix.
 Eigen::Vector3d log(const Eigen::Matrix3d& R);

@@ -32,9 +32,9 @@ struct EvalSettings {
 };
 
 struct Cell {
-  std::string method;           ///< methods.hpp name
-  std::string head;             ///< flow, ddpm, cvae, c8ddpm
-  int demos = 0;                ///< the first `demos` demos of the demo file
+  std::string method;  ///< methods.hpp name
+  std::string head;    ///< flow, ddpm, cvae, c8ddpm
+  int demos = 0;       ///< the first `demos` demos of the demo file
   std::uint64_t train_seed = 1;
   sim::TrainingData data;       ///< the demos' mirror images too, or not
   policy::PolicyConfig config;  ///< representation, head and the resolved step budget set
@@ -43,8 +43,9 @@ struct Cell {
 
   /// "hand_centric/flow, 40 demos, train seed 1".
   std::string describe() const;
-  std::string model_path() const;                                        ///< "models/<hash>.hcm"
-  std::string result_path(SceneSet set, const EvalSettings& eval) const;  ///< "results/<hash>.<set>-s<seed>-n<trials>.json"
+  std::string model_path() const;  ///< "models/<hash>.hcm"
+  std::string result_path(SceneSet set, const EvalSettings& eval)
+      const;  ///< "results/<hash>.<set>-s<seed>-n<trials>.json"
 };
 
 /// FNV-1a 64 of `bytes`, as 16 hex digits.
@@ -66,8 +67,9 @@ int automatic_steps(const sim::TrainingData& data, long long demo_samples);
 /// representation and the head, and `steps` Adam steps (0: automatic_steps, of 8 times the
 /// demo samples for c8ddpm's augmented data), and `c8_centre` (x, y) as the point c8ddpm rotates
 /// about (other heads ignore it); hash set.
-Cell make_cell(const std::string& method, const std::string& representation, const std::string& head, int demos,
-               std::uint64_t train_seed, long long demo_samples, const std::string& demo_digest, int steps = 0,
+Cell make_cell(const std::string& method, const std::string& representation,
+               const std::string& head, int demos, std::uint64_t train_seed, long long demo_samples,
+               const std::string& demo_digest, int steps = 0,
                const sim::TrainingData& data = sim::TrainingData(),
                std::array<double, 2> c8_centre = {0.0, 0.0});
 

@@ -23,11 +23,11 @@
 namespace handcentric::experiments {
 
 struct FlowFigureOptions {
-  int demos = 20;                ///< expert demos on train scenes (training samples drawn)
-  std::uint64_t seed = 1;        ///< of the demo scenes, the expert and the noise draws
-  int noise_draws = 10;          ///< arrows per panel
-  double rotation_deg = 120.0;   ///< g's rotation about the world z axis
-  double translation_x = 40.0;   ///< g's translation (same units as the sim: cm)
+  int demos = 20;               ///< expert demos on train scenes (training samples drawn)
+  std::uint64_t seed = 1;       ///< of the demo scenes, the expert and the noise draws
+  int noise_draws = 10;         ///< arrows per panel
+  double rotation_deg = 120.0;  ///< g's rotation about the world z axis
+  double translation_x = 40.0;  ///< g's translation (same units as the sim: cm)
   double translation_y = -25.0;
   /// Throws InvalidArgument naming the field and its range.
   void validate() const;
@@ -35,9 +35,9 @@ struct FlowFigureOptions {
 
 /// One column of the figure: one representation, the chunk before and after g.
 struct FlowColumn {
-  std::string representation;                        ///< "absolute", "relative", "hand_centric"
-  std::vector<Eigen::Vector2d> training_positions;   ///< a_1's (x, y) over the training scenes
-  Eigen::Vector2d original = Eigen::Vector2d::Zero();     ///< a_1 of the chosen chunk
+  std::string representation;                          ///< "absolute", "relative", "hand_centric"
+  std::vector<Eigen::Vector2d> training_positions;     ///< a_1's (x, y) over the training scenes
+  Eigen::Vector2d original = Eigen::Vector2d::Zero();  ///< a_1 of the chosen chunk
   Eigen::Vector2d transformed = Eigen::Vector2d::Zero();  ///< a_1 of g * that chunk
   /// |a_1(g * scene) - a_1(scene)| over all six numbers of a_1: 0 when a_1's flow problem is
   /// invariant under g (up to rounding).

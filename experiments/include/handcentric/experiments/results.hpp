@@ -14,8 +14,8 @@ namespace handcentric::experiments {
 
 /// `handcentric eval --json`: {"trials", "success", "collision", "timeout" (rates), "clipped",
 /// "policy", "dist", "seed"}, one line.
-std::string eval_json(const sim::RolloutSummary& summary, const std::string& policy, const std::string& dist,
-                      std::uint64_t seed);
+std::string eval_json(const sim::RolloutSummary& summary, const std::string& policy,
+                      const std::string& dist, std::uint64_t seed);
 
 /// The counts back from eval_json text. Throws InvalidArgument naming `source` when it is not
 /// such an object (a cut or foreign file).

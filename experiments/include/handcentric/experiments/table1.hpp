@@ -33,14 +33,14 @@ struct Table1Options {
   EvalSettings eval;
   int steps = 0;  ///< Adam steps per cell; 0: the library's automatic budget (PolicyConfig)
   sim::TrainingData data;  ///< every cell's training data recipe (the demos' mirror images too)
-  int jobs = 0;  ///< trainings at once; 0: one per hardware thread
+  int jobs = 0;            ///< trainings at once; 0: one per hardware thread
   std::string out = "table1";
   bool resume = false;
   bool quiet = false;
 
   /// Throws InvalidArgument naming the first bad value and the fix (a demo count outside
-  /// 1..1000 or repeated, steps < 0, no method, no training seed, trials < 1, jobs < 0, ood_seed equal to
-  /// eval_seed: the OOD set would be the paired one).
+  /// 1..1000 or repeated, steps < 0, no method, no training seed, trials < 1, jobs < 0, ood_seed
+  /// equal to eval_seed: the OOD set would be the paired one).
   void validate() const;
 };
 
@@ -77,6 +77,7 @@ std::string collect_table1(const std::string& dir);
 /// The markdown of `rows`: per method and head, the id success (mean over training seeds) at
 /// each demo count and the OOD success (independent, and paired) at each count, with the
 /// paper's row beside it.
-std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval, std::uint64_t demo_seed);
+std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval,
+                            std::uint64_t demo_seed);
 
 }  // namespace handcentric::experiments

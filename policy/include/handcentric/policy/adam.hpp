@@ -22,7 +22,8 @@ class Adam {
   /// One update of `parameters` from gradient_scale * `gradient` (same length as the
   /// constructor's count); the scale is where clipping goes (gradient_clip_scale), so the
   /// gradient is not rewritten first.
-  void step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient, float gradient_scale = 1.0f);
+  void step(Eigen::VectorXf& parameters, const Eigen::VectorXf& gradient,
+            float gradient_scale = 1.0f);
 
   long long steps_taken() const { return t_; }
 

@@ -26,7 +26,8 @@ class ByteWriter {
 class ByteReader {
  public:
   /// `source` names the file in error messages.
-  ByteReader(const std::string& bytes, std::string source, std::size_t begin = 0, std::size_t end = std::string::npos);
+  ByteReader(const std::string& bytes, std::string source, std::size_t begin = 0,
+             std::size_t end = std::string::npos);
   std::uint32_t u32();
   std::uint64_t u64();
   double f64();
@@ -49,7 +50,8 @@ class ByteReader {
   std::size_t position_, end_;
 };
 
-/// 64-bit FNV-1a of `data` (Fowler-Noll-Vo; offset basis 14695981039346656037, prime 1099511628211).
+/// 64-bit FNV-1a of `data` (Fowler-Noll-Vo; offset basis 14695981039346656037, prime
+/// 1099511628211).
 std::uint64_t fnv1a64(const char* data, std::size_t size);
 
 }  // namespace handcentric::policy

@@ -26,12 +26,13 @@ Eigen::Matrix3d right_jacobian_inverse(const Eigen::Vector3d& r);
 /// not a multiple of 6.
 Eigen::VectorXd act_on_actions(const Eigen::Matrix3d& R, const Eigen::VectorXd& a);
 
-/// g o for an absolute observation of H past poses (H + 1 blocks of 6), then `hand_points` eye-in-hand
-/// points, then world points. Throws InvalidArgument for a length that does not fit.
-Eigen::VectorXd act_on_observation(const Eigen::Matrix3d& R, const Eigen::VectorXd& o, int history_length,
-                                   int hand_points);
+/// g o for an absolute observation of H past poses (H + 1 blocks of 6), then `hand_points`
+/// eye-in-hand points, then world points. Throws InvalidArgument for a length that does not fit.
+Eigen::VectorXd act_on_observation(const Eigen::Matrix3d& R, const Eigen::VectorXd& o,
+                                   int history_length, int hand_points);
 
 /// The differential of a -> g a at `a`, applied to the velocity `v` (see above).
-Eigen::VectorXd push_velocity(const Eigen::Matrix3d& R, const Eigen::VectorXd& a, const Eigen::VectorXd& v);
+Eigen::VectorXd push_velocity(const Eigen::Matrix3d& R, const Eigen::VectorXd& a,
+                              const Eigen::VectorXd& v);
 
 }  // namespace handcentric::policy::c8

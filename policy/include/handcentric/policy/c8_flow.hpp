@@ -14,7 +14,7 @@ namespace handcentric::policy {
 
 /// F (symmetrized = true) or the plain network field f (symmetrized = false) at raw absolute
 /// action x and raw absolute observation o. Throws InvalidArgument if `head` is not a c8flow head.
-Eigen::VectorXd c8_velocity(const Head& head, const Eigen::VectorXd& x, const Eigen::VectorXd& o, double t,
-                            bool symmetrized);
+Eigen::VectorXd c8_velocity(const Head& head, const Eigen::VectorXd& x, const Eigen::VectorXd& o,
+                            double t, bool symmetrized);
 
 }  // namespace handcentric::policy

@@ -71,7 +71,7 @@ struct PolicyConfig {
   /// cosine by default: on 100 peg-in-hole demos (H = 0, 60000 steps) flow / hand_centric
   /// succeeds in 40 of 50 tuning rollouts with it and 13 of 50 with a constant rate (docs/SIM.md).
   LearningRateSchedule lr_schedule = LearningRateSchedule::cosine;
-  double weight_decay = 0.0;  ///< decoupled (AdamW)
+  double weight_decay = 0.0;   ///< decoupled (AdamW)
   double gradient_clip = 1.0;  ///< global L2 norm; 0 disables
   /// Keep the exponential moving average of the weights (weight_average.hpp) and put it in the
   /// model: 0 = off (the default), 0.999 is usual.
@@ -87,9 +87,9 @@ struct PolicyConfig {
   /// 4: replanning twice as often corrects the approach to the hole before it touches a wall
   /// (0.92 -> 0.97 with noise_scale 0; docs/EXPERIMENTS.md).
   int execute = 4;
-  int euler_steps = 10;          ///< rectified flow, eq. (5)
-  int ddpm_train_steps = 100;    ///< DDPM diffusion steps
-  int ddim_steps = 10;           ///< DDIM sampling steps
+  int euler_steps = 10;        ///< rectified flow, eq. (5)
+  int ddpm_train_steps = 100;  ///< DDPM diffusion steps
+  int ddim_steps = 10;         ///< DDIM sampling steps
   int cvae_latent = 16;
   double cvae_kl_weight = 1e-2;
   /// The point C8 rotates about (world x, y; the task's cm) for heads c8ddpm and c8flow_planar

@@ -43,7 +43,8 @@ class Head {
   virtual void finish_training() = 0;
 
   /// One raw action vector per raw observation column; all noise from `rng`.
-  virtual Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const = 0;
+  virtual Eigen::MatrixXf sample(const Eigen::MatrixXf& observations,
+                                 std::mt19937_64& rng) const = 0;
 
   /// Normalization statistics and weights (the config is stored by the model file).
   virtual void write(ByteWriter& out) const = 0;

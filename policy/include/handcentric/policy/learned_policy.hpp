@@ -32,7 +32,8 @@ class LearnedPolicy final : public ChunkPolicy {
   /// Throws InvalidScene for an invalid observation or one whose H or point counts differ from
   /// training, and NonFiniteAction (an InvalidScene) for a non-finite output (an observation far
   /// outside the training data, or diverged weights).
-  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  std::uint64_t noise_seed) const override;
 
   /// The head's raw action vector for `observation` (before decoding).
   Eigen::VectorXd action_vector(const Scene& observation, std::uint64_t noise_seed) const;

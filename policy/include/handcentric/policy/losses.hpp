@@ -14,7 +14,8 @@ template <typename Scalar>
 using MatrixX = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
 
 template <typename Scalar>
-double mse_loss(const MatrixX<Scalar>& pred, const MatrixX<Scalar>& target, MatrixX<Scalar>& d_pred) {
+double mse_loss(const MatrixX<Scalar>& pred, const MatrixX<Scalar>& target,
+                MatrixX<Scalar>& d_pred) {
   d_pred = pred - target;
   const auto n = static_cast<double>(d_pred.size());
   const double loss = static_cast<double>(d_pred.squaredNorm()) / n;
@@ -27,7 +28,8 @@ double gaussian_kl_loss(const MatrixX<Scalar>& mu, const MatrixX<Scalar>& log_va
                         MatrixX<Scalar>& d_mu, MatrixX<Scalar>& d_log_var) {
   const auto n = static_cast<double>(mu.size());
   const auto exp_lv = log_var.array().exp();
-  const double kl = 0.5 * static_cast<double>((mu.array().square() + exp_lv - log_var.array() - Scalar(1)).sum());
+  const double kl =
+      0.5 * static_cast<double>((mu.array().square() + exp_lv - log_var.array() - Scalar(1)).sum());
   const auto scale = static_cast<Scalar>(weight / n);
   d_mu = scale * mu;
   d_log_var = (scale * Scalar(0.5) * (exp_lv - Scalar(1))).matrix();

@@ -68,9 +68,9 @@ class MlpT {
   std::vector<Eigen::Index> offsets_;  ///< start of W_l in parameters_; b_l follows W_l
   Vector parameters_;
   Vector gradient_;
-  std::vector<Matrix> z_;  ///< pre-activations of the last forward()
+  std::vector<Matrix> z_;        ///< pre-activations of the last forward()
   std::vector<Matrix> sigmoid_;  ///< SiLU only: sigmoid(z_[l]) of the last forward()
-  std::vector<Matrix> a_;  ///< a_[0] = input, a_[l] = act(z_[l-1])
+  std::vector<Matrix> a_;        ///< a_[0] = input, a_[l] = act(z_[l-1])
   Matrix delta_[2];
   Vector ones_;  ///< float: batch ones, for db = delta 1
 };

@@ -14,8 +14,8 @@
 namespace handcentric::policy {
 
 struct TrainingProgress {
-  int step = 0;   ///< steps done
-  int steps = 0;  ///< steps in total
+  int step = 0;                     ///< steps done
+  int steps = 0;                    ///< steps in total
   double loss = 0.0;                ///< mean minibatch loss since the previous report
   double samples_per_second = 0.0;  ///< since the start
   double eta_seconds = 0.0;
@@ -44,8 +44,9 @@ double learning_rate_at(const PolicyConfig& config, int step);
 /// in the returned policy's config come from the data. `progress` (optional) is called about
 /// every `report_every` steps and after the last step. Throws InvalidArgument for a bad config
 /// or a non-finite loss (diverged training), InvalidScene for bad scenes (dataset.hpp).
-LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes, std::uint64_t seed,
-                           const ProgressCallback& progress = {}, int report_every = 100);
+LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes,
+                           std::uint64_t seed, const ProgressCallback& progress = {},
+                           int report_every = 100);
 
 /// The same on already encoded data (benchmarks; `config.representation` must still name the
 /// representation that encoded it).

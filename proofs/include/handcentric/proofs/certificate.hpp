@@ -46,8 +46,8 @@ Instance generic_instance(Group group);
 using Side = std::function<GiNaC::matrix(const Instance&)>;
 
 /// A flow (or any representation component) of a scene.
-using Flow =
-    std::function<GiNaC::matrix(const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex& t)>;
+using Flow = std::function<GiNaC::matrix(const ExactScene& scene, const GiNaC::matrix& eps,
+                                         const GiNaC::ex& t)>;
 
 /// lhs = f(g * scene, eps, t)
 Side moved(const Flow& flow);
@@ -57,7 +57,8 @@ Side unmoved(const Flow& flow);
 /// How a counterexample's witness is shown: its inputs in words, and what each side is
 /// (e.g. "f(T~ scene)" and "f(scene)").
 struct WitnessText {
-  WitnessText(std::string inputs_text = "", std::string lhs = "lhs", std::string rhs = "rhs")  // NOLINT
+  WitnessText(std::string inputs_text = "", std::string lhs = "lhs",
+              std::string rhs = "rhs")  // NOLINT
       : inputs(std::move(inputs_text)), lhs_name(std::move(lhs)), rhs_name(std::move(rhs)) {}
   WitnessText(const char* inputs_text) : WitnessText(std::string(inputs_text)) {}  // NOLINT
   std::string inputs;

@@ -45,8 +45,8 @@ struct Claim {
 };
 
 /// A claim that lhs = rhs for every instance of `group` (symbols everywhere).
-Claim identity_claim(std::string id, std::string statement, ClaimSection section, Side lhs, Side rhs,
-                     Group group, std::string note = "");
+Claim identity_claim(std::string id, std::string statement, ClaimSection section, Side lhs,
+                     Side rhs, Group group, std::string note = "");
 
 /// A claim that lhs != rhs at the exact `witness`, described by `inputs` in the report.
 Claim counterexample_claim(std::string id, std::string statement, ClaimSection section, Side lhs,

@@ -10,7 +10,8 @@
 
 namespace handcentric::proofs {
 
-/// eqs. (9), (23), (26), (16) under translations, Lemma 1 / eq. (8), Lemma 2 with eq. (9), eq. (11).
+/// eqs. (9), (23), (26), (16) under translations, Lemma 1 / eq. (8), Lemma 2 with eq. (9),
+/// eq. (11).
 std::vector<Claim> identity_claims();
 
 /// eqs. (11), (13), (16) under rotations, (18), (30) pointwise; Lemma 2 without eye-in-hand.

@@ -28,8 +28,8 @@ bool is_exact_rotation(const GiNaC::matrix& R);
 /// True when every entry of the column is a rational number.
 bool is_rational_column(const GiNaC::matrix& v);
 
-/// True when the exact rotation R has angle below pi, i.e. trace R > -1 (cos(angle) = (tr R - 1)/2),
-/// where r is injective. False for a non-rational matrix.
+/// True when the exact rotation R has angle below pi, i.e. trace R > -1
+/// (cos(angle) = (tr R - 1)/2), where r is injective. False for a non-rational matrix.
 bool has_angle_below_pi(const GiNaC::matrix& R);
 
 /// r(R) exactly (see above). Throws InvalidRotation when R is not an exact rational rotation,

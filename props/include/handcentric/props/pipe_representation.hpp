@@ -82,7 +82,7 @@ class PipeRepresentation final : public Representation {
   mutable std::optional<PluginCapabilities> capabilities_;
   mutable bool has_observation_ = false;
   mutable std::unordered_map<std::string, PluginReply> cache_;
-  mutable std::string last_scene_bytes_;           ///< the last scene encoded, as raw bytes
+  mutable std::string last_scene_bytes_;             ///< the last scene encoded, as raw bytes
   mutable const PluginReply* last_reply_ = nullptr;  ///< its answer, in cache_
   /// (H, K, #hand points, #world points) -> (actions length, observation length, has observation)
   mutable std::map<std::tuple<int, int, int, int>, std::tuple<Eigen::Index, Eigen::Index, bool>>

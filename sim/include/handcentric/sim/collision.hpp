@@ -23,7 +23,8 @@
 
 namespace handcentric::sim {
 
-/// Distances at or below this (cm) count as contact: 1 micrometre, ~100x float rounding near the hole.
+/// Distances at or below this (cm) count as contact: 1 micrometre, ~100x float rounding near the
+/// hole.
 constexpr double kContactDistance = 1e-4;
 
 /// The pose at parameter s in [0, 1] of the motion from `from` to `to`, linear in (theta, x, y)
@@ -46,7 +47,8 @@ class CollisionChecker {
 
   /// Whether the peg touches the hole anywhere on the motion from hole_T_hand_from to
   /// hole_T_hand_to (both ends included), checked continuously as described above.
-  bool motion_collides(const RigidTransform& hole_T_hand_from, const RigidTransform& hole_T_hand_to) const;
+  bool motion_collides(const RigidTransform& hole_T_hand_from,
+                       const RigidTransform& hole_T_hand_to) const;
 
   /// Distance queries made so far by this checker (for benchmarks and tests).
   std::uint64_t queries() const { return queries_; }

@@ -14,7 +14,8 @@
 // Bounded input: load_demos refuses a file that passes one of the limits below with
 // InvalidDemoFile, before it allocates for what is over the limit. Its memory is at most one line
 // (and that line's JSON tree, ~20 bytes per byte of the line) plus the poses it keeps, so a
-// hostile or broken file costs at most a few hundred MB (tests/sim/test_demo_limits.cpp measures it).
+// hostile or broken file costs at most a few hundred MB (tests/sim/test_demo_limits.cpp measures
+// it).
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -57,7 +58,8 @@ struct Demo {
 
 /// Reads and validates a demo file (format above). Throws InvalidDemoFile naming the record, also
 /// for a file over one of the DemoFileLimits (naming the limit).
-std::vector<Demo> load_demos(const std::string& path, const DemoFileLimits& limits = DemoFileLimits());
+std::vector<Demo> load_demos(const std::string& path,
+                             const DemoFileLimits& limits = DemoFileLimits());
 
 /// load_demos on a file's bytes already in memory (received, embedded, or a fuzzer's input);
 /// `source` names them in errors as the path would. Same checks, limits and errors.
@@ -71,9 +73,9 @@ void save_demos(const std::string& path, const std::vector<Demo>& demos,
 
 /// The eye-in-hand observation of Sec. 4.2: the two corners of the hole's opening
 /// (left, then right) in the frame of the hand at world_T_hand.
-std::vector<Eigen::Vector3d> eye_in_hand_points(const RigidTransform& world_T_hole,
-                                                const RigidTransform& world_T_hand,
-                                                const PegHoleGeometry& geometry = PegHoleGeometry());
+std::vector<Eigen::Vector3d> eye_in_hand_points(
+    const RigidTransform& world_T_hole, const RigidTransform& world_T_hand,
+    const PegHoleGeometry& geometry = PegHoleGeometry());
 
 /// One Scene per control step t = 0..T-1 of `demo`: history T_t, T_{t-1}, ..., T_{t-H} (the
 /// first pose repeated before the start), chunk T_{t+1}..T_{t+K} (the last pose repeated after
@@ -119,7 +121,9 @@ struct TrainingData {
   std::uint64_t perturbation_seed = 1;
   /// The samples of `demo_samples` demo scenes with their mirror images, the count a training
   /// budget grows with (the perturbed copies, which vary those samples, are not counted).
-  long long samples(long long demo_samples) const { return mirror ? 2 * demo_samples : demo_samples; }
+  long long samples(long long demo_samples) const {
+    return mirror ? 2 * demo_samples : demo_samples;
+  }
   /// Throws InvalidArgument naming the field for a negative count or offset, or recovery_steps < 1.
   void validate() const;
   /// Every field as "name=value" lines, in a fixed order: what a cache key of a model trained

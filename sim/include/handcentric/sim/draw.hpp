@@ -35,10 +35,12 @@ constexpr std::uint8_t kSuccessRgb[3] = {40, 170, 60};
 constexpr std::uint8_t kCollisionRgb[3] = {220, 30, 30};
 
 /// Throws InvalidArgument for a size outside [64, 4096].
-Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry = PegHoleGeometry(), int size = 800);
-Image draw_demos(const std::vector<Demo>& demos, const PegHoleGeometry& geometry = PegHoleGeometry(), int size = 800);
-Image draw_rollout(const TaskScene& scene, const Rollout& rollout, const PegHoleGeometry& geometry = PegHoleGeometry(),
-                   int size = 800);
+Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry = PegHoleGeometry(),
+                 int size = 800);
+Image draw_demos(const std::vector<Demo>& demos,
+                 const PegHoleGeometry& geometry = PegHoleGeometry(), int size = 800);
+Image draw_rollout(const TaskScene& scene, const Rollout& rollout,
+                   const PegHoleGeometry& geometry = PegHoleGeometry(), int size = 800);
 
 /// Writes `image` as a PNG, atomically. Throws Error naming the path when it cannot.
 void write_png(const std::string& path, const Image& image);

@@ -18,11 +18,14 @@ struct ExpertCheck {
   int rollout_success = 0;    ///< closed-loop expert rollouts that inserted the peg
   int rollouts = 0;
   /// Both rates at or above kExpertBar.
-  bool passes() const { return solved_rate >= kExpertBar && rollout_success >= kExpertBar * rollouts; }
+  bool passes() const {
+    return solved_rate >= kExpertBar && rollout_success >= kExpertBar * rollouts;
+  }
 };
 
 /// The expert's demos on scenes 0..scenes-1 of (distribution, seed) and its closed-loop rollouts
 /// on scenes 0..rollouts-1 of the same stream. Throws InvalidArgument for a count below 1.
-ExpertCheck check_expert(const SceneDistribution& distribution, int scenes, int rollouts, std::uint64_t seed);
+ExpertCheck check_expert(const SceneDistribution& distribution, int scenes, int rollouts,
+                         std::uint64_t seed);
 
 }  // namespace handcentric::sim

@@ -10,11 +10,15 @@ template <typename DemoType>
 struct BasicExpertRun {
   std::vector<DemoType> demos;  ///< one per solved scene, in scene order
   int scenes = 0;
-  int unsolved = 0;             ///< scenes where every attempt was invalid
-  int solutions = 0;            ///< plans made
-  int discarded = 0;            ///< invalid plans among them
-  double discard_rate() const { return solutions == 0 ? 0.0 : static_cast<double>(discarded) / solutions; }
-  double solved_rate() const { return scenes == 0 ? 0.0 : 1.0 - static_cast<double>(unsolved) / scenes; }
+  int unsolved = 0;   ///< scenes where every attempt was invalid
+  int solutions = 0;  ///< plans made
+  int discarded = 0;  ///< invalid plans among them
+  double discard_rate() const {
+    return solutions == 0 ? 0.0 : static_cast<double>(discarded) / solutions;
+  }
+  double solved_rate() const {
+    return scenes == 0 ? 0.0 : 1.0 - static_cast<double>(unsolved) / scenes;
+  }
 
   /// Adds another run's counts and moves its demos to the end.
   void append(BasicExpertRun&& other) {

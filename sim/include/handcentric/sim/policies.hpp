@@ -1,7 +1,7 @@
 #pragma once
 // Policies that need no training, for testing the rollout loop and for the benchmarks. All of
-// them read only the observation (hand history and eye-in-hand points), so they are equivariant, eq. (4):
-// act(g * o, s) = g * act(o, s) for every planar g (tests/sim checks the expert's).
+// them read only the observation (hand history and eye-in-hand points), so they are equivariant,
+// eq. (4): act(g * o, s) = g * act(o, s) for every planar g (tests/sim checks the expert's).
 //
 //   ExpertPolicy   : the trajectory-optimization expert, closed loop: reads the hole from the two
 //                    eye-in-hand corners, replans from the current pose without a via point.
@@ -29,9 +29,11 @@ RigidTransform hand_T_hole_from_observation(const Scene& observation);
 
 class ExpertPolicy final : public ChunkPolicy {
  public:
-  explicit ExpertPolicy(const PegHoleGeometry& geometry = PegHoleGeometry(), int chunk_length = kChunkLength);
+  explicit ExpertPolicy(const PegHoleGeometry& geometry = PegHoleGeometry(),
+                        int chunk_length = kChunkLength);
   std::string name() const override { return "expert"; }
-  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  std::uint64_t noise_seed) const override;
 
  private:
   CollisionChecker checker_;
@@ -43,7 +45,8 @@ class ReplayPolicy final : public ChunkPolicy {
   /// Throws InvalidArgument for an empty demo.
   explicit ReplayPolicy(const Demo& demo, int chunk_length = kChunkLength);
   std::string name() const override { return "replay"; }
-  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  std::uint64_t noise_seed) const override;
 
  private:
   std::vector<RigidTransform> hole_T_hand_;
@@ -54,7 +57,8 @@ class StraightPolicy final : public ChunkPolicy {
  public:
   explicit StraightPolicy(double step_cm = kMaxStepCm, int chunk_length = kChunkLength);
   std::string name() const override { return "straight"; }
-  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  std::uint64_t noise_seed) const override;
 
  private:
   double step_cm_;
@@ -64,7 +68,8 @@ class StraightPolicy final : public ChunkPolicy {
 class HoldPolicy final : public ChunkPolicy {
  public:
   std::string name() const override { return "hold"; }
-  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  std::uint64_t noise_seed) const override;
 };
 
 /// "expert", "straight", "hold" (the policies a command line can name without a file).

@@ -29,9 +29,9 @@ namespace handcentric::sim {
 constexpr int kStepBudget = 200;
 
 struct RolloutOptions {
-  int history = 2;         ///< H past poses in the observation
-  int execute = 8;         ///< poses executed per chunk
-  int max_replans = 25;    ///< kStepBudget / execute
+  int history = 2;       ///< H past poses in the observation
+  int execute = 8;       ///< poses executed per chunk
+  int max_replans = 25;  ///< kStepBudget / execute
   double max_step_cm = kMaxStepCm;
   double max_step_deg = kMaxStepDeg;
   /// A non-finite pose from the policy: false ends the rollout as Outcome::invalid, true throws
@@ -63,11 +63,13 @@ struct Rollout {
 
 /// The observation at the end of `world_T_hand` (history of `history` past poses, eye-in-hand
 /// corners of the opening). Throws InvalidArgument for an empty trajectory or history < 0.
-Scene observation(const RigidTransform& world_T_hole, const std::vector<RigidTransform>& world_T_hand, int history,
+Scene observation(const RigidTransform& world_T_hole,
+                  const std::vector<RigidTransform>& world_T_hand, int history,
                   const PegHoleGeometry& geometry = PegHoleGeometry());
 
 /// Whether the hand at hole_T_hand has its tip kSuccessDepth deep and inside the opening's width.
-bool is_inserted(const RigidTransform& hole_T_hand, const PegHoleGeometry& geometry = PegHoleGeometry());
+bool is_inserted(const RigidTransform& hole_T_hand,
+                 const PegHoleGeometry& geometry = PegHoleGeometry());
 
 /// One rollout; act() call r gets the noise seed stream_seed(seed, r). Throws InvalidArgument
 /// when the policy returns an empty chunk (naming the policy and the replan); a non-finite pose

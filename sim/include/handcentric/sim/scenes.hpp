@@ -55,17 +55,20 @@ constexpr double kStartMaxY = 20.0;
 constexpr double kStartMaxAbsAngleDeg = 40.0;
 
 /// Scene `index` of the stream `seed`.
-TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed, std::uint64_t index);
+TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed,
+                       std::uint64_t index);
 
 /// Scenes 0..n-1 of the stream `seed`. Throws InvalidArgument for n < 0.
-std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n, std::uint64_t seed);
+std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n,
+                                     std::uint64_t seed);
 
 /// A global planar transform from "DEG,X,Y" (rotation about z in degrees, then translation in
 /// cm), as the command line takes it. Throws InvalidArgument naming the text and the form.
 RigidTransform parse_planar_transform(const std::string& text);
 
 /// g * scene for every scene: "arbitrary global SE(2) transforms of a scene set".
-std::vector<TaskScene> transform_scenes(const RigidTransform& g, const std::vector<TaskScene>& scenes);
+std::vector<TaskScene> transform_scenes(const RigidTransform& g,
+                                        const std::vector<TaskScene>& scenes);
 
 /// A seed for sub-stream `index` of `seed` (splitmix64 of both), shared by the sim's samplers.
 std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t index);

@@ -50,11 +50,13 @@ struct DepthImage {
 
 /// The nearest hit of the ray origin + t direction (t >= 0) with the axis-aligned box, or a
 /// negative number when it misses (slab method; a ray starting inside the box hits at t = 0).
-double ray_box_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, const Box3& box);
+double ray_box_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                   const Box3& box);
 
 /// The depth image seen by `camera` on the hand at hand_T_slot relative to the slot. Throws
 /// InvalidArgument for a bad camera or geometry.
-DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera, const RigidTransform& hand_T_slot);
+DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera,
+                        const RigidTransform& hand_T_slot);
 
 /// The same for a scene in the world: renders hand_T_slot = world_T_hand^-1 world_T_slot.
 DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera,

@@ -58,7 +58,8 @@ class CollisionChecker {
 
   /// Whether the blade touches the block anywhere on the motion from slot_T_hand_from to
   /// slot_T_hand_to (both ends included), by conservative advancement as described above.
-  bool motion_collides(const RigidTransform& slot_T_hand_from, const RigidTransform& slot_T_hand_to) const;
+  bool motion_collides(const RigidTransform& slot_T_hand_from,
+                       const RigidTransform& slot_T_hand_to) const;
 
   /// Pose queries made so far by this checker (each is one query per block box).
   std::uint64_t queries() const { return queries_; }

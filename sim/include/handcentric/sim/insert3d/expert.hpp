@@ -57,23 +57,26 @@ struct ExpertOptions {
 };
 
 struct ExpertPlan {
-  bool valid = false;                      ///< collision-free and inserted within kMaxDemoSteps
-  std::vector<RigidTransform> slot_T_hand; ///< at each control step, [0] = start
+  bool valid = false;                       ///< collision-free and inserted within kMaxDemoSteps
+  std::vector<RigidTransform> slot_T_hand;  ///< at each control step, [0] = start
 };
 
 /// One plan from slot_T_hand_start (one random via point drawn from rng), then validated.
 ExpertPlan plan_in_slot_frame(const RigidTransform& slot_T_hand_start, std::mt19937_64& rng,
-                              const CollisionChecker& checker, const ExpertOptions& options = ExpertOptions());
+                              const CollisionChecker& checker,
+                              const ExpertOptions& options = ExpertOptions());
 
 using ExpertRun = BasicExpertRun<Demo>;
 
 /// The expert on one scene: up to options.attempts plans from the stream (seed, index), the
 /// first valid one mapped to the world (world_T_hand = world_T_slot slot_T_hand).
 ExpertRun expert_demo(const TaskScene& scene, std::uint64_t seed, std::uint64_t index,
-                      const CollisionChecker& checker, const ExpertOptions& options = ExpertOptions());
+                      const CollisionChecker& checker,
+                      const ExpertOptions& options = ExpertOptions());
 
 /// The expert on every scene (scene i uses stream (seed, i)).
-ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed, const CollisionChecker& checker,
+ExpertRun expert_demos(const std::vector<TaskScene>& scenes, std::uint64_t seed,
+                       const CollisionChecker& checker,
                        const ExpertOptions& options = ExpertOptions());
 
 }  // namespace handcentric::sim::insert3d

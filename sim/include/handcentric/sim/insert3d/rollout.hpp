@@ -48,8 +48,8 @@ Scene observe(const TaskScene& scene, const std::vector<RigidTransform>& world_T
 
 /// One closed-loop rollout. Throws InvalidArgument for bad options or an empty chunk (naming the
 /// policy).
-Rollout rollout(const ChunkPolicy& policy, const TaskScene& scene, std::uint64_t seed, const CollisionChecker& checker,
-                const RolloutOptions& options = RolloutOptions());
+Rollout rollout(const ChunkPolicy& policy, const TaskScene& scene, std::uint64_t seed,
+                const CollisionChecker& checker, const RolloutOptions& options = RolloutOptions());
 
 /// The slot's pose in the hand frame read from the four opening corners in the hand frame
 /// (BladeSlotGeometry::opening_corners' order): what an eye-in-hand policy knows of the slot.
@@ -60,9 +60,11 @@ RigidTransform hand_T_slot_from_corners(const std::vector<Eigen::Vector3d>& hand
 /// poses.
 class ClosedLoopExpert final : public ChunkPolicy {
  public:
-  explicit ClosedLoopExpert(int chunk_length = 16, const BladeSlotGeometry& geometry = BladeSlotGeometry());
+  explicit ClosedLoopExpert(int chunk_length = 16,
+                            const BladeSlotGeometry& geometry = BladeSlotGeometry());
   std::string name() const override { return "insert3d-expert"; }
-  std::vector<RigidTransform> act(const Scene& observation, std::uint64_t noise_seed) const override;
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  std::uint64_t noise_seed) const override;
 
  private:
   int chunk_length_;

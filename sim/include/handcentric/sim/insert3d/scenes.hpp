@@ -69,9 +69,11 @@ struct SceneDistribution {
 Rotation rotation_from_xyz_deg(const Eigen::Vector3d& xyz_deg);
 
 /// Scene `index` of the stream `seed`.
-TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed, std::uint64_t index);
+TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed,
+                       std::uint64_t index);
 
 /// Scenes 0..n-1 of the stream `seed`. Throws InvalidArgument for n < 0.
-std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n, std::uint64_t seed);
+std::vector<TaskScene> sample_scenes(const SceneDistribution& distribution, int n,
+                                     std::uint64_t seed);
 
 }  // namespace handcentric::sim::insert3d
