@@ -23,7 +23,6 @@
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/cell.hpp"
 #include "handcentric/experiments/insert3d_key_points.hpp"
-#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -108,11 +107,8 @@ int run_train(const TrainOptions& options) {
   }
   const std::size_t used =
       options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
-  if (config.steps == 0) {
-    // c8ddpm trains on 8 rotated copies of every scene: its budget counts them
-    config.steps = experiments::automatic_steps(
-        data, policy::c8::augmentation_copies(config.head) * demo_samples);
-  }
+  if (config.steps == 0)
+    config.steps = experiments::automatic_steps(data, config.head, demo_samples);
 
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   const int report_every = terminal ? 50 : std::max(1, config.steps / 10);

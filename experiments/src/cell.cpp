@@ -4,7 +4,6 @@
 
 #include <cstdio>
 
-#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 
@@ -56,8 +55,8 @@ std::string cell_hash(const Cell& cell) {
   return digest(text);
 }
 
-int automatic_steps(const sim::TrainingData& data, long long demo_samples) {
-  return policy::training_budget(data.samples(demo_samples));
+int automatic_steps(const sim::TrainingData& data, policy::HeadKind head, long long demo_samples) {
+  return policy::training_budget(head, data.samples(demo_samples));
 }
 
 Cell make_cell(const std::string& method, const std::string& representation,
@@ -77,10 +76,8 @@ Cell make_cell(const std::string& method, const std::string& representation,
   cell.config.c8_centre_x = c8_centre[0];
   cell.config.c8_centre_y = c8_centre[1];
   if (steps > 0) cell.config.steps = steps;
-  if (cell.config.steps == 0) {
-    const long long copies = policy::c8::augmentation_copies(cell.config.head);
-    cell.config.steps = automatic_steps(data, copies * demo_samples);
-  }
+  if (cell.config.steps == 0)
+    cell.config.steps = automatic_steps(data, cell.config.head, demo_samples);
   cell.config.validate();
   cell.hash = cell_hash(cell);
   return cell;

@@ -22,6 +22,12 @@ int training_budget(long long samples) {
                                      static_cast<long long>(kBudgetMaxSteps)));
 }
 
+int training_budget(HeadKind head, long long samples) {
+  const int copies = c8::augmentation_copies(head);
+  if (copies == 1) return training_budget(samples);
+  return std::min(training_budget(copies * samples), kC8BudgetMaxSteps);
+}
+
 double learning_rate_at(const PolicyConfig& config, int step) {
   if (step < 1 || step > config.steps) {
     throw InvalidArgument("learning_rate_at: step " + std::to_string(step) + " is outside 1.." +
@@ -54,7 +60,7 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
   if (data.size() == 0)
     throw InvalidScene("no training samples: give at least one demonstration step");
   if (config.steps == 0) {
-    config.steps = training_budget(c8::augmentation_copies(config.head) * data.size());
+    config.steps = training_budget(config.head, data.size());
   }
   config.action_dimension = static_cast<int>(data.actions.rows());
   config.observation_dimension = static_cast<int>(data.observations.rows());

@@ -91,14 +91,18 @@ TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget"
                      m.c8_centre);
   };
   const Cell centre = c8_cell(c8[0]), base = c8_cell(c8[1]);
-  // 320 demo scenes, their mirror images, and the 8 C8 images of each (the perturbed copies
-  // add no steps).
-  CHECK(centre.config.steps == automatic_steps(sim::TrainingData(), 8 * 320));
+  // 320 demo scenes, their mirror images, and the 8 C8 images of each: 6 x 5120 steps, over
+  // the C8 cap (the perturbed copies add no steps).
+  CHECK(centre.config.steps == policy::kC8BudgetMaxSteps);
   sim::TrainingData no_copies;
   no_copies.perturbed_copies = 0;
   CHECK(make_cell(c8[0].name, c8[0].representation, c8[0].fixed_head, 10, 1, 320, "00ff", 0,
                   no_copies, c8[0].c8_centre)
-            .config.steps == policy::training_budget(8 * 640));
+            .config.steps == policy::kC8BudgetMaxSteps);
+  // 40 demo scenes: 6 x 8 x 80 = 3840 steps, under the cap, so the 8x data is counted.
+  CHECK(make_cell(c8[0].name, c8[0].representation, c8[0].fixed_head, 2, 1, 40, "00ff", 0, {},
+                  c8[0].c8_centre)
+            .config.steps == 3840);
   CHECK(centre.hash != base.hash);
   CHECK(base.config.c8_centre_y == -60.0);
   // A non-C8 cell ignores the centre, so its hash (and cached model) does not depend on it.

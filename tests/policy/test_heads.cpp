@@ -266,6 +266,15 @@ TEST_CASE("the_automatic_budget_grows_with_the_samples_between_its_bounds", "[un
   CHECK(training_budget(mid) == static_cast<int>(std::llround(kBudgetStepsPerSample * mid)));
   CHECK(training_budget(mid) < training_budget(2 * mid));
   HC_CHECK_THROWS(training_budget(0), InvalidArgument, Catch::Contains("no training samples"));
+  // Per head: the C8 heads count their 8x augmented data up to their own cap.
+  CHECK(training_budget(HeadKind::flow, 1000) == 6000);
+  CHECK(training_budget(HeadKind::ddpm, 100000) == kBudgetMaxSteps);
+  CHECK(training_budget(HeadKind::c8ddpm, 100) == 4800);
+  CHECK(training_budget(HeadKind::c8flow_planar, 100) == 4800);
+  CHECK(training_budget(HeadKind::c8ddpm, 1000) == kC8BudgetMaxSteps);
+  CHECK(training_budget(HeadKind::c8ddpm, 10) == kBudgetMinSteps);
+  HC_CHECK_THROWS(training_budget(HeadKind::c8ddpm, 0), InvalidArgument,
+                  Catch::Contains("no training samples"));
   // steps = 0 trains the budget and the model records the steps it ran.
   PolicyConfig config = test::small_config(HeadKind::flow, "hand_centric", 0);
   config.hidden_width = 8;

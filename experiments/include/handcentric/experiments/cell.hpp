@@ -56,16 +56,17 @@ std::string digest(const std::string& bytes);
 std::string cell_hash(const Cell& cell);
 
 /// The automatic training budget (Adam steps) for `demo_samples` scenes of demos trained on
-/// under `data`, the one `handcentric train` and every table cell use: trainer.hpp's
-/// training_budget of the samples with their mirror images (6 per sample, 3000 to 30000); the
-/// perturbed copies add no steps. Measured on the tuning seeds (docs/EXPERIMENTS.md): with 4
-/// copies 100 demos insert 1.00 after 10000 steps already, but relative actions need the 30000
-/// (0.35 after 10000, 0.61 after 30000), and every method gets the same budget.
-int automatic_steps(const sim::TrainingData& data, long long demo_samples);
+/// under `data` with `head`, the one `handcentric train` and every table cell use: trainer.hpp's
+/// training_budget(head, samples) of the samples with their mirror images (6 per sample, 3000
+/// to 30000; the C8 heads count their 8x data up to 10000); the perturbed copies add no steps.
+/// Measured on the tuning seeds (docs/EXPERIMENTS.md): with 4 copies 100 demos insert 1.00
+/// after 10000 steps already, but relative actions need the 30000 (0.35 after 10000, 0.61
+/// after 30000), and the hand-centric, relative and absolute rows get the same budget.
+int automatic_steps(const sim::TrainingData& data, policy::HeadKind head,
+                    long long demo_samples);
 
 /// A cell with its config from the library defaults (PolicyConfig{}), the method's
-/// representation and the head, and `steps` Adam steps (0: automatic_steps, of 8 times the
-/// demo samples for c8ddpm's augmented data), and `c8_centre` (x, y) as the point c8ddpm rotates
+/// representation and the head, and `steps` Adam steps (0: automatic_steps), and `c8_centre` (x, y) as the point c8ddpm rotates
 /// about (other heads ignore it); hash set.
 Cell make_cell(const std::string& method, const std::string& representation,
                const std::string& head, int demos, std::uint64_t train_seed, long long demo_samples,

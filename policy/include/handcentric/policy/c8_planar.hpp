@@ -63,7 +63,7 @@ Eigen::Vector2d centre_of(const PolicyConfig& config);
 
 /// How many training samples each demo step stands for: 8 for c8ddpm and c8flow_planar, which
 /// train on every sample's C8 orbit (the 8x augmented data), 1 for every other head. The automatic
-/// budget (training_budget) counts the augmented data: training_budget(copies * samples).
+/// budget counts the augmented data (training_budget(HeadKind, samples), trainer.hpp).
 int augmentation_copies(HeadKind head);
 
 /// The config of the network inside a c8ddpm (c8flow_planar) head: a DDPM (flow) head on the
