@@ -23,7 +23,7 @@ export LSAN_OPTIONS="suppressions=$root/tests/support/lsan.supp:print_suppressio
 
 # Clang: libFuzzer needs it, and one tree then serves the tests and the fuzz targets.
 start=$(date +%s)
-CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" \
+CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_UNITY_BUILD=ON \
       -DHANDCENTRIC_SANITIZE=address,undefined -DHANDCENTRIC_FUZZ=ON -DHANDCENTRIC_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build_dir" -j "$jobs"
 built=$(date +%s)

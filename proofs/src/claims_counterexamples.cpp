@@ -9,17 +9,7 @@
 namespace handcentric::proofs {
 namespace {
 
-constexpr ClaimSection kSection = ClaimSection::counterexamples;
-
-Flow with_noise(GiNaC::matrix (*f)(const ExactScene&, const GiNaC::matrix&)) {
-  return [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) {
-    return f(scene, eps);
-  };
-}
-
-Flow ignoring_noise(GiNaC::matrix (*f)(const ExactScene&)) {
-  return [f](const ExactScene& scene, const GiNaC::matrix&, const GiNaC::ex&) { return f(scene); };
-}
+constexpr ClaimSection kCounterexamples = ClaimSection::counterexamples;
 
 // The 3-4-5 rotation about z: cos = 3/5, sin = 4/5 (q = (2, 0, 0, 1)).
 GiNaC::matrix rotation_345() {
@@ -46,7 +36,7 @@ Witness witness(const ExactPose& g, const ExactPose& world_T_hand0, const ExactP
 
 Claim invariance_counterexample(std::string id, std::string statement, const Flow& flow,
                                 const Witness& w, std::string note = "") {
-  return counterexample_claim(std::move(id), std::move(statement), kSection, moved(flow),
+  return counterexample_claim(std::move(id), std::move(statement), kCounterexamples, moved(flow),
                               unmoved(flow), w.instance,
                               WitnessText(w.inputs, "f(T~ scene)", "f(scene)"), std::move(note));
 }

@@ -16,6 +16,11 @@
 
 namespace handcentric::test {
 
+/// The library's log as a plain function, the control beside the planted faults below.
+inline Eigen::Vector3d real_log(const Eigen::Matrix3d& R) {
+  return so3::log(R);
+}
+
 /// The textbook log: phi = acos((tr R - 1)/2), r = phi / (2 sin phi) vee(R - R^T).
 /// Loses all accuracy near pi (divides by sin phi) and near 0 (acos of ~1).
 inline Eigen::Vector3d naive_log(const Eigen::Matrix3d& R) {

@@ -259,10 +259,6 @@ struct LogUnderTest {
   Eigen::Vector3d (*log)(const Eigen::Matrix3d&);
 };
 
-Eigen::Vector3d real_log(const Eigen::Matrix3d& R) {
-  return so3::log(R);
-}
-
 auto within_documented_error(LogUnderTest under_test) {
   return [under_test] {
     const Eigen::Vector3d r = rotation_vector();
@@ -481,7 +477,7 @@ TEST_CASE("mutant_numerics_textbook_se3_exp_is_not_finite_on_huge_rotations", "[
 
 TEST_CASE("numerics_exp_and_log_stay_within_their_documented_error", "[property]") {
   require_numeric_property("exp and log within so3.hpp's bounds",
-                           within_documented_error({real_log}));
+                           within_documented_error({test::real_log}));
 }
 
 TEST_CASE("mutant_numerics_naive_log_leaves_the_documented_error", "[property]") {

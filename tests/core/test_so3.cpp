@@ -60,10 +60,6 @@ auto log_exp_roundtrip(LogFn log_fn) {
   };
 }
 
-Eigen::Vector3d real_log(const Eigen::Matrix3d& R) {
-  return so3::log(R);
-}
-
 // Rotation by pi about unit axis v, built exactly as 2 v v^T - I (symmetric: no sign in it).
 Eigen::Matrix3d half_turn(const Eigen::Vector3d& v) {
   return 2.0 * v * v.transpose() - Eigen::Matrix3d::Identity();
@@ -90,12 +86,12 @@ bool canonical_at_pi(LogFn log_fn) {
 }  // namespace
 
 TEST_CASE("exp_of_log_is_identity_on_a_million_haar_rotations", "[unit]") {
-  CHECK(max_exp_log_error(real_log, 1'000'000, 1, haar) <= 1e-12);
+  CHECK(max_exp_log_error(test::real_log, 1'000'000, 1, haar) <= 1e-12);
 }
 
 TEST_CASE("exp_of_log_is_identity_within_1e-10_of_pi_and_of_0", "[unit]") {
-  CHECK(max_exp_log_error(real_log, 100'000, 2, near_pi) <= 1e-12);
-  CHECK(max_exp_log_error(real_log, 100'000, 3, near_zero) <= 1e-12);
+  CHECK(max_exp_log_error(test::real_log, 100'000, 2, near_pi) <= 1e-12);
+  CHECK(max_exp_log_error(test::real_log, 100'000, 3, near_zero) <= 1e-12);
 }
 
 TEST_CASE("mutant_naive_acos_log_fails_exp_of_log_near_pi_and_0", "[unit]") {
@@ -104,7 +100,7 @@ TEST_CASE("mutant_naive_acos_log_fails_exp_of_log_near_pi_and_0", "[unit]") {
 }
 
 TEST_CASE("log_of_exp_is_identity_below_pi_minus_1e-9", "[property]") {
-  props::require_property("log(exp(r)) = r", log_exp_roundtrip(real_log));
+  props::require_property("log(exp(r)) = r", log_exp_roundtrip(test::real_log));
 }
 
 TEST_CASE("mutant_naive_log_falsifies_log_of_exp", "[property]") {
@@ -112,7 +108,7 @@ TEST_CASE("mutant_naive_log_falsifies_log_of_exp", "[property]") {
 }
 
 TEST_CASE("log_at_exactly_pi_returns_the_canonical_sign", "[unit]") {
-  CHECK(canonical_at_pi(real_log));
+  CHECK(canonical_at_pi(test::real_log));
   CHECK_FALSE(canonical_at_pi(test::flipped_sign_log));  // planted fault is caught
 }
 

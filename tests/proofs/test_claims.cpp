@@ -30,15 +30,6 @@ const Claim& claim(const std::string& id) {
   return *it;
 }
 
-Flow with_noise(GiNaC::matrix (*f)(const ExactScene&, const GiNaC::matrix&)) {
-  return [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) {
-    return f(scene, eps);
-  };
-}
-
-Flow ignoring_noise(GiNaC::matrix (*f)(const ExactScene&)) {
-  return [f](const ExactScene& scene, const GiNaC::matrix&, const GiNaC::ex&) { return f(scene); };
-}
 
 bool identity_holds(const Flow& flow, Group group) {
   return certify_identity(moved(flow), unmoved(flow), generic_instance(group)).verified;

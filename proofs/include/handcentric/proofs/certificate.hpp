@@ -49,6 +49,18 @@ using Side = std::function<GiNaC::matrix(const Instance&)>;
 using Flow = std::function<GiNaC::matrix(const ExactScene& scene, const GiNaC::matrix& eps,
                                          const GiNaC::ex& t)>;
 
+/// A flow component of the scene and eps only (flows.hpp), as a Flow that ignores t.
+inline Flow with_noise(GiNaC::matrix (*f)(const ExactScene&, const GiNaC::matrix&)) {
+  return [f](const ExactScene& scene, const GiNaC::matrix& eps, const GiNaC::ex&) {
+    return f(scene, eps);
+  };
+}
+
+/// A component of the scene only (flows.hpp), as a Flow that ignores eps and t.
+inline Flow ignoring_noise(GiNaC::matrix (*f)(const ExactScene&)) {
+  return [f](const ExactScene& scene, const GiNaC::matrix&, const GiNaC::ex&) { return f(scene); };
+}
+
 /// lhs = f(g * scene, eps, t)
 Side moved(const Flow& flow);
 /// rhs = f(scene, eps, t)
