@@ -42,9 +42,8 @@ function(handcentric_test name)
   # Catch2's single header and RapidCheck's are most of each test file's compile time: parse
   # them once per executable.
   target_precompile_headers(${name} PRIVATE <catch2/catch.hpp> <rapidcheck.h> <Eigen/Core>)
-  # Never a unity build (CMAKE_UNITY_BUILD, which scripts/build.sh turns on for the libraries
-  # and the command): test files keep file-local helpers of the same names.
-  set_target_properties(${name} PROPERTIES UNITY_BUILD OFF)
+  # With CMAKE_UNITY_BUILD (scripts/build.sh) the test files of one program compile together,
+  # so their file-local helpers need distinct names.
   handcentric_warnings(${name})
   foreach(label IN LISTS ARG_LABELS)
     catch_discover_tests(${name} TEST_SPEC "[${label}]" PROPERTIES LABELS ${label})

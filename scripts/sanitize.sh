@@ -28,13 +28,22 @@ CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -D
 cmake --build "$build_dir" -j "$jobs"
 built=$(date +%s)
 
-# Left out, for time (docs/RELIABILITY.md has the figures):
+# Left out, for time (docs/RELIABILITY.md has the figures; the Release tree of CI runs all of it):
 #  - the numerics properties run 1e4 cases each instead of 1e5 (RapidCheck's allocations under
-#    ASan make a case ~100 times slower; the Release tree of CI runs the 1e5);
+#    ASan make a case ~100 times slower);
 #  - policy_unit_suite_on_{generic,avx2}_kernels, the whole policy unit suite again on the other
-#    kernel sets: test_kernels runs every kernel target and the whole Mlp on each.
+#    kernel sets: test_kernels runs every kernel target and the whole Mlp on each;
+#  - the end-to-end tests that run the `handcentric` command through whole trainings, audits,
+#    tables or reports, or a Python plug-in (which runs in the unsanitized interpreter): half of
+#    this run's time. The library code they drive runs under the sanitizers in the unit tests,
+#    and the command's refusals of bad input (the short `*_cli_*` tests) stay in.
 export HANDCENTRIC_NUMERIC_CASES=10000
-(cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E '^policy_unit_suite_on_')
+end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_gates_exit_1|'\
+'^table1_cli_in_process_plan|^policy_cli_train_defaults_to_the_automatic_budget|'\
+'^table1_c8_cell_from_its_plan_line|^audit_model_finds_a_trained|^protocol_v2_plugin_gets|'\
+'^python_plugin_audit_matches|^main_report_opens_with|^outputs_are_whole_or_absent_after_sigkill|'\
+'^table[12]_cli_writes_the_table|^report_page_writes_markdown_and_html'
+(cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 
 FUZZ_BUILD_DIR="$build_dir" FUZZ_CXX="$cxx" bash "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-60}"

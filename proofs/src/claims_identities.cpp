@@ -41,7 +41,8 @@ Claim eq11_printed_claim() {
   return identity_claim(
       "A.1 eq. (11), right-hand side",
       "The moved absolute translation flow equals the printed T~ o (p_k - eps) + R~ eps - eps.",
-      kIdentities, moved(with_noise(flows::absolute_translation)), printed_right, Group::rigid_motions,
+      kIdentities, moved(with_noise(flows::absolute_translation)), printed_right,
+      Group::rigid_motions,
       "T~ o v is read as R~ v + p~ (a point moved by T~). The printed algebra is right; the "
       "non-invariance it shows is certified under item 2.");
 }

@@ -62,14 +62,15 @@ std::vector<float> random_floats(std::size_t n, std::mt19937_64& rng) {
 
 // A GEMM problem with its own storage: op(A) m x k, op(B) k x n, leading dimensions padded
 // by `pad` so strides differ from the sizes; C is prefilled with garbage (it must be overwritten).
-struct Problem {
+struct GemmProblem {
   Op op_a, op_b;
   int m, n, k, pad;
   bool bias;
   std::vector<float> a, b, row_bias, c;
   int lda, ldb, ldc;
 
-  Problem(Op op_a_, Op op_b_, int m_, int n_, int k_, int pad_, bool bias_, std::mt19937_64& rng)
+  GemmProblem(Op op_a_, Op op_b_, int m_, int n_, int k_, int pad_, bool bias_,
+              std::mt19937_64& rng)
       : op_a(op_a_), op_b(op_b_), m(m_), n(n_), k(k_), pad(pad_), bias(bias_) {
     const int a_rows = op_a == Op::none ? m : k, a_cols = op_a == Op::none ? k : m;
     const int b_rows = op_b == Op::none ? k : n, b_cols = op_b == Op::none ? n : k;
@@ -92,7 +93,7 @@ struct Problem {
 // The worst |C - C_ref| / bound over C, with C_ref in double and the bound the float rounding
 // of a k-term sum, 4 k eps (sum_p |a_ip b_pj| + |bias_i|) + 1e-30. `skip_last_term` plants a
 // fault in the reference (the last product left out), which the check must catch.
-double gemm_error(const Problem& problem, bool skip_last_term = false) {
+double gemm_error(const GemmProblem& problem, bool skip_last_term = false) {
   double worst = 0.0;
   for (int j = 0; j < problem.n; ++j) {
     for (int i = 0; i < problem.m; ++i) {
@@ -156,7 +157,7 @@ TEST_CASE("every_kernel_set_multiplies_like_the_double_reference", "[unit]") {
         for (Op op_b : {Op::none, Op::transpose}) {
           for (int pad : {0, 3}) {
             const bool bias = (shape.m + shape.k + pad) % 2 == 0;
-            Problem problem(op_a, op_b, shape.m, shape.n, shape.k, pad, bias, rng);
+            GemmProblem problem(op_a, op_b, shape.m, shape.n, shape.k, pad, bias, rng);
             set->gemm(problem.gemm());
             INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a)
                       << " op_b " << int(op_b) << " pad " << pad << " bias " << bias);
@@ -175,7 +176,7 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
   for (const auto& [name, set] : every_target()) {
     INFO("target " << name);
     for (const Shape& shape : {Shape{33, 13, 31}, Shape{256, 1, 256}}) {
-      Problem problem(Op::none, Op::none, shape.m, shape.n, shape.k, 0, false, rng);
+      GemmProblem problem(Op::none, Op::none, shape.m, shape.n, shape.k, 0, false, rng);
       set->gemm(problem.gemm());
       CHECK(gemm_error(problem) <= 1.0);
       CHECK(gemm_error(problem, /*skip_last_term=*/true) > 1.0);
@@ -188,7 +189,7 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
 // a (leading dimension lds, unlike C's). Returns the worst error over C in units of the bound;
 // `skip_epilogue` plants a fault in the reference (the epilogue left out), which the check must
 // catch.
-double epilogue_error(Problem& problem, kernels::Epilogue epilogue, int lds,
+double epilogue_error(GemmProblem& problem, kernels::Epilogue epilogue, int lds,
                       const std::vector<float>& s_in, const std::vector<float>& a_in,
                       const std::vector<float>& s_out, bool skip_epilogue = false) {
   double worst = 0.0;
@@ -232,7 +233,7 @@ TEST_CASE("every_kernel_set_applies_the_silu_epilogues_on_every_path", "[unit]")
              {kernels::Epilogue::silu, kernels::Epilogue::silu_derivative}) {
           for (bool keep_sigmoid : {false, true}) {
             if (epilogue == kernels::Epilogue::silu_derivative && !keep_sigmoid) continue;
-            Problem problem(op_a, Op::none, shape.m, shape.n, shape.k, 3, true, rng);
+            GemmProblem problem(op_a, Op::none, shape.m, shape.n, shape.k, 3, true, rng);
             for (float& x : problem.a) x *= 3.0f;  // z spans both tails of the sigmoid
             const int lds = problem.ldc + 5;
             const std::size_t size = static_cast<std::size_t>(lds) * std::max(shape.n, 1);

@@ -72,14 +72,14 @@ GradientErrors gradient_errors(MlpD& net, MlpD& numeric_net, const Eigen::Matrix
   return errors;
 }
 
-struct Problem {
+struct MlpProblem {
   MlpD net;
   Eigen::MatrixXd input, weights;
 };
 
-Problem make_problem(Activation activation, std::uint64_t seed) {
+MlpProblem make_mlp_problem(Activation activation, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
-  Problem problem{MlpD({5, 7, 6, 3}, activation), Eigen::MatrixXd(5, 4), Eigen::MatrixXd(3, 4)};
+  MlpProblem problem{MlpD({5, 7, 6, 3}, activation), Eigen::MatrixXd(5, 4), Eigen::MatrixXd(3, 4)};
   problem.net.initialize(rng);
   // Inputs away from 0 so that no ReLU pre-activation sits within h of its kink.
   for (Eigen::Index i = 0; i < problem.input.size(); ++i)
@@ -99,7 +99,7 @@ constexpr double kGradientTolerance = 1e-6;
 TEST_CASE("mlp_backprop_matches_finite_differences_for_every_layer", "[unit]") {
   for (Activation activation : {Activation::silu, Activation::relu}) {
     INFO(to_string(activation));
-    Problem p = make_problem(activation, 7);
+    MlpProblem p = make_mlp_problem(activation, 7);
     MlpD numeric = p.net;
     const GradientErrors errors = gradient_errors(p.net, numeric, p.input, p.weights);
     CHECK(errors.parameters < kGradientTolerance);
@@ -108,7 +108,7 @@ TEST_CASE("mlp_backprop_matches_finite_differences_for_every_layer", "[unit]") {
 }
 
 TEST_CASE("mutant_gradients_fail_the_finite_difference_check", "[unit]") {
-  Problem p = make_problem(Activation::silu, 7);
+  MlpProblem p = make_mlp_problem(Activation::silu, 7);
   MlpD numeric = p.net;
   // A dropped bias gradient of the last layer (the last 3 parameters are b_3).
   const auto drop_last_bias = [](Eigen::VectorXd& g) { g.tail(3).setZero(); };

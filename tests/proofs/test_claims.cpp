@@ -30,7 +30,6 @@ const Claim& claim(const std::string& id) {
   return *it;
 }
 
-
 bool identity_holds(const Flow& flow, Group group) {
   return certify_identity(moved(flow), unmoved(flow), generic_instance(group)).verified;
 }

@@ -46,7 +46,13 @@ inline std::string python() {
   return HANDCENTRIC_PYTHON;
 }
 inline std::string python_example() {
-  return python() + " " + HANDCENTRIC_SOURCE_DIR + "/examples/python_representation/repr.py";
+  // Appended piece by piece: GCC 12 at -O3 reports a false out-of-bounds memcpy for the chain
+  // of operator+ on string literals once the calls are inlined into a unity build.
+  std::string command = python();
+  command += " ";
+  command += HANDCENTRIC_SOURCE_DIR;
+  command += "/examples/python_representation/repr.py";
+  return command;
 }
 /// `python tests/props/plugins/<file> [arguments]`.
 inline std::string test_plugin(const std::string& file, const std::string& arguments = "") {

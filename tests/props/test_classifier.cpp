@@ -16,7 +16,7 @@ using props::Mode;
 
 namespace {
 
-props::ClassifierOptions fast() {
+props::ClassifierOptions fast_classifier() {
   props::ClassifierOptions options;
   options.check.cases = 200;
   options.distribution.cases = 5;
@@ -31,7 +31,8 @@ const std::vector<Group> kAll = {Group::translation, Group::rotation, Group::se2
 }  // namespace
 
 TEST_CASE("builtin_representations_are_classified_as_the_paper_says", "[property]") {
-  const auto absolute = props::classify_representation(make_representation("absolute"), fast());
+  const auto absolute =
+      props::classify_representation(make_representation("absolute"), fast_classifier());
   for (Component c : {Component::actions, Component::observation, Component::flow_input,
                       Component::flow_target}) {
     CHECK(props::invariant_groups(absolute, c, Mode::pointwise) == kNone);
@@ -39,7 +40,8 @@ TEST_CASE("builtin_representations_are_classified_as_the_paper_says", "[property
   CHECK(props::invariant_groups(absolute, Component::flow_target, Mode::distribution) == kNone);
   for (const char* name : {"relative", "relative_diff"}) {
     INFO(name);
-    const auto relative = props::classify_representation(make_representation(name), fast());
+    const auto relative =
+        props::classify_representation(make_representation(name), fast_classifier());
     CHECK(props::invariant_groups(relative, Component::actions, Mode::pointwise) == kTranslation);
     CHECK(props::invariant_groups(relative, Component::observation, Mode::pointwise) == kNone);
     CHECK(props::invariant_groups(relative, Component::flow_target, Mode::pointwise) ==
@@ -48,7 +50,7 @@ TEST_CASE("builtin_representations_are_classified_as_the_paper_says", "[property
           kTranslation);
   }
   const auto hand_centric =
-      props::classify_representation(make_representation("hand_centric"), fast());
+      props::classify_representation(make_representation("hand_centric"), fast_classifier());
   for (Component c : {Component::actions, Component::observation, Component::flow_input,
                       Component::flow_target}) {
     CHECK(props::invariant_groups(hand_centric, c, Mode::pointwise) == kAll);
@@ -61,7 +63,8 @@ TEST_CASE("builtin_representations_are_classified_as_the_paper_says", "[property
 
 TEST_CASE("actionflow_target_is_classified_pointwise_none_in_distribution_rotations",
           "[property]") {
-  const auto actionflow = props::classify_flow_target(std::make_shared<ActionFlowTarget>(), fast());
+  const auto actionflow =
+      props::classify_flow_target(std::make_shared<ActionFlowTarget>(), fast_classifier());
   CHECK(props::invariant_groups(actionflow, Component::flow_target, Mode::pointwise) == kNone);
   CHECK(props::invariant_groups(actionflow, Component::flow_input, Mode::pointwise) == kNone);
   CHECK(props::invariant_groups(actionflow, Component::flow_target, Mode::distribution) ==
@@ -72,7 +75,7 @@ TEST_CASE("actionflow_target_is_classified_pointwise_none_in_distribution_rotati
 TEST_CASE("mutant_encoder_is_classified_translation_only_and_reported_as_a_mismatch",
           "[property]") {
   props::Classification mutant = props::classify_representation(
-      std::make_shared<test::ForgetsRotationOnTranslation>(), fast());
+      std::make_shared<test::ForgetsRotationOnTranslation>(), fast_classifier());
   CHECK(props::invariant_groups(mutant, Component::actions, Mode::pointwise) == kTranslation);
   mutant.name = "hand_centric";  // judged as if it claimed to be hand-centric
   CHECK_FALSE(props::mismatches_with_paper(mutant).empty());
@@ -92,7 +95,7 @@ TEST_CASE("audit_rejects_unknown_names_and_bad_case_counts", "[unit]") {
 TEST_CASE("every_builtin_cell_matches_its_expectation_in_both_views", "[property]") {
   for (const std::string& name : builtin_representation_names()) {
     const props::Classification c =
-        props::classify_representation(make_representation(name), fast());
+        props::classify_representation(make_representation(name), fast_classifier());
     INFO(name);
     for (const auto& line : props::mismatches_with_paper(c)) INFO(line);
     CHECK(props::mismatches_with_paper(c).empty());
@@ -108,7 +111,7 @@ TEST_CASE("every_builtin_cell_matches_its_expectation_in_both_views", "[property
 
 TEST_CASE("copying_world_points_raw_is_caught_in_the_third_person_view_only", "[property]") {
   const auto raw = std::make_shared<test::RawWorldPoints>();
-  const props::Classification c = props::classify_representation(raw, fast());
+  const props::Classification c = props::classify_representation(raw, fast_classifier());
   CHECK(props::invariant_groups(c, Component::observation, Mode::pointwise,
                                 props::View::eye_in_hand) == kAll);
   CHECK(props::invariant_groups(c, Component::observation, Mode::pointwise,
@@ -120,7 +123,7 @@ TEST_CASE("copying_world_points_raw_is_caught_in_the_third_person_view_only", "[
   CHECK(se3->witness->scene.world_points.size() >= 1);
   CHECK(props::recompute_error(props::observation_of(raw), *se3->witness) == se3->witness->error);
   // Planted fault: a "third-person" generator that drops the world points sees nothing wrong.
-  props::ClassifierOptions dropping = fast();
+  props::ClassifierOptions dropping = fast_classifier();
   dropping.views = {props::View::third_person};
   props::CheckOptions check = props::with_view(dropping.check, props::View::third_person);
   check.shape.min_world_points = check.shape.max_world_points = 0;
@@ -192,7 +195,7 @@ TEST_CASE("injectivity_catches_degenerate_maps_and_proves_the_builtins", "[prope
 
 TEST_CASE("float32_rounding_gets_a_note_and_passes_at_float32_tolerance", "[property]") {
   const auto float32 = std::make_shared<test::Float32HandCentric>();
-  props::ClassifierOptions strict = fast();
+  props::ClassifierOptions strict = fast_classifier();
   strict.views = {props::View::eye_in_hand};
   strict.in_distribution = false;
   const props::Classification at_double = props::classify_representation(float32, strict);

@@ -27,7 +27,7 @@ Eigen::MatrixXd normal_sample(int rows, int cols, std::uint64_t seed, double shi
   return m;
 }
 
-props::CheckOptions fast() {
+props::CheckOptions fast_check() {
   props::CheckOptions options = props::eye_in_hand_options();
   options.cases = 10;
   return options;
@@ -64,15 +64,15 @@ TEST_CASE("actionflow_target_is_rotation_invariant_in_distribution_but_not_trans
           "[property]") {
   const auto actionflow = std::make_shared<ActionFlowTarget>();
   for (Group group : {Group::rotation, Group::c8}) {
-    const props::Verdict verdict =
-        props::check_distribution_invariance(actionflow, Component::flow_target, group, fast());
+    const props::Verdict verdict = props::check_distribution_invariance(
+        actionflow, Component::flow_target, group, fast_check());
     INFO(props::to_string(group) << ": min p " << verdict.min_p_value);
     CHECK(verdict.invariant);
     CHECK(verdict.mode == props::Mode::distribution);
   }
   for (Group group : {Group::translation, Group::se2, Group::se3}) {
-    const props::Verdict verdict =
-        props::check_distribution_invariance(actionflow, Component::flow_target, group, fast());
+    const props::Verdict verdict = props::check_distribution_invariance(
+        actionflow, Component::flow_target, group, fast_check());
     INFO(props::to_string(group));
     CHECK_FALSE(verdict.invariant);
     CHECK(verdict.method == props::Method::exact_gaussian);
@@ -84,8 +84,8 @@ TEST_CASE("actionflow_target_is_rotation_invariant_in_distribution_but_not_trans
 
 TEST_CASE("mutant_biased_noise_breaks_rotation_invariance_in_distribution", "[property]") {
   const auto mutant = std::make_shared<test::BiasedNoiseActionFlow>();
-  const props::Verdict verdict =
-      props::check_distribution_invariance(mutant, Component::flow_target, Group::rotation, fast());
+  const props::Verdict verdict = props::check_distribution_invariance(
+      mutant, Component::flow_target, Group::rotation, fast_check());
   CHECK_FALSE(verdict.invariant);
   CHECK(verdict.method == props::Method::exact_gaussian);
   REQUIRE(verdict.witness.has_value());
@@ -97,13 +97,13 @@ TEST_CASE("a_pointwise_invariant_flow_is_invariant_in_distribution", "[property]
       std::make_shared<RectifiedFlow>(std::make_shared<HandCentricRepresentation>());
   for (Component component : {Component::flow_input, Component::flow_target}) {
     const props::Verdict verdict =
-        props::check_distribution_invariance(hand_flow, component, Group::se3, fast());
+        props::check_distribution_invariance(hand_flow, component, Group::se3, fast_check());
     CHECK(verdict.invariant);
     CHECK(verdict.method == props::Method::exact_gaussian);
     CHECK_FALSE(verdict.detectable_shift.has_value());
   }
   CHECK_THROWS_AS(
-      props::check_distribution_invariance(hand_flow, Component::actions, Group::se3, fast()),
+      props::check_distribution_invariance(hand_flow, Component::actions, Group::se3, fast_check()),
       InvalidArgument);
 }
 
@@ -171,7 +171,7 @@ TEST_CASE("the_world_delta_mode_is_never_called_invariant_in_distribution_under_
   // The false "yes" an energy test gave on about one seed in four: now an exact answer.
   const auto delta = std::make_shared<RectifiedFlow>(std::make_shared<test::WorldDelta>());
   for (std::uint64_t seed = 1; seed <= 50; ++seed) {
-    props::CheckOptions options = fast();
+    props::CheckOptions options = fast_check();
     options.seed = seed;
     for (Group group : {Group::rotation, Group::se2, Group::se3, Group::c8}) {
       const props::Verdict verdict =
@@ -191,7 +191,7 @@ TEST_CASE("a_flow_not_affine_in_the_noise_falls_back_to_the_energy_test_and_says
   const auto cubed =
       std::make_shared<test::CubedNoiseFlow>(std::make_shared<HandCentricRepresentation>());
   const props::Verdict same =
-      props::check_distribution_invariance(cubed, Component::flow_target, Group::se3, fast());
+      props::check_distribution_invariance(cubed, Component::flow_target, Group::se3, fast_check());
   CHECK(same.invariant);
   CHECK(same.method == props::Method::energy_test);
   REQUIRE(same.detectable_shift.has_value());
@@ -199,7 +199,7 @@ TEST_CASE("a_flow_not_affine_in_the_noise_falls_back_to_the_energy_test_and_says
   const auto absolute =
       std::make_shared<test::CubedNoiseFlow>(std::make_shared<AbsoluteRepresentation>());
   const props::Verdict moved = props::check_distribution_invariance(
-      absolute, Component::flow_target, Group::translation, fast());
+      absolute, Component::flow_target, Group::translation, fast_check());
   CHECK_FALSE(moved.invariant);
   CHECK(moved.method == props::Method::energy_test);
   REQUIRE(moved.witness.has_value());

@@ -14,7 +14,7 @@ using props::Group;
 
 namespace {
 
-constexpr int kChunk = 3;
+constexpr int kAuditChunk = 3;
 
 // T_k = T_0 exp(step)^k, then + sigma * n_k in the world frame (the planted fault: noise in the
 // wrong frame) or in the hand frame (R_0 n_k: equivariant). Affine in the noise n.
@@ -22,13 +22,13 @@ class NoisyStraightPolicy final : public props::NoisyPolicy {
  public:
   explicit NoisyStraightPolicy(bool world_frame_noise) : world_(world_frame_noise) {}
   std::string name() const override { return world_ ? "world_frame_noise" : "hand_frame_noise"; }
-  Eigen::Index noise_dimension() const override { return 3 * kChunk; }
+  Eigen::Index noise_dimension() const override { return 3 * kAuditChunk; }
   std::vector<RigidTransform> act(const Scene& o, const Eigen::VectorXd& noise) const override {
     Twist step;
     step << 0.05, 0.0, 0.01, 0.0, 0.1, 0.0;
     std::vector<RigidTransform> chunk;
     RigidTransform T = o.world_T_hand0();
-    for (int k = 0; k < kChunk; ++k) {
+    for (int k = 0; k < kAuditChunk; ++k) {
       T = T * RigidTransform::exp(step);
       const Eigen::Vector3d n = 0.1 * noise.segment<3>(3 * k);
       const Eigen::Vector3d shift =
@@ -42,7 +42,7 @@ class NoisyStraightPolicy final : public props::NoisyPolicy {
   bool world_;
 };
 
-props::ClassifierOptions fast() {
+props::ClassifierOptions fast_audit() {
   props::ClassifierOptions options;
   options.check.cases = 100;
   options.distribution.cases = 5;
@@ -54,8 +54,8 @@ props::ClassifierOptions fast() {
 TEST_CASE("any_network_inside_the_hand_centric_outer_policy_is_equivariant_pointwise_and_in_law",
           "[property]") {
   const auto inner = std::make_shared<props::RandomOuterPolicy>(
-      std::make_shared<HandCentricRepresentation>(), 6, kChunk, std::vector<int>{16}, 3);
-  props::ClassifierOptions options = fast();
+      std::make_shared<HandCentricRepresentation>(), 6, kAuditChunk, std::vector<int>{16}, 3);
+  props::ClassifierOptions options = fast_audit();
   options.views = {props::View::eye_in_hand};
   options.check.shape.min_history = options.check.shape.max_history = 0;
   options.check.shape.max_hand_points = 0;
@@ -90,7 +90,7 @@ TEST_CASE(
 
 TEST_CASE("a_policy_whose_decoder_forgets_R0_is_not_rotation_equivariant", "[property]") {
   const auto forgets = std::make_shared<props::RandomOuterPolicy>(
-      std::make_shared<test::DecoderForgetsR0>(), 6, kChunk, std::vector<int>{16}, 4);
+      std::make_shared<test::DecoderForgetsR0>(), 6, kAuditChunk, std::vector<int>{16}, 4);
   props::CheckOptions options = props::eye_in_hand_options();
   options.shape.min_history = options.shape.max_history = 0;
   options.shape.max_hand_points = 0;
@@ -109,10 +109,10 @@ TEST_CASE("a_mean_moved_by_a_frame_mix_up_is_caught_in_law_by_the_paired_mean_te
   class MixedFrames final : public props::NoisyPolicy {
    public:
     std::string name() const override { return "mixed_frames"; }
-    Eigen::Index noise_dimension() const override { return 3 * kChunk; }
+    Eigen::Index noise_dimension() const override { return 3 * kAuditChunk; }
     std::vector<RigidTransform> act(const Scene& o, const Eigen::VectorXd& noise) const override {
       std::vector<RigidTransform> chunk;
-      for (int k = 0; k < kChunk; ++k) {
+      for (int k = 0; k < kAuditChunk; ++k) {
         const Eigen::Vector3d n = 0.3 * noise.segment<3>(3 * k).array().cube().matrix();
         // A world-frame offset (0.05 along world x) where a hand-frame one was meant.
         chunk.push_back(o.world_T_hand0() * RigidTransform::from_translation(n) *

@@ -36,7 +36,7 @@ std::string record_of(std::size_t poses) {
   return line + "]}\n";
 }
 
-void write(const std::string& path, const std::string& text) {
+void write_bytes(const std::string& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
 
@@ -75,7 +75,7 @@ TEST_CASE("a_demo_line_of_a_billion_poses_is_refused_at_the_line_limit", "[unit]
   const std::string path = test::limits_temp_path("long_line.jsonl");
   std::string start = kHeaderOfOne + "\n" + kRecordStart;
   while (start.size() < (std::size_t{5} << 20)) start += kPose + ",";
-  write(path, start);
+  write_bytes(path, start);
   std::filesystem::resize_file(path, std::uintmax_t{1'000'000'000} * (kPose.size() + 1));
   const std::string limit = std::to_string(DemoFileLimits().max_line_bytes);
   check_refused(load_in_child(path), "record 1 (line 2)", "longer than " + limit + " bytes");
@@ -86,7 +86,7 @@ TEST_CASE("a_demo_line_of_a_billion_poses_is_refused_at_the_line_limit", "[unit]
 TEST_CASE("a_header_line_without_end_is_refused_at_the_line_limit", "[unit]") {
   // 2 GiB of zeros and no newline: the header is never read whole.
   const std::string path = test::limits_temp_path("no_newline.jsonl");
-  write(path, "");
+  write_bytes(path, "");
   std::filesystem::resize_file(path, std::uintmax_t{2} << 30);
   check_refused(load_in_child(path), "line 1 (header)", "longer than");
   check_cli_refuses(path, "longer than");
@@ -97,19 +97,20 @@ TEST_CASE("json_nested_deeper_than_the_limit_is_refused", "[unit]") {
   // 1,000,000 nested arrays in 2 MB: within the line limit, refused at depth 8.
   const std::string path = test::limits_temp_path("deep.jsonl");
   const std::size_t depth = 1'000'000;
-  write(path, kHeaderOfOne + "\n" + std::string(depth, '[') + std::string(depth, ']') + "\n");
+  write_bytes(path, kHeaderOfOne + "\n" + std::string(depth, '[') + std::string(depth, ']') + "\n");
   check_refused(load_in_child(path), "record 1 (line 2)", "nested deeper than 8 levels");
   check_cli_refuses(path, "nested deeper than 8 levels");
   // the header too
-  write(path, R"({"format":"handcentric-demos","version":1,"count":1,"x":)" +
-                  std::string(depth, '[') + std::string(depth, ']') + "}\n");
+  write_bytes(path, R"({"format":"handcentric-demos","version":1,"count":1,"x":)" +
+                        std::string(depth, '[') + std::string(depth, ']') + "}\n");
   check_refused(load_in_child(path), "line 1 (header)", "nested deeper than 8 levels");
   std::filesystem::remove(path);
 }
 
 TEST_CASE("a_header_announcing_a_billion_demos_is_refused_before_any_record", "[unit]") {
   const std::string path = test::limits_temp_path("billion.jsonl");
-  write(path, R"({"clearance":0.1,"count":1000000000,"format":"handcentric-demos","version":1})"
+  write_bytes(path,
+              R"({"clearance":0.1,"count":1000000000,"format":"handcentric-demos","version":1})"
               "\n" +
                   record_of(1));
   check_refused(load_in_child(path), "line 1 (header)",
@@ -121,12 +122,12 @@ TEST_CASE("a_header_announcing_a_billion_demos_is_refused_before_any_record", "[
 TEST_CASE("a_demo_of_more_poses_than_the_limit_is_refused", "[unit]") {
   // 10001 poses: a 330 KB line, within the line limit.
   const std::string path = test::limits_temp_path("many_poses.jsonl");
-  write(path, kHeaderOfOne + "\n" + record_of(10'001));
+  write_bytes(path, kHeaderOfOne + "\n" + record_of(10'001));
   check_refused(load_in_child(path), "record 1 (line 2)",
                 "a demo of 10001 poses, more than the limit of 10000");
   check_cli_refuses(path, "10001 poses");
   // exactly at the limit it loads
-  write(path, kHeaderOfOne + "\n" + record_of(10'000));
+  write_bytes(path, kHeaderOfOne + "\n" + record_of(10'000));
   const test::ChildRun at_limit = load_in_child(path);
   CHECK(at_limit.out == "loaded 1");
   std::filesystem::remove(path);
@@ -147,23 +148,23 @@ TEST_CASE("demo_files_over_each_limit_are_refused_and_files_at_it_load", "[unit]
     for (std::size_t n : poses) text += record_of(n);
     return text;
   };
-  write(path, file(3, {2, 2, 2}));
+  write_bytes(path, file(3, {2, 2, 2}));
   CHECK(load_in_child(path, limits).out == "loaded 3");
-  write(path, file(4, {1, 1, 1, 1}));
+  write_bytes(path, file(4, {1, 1, 1, 1}));
   check_refused(load_in_child(path, limits), "line 1 (header)",
                 "4 demos, more than the limit of 3");
-  write(path, file(1, {5}));
+  write_bytes(path, file(1, {5}));
   check_refused(load_in_child(path, limits), "record 1",
                 "a demo of 5 poses, more than the limit of 4");
-  write(path, file(2, {4, 3}));
+  write_bytes(path, file(2, {4, 3}));
   check_refused(load_in_child(path, limits), "record 2",
                 "7 poses, more than the limit of 6 for one file");
-  write(path, kHeaderOfOne + "\n" +
-                  R"({"world_T_hole":[[[[1]]]],"world_T_hand":[]})"
-                  "\n");
+  write_bytes(path, kHeaderOfOne + "\n" +
+                        R"({"world_T_hole":[[[[1]]]],"world_T_hand":[]})"
+                        "\n");
   check_refused(load_in_child(path, limits), "record 1", "nested deeper than 4 levels");
   limits.max_line_bytes = record_of(2).size() - 1;  // the line without its newline fits exactly
-  write(path, file(1, {2}));
+  write_bytes(path, file(1, {2}));
   CHECK(load_in_child(path, limits).out == "loaded 1");
   limits.max_line_bytes -= 1;
   check_refused(load_in_child(path, limits), "record 1",

@@ -62,7 +62,7 @@ double median_start_x(const std::vector<TaskScene>& all) {
   return 0.5 * (x[x.size() / 2 - 1] + x[x.size() / 2]);
 }
 
-std::string temp_path(const std::string& name) {
+std::string invalid_temp_path(const std::string& name) {
   return (std::filesystem::temp_directory_path() /
           ("handcentric_test_invalid_" + std::to_string(::getpid()) + "_" + name))
       .string();
@@ -160,7 +160,7 @@ TEST_CASE("eval_counts_a_diverging_model_as_invalid_trials_and_strict_stops_at_t
         observation(scene.world_T_hole, {scene.world_T_hand_start}, 0).hand_points[0].x());
   }
   std::sort(corner_x.begin(), corner_x.end());
-  const std::string path = temp_path("diverging.model");
+  const std::string path = invalid_temp_path("diverging.model");
   std::ofstream(path, std::ios::binary) << diverging_model(0.5 * (corner_x[5] + corner_x[6]));
 
   const policy::LearnedPolicy model = policy::load_model(path);

@@ -14,7 +14,7 @@ using namespace handcentric::sim::insert3d;
 
 namespace {
 
-std::string temp_path(const std::string& name) {
+std::string insert3d_temp_path(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("handcentric_insert3d_" + name)).string();
 }
 
@@ -35,7 +35,7 @@ std::string first_line(const std::string& path) {
 TEST_CASE("insert3d_demo_files_round_trip_bit_for_bit_and_record_their_task", "[unit]") {
   const std::vector<Demo> demos = some_demos(3);
   REQUIRE(demos.size() == 3u);
-  const std::string path = temp_path("round_trip.jsonl");
+  const std::string path = insert3d_temp_path("round_trip.jsonl");
   save_demos(path, demos);
   CHECK_THAT(first_line(path), Catch::Matchers::Contains("\"task\":\"insert3d\"") &&
                                    Catch::Matchers::Contains("\"clearance_per_side\":0.1"));
@@ -52,12 +52,12 @@ TEST_CASE("insert3d_demo_files_round_trip_bit_for_bit_and_record_their_task", "[
 }
 
 TEST_CASE("insert3d_and_2d_demo_files_are_not_mixed_up", "[unit]") {
-  const std::string path3d = temp_path("mix3d.jsonl");
+  const std::string path3d = insert3d_temp_path("mix3d.jsonl");
   save_demos(path3d, some_demos(1));
   CHECK_THROWS_WITH(sim::load_demos(path3d),
                     Catch::Matchers::Contains("task 'insert3d', not 'peg2d'") &&
                         Catch::Matchers::Contains("--task insert3d"));
-  const std::string path2d = temp_path("mix2d.jsonl");
+  const std::string path2d = insert3d_temp_path("mix2d.jsonl");
   sim::save_demos(path2d, {sim::Demo{RigidTransform(), {RigidTransform::planar(0.1, 1.0, 2.0)}}});
   CHECK_THAT(first_line(path2d), Catch::Matchers::Contains("\"task\":\"peg2d\""));
   CHECK_THROWS_AS(load_demos(path2d), sim::InvalidDemoFile);

@@ -42,7 +42,7 @@ policy::LearnedPolicy trained_3d_policy(const std::string& representation) {
 
 // The largest |g T_t - T'_t| (cm + Frobenius of the rotation) over rollouts of 3 train scenes
 // and of g * scene for 3 random g in SE(3) each (rotation Haar-uniform, translation up to 60 cm).
-double worst_gap(const ChunkPolicy& policy, bool& same_outcomes) {
+double worst_gap_3d(const ChunkPolicy& policy, bool& same_outcomes) {
   const insert3d::CollisionChecker checker;
   insert3d::RolloutOptions options;
   options.history = kHistory;
@@ -76,7 +76,7 @@ TEST_CASE("a_trained_hand_centric_3d_policy_is_se3_equivariant_in_closed_loop", 
   bool same_outcomes = false;
   const experiments::SlotKeyPointPolicy policy(
       std::make_shared<policy::LearnedPolicy>(trained_3d_policy("hand_centric")));
-  const double gap = worst_gap(policy, same_outcomes);
+  const double gap = worst_gap_3d(policy, same_outcomes);
   INFO("largest gap between g * rollout(scene) and rollout(g * scene): " << gap);
   CHECK(gap < 1e-9);
   CHECK(same_outcomes);
@@ -86,7 +86,7 @@ TEST_CASE("mutant_absolute_3d_policy_is_not_se3_equivariant_in_closed_loop", "[p
   bool same_outcomes = false;
   const experiments::SlotKeyPointPolicy policy(
       std::make_shared<policy::LearnedPolicy>(trained_3d_policy("absolute")));
-  const double gap = worst_gap(policy, same_outcomes);
+  const double gap = worst_gap_3d(policy, same_outcomes);
   INFO("largest gap: " << gap);
   CHECK(gap > 1.0);  // centimetres: the moved rollout goes elsewhere
 }

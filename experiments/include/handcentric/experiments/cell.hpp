@@ -62,12 +62,11 @@ std::string cell_hash(const Cell& cell);
 /// Measured on the tuning seeds (docs/EXPERIMENTS.md): with 4 copies 100 demos insert 1.00
 /// after 10000 steps already, but relative actions need the 30000 (0.35 after 10000, 0.61
 /// after 30000), and the hand-centric, relative and absolute rows get the same budget.
-int automatic_steps(const sim::TrainingData& data, policy::HeadKind head,
-                    long long demo_samples);
+int automatic_steps(const sim::TrainingData& data, policy::HeadKind head, long long demo_samples);
 
 /// A cell with its config from the library defaults (PolicyConfig{}), the method's
-/// representation and the head, and `steps` Adam steps (0: automatic_steps), and `c8_centre` (x, y) as the point c8ddpm rotates
-/// about (other heads ignore it); hash set.
+/// representation and the head, and `steps` Adam steps (0: automatic_steps), and `c8_centre` (x, y)
+/// as the point c8ddpm rotates about (other heads ignore it); hash set.
 Cell make_cell(const std::string& method, const std::string& representation,
                const std::string& head, int demos, std::uint64_t train_seed, long long demo_samples,
                const std::string& demo_digest, int steps = 0,
