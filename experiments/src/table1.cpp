@@ -176,6 +176,9 @@ void Table1Options::validate() const {
         "--ood-seed " + std::to_string(eval.ood_seed) +
         " equals --eval-seed: the independent OOD scenes would be the paired ones; choose another");
   }
+  // Before anything is written: a bad recipe would otherwise fail only when the first cell
+  // trains, after the demo file and cells.json.
+  data.validate();
 }
 
 std::vector<int> parse_int_list(const std::string& text, const std::string& option) {

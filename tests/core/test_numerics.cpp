@@ -1,4 +1,4 @@
-// Numerical robustness of the geometry (issue 14, item 5), as RapidCheck properties over
+// Numerical robustness of the geometry (docs/RELIABILITY.md, item 5), as RapidCheck properties over
 // generated inputs that reach the ends of double's range:
 //   1. no geometry function returns a non-finite value for a valid input (rigid_transform.hpp
 //      says which inputs are valid);

@@ -137,6 +137,10 @@ TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
   options = Table1Options();
   options.eval.trials = 0;
   HC_CHECK_THROWS(options.validate(), InvalidArgument, Contains("--trials"));
+  options = Table1Options();
+  options.data.perturbed_copies = -1;
+  HC_CHECK_THROWS(options.validate(), InvalidArgument,
+                  Contains("perturbed_copies") && Contains("got -1"));
 }
 
 TEST_CASE("eval_json_round_trips_its_counts_and_rejects_foreign_files", "[unit]") {

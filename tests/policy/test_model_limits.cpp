@@ -1,7 +1,7 @@
-// Bounded input (issue 14, item 4): model files that claim absurd sizes are InvalidModelFile
-// errors raised before anything of that size is read or allocated. Each case runs the loader in
-// a child process, and `handcentric eval --model` as another, and checks that the child's peak
-// memory stays under 512 MB (child_process.hpp).
+// Bounded input (docs/RELIABILITY.md, item 4): model files that claim absurd sizes are
+// InvalidModelFile errors raised before anything of that size is read or allocated. Each case runs
+// the loader in a child process, and `handcentric eval --model` as another, and checks that the
+// child's peak memory stays under 512 MB (child_process.hpp).
 #include <catch2/catch.hpp>
 
 #include <unistd.h>

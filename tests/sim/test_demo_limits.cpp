@@ -1,7 +1,7 @@
-// Bounded input (issue 14, item 4): demo files over a DemoFileLimits bound are InvalidDemoFile
-// errors naming the limit, raised before the loader reads or allocates what is over it. Each
-// case runs load_demos in a child process, and `handcentric render --demos` as another, and
-// checks that the child's peak memory stays under 512 MB (child_process.hpp).
+// Bounded input (docs/RELIABILITY.md, item 4): demo files over a DemoFileLimits bound are
+// InvalidDemoFile errors naming the limit, raised before the loader reads or allocates what is over
+// it. Each case runs load_demos in a child process, and `handcentric render --demos` as another,
+// and checks that the child's peak memory stays under 512 MB (child_process.hpp).
 #include <catch2/catch.hpp>
 
 #include <unistd.h>

@@ -1,5 +1,5 @@
-// Long runs (issue 14, item 6): a policy that returns a non-finite pose on some scenes makes
-// those trials invalid (failures with their own count) instead of ending the evaluation; with
+// Long runs (docs/RELIABILITY.md, item 6): a policy that returns a non-finite pose on some scenes
+// makes those trials invalid (failures with their own count) instead of ending the evaluation; with
 // stop_on_invalid (`eval --strict`) the first one is an error. Planted faults: a scripted policy
 // that returns nan where the hand starts right of a line, one that throws NonFiniteAction there,
 // and a model file whose finite weights overflow to infinity on part of the scenes.

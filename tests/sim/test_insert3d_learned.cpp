@@ -1,4 +1,4 @@
-// Theorem 1 in closed loop in 3D (issue 16, item 6): a TRAINED hand-centric flow policy, rolled
+// Theorem 1 in closed loop in 3D: a TRAINED hand-centric flow policy, rolled
 // out on a 3D scene and on g * scene for random g in SE(3) with the same noise seeds, drives the
 // hand along g times its original trajectory to the same outcome, whatever the network learned.
 // The planted fault is the same loop with absolute actions: its trajectories do not move with g.

@@ -1,8 +1,8 @@
 #pragma once
 // Runs a function or a program in a child process and measures its peak memory: the
-// bounded-input tests (issue 14) assert that refusing a hostile file costs less than
-// kPeakMemoryLimitBytes, and a child keeps a regression (an attempt to allocate terabytes) from
-// taking the test process, or the machine, down with it.
+// bounded-input tests (docs/RELIABILITY.md, item 4) assert that refusing a hostile file costs less
+// than kPeakMemoryLimitBytes, and a child keeps a regression (an attempt to allocate terabytes)
+// from taking the test process, or the machine, down with it.
 //
 // The peak is getrusage's ru_maxrss of the child (wait4), which on Linux includes the resident
 // memory the child inherited at fork, so it over-estimates what the call itself used; each test

@@ -1,5 +1,5 @@
 #pragma once
-// Scene: what a policy sees and does at one control step, in the world frame (DESIGN.md).
+// Scene: what a policy sees and does at one control step, in the world frame.
 //
 //   world_T_hand_history[h] = T_{-h}, h = 0..H   (index 0 is the hand now, T_0)
 //   world_T_hand_chunk[k-1] = T_k,    k = 1..K   (the action chunk a_{1:K})

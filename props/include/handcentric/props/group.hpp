@@ -1,5 +1,6 @@
 #pragma once
-// The transform families a representation is checked against (DESIGN.md "Group").
+// The transform families a representation is checked against (docs/AUDIT.md has how each is
+// checked).
 //
 //   translation : p~ in R^3, R~ = I
 //   rotation    : R~ in SO(3) about the world origin, p~ = 0

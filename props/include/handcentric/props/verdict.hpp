@@ -1,5 +1,6 @@
 #pragma once
-// Verdict: what one invariance / equivariance check concluded (DESIGN.md "Check").
+// Verdict: what one invariance / equivariance check concluded; docs/AUDIT.md says what each verdict
+// means.
 //
 // A verdict says whether the check held, the largest error seen, how many cases it ran, the
 // seed that replays it, and, when it did not hold, a witness shrunk by RapidCheck: the scene,
