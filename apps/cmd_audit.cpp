@@ -199,17 +199,18 @@ int run_audit(const AuditCommandOptions& options) {
                                                          : "")
       << "\n"
       << (policies ? "'yes' = equivariant, a(g o, n) = g a(o, n) (eq. 4); pointwise with the same "
-                     "noise n, in "
-                     "distribution with n ~ N(0, I). "
+                     "noise n, in distribution with n ~ N(0, I). "
                    : "'yes' = invariant. ")
       << "The number is the largest error seen: pointwise the largest difference; in distribution, "
-         "exactly "
-         "for maps affine in the noise, the larger difference of the two Gaussian laws' means and "
-         "covariances, else (marked ~) the energy distance of a permutation test at level "
+         "exactly for maps affine in the noise, the larger difference of the two Gaussian laws' "
+         "means and covariances, else (marked ~) the energy distance of a permutation test at "
+         "level "
       << used.distribution.family_alpha << " per cell. Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
   return gate(results, expectations);
 }
+
+}  // namespace
 
 void add_audit_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<AuditCommandOptions>();
@@ -252,8 +253,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option(
          "--expect", options->expect,
          "a gate: exit 1 with the witness unless every check under GROUP holds (COMPONENT:GROUP "
-         "for "
-         "one component), e.g. --expect se3 or --expect actions:se3,observation:translation")
+         "for one component), e.g. --expect se3 or --expect actions:se3,observation:translation")
       ->delimiter(',');
   cmd->add_flag("--json", options->json,
                 "print the JSON document of docs/AUDIT.md instead of tables");
@@ -273,7 +273,4 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->callback([options, &exit_code] { exit_code = run_audit(*options); });
 }
 
-const CommandRegistration audit_command("audit", add_audit_command);
-
-}  // namespace
 }  // namespace handcentric::apps

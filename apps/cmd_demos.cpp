@@ -82,6 +82,8 @@ int run_demos(const DemosOptions& options) {
   return report(options, distribution.name, run);
 }
 
+}  // namespace
+
 void add_demos_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<DemosOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -121,7 +123,4 @@ void add_demos_command(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistration demos_command("demos", add_demos_command);
-
-}  // namespace
 }  // namespace handcentric::apps

@@ -131,6 +131,8 @@ int run_eval(const EvalOptions& options) {
   return 0;
 }
 
+}  // namespace
+
 void add_eval_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<EvalOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -189,10 +191,8 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistration eval_command("eval", add_eval_command);
-
 // Main-report section: the sim's own bar (sim/expert_check.hpp) on seeded scenes.
-int run_sim_section(std::ostream& out) {
+int run_sim_section(std::ostream& out, const ReportOptions&) {
   constexpr int kScenes = 200;
   constexpr int kRollouts = 50;
   constexpr std::uint64_t kSeed = 1;
@@ -216,9 +216,4 @@ int run_sim_section(std::ostream& out) {
   return status;
 }
 
-const ReportSection sim_section(40, "sim", [](std::ostream& out, const ReportOptions&) {
-  return run_sim_section(out);
-});
-
-}  // namespace
 }  // namespace handcentric::apps

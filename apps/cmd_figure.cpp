@@ -30,6 +30,8 @@ int run_flow_figure(const FigureOptions& options) {
   return 0;
 }
 
+}  // namespace
+
 void add_figure_command(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand("figure", "the paper's figures as PNGs (flow: Fig. 3)");
   cmd->require_subcommand(1);
@@ -54,7 +56,4 @@ void add_figure_command(CLI::App& app, int& exit_code) {
   flow->callback([options, &exit_code] { exit_code = run_flow_figure(*options); });
 }
 
-const CommandRegistration figure_command("figure", add_figure_command);
-
-}  // namespace
 }  // namespace handcentric::apps

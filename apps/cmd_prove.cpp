@@ -31,6 +31,8 @@ int run_prove(const ProveOptions& options) {
   return proofs::count_verified(outcomes) == static_cast<int>(outcomes.size()) ? 0 : 1;
 }
 
+}  // namespace
+
 void add_prove_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<ProveOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -44,19 +46,12 @@ void add_prove_command(CLI::App& app, int& exit_code) {
   cmd->callback([options, &exit_code] { exit_code = run_prove(*options); });
 }
 
-int run_proofs_section(std::ostream& out) {
+int run_proofs_section(std::ostream& out, const ReportOptions&) {
   const std::vector<proofs::ClaimOutcome> outcomes = proofs::certify_all(proofs::paper_claims());
   out << "handcentric prove: the paper's claims as exact certificates (details: `handcentric "
-         "prove`, "
-         "docs/CLAIMS.md)\n"
+         "prove`, docs/CLAIMS.md)\n"
       << proofs::summary_text(outcomes);
   return proofs::count_verified(outcomes) == static_cast<int>(outcomes.size()) ? 0 : 1;
 }
 
-const CommandRegistration prove_command("prove", add_prove_command);
-const ReportSection proofs_section(20, "proofs", [](std::ostream& out, const ReportOptions&) {
-  return run_proofs_section(out);
-});
-
-}  // namespace
 }  // namespace handcentric::apps

@@ -110,6 +110,8 @@ int run_render(const RenderOptions& options) {
   return 0;
 }
 
+}  // namespace
+
 void add_render_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<RenderOptions>();
   CLI::App* cmd = app.add_subcommand(
@@ -152,7 +154,4 @@ void add_render_command(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistration render_command("render", add_render_command);
-
-}  // namespace
 }  // namespace handcentric::apps

@@ -24,9 +24,8 @@
 #include "handcentric/props/audit.hpp"
 
 namespace handcentric::apps {
-namespace {
 
-int run_audit_section(const ReportOptions& options, std::ostream& out) {
+int run_audit_section(std::ostream& out, const ReportOptions& options) {
   props::AuditOptions audit;
   audit.cases = options.cases;
   audit.seed = options.seed;
@@ -43,21 +42,21 @@ int run_audit_section(const ReportOptions& options, std::ostream& out) {
       mismatches.push_back(std::move(line));
   }
   if (mismatches.empty()) {
-    out << "Every cell matches App. A of the paper in the eye-in-hand view: absolute - no symmetry "
-           "(eqs. 11, "
-           "13); relative and relative_diff - translation only (eq. 16); hand_centric - all of "
-           "SE(3) (eqs. 9, "
-           "23, 26); ActionFlow - pointwise none, in distribution rotations only (eq. 29). The "
-           "third-person "
-           "cells match the same pattern, on this library's rule for world points (copied raw by "
-           "absolute, "
-           "relative, relative_diff and ActionFlow; taken into the hand frame by hand_centric).\n";
+    // One paragraph on the terminal: the literals are joined without line breaks.
+    out << "Every cell matches App. A of the paper in the eye-in-hand view: absolute - no "
+           "symmetry (eqs. 11, 13); relative and relative_diff - translation only (eq. 16); "
+           "hand_centric - all of SE(3) (eqs. 9, 23, 26); ActionFlow - pointwise none, in "
+           "distribution rotations only (eq. 29). The third-person cells match the same pattern, "
+           "on this library's rule for world points (copied raw by absolute, relative, "
+           "relative_diff and ActionFlow; taken into the hand frame by hand_centric).\n";
     return 0;
   }
   out << mismatches.size() << " cell(s) differ from the paper:\n";
   for (const auto& line : mismatches) out << "  " << line << "\n";
   return 1;
 }
+
+namespace {
 
 struct PageOptions {
   std::string out;    ///< empty: print the report on stdout
@@ -94,14 +93,6 @@ std::string table_into(const std::string& dir, const std::vector<int>& demo_coun
   return experiments::collect_table1(grid.dir);
 }
 
-std::string section_title(const std::string& name) {
-  if (name == "audit")
-    return "Audit: which global transforms each representation is invariant under";
-  if (name == "proofs") return "Certificates: the paper's claims, exactly";
-  if (name == "sim") return "The 2D peg-in-hole task: the expert's bar";
-  return name;
-}
-
 // A nested Markdown document under one of the page's headings: its own title goes (the page's
 // heading replaces it), its other headings move one level down.
 std::string demoted(const std::string& markdown) {
@@ -121,20 +112,16 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
   std::ostringstream md;
   md << "# handcentric report\n\n"
      << "What this library checks of \"Guaranteed SE(3)-Equivariant Control via Hand-Centric "
-        "Behavior "
-        "Cloning\", run on this machine: the audit of the built-in representations, the exact "
-        "certificates, "
-        "the 2D sim's own bar, Fig. 3, Table 1 and Fig. 5. Regenerate with `handcentric report "
-        "--out DIR"
+        "Behavior Cloning\", run on this machine: the audit of the built-in representations, "
+        "the exact certificates, the 2D sim's own bar, Fig. 3, Table 1 and Fig. 5. Regenerate "
+        "with `handcentric report --out DIR"
      << (page.full ? " --full" : "") << "`.\n\n";
   int status = 0;
-  const std::vector<RegisteredSection> sections = report_sections();
-  for (const RegisteredSection& section : sections) {
+  for (const ReportSection& section : report_sections()) {
     std::ostringstream text;
     const int section_status = section.run(text, options);
     if (section_status != 0) status = 1;
-    md << "## " << section_title(section.name) << (section_status == 0 ? "" : " (FAILS its bar)")
-       << "\n\n```\n"
+    md << "## " << section.title << (section_status == 0 ? "" : " (FAILS its bar)") << "\n\n```\n"
        << text.str() << "```\n\n";
   }
 
@@ -143,8 +130,8 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
                                      experiments::compute_flow_figure());
   md << "## Fig. 3: the flow of the first action under a global transform\n\n"
      << "Rows: a demonstrated chunk and the same chunk after a global transform g; columns: "
-        "absolute, "
-        "relative and hand-centric actions (`handcentric figure flow`).\n\n![Fig. 3](fig3.png)\n\n";
+        "absolute, relative and hand-centric actions (`handcentric figure flow`).\n\n"
+        "![Fig. 3](fig3.png)\n\n";
 
   const std::vector<int> demo_counts = page.full
                                            ? std::vector<int>(experiments::kPaperDemoCounts.begin(),
@@ -159,8 +146,7 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
   if (!page.full) {
     md << "A quick run: demo counts " << page.demos << " only, " << trials
        << " rollouts per scene set (the paper: 5 to 100 demos, 100 trials); `--full` runs the "
-          "paper's grid. "
-          "Models and results are in `table1/`.\n\n";
+          "paper's grid. Models and results are in `table1/`.\n\n";
   }
   md << demoted(table) << "\n![Table 1](table1/table1.png)\n\n";
 
@@ -176,8 +162,7 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
         "counts "
      << (page.full ? std::string("10, 40, 100") : page.ablation_demos) << ", " << trials
      << " rollouts per scene set. The paper's finding: the representation, not the learning "
-        "algorithm, "
-        "decides success.\n\n"
+        "algorithm, decides success.\n\n"
      << demoted(ablation) << "\n![Fig. 5](fig5/table1.png)\n\n";
 
   const double seconds =
@@ -192,6 +177,8 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
             << (status == 0 ? "" : "; a section FAILS its bar") << "\n";
   return status;
 }
+
+}  // namespace
 
 void add_report_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<ReportOptions>();
@@ -224,10 +211,4 @@ void add_report_command(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistration report_command("report", add_report_command);
-const ReportSection audit_section(10, "audit", [](std::ostream& out, const ReportOptions& options) {
-  return run_audit_section(options, out);
-});
-
-}  // namespace
 }  // namespace handcentric::apps

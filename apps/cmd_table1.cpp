@@ -57,6 +57,8 @@ int run_table1_command(Table1CommandOptions options) {
   return 0;
 }
 
+}  // namespace
+
 void add_table1_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<Table1CommandOptions>();
   experiments::Table1Options& t = options->table;
@@ -102,7 +104,4 @@ void add_table1_command(CLI::App& app, int& exit_code) {
   cmd->callback([options, &exit_code] { exit_code = run_table1_command(*options); });
 }
 
-const CommandRegistration table1_command("table1", add_table1_command);
-
-}  // namespace
 }  // namespace handcentric::apps

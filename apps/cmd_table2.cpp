@@ -12,8 +12,6 @@
 #include "handcentric/experiments/table2.hpp"
 
 namespace handcentric::apps {
-namespace {
-
 void add_table2_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<experiments::Table2Options>();
   CLI::App* cmd = app.add_subcommand(
@@ -55,7 +53,4 @@ void add_table2_command(CLI::App& app, int& exit_code) {
   });
 }
 
-const CommandRegistration table2_command("table2", add_table2_command);
-
-}  // namespace
 }  // namespace handcentric::apps

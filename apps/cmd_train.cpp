@@ -140,6 +140,8 @@ int run_train(const TrainOptions& options) {
   return 0;
 }
 
+}  // namespace
+
 void add_train_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<TrainOptions>();
   CLI::App* cmd =
@@ -208,7 +210,4 @@ void add_train_command(CLI::App& app, int& exit_code) {
   cmd->callback([options, &exit_code] { exit_code = run_train(*options); });
 }
 
-const CommandRegistration train_command("train", add_train_command);
-
-}  // namespace
 }  // namespace handcentric::apps

@@ -1,5 +1,5 @@
-// `handcentric`: the command line. Plain `handcentric` prints the main report; every subcommand
-// registers itself from its own cmd_*.cpp (see commands.hpp).
+// `handcentric`: the command line. Plain `handcentric` prints the main report; the subcommands
+// are listed in commands.cpp, each defined in its own cmd_*.cpp.
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
@@ -13,7 +13,7 @@ int main(int argc, char** argv) {
       "Without a subcommand it prints the main report."};
   app.require_subcommand(0, 1);
   int exit_code = 0;
-  for (const auto& command : handcentric::apps::registered_commands()) command.add(app, exit_code);
+  for (const auto& command : handcentric::apps::commands()) command.add(app, exit_code);
   try {
     app.parse(argc, argv);
     if (app.get_subcommands().empty()) exit_code = handcentric::apps::run_main_report(std::cout);

@@ -691,8 +691,7 @@ PYBIND11_MODULE(handcentric, m) {
   namespace props = handcentric::props;
   m.doc() =
       "Audit action representations and whole policies for equivariance under global rigid "
-      "transforms "
-      "(docs/AUDIT.md, docs/AUDIT_YOUR_POLICY.md).";
+      "transforms (docs/AUDIT.md, docs/AUDIT_YOUR_POLICY.md).";
   m.attr("__version__") = HANDCENTRIC_VERSION;
 
   static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
@@ -887,7 +886,6 @@ Every view in `views` must hold.)doc");
       },
       py::arg("path"), py::kw_only(), py::arg("history") = 0, py::arg("chunk") = 8,
       "Every control step of every demo in a file, stacked: {'history': (N, H+1, 4, 4), 'chunk': "
-      "(N, K, 4, 4), "
-      "'hand_points': (N, 2, 3)} (the sim's eye-in-hand points: the hole's corners in the hand "
-      "frame).");
+      "(N, K, 4, 4), 'hand_points': (N, 2, 3)} (the sim's eye-in-hand points: the hole's "
+      "corners in the hand frame).");
 }

@@ -2,7 +2,8 @@
 # Configures and builds handcentric (Release, every core) into ${BUILD_DIR:-build}, as a unity
 # build: the libraries and the command compile a few batches of files instead of one compiler
 # run per file, which takes a fresh build from ~8.5 to ~6 minutes on two cores
-# (docs/BENCHMARKS.md, "Build"); the test programs are never unity-built (HandcentricTarget.cmake).
+# (docs/BENCHMARKS.md, "Build"). The test programs are unity-built too, so file-local helpers
+# need distinct names across a program's files (cmake/HandcentricTarget.cmake).
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"

@@ -49,13 +49,14 @@ bool is_image(const std::string& line) {
 }
 
 const char* kStyle =
-    "body{font-family:system-ui,sans-serif;max-width:1400px;margin:2em auto;padding:0 "
-    "1em;color:#222}"
+    "body{font-family:system-ui,sans-serif;max-width:1400px;margin:2em auto;padding:0 1em;"
+    "color:#222}"
     "pre{background:#f6f6f6;padding:.8em;white-space:pre-wrap;font-size:13px;line-height:1.35}"
-    "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:.25em "
-    ".6em;text-align:left}"
-    "th{background:#f0f0f0}img{max-width:100%;border:1px solid "
-    "#ddd}code{background:#f3f3f3;padding:0 .2em}";
+    "table{border-collapse:collapse;margin:1em 0}"
+    "td,th{border:1px solid #ccc;padding:.25em .6em;text-align:left}"
+    "th{background:#f0f0f0}"
+    "img{max-width:100%;border:1px solid #ddd}"
+    "code{background:#f3f3f3;padding:0 .2em}";
 
 }  // namespace
 

@@ -440,12 +440,10 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
   std::snprintf(
       line, sizeof line,
       "Success over %d closed-loop rollouts per cell (mean over %zu training seed%s). Scenes: `id` "
-      "= "
-      "train distribution, eval seed %llu; `ood` = bottom-up holes, their own seed %llu; `ood "
-      "paired` = "
-      "the global transforms of the id scenes (same seed, same noise: equal to id exactly when the "
-      "policy "
-      "is equivariant). Demos: the first N of `demos --n 100 --dist train --seed %llu`.\n\n",
+      "= train distribution, eval seed %llu; `ood` = bottom-up holes, their own seed %llu; `ood "
+      "paired` = the global transforms of the id scenes (same seed, same noise: equal to id "
+      "exactly when the policy is equivariant). Demos: the first N of `demos --n 100 --dist "
+      "train --seed %llu`.\n\n",
       eval.trials, seeds.size(), seeds.size() == 1 ? "" : "s",
       static_cast<unsigned long long>(eval.eval_seed),
       static_cast<unsigned long long>(eval.ood_seed), static_cast<unsigned long long>(demo_seed));

@@ -281,8 +281,7 @@ std::string table2_markdown(const std::vector<Table2Row>& rows) {
        << rate_with_interval(row.random_se3) << " |\n";
   }
   md << "\nThe paper's Table 2 for reference (a real robot, blade insertion, 35 trials; not "
-        "rerunnable "
-        "here):\n\n"
+        "rerunnable here):\n\n"
         "| method | in distribution | out of distribution (horizontal stacks) |\n"
         "|---|---|---|\n"
         "| hand-centric (paper) | 26/30 (0.87) | 5/5 (1.00) |\n";

@@ -24,8 +24,7 @@ Claim lemma1_claim() {
   return identity_claim(
       "Sec. 3.1 Lemma 1, eq. (8)",
       "If the hand-centric policy is invariant, the outer action a_k = T_0 Ra_k is "
-      "SE(3)-equivariant: "
-      "moving the scene by T~ gives (T~ T_0) Ra_k = T~ a_k.",
+      "SE(3)-equivariant: moving the scene by T~ gives (T~ T_0) Ra_k = T~ a_k.",
       kIdentities, outer_of_moved_scene, moved_outer_action, Group::rigid_motions,
       "Ra_k is a generic pose that does not depend on T~ (the invariance assumed by Lemma 1); "
       "the identity is on all 12 entries of the pose.");

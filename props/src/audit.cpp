@@ -155,8 +155,7 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
           << " in-distribution 'yes' cell(s) (marked ~) were decided by an energy test, "
           << "the output not being affine in the noise: each finds a mean shift of " << shift
           << " or more (the largest over the cells; per cell in the JSON's detectable_shift) with "
-             "90% power; "
-             "smaller differences can hide\n";
+             "90% power; smaller differences can hide\n";
     }
     if (const auto& injectivity = classification.injectivity) {
       if (injectivity->injective == false) {

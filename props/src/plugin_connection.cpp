@@ -90,10 +90,8 @@ PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body
       fail(who() + " gave no answer to request " + std::to_string(id) + " within " +
            seconds_text(timeout_seconds_) +
            " s; a plug-in must write one line per request and flush it (Python: print(..., "
-           "flush=True) or "
-           "sys.stdout.flush(), or run it as python3 -u: a pipe is block-buffered), or raise "
-           "--timeout if it is "
-           "just slow");
+           "flush=True) or sys.stdout.flush(), or run it as python3 -u: a pipe is block-buffered), "
+           "or raise --timeout if it is just slow");
   }
   seconds_waiting_ += std::chrono::duration<double>(Clock::now() - written).count();
   PluginReply reply;

@@ -1,7 +1,8 @@
 // The products of one training step of the anchor network (57 -> 256 -> 256 -> 256 -> 24, batch
 // 256), one at a time, on the kernel set this CPU runs (or HANDCENTRIC_KERNELS): where a step's
-// time goes, per product. items/s x 1e-9 = GFLOP/s. Uses the private kernel interface
-// (policy/src/kernels/kernel_set.hpp), as tests/policy does.
+// time goes, per product. items/s x 1e-9 = GFLOP/s. It times the private kernel interface
+// (kernel_set.hpp), which is why it lives here and not in bench/, whose benchmarks use the
+// public API only. Built as build/bench/bench_kernels with the other benchmarks.
 #include <benchmark/benchmark.h>
 
 #include <random>
