@@ -63,7 +63,7 @@ int run_insert3d_render(const RenderOptions& options) {
     const sim::insert3d::CollisionChecker checker;
     rollout = sim::insert3d::rollout(policy, scene, sim::stream_seed(options.seed, options.index),
                                      checker, loaded.rollout_options);
-    what = "rollout (" + sim::insert3d::to_string(rollout.outcome) + " after " +
+    what = "rollout (" + sim::outcome_name(rollout.outcome) + " after " +
            std::to_string(rollout.world_T_hand.size() - 1) + " steps)";
     what += " of " + policy.name();
   }

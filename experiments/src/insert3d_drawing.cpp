@@ -113,9 +113,9 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
   }
   const cv::Scalar last_colour =
       n == 1 ? rgb(30, 60, 200)
-      : rollout.outcome == insert3d::Outcome::success
+      : rollout.outcome == sim::Outcome::success
           ? rgb(sim::kSuccessRgb[0], sim::kSuccessRgb[1], sim::kSuccessRgb[2])
-      : rollout.outcome == insert3d::Outcome::collision
+      : rollout.outcome == sim::Outcome::collision
           ? rgb(sim::kCollisionRgb[0], sim::kCollisionRgb[1], sim::kCollisionRgb[2])
           : rgb(120, 120, 120);
   draw_box(canvas, view, rollout.world_T_hand.back(), geometry.blade_in_hand(), last_colour, 3);

@@ -52,16 +52,16 @@ Insert3dCounts evaluate_insert3d(const ChunkPolicy& policy,
     ++counts.trials;
     counts.clipped += result.clipped;
     switch (result.outcome) {
-      case insert3d::Outcome::success:
+      case sim::Outcome::success:
         ++counts.success;
         break;
-      case insert3d::Outcome::collision:
+      case sim::Outcome::collision:
         ++counts.collision;
         break;
-      case insert3d::Outcome::timeout:
+      case sim::Outcome::timeout:
         ++counts.timeout;
         break;
-      case insert3d::Outcome::invalid:
+      case sim::Outcome::invalid:
         ++counts.invalid;
         break;
     }

@@ -27,8 +27,6 @@
 
 namespace handcentric::policy {
 
-std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config, double initial_noise);
-
 namespace {
 
 class C8PlanarHead final : public Head {
@@ -38,7 +36,7 @@ class C8PlanarHead final : public Head {
         observations_(c8::observation_layout(config)),
         centre_(c8::centre_of(config)),
         kind_(config.head),
-        inner_(make_inner(c8::inner_config(config), config.noise_scale)) {}
+        inner_(make_head(c8::inner_config(config))) {}
 
   HeadKind kind() const override { return kind_; }
 
@@ -93,11 +91,6 @@ class C8PlanarHead final : public Head {
                         const c8::Layout& layout) const {
     return c8::act_planar(k, centre_, c8::encode_planar(absolute.cast<double>(), layout), layout)
         .cast<float>();
-  }
-
-  static std::unique_ptr<Head> make_inner(const PolicyConfig& inner, double noise_scale) {
-    // The flow head reads noise_scale from its config; the DDPM head is told it.
-    return inner.head == HeadKind::ddpm ? make_ddpm_head(inner, noise_scale) : make_head(inner);
   }
 
   c8::Layout actions_, observations_;

@@ -43,10 +43,10 @@ std::vector<double> cosine_alpha_bar(int T) {
 
 class DdpmHead final : public NetworkHead {
  public:
-  DdpmHead(const PolicyConfig& config, double initial_noise)
+  explicit DdpmHead(const PolicyConfig& config)
       : NetworkHead(config),
         alpha_bar_(cosine_alpha_bar(config.ddpm_train_steps)),
-        initial_noise_(static_cast<float>(initial_noise)) {}
+        initial_noise_(static_cast<float>(config.noise_scale)) {}
   HeadKind kind() const override { return HeadKind::ddpm; }
 
   void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
@@ -132,12 +132,7 @@ class DdpmHead final : public NetworkHead {
 // integration does: 0 (the default) samples the most likely chunk (eq. 6), which the 0.1 cm
 // clearance needs (docs/EXPERIMENTS.md).
 std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config) {
-  return std::make_unique<DdpmHead>(config, config.noise_scale);
-}
-
-// For c8ddpm (c8_planar_head.cpp), which samples like the flow heads, at config.noise_scale.
-std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config, double initial_noise) {
-  return std::make_unique<DdpmHead>(config, initial_noise);
+  return std::make_unique<DdpmHead>(config);
 }
 
 }  // namespace handcentric::policy

@@ -43,20 +43,6 @@ RolloutOptions RolloutOptions::for_policy(int history, int execute) {
   return options;
 }
 
-std::string outcome_name(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::success:
-      return "success";
-    case Outcome::collision:
-      return "collision";
-    case Outcome::timeout:
-      return "timeout";
-    case Outcome::invalid:
-      return "invalid";
-  }
-  return "unknown";
-}
-
 Scene observation(const RigidTransform& world_T_hole,
                   const std::vector<RigidTransform>& world_T_hand, int history,
                   const PegHoleGeometry& geometry) {

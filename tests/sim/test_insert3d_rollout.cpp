@@ -11,6 +11,7 @@
 
 using namespace handcentric;
 using namespace handcentric::sim::insert3d;
+using handcentric::sim::Outcome;
 
 namespace {
 

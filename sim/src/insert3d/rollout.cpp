@@ -44,20 +44,6 @@ void RolloutOptions::validate() const {
     throw InvalidArgument("rollout max_replans must be >= 1, got " + std::to_string(max_replans));
 }
 
-std::string to_string(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::success:
-      return "success";
-    case Outcome::collision:
-      return "collision";
-    case Outcome::timeout:
-      return "timeout";
-    case Outcome::invalid:
-      return "invalid";
-  }
-  return "?";
-}
-
 Scene observe(const TaskScene& scene, const std::vector<RigidTransform>& world_T_hand, int history,
               const BladeSlotGeometry& geometry) {
   if (world_T_hand.empty())

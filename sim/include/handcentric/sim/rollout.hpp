@@ -21,6 +21,7 @@
 #include "handcentric/core/scene.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/expert.hpp"
+#include "handcentric/sim/outcome.hpp"
 #include "handcentric/sim/scenes.hpp"
 
 namespace handcentric::sim {
@@ -45,11 +46,6 @@ struct RolloutOptions {
   /// chunk, with replans enough for kStepBudget steps (the same time limit for every execute).
   static RolloutOptions for_policy(int history, int execute);
 };
-
-enum class Outcome { success, collision, timeout, invalid };
-
-/// "success", "collision", "timeout", "invalid".
-std::string outcome_name(Outcome outcome);
 
 struct Rollout {
   Outcome outcome = Outcome::timeout;

@@ -20,6 +20,7 @@
 #include "handcentric/core/scene.hpp"
 #include "handcentric/sim/insert3d/collision.hpp"
 #include "handcentric/sim/insert3d/scenes.hpp"
+#include "handcentric/sim/outcome.hpp"
 
 namespace handcentric::sim::insert3d {
 
@@ -31,10 +32,6 @@ struct RolloutOptions {
   /// Throws InvalidArgument naming the value: history < 0, execute < 1, max_replans < 1.
   void validate() const;
 };
-
-enum class Outcome { success, collision, timeout, invalid };
-
-std::string to_string(Outcome outcome);
 
 struct Rollout {
   Outcome outcome = Outcome::timeout;
