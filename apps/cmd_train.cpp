@@ -39,6 +39,7 @@ struct TrainOptions {
   policy::PolicyConfig config;
   std::string head = policy::to_string(config.head);
   std::string lr_schedule = policy::to_string(config.lr_schedule);
+  std::string ddpm_prediction = policy::to_string(config.ddpm_prediction);
   std::uint64_t seed = 1;
   int max_demos = 0;
   sim::TrainingData data;
@@ -64,6 +65,7 @@ int run_train(const TrainOptions& options) {
   policy::PolicyConfig config = options.config;
   config.head = policy::parse_head(options.head);
   config.lr_schedule = policy::parse_schedule(options.lr_schedule);
+  config.ddpm_prediction = policy::parse_ddpm_prediction(options.ddpm_prediction);
   make_representation(config.representation);  // an unknown name fails before the demos load
   if (config.steps < 0) {
     throw InvalidArgument("--steps must be >= 1, or 0 for the automatic budget, got " +
@@ -202,6 +204,13 @@ void add_train_command(CLI::App& app, int& exit_code) {
                   "constant|cosine (from --lr down to ~0 at the last step)")
       ->capture_default_str();
   cmd->add_option("--euler-steps", config.euler_steps, "Euler steps of the flow sampler")
+      ->capture_default_str();
+  cmd->add_option("--ddpm-prediction", options->ddpm_prediction,
+                  "head ddpm: what the network predicts, sample (the clean chunk) or epsilon (the "
+                  "noise)")
+      ->capture_default_str();
+  cmd->add_option("--cvae-kl-weight", config.cvae_kl_weight,
+                  "head cvae: weight of the KL term in the loss")
       ->capture_default_str();
   cmd->add_option("--time-embedding", config.time_embedding,
                   "sinusoidal features of t (even), 0 for t itself")

@@ -62,6 +62,16 @@ LearningRateSchedule parse_schedule(const std::string& name) {
   throw InvalidArgument("unknown learning-rate schedule '" + name + "': use constant or cosine");
 }
 
+std::string to_string(DdpmPrediction prediction) {
+  return prediction == DdpmPrediction::sample ? "sample" : "epsilon";
+}
+
+DdpmPrediction parse_ddpm_prediction(const std::string& name) {
+  if (name == "epsilon") return DdpmPrediction::epsilon;
+  if (name == "sample") return DdpmPrediction::sample;
+  throw InvalidArgument("unknown DDPM prediction '" + name + "': use epsilon or sample");
+}
+
 namespace {
 
 void require(bool ok, const std::string& field, const std::string& value,
@@ -97,23 +107,14 @@ double parse_double(const std::string& key, const std::string& text) {
   return value;
 }
 
-#define HC_INT_FIELD(name)                                                                        \
-  Field {                                                                                         \
-#name, [](const PolicyConfig&                                                                 \
-                  c) { return std::to_string(c.name); },                                          \
-                                                      [](PolicyConfig & c,                        \
-                                                         const std::string&                       \
-                                                             v) { c.name = parse_int(#name, v); } \
-  }
-#define HC_DOUBLE_FIELD(name)                                                                    \
-  Field {                                                                                        \
-#name,                                                                                       \
-        [](const PolicyConfig&                                                                   \
-               c) { return format_number(c.name); },                                             \
-                                                  [](PolicyConfig & c,                           \
-                                                     const std::string&                          \
-                                                         v) { c.name = parse_double(#name, v); } \
-  }
+// clang-format off
+#define HC_INT_FIELD(name)                                                              \
+  Field{#name, [](const PolicyConfig& c) { return std::to_string(c.name); },           \
+        [](PolicyConfig& c, const std::string& v) { c.name = parse_int(#name, v); }}
+#define HC_DOUBLE_FIELD(name)                                                           \
+  Field{#name, [](const PolicyConfig& c) { return format_number(c.name); },            \
+        [](PolicyConfig& c, const std::string& v) { c.name = parse_double(#name, v); }}
+// clang-format on
 
 const std::vector<Field>& fields() {
   static const std::vector<Field> all = {
@@ -145,6 +146,10 @@ const std::vector<Field>& fields() {
       HC_INT_FIELD(euler_steps),
       HC_INT_FIELD(ddpm_train_steps),
       HC_INT_FIELD(ddim_steps),
+      Field{"ddpm_prediction", [](const PolicyConfig& c) { return to_string(c.ddpm_prediction); },
+            [](PolicyConfig& c, const std::string& v) {
+              c.ddpm_prediction = parse_ddpm_prediction(v);
+            }},
       HC_INT_FIELD(cvae_latent),
       HC_DOUBLE_FIELD(cvae_kl_weight),
       HC_DOUBLE_FIELD(noise_scale),
@@ -215,6 +220,7 @@ std::string PolicyConfig::to_text() const {
   for (const Field& field : fields()) {
     if (!is_c8_planar(head) && field.key.starts_with("c8_")) continue;  // see config.hpp
     if (field.key == "task" && task == kTaskPeg2d) continue;            // absent reads as peg2d
+    if (field.key == "ddpm_prediction" && head != HeadKind::ddpm) continue;  // see config.hpp
     text += field.key + "=" + field.get(*this) + "\n";
   }
   return text;
@@ -222,6 +228,7 @@ std::string PolicyConfig::to_text() const {
 
 PolicyConfig PolicyConfig::from_text(const std::string& text) {
   PolicyConfig config;
+  bool has_ddpm_prediction = false;
   std::istringstream in(text);
   std::string line;
   while (std::getline(in, line)) {
@@ -230,6 +237,7 @@ PolicyConfig PolicyConfig::from_text(const std::string& text) {
     if (eq == std::string::npos)
       throw InvalidArgument("policy config: line '" + line + "' is not key=value");
     const std::string key = line.substr(0, eq);
+    if (key == "ddpm_prediction") has_ddpm_prediction = true;
     bool known = false;
     for (const Field& field : fields()) {
       if (field.key == key) {
@@ -239,6 +247,9 @@ PolicyConfig PolicyConfig::from_text(const std::string& text) {
     }
     if (!known) throw InvalidArgument("policy config: unknown key '" + key + "'");
   }
+  // A ddpm model written before the setting existed predicted the noise.
+  if (config.head == HeadKind::ddpm && !has_ddpm_prediction)
+    config.ddpm_prediction = DdpmPrediction::epsilon;
   config.validate();
   return config;
 }

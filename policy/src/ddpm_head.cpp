@@ -1,18 +1,25 @@
-// DDPM (Ho et al. 2020) with epsilon prediction, for the App. B ablation; DDIM sampling (Song et
-// al. 2021, eta = 0) in config.ddim_steps steps. In normalized coordinates, like the flow head.
+// DDPM (Ho et al. 2020) for the App. B ablation; DDIM sampling (Song et al. 2021, eta = 0) in
+// config.ddim_steps steps. In normalized coordinates, like the flow head. The network predicts
+// the clean chunk (config.ddpm_prediction = sample, the default) or the noise (epsilon).
 //
 //   schedule  cosine (Nichol & Dhariwal 2021): abar(s) = cos^2(((s / T) + 0.008) / 1.008 * pi / 2)
 //             normalized by abar(0), beta_k = min(1 - abar_k / abar_{k-1}, 0.999),
 //             abar_k = prod(1 - beta)
-//   training  k uniform in 0..T-1, x = sqrt(abar_k) a + sqrt(1 - abar_k) eps, target eps,
-//             network input [x, time features of (k + 1) / T, o]
+//   training  k uniform in 0..T-1, x = sqrt(abar_k) a + sqrt(1 - abar_k) eps, target a (sample)
+//             or eps (epsilon), network input [x, time features of (k + 1) / T, o]
 //   sampling  tau_i = T - 1 - i * (T / S), i = 0..S-1;
-//             x0_hat = (x - sqrt(1 - abar) eps_hat) / sqrt(abar),
-//             clipped to the range of the normalized training actions (at least +-1), as
+//             sample:  x0_hat = the network's output,
+//                      eps_hat = (x - sqrt(abar) x0_hat) / sqrt(1 - abar);
+//             epsilon: x0_hat = (x - sqrt(1 - abar) eps_hat) / sqrt(abar);
+//             x0_hat clipped to the range of the normalized training actions (at least +-1), as
 //             Diffusion Policy clips to its data range;
 //             x <- sqrt(abar_prev) x0_hat + sqrt(1 - abar_prev) eps_hat.
-//             Without the clip, the first step (abar_{T-1} ~ 2e-7) multiplies any error in
-//             eps_hat by ~2000 and the later steps start far outside the training distribution.
+//             With epsilon, the first step (abar_{T-1} ~ 2e-7) multiplies any error in eps_hat
+//             by ~2000: without the clip the later steps would start far outside the training
+//             distribution, and even with it the chunk misses the 0.1 cm clearance (0.00
+//             success where sample prediction reaches 0.87; docs/EXPERIMENTS.md). With sample,
+//             eps_hat divides by sqrt(1 - abar) >= sqrt(1 - abar_0) ~ 0.025 only at the last
+//             step, whose x0_hat is the result.
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -90,7 +97,8 @@ class DdpmHead final : public NetworkHead {
                   static_cast<float>(std::sqrt(1.0 - alpha_bar_[k])) * noise_.col(j);
     }
     assemble(x_, t_, o_, input_);
-    return regress(network_.forward(input_), noise_);
+    return regress(network_.forward(input_),
+                   config_.ddpm_prediction == DdpmPrediction::sample ? a_ : noise_);
   }
 
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
@@ -102,17 +110,24 @@ class DdpmHead final : public NetworkHead {
     fill_standard_normal(rng, x);
     const Eigen::VectorXf& active = action_normalizer_.active_float();
     x.array().colwise() *= active.array() * initial_noise_;
-    Eigen::MatrixXf input, eps_hat, scratch[2];
+    const bool predicts_sample = config_.ddpm_prediction == DdpmPrediction::sample;
+    Eigen::MatrixXf input, output, x0, eps_hat, scratch[2];
     for (int i = 0; i < S; ++i) {
       const int k = T - 1 - i * (T / S);
       const int k_prev = i + 1 < S ? T - 1 - (i + 1) * (T / S) : -1;
       const double abar = alpha_bar_[k], abar_prev = k_prev >= 0 ? alpha_bar_[k_prev] : 1.0;
+      const float signal = static_cast<float>(std::sqrt(abar));
+      const float noise = static_cast<float>(std::sqrt(1.0 - abar));
       assemble(x, Eigen::VectorXd::Constant(batch, static_cast<double>(k + 1) / T), o, input);
-      network_.infer(input, eps_hat, scratch);
-      eps_hat.array().colwise() *= active.array();
-      Eigen::MatrixXf x0 = (x - static_cast<float>(std::sqrt(1.0 - abar)) * eps_hat) /
-                           static_cast<float>(std::sqrt(abar));
-      x0 = x0.cwiseMax(-clip_).cwiseMin(clip_);
+      network_.infer(input, output, scratch);
+      output.array().colwise() *= active.array();
+      if (predicts_sample) {
+        x0 = output.cwiseMax(-clip_).cwiseMin(clip_);
+        eps_hat = (x - signal * x0) / noise;
+      } else {
+        eps_hat = output;
+        x0 = ((x - noise * eps_hat) / signal).cwiseMax(-clip_).cwiseMin(clip_);
+      }
       x = static_cast<float>(std::sqrt(abar_prev)) * x0 +
           static_cast<float>(std::sqrt(1.0 - abar_prev)) * eps_hat;
     }

@@ -8,6 +8,8 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/so3.hpp"
+#include "handcentric/policy/binary_io.hpp"
+#include "handcentric/policy/head.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "throws.hpp"
@@ -77,21 +79,25 @@ TEST_CASE("mutant_untrained_heads_miss_the_two_modes", "[unit]") {
 
 namespace {
 
-// Trains on two scenes (one chunk per observation) and returns (final loss, max distance of a
-// sampled chunk to its demo). Two, not one: with one scene every dimension is constant and the
-// heads reproduce it exactly without learning anything (normalizer.hpp, active = 0).
-std::pair<double, double> overfit_one_chunk(
-    HeadKind head, int steps, LearningRateSchedule schedule = LearningRateSchedule::constant) {
-  const std::vector<Scene> scenes = test::small_scenes(2, 17);
-  double last_loss = 0.0;
+// Two scenes, one chunk per observation. Two, not one: with one scene every dimension is
+// constant and the heads reproduce it exactly without learning anything (normalizer.hpp,
+// active = 0).
+std::vector<Scene> overfit_scenes() {
+  return test::small_scenes(2, 17);
+}
+
+PolicyConfig overfit_config(HeadKind head, int steps, LearningRateSchedule schedule) {
   PolicyConfig config = test::small_config(head, "hand_centric", steps);
   config.hidden_width = 64;
   config.learning_rate = 1e-2;
   config.lr_schedule = schedule;
-  const LearnedPolicy policy = train_policy(
-      config, scenes, 3, [&](const TrainingProgress& p) { last_loss = p.loss; }, 100);
+  return config;
+}
+
+// The largest distance of a sampled chunk's pose to the demo's, over both scenes and 5 seeds.
+double worst_distance_to_demo(const LearnedPolicy& policy) {
   double worst = 0.0;
-  for (const Scene& scene : scenes) {
+  for (const Scene& scene : overfit_scenes()) {
     for (std::uint64_t seed = 0; seed < 5; ++seed) {
       const auto chunk = policy.act(scene, seed);
       for (std::size_t k = 0; k < chunk.size(); ++k) {
@@ -99,7 +105,21 @@ std::pair<double, double> overfit_one_chunk(
       }
     }
   }
-  return {last_loss, worst};
+  return worst;
+}
+
+// Trains on the two scenes and returns (final loss, worst distance of a sampled chunk to its
+// demo).
+std::pair<double, double> overfit_one_chunk(const PolicyConfig& config) {
+  double last_loss = 0.0;
+  const LearnedPolicy policy = train_policy(
+      config, overfit_scenes(), 3, [&](const TrainingProgress& p) { last_loss = p.loss; }, 100);
+  return {last_loss, worst_distance_to_demo(policy)};
+}
+
+std::pair<double, double> overfit_one_chunk(
+    HeadKind head, int steps, LearningRateSchedule schedule = LearningRateSchedule::constant) {
+  return overfit_one_chunk(overfit_config(head, steps, schedule));
 }
 
 }  // namespace
@@ -111,15 +131,65 @@ TEST_CASE("every_head_overfits_one_chunk_per_observation", "[unit]") {
   // at the start), so their loss bound is 0.15 and the real check is the sampled chunk (the
   // untrained network misses it by > 1). With the default cosine schedule: under a constant
   // rate of 1e-2 the result depends on the noise stream (DDPM ended 0.2-0.4 from the demo).
+  std::vector<PolicyConfig> configs;
   for (HeadKind head : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae}) {
-    INFO(to_string(head));
     // DDPM needs more steps: its 10 DDIM steps start from abar ~ 2e-7 (ddpm_head.cpp).
-    const auto [loss, distance_to_demo] =
-        overfit_one_chunk(head, head == HeadKind::ddpm ? 4000 : 2000, LearningRateSchedule::cosine);
+    configs.push_back(
+        overfit_config(head, head == HeadKind::ddpm ? 4000 : 2000, LearningRateSchedule::cosine));
+  }
+  configs.push_back(configs[1]);  // the DDPM again, predicting the noise instead of the sample
+  configs.back().ddpm_prediction = DdpmPrediction::epsilon;
+  for (const PolicyConfig& config : configs) {
+    INFO(to_string(config.head) << ", DDPM prediction " << to_string(config.ddpm_prediction));
+    const auto [loss, distance_to_demo] = overfit_one_chunk(config);
     INFO("final loss " << loss << ", worst distance " << distance_to_demo);
     CHECK(distance_to_demo < 0.2);
-    CHECK(loss < (head == HeadKind::cvae ? 1e-3 : 0.15));
+    // The sample-predicting DDPM regresses the chunk itself, which it can fit like the CVAE.
+    const bool fits_exactly =
+        config.head == HeadKind::cvae ||
+        (config.head == HeadKind::ddpm && config.ddpm_prediction == DdpmPrediction::sample);
+    CHECK(loss < (fits_exactly ? 1e-3 : 0.15));
   }
+}
+
+TEST_CASE("mutant_ddpm_weights_sampled_with_the_other_prediction_miss_the_chunk", "[unit]") {
+  // Planted fault: the weights of a DDPM trained to predict the sample, read by a head that
+  // takes their output for the noise (what a sampler ignoring ddpm_prediction would do). The
+  // check of the test above must reject it.
+  const PolicyConfig config = overfit_config(HeadKind::ddpm, 4000, LearningRateSchedule::cosine);
+  const LearnedPolicy trained = train_policy(config, overfit_scenes(), 3);
+  REQUIRE(worst_distance_to_demo(trained) < 0.2);  // the positive control
+  ByteWriter weights;
+  trained.head().write(weights);
+  PolicyConfig misread = trained.config();
+  misread.ddpm_prediction = DdpmPrediction::epsilon;
+  std::shared_ptr<Head> head = make_head(misread);
+  ByteReader in(weights.bytes(), "weights");
+  head->read(in);
+  const LearnedPolicy mutant(misread, trained.shared_representation(), std::move(head));
+  CHECK(worst_distance_to_demo(mutant) > 0.2);
+}
+
+TEST_CASE("the_ddpm_prediction_is_stored_for_ddpm_models_and_absent_reads_as_epsilon", "[unit]") {
+  PolicyConfig ddpm = test::small_config(HeadKind::ddpm, "hand_centric", 1);
+  CHECK(ddpm.ddpm_prediction == DdpmPrediction::sample);  // the default
+  CHECK(ddpm.to_text().find("ddpm_prediction=sample\n") != std::string::npos);
+  CHECK(PolicyConfig::from_text(ddpm.to_text()).ddpm_prediction == DdpmPrediction::sample);
+  ddpm.ddpm_prediction = DdpmPrediction::epsilon;
+  CHECK(PolicyConfig::from_text(ddpm.to_text()).ddpm_prediction == DdpmPrediction::epsilon);
+  // A ddpm model file written before the setting existed has no line: it predicted the noise.
+  std::string old_text = ddpm.to_text();
+  const std::size_t at = old_text.find("ddpm_prediction=");
+  REQUIRE(at != std::string::npos);
+  old_text.erase(at, old_text.find('\n', at) - at + 1);
+  CHECK(PolicyConfig::from_text(old_text).ddpm_prediction == DdpmPrediction::epsilon);
+  // Other heads do not store it, so their model files and table cell hashes are unchanged.
+  for (HeadKind head : {HeadKind::flow, HeadKind::cvae, HeadKind::c8ddpm}) {
+    CHECK(test::small_config(head, "absolute", 1).to_text().find("ddpm_prediction") ==
+          std::string::npos);
+  }
+  HC_CHECK_THROWS(parse_ddpm_prediction("x0"), InvalidArgument,
+                  Catch::Contains("'x0'") && Catch::Contains("epsilon or sample"));
 }
 
 TEST_CASE("constant_action_dimensions_are_reproduced_exactly", "[unit]") {
@@ -256,6 +326,8 @@ TEST_CASE("the_library_defaults_are_the_configuration_that_inserts_the_peg", "[u
   CHECK(defaults.steps == 0);  // the automatic budget
   CHECK(defaults.noise_scale == 0.0);
   CHECK(defaults.execute == 4);
+  CHECK(defaults.ddpm_prediction == DdpmPrediction::sample);
+  CHECK(defaults.cvae_kl_weight == 10.0);
   defaults.validate();
 }
 

@@ -67,7 +67,8 @@ Eigen::Vector2d centre_of(const PolicyConfig& config);
 int augmentation_copies(HeadKind head);
 
 /// The config of the network inside a c8ddpm (c8flow_planar) head: a DDPM (flow) head on the
-/// planar dimensions, with every other setting of config (network, training, noise_scale).
+/// planar dimensions, with every other setting of config (network, training, noise_scale); the
+/// DDPM predicts epsilon whatever config.ddpm_prediction says.
 /// Throws InvalidArgument if config's action or observation dimension does not fit its layout
 /// (an observation with extra poses or scalars, which the C8 baseline does not transform).
 PolicyConfig inner_config(const PolicyConfig& config);
