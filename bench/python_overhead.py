@@ -62,7 +62,8 @@ def best_of(n, function):
 
 
 def run_cli(*args):
-    return subprocess.run([CLI, "audit", *args, "--json"], check=True, capture_output=True, text=True).stdout
+    return subprocess.run([CLI, "audit", *args, "--json"], check=True, capture_output=True,
+                          text=True).stdout
 
 
 def hand_centric_actions(history, chunk, hand_points, world_points):
@@ -71,8 +72,8 @@ def hand_centric_actions(history, chunk, hand_points, world_points):
 
 def hand_centric_observation(history, hand_points, world_points):
     T0 = history[0]
-    return np.concatenate([hp.pose_vector(hp.relative_pose(T0, history)).ravel(), hand_points.ravel(),
-                           hp.relative_points(T0, world_points).ravel()])
+    return np.concatenate([hp.pose_vector(hp.relative_pose(T0, history)).ravel(),
+                           hand_points.ravel(), hp.relative_points(T0, world_points).ravel()])
 
 
 def in_process(cases):
@@ -88,14 +89,16 @@ def piped(cases, folder, helper):
     with open(script, "w") as out:
         out.write(PLUGIN % (os.path.abspath(helper), count))
     command = "%s %s" % (sys.executable, script)
-    seconds, _ = best_of(3, lambda: run_cli("--exec", command, "--group", "se3", "--view", "eye_in_hand",
+    seconds, _ = best_of(3, lambda: run_cli("--exec", command, "--group", "se3",
+                                            "--view", "eye_in_hand",
                                             "--cases", str(cases), "--seed", "1"))
     return seconds, int(open(count).read())
 
 
 def main():
     helper = os.path.join(os.path.dirname(os.path.realpath(__file__)), "..", "python")
-    args = (np.stack([np.eye(4)] * 3), np.stack([np.eye(4)] * 8), np.zeros((2, 3)), np.zeros((0, 3)))
+    args = (np.stack([np.eye(4)] * 3), np.stack([np.eye(4)] * 8), np.zeros((2, 3)),
+            np.zeros((0, 3)))
     alone_s, _ = best_of(3, lambda: [zeros(*args) for _ in range(10000)])
     print("the callable alone: %.2f us per call" % (1e6 * alone_s / 10000))
     rows = [("in process", in_process)]
@@ -107,7 +110,8 @@ def main():
                   "%.1f us per further call (best of 3)"
                   % (name, big_s, big_calls, small_s, small_calls,
                      1e6 * (big_s - small_s) / (big_calls - small_calls)))
-    seconds, result = best_of(3, lambda: handcentric.audit(hand_centric_actions, hand_centric_observation))
+    seconds, result = best_of(3, lambda: handcentric.audit(hand_centric_actions,
+                                                           hand_centric_observation))
     holds = all(c["invariant"] for c in result["checks"])
     print("default in-process audit of a NumPy hand-centric representation (1000 cases, 5 groups, "
           "2 views, %d checks, all invariant: %s): %.2f s (best of 3; goal < 5 s)"

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Do two independent trainings on the two cores each keep >= 90% of the speed of one alone?
-# It runs the training benchmark alone on core 0, then one copy on each of cores 0 and 1 at the same
-# time. Prints the three rates and, last, `kept: X Y` = each concurrent rate / the solo rate.
+# It runs the training benchmark alone on core 0, then one copy on each of cores 0 and 1 at the
+# same time. Prints the three rates and, last, `kept: X Y` = each concurrent rate / the solo rate.
 #
 #   bench/two_trainings.sh [BUILD_DIR]        (default: build; needs 2 cores and taskset)
 set -euo pipefail
@@ -33,5 +33,6 @@ wait "$pid0" "$pid1"
 both0="$(rate <"$out0")" both1="$(rate <"$out1")"
 echo "solo (core 0): $solo samples/s"
 echo "together: core 0 $both0, core 1 $both1 samples/s"
-python3 -c 'import sys; s = float(sys.argv[1]); print("kept: %.3f %.3f" % (float(sys.argv[2]) / s, float(sys.argv[3]) / s))' \
+python3 -c 'import sys; s = float(sys.argv[1]); '\
+'print("kept: %.3f %.3f" % (float(sys.argv[2]) / s, float(sys.argv[3]) / s))' \
   "$solo" "$both0" "$both1"

@@ -3,7 +3,8 @@
 
 57 inputs (24 noisy action + 1 time + 32 observation) -> 256 -> 256 -> 256 -> 24, SiLU, Adam
 (lr 1e-3), batch 256, float32, eq. (5) loss. Prints one JSON line:
-  {"threads": T, "train_samples_per_s": best over repetitions, "sample_us": median 10-step Euler at batch 1}
+  {"threads": T, "train_samples_per_s": best over repetitions, \
+"sample_us": median 10-step Euler at batch 1}
 """
 import argparse
 import json
@@ -66,7 +67,8 @@ def main():
     optimizer = torch.optim.Adam(net.parameters(), lr=1e-3)
     train_rate(net, optimizer, 1.0)  # warm-up
     best = max(train_rate(net, optimizer, args.seconds) for _ in range(args.repetitions))
-    print(json.dumps({"threads": args.threads, "train_samples_per_s": best, "sample_us": sample_us(net)}))
+    print(json.dumps({"threads": args.threads, "train_samples_per_s": best,
+                      "sample_us": sample_us(net)}))
 
 
 if __name__ == "__main__":

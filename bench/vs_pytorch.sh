@@ -16,7 +16,8 @@ bench="$build/bench/bench_policy"
 python=/usr/bin/python3
 
 if [[ ! -x "$bench" ]]; then
-  echo "vs_pytorch.sh: $bench not found: build first (cmake --build $build --target bench_policy)" >&2
+  echo "vs_pytorch.sh: $bench not found: build first (cmake --build $build --target bench_policy)" \
+    >&2
   exit 1
 fi
 # Debian's torch does its CPU matrix products through whatever libblas.so.3 the alternatives
@@ -33,13 +34,15 @@ if ((${#missing[@]})); then
   $sudo_cmd apt-get update
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y "${missing[@]}"
 fi
-echo "pytorch's BLAS: $(readlink -f /usr/lib/x86_64-linux-gnu/libblas.so.3 2>/dev/null || echo unknown)"
+echo "pytorch's BLAS: $(readlink -f /usr/lib/x86_64-linux-gnu/libblas.so.3 2>/dev/null ||
+                        echo unknown)"
 echo "handcentric's kernels: ${HANDCENTRIC_KERNELS:-best for this CPU}"
 
 # Both sides pinned: one thread on core 0 (two threads on cores 0 and 1), when taskset exists.
 pin() { if command -v taskset >/dev/null; then taskset -c "$1" "${@:2}"; else "${@:2}"; fi; }
 
-ours_json="$(pin 0 "$bench" --benchmark_filter='BM_flow_train_step_batch256|BM_flow_sample_10_euler_steps_batch1' \
+ours_json="$(pin 0 "$bench" \
+  --benchmark_filter='BM_flow_train_step_batch256|BM_flow_sample_10_euler_steps_batch1' \
   --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"
 read -r ours_rate ours_sample_us < <("$python" -c '
 import json, sys
@@ -54,14 +57,18 @@ for threads in 1 2; do
   if [[ "$threads" -eq 2 ]]; then cores=0,1; fi
   line="$(pin "$cores" "$python" "$here/vs_pytorch.py" --threads "$threads")"
   echo "pytorch: $line"
-  rate="$("$python" -c 'import json,sys; print(json.loads(sys.argv[1])["train_samples_per_s"])' "$line")"
-  if "$python" -c 'import sys; sys.exit(0 if float(sys.argv[1]) > float(sys.argv[2]) else 1)' "$rate" "$torch_best"; then
+  rate="$("$python" -c 'import json,sys; print(json.loads(sys.argv[1])["train_samples_per_s"])' \
+    "$line")"
+  if "$python" -c 'import sys; sys.exit(0 if float(sys.argv[1]) > float(sys.argv[2]) else 1)' \
+       "$rate" "$torch_best"; then
     torch_best="$rate"
   fi
   if [[ "$threads" -eq 1 ]]; then
-    torch_sample_us="$("$python" -c 'import json,sys; print(json.loads(sys.argv[1])["sample_us"])' "$line")"
+    torch_sample_us="$("$python" -c 'import json,sys; print(json.loads(sys.argv[1])["sample_us"])' \
+      "$line")"
   fi
 done
 echo "handcentric: train ${ours_rate} samples/s, 10-step Euler sampling at batch 1 ${ours_sample_us} us"
 echo "pytorch: best train ${torch_best} samples/s (1 or 2 threads), sampling ${torch_sample_us} us (1 thread)"
-"$python" -c 'import sys; print("ratio: %.3f" % (float(sys.argv[1]) / float(sys.argv[2])))' "$ours_rate" "$torch_best"
+"$python" -c 'import sys; print("ratio: %.3f" % (float(sys.argv[1]) / float(sys.argv[2])))' \
+  "$ours_rate" "$torch_best"

@@ -2,7 +2,8 @@
 # libFuzzer ships with clang only (Debian: clang-14 and libfuzzer-14-dev), so any other compiler
 # is refused at configure time rather than failing at link time.
 #
-#   CXX=clang++ cmake -S . -B build-fuzz -DHANDCENTRIC_FUZZ=ON -DHANDCENTRIC_SANITIZE=address,undefined
+#   CXX=clang++ cmake -S . -B build-fuzz -DHANDCENTRIC_FUZZ=ON \
+#     -DHANDCENTRIC_SANITIZE=address,undefined
 #
 # Every project target is compiled with coverage feedback (-fsanitize=fuzzer-no-link), so the
 # fuzzer is guided by the branches of the library it calls, not only by those of the target.

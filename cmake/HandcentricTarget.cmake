@@ -10,7 +10,8 @@ function(handcentric_library module)
   set(target handcentric_${module})
   add_library(${target} ${ARG_SOURCES})
   add_library(handcentric::${module} ALIAS ${target})
-  set_target_properties(${target} PROPERTIES EXPORT_NAME ${module} OUTPUT_NAME handcentric_${module})
+  set_target_properties(${target} PROPERTIES EXPORT_NAME ${module}
+                                             OUTPUT_NAME handcentric_${module})
   target_include_directories(${target} PUBLIC
     $<BUILD_INTERFACE:${CMAKE_CURRENT_SOURCE_DIR}/include>
     $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)

@@ -23,8 +23,10 @@ def bar(text):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("table")
-    parser.add_argument("--min", type=bar, action="append", default=[], help="value must be >= this")
-    parser.add_argument("--max", type=bar, action="append", default=[], help="value must be <= this")
+    parser.add_argument("--min", type=bar, action="append", default=[],
+                        help="value must be >= this")
+    parser.add_argument("--max", type=bar, action="append", default=[],
+                        help="value must be <= this")
     args = parser.parse_args()
     with open(args.table) as f:
         rows = json.load(f)["rows"]
@@ -32,7 +34,8 @@ def main():
     bars = [(b, ">=") for b in args.min] + [(b, "<=") for b in args.max]
     for (method, head, demos, field, value), op in bars:
         values = [r[field] for r in rows
-                  if r["method"] == method and r["head"] == head and r["demos"] == demos and r.get(field) is not None]
+                  if r["method"] == method and r["head"] == head and r["demos"] == demos
+                  and r.get(field) is not None]
         name = f"{method}/{head} at {demos} demos, {field}"
         if not values:
             failures.append(f"{name}: no result")

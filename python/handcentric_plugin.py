@@ -302,9 +302,11 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             value = request["noise"]
             if not isinstance(value, list) or not value or not all(map(_is_number, value)):
                 raise _Malformed("'noise' must be a non-empty list of numbers")
-            noise = np.array(value, dtype=np.float64) if np is not None else [float(x) for x in value]
-            return {"id": rid, "chunk": _chunk(call(_policy, rid, (history, hand_points, world_points,
-                                                                    noise), named))}
+            noise = (np.array(value, dtype=np.float64) if np is not None
+                     else [float(x) for x in value])
+            return {"id": rid,
+                    "chunk": _chunk(call(_policy, rid,
+                                         (history, hand_points, world_points, noise), named))}
         if "decode" in request:
             if decode is None:
                 raise _Malformed("a decode request, but the plug-in declared no decode")
@@ -390,14 +392,16 @@ def rotation_vector(R):
     R = _real(R)
     shape = R.shape[:-2]
     R = R.reshape(-1, 3, 3)
-    w = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], axis=-1)  # 2 sin axis
+    w = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]],
+                 axis=-1)  # 2 sin axis
     cos_angle = np.clip(0.5 * (R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2] - 1), -1, 1)
     sin_angle = 0.5 * np.linalg.norm(w, axis=-1)
     angle = np.arctan2(sin_angle, cos_angle)  # atan2 stays accurate where acos and asin are not
     out = np.empty_like(w)
     small = angle < 1e-6  # first order, error O(angle^3): r = vee(R - R^T) / 2
     out[small] = 0.5 * w[small]
-    middle = ~small & (angle < 0.5 * np.pi)  # w / (2 sin) loses digits only as sin -> 0, i.e. near pi
+    # w / (2 sin) loses digits only as sin -> 0, i.e. near pi
+    middle = ~small & (angle < 0.5 * np.pi)
     out[middle] = (angle[middle] / (2 * sin_angle[middle]))[:, None] * w[middle]
     large = ~small & ~middle
     if large.any():
@@ -445,7 +449,8 @@ def relative_pose(T0, T):
     T0, T = _real(T0), _real(T)
     out = np.zeros(T.shape, dtype=np.result_type(T0, T))
     out[..., :3, :3] = T0[:3, :3].T @ T[..., :3, :3]
-    out[..., :3, 3] = (T[..., :3, 3] - T0[:3, 3]) @ T0[:3, :3]  # row: (p - p0)^T R0 = (R0^T (p - p0))^T
+    # row: (p - p0)^T R0 = (R0^T (p - p0))^T
+    out[..., :3, 3] = (T[..., :3, 3] - T0[:3, 3]) @ T0[:3, :3]
     out[..., 3, 3] = 1
     return out
 

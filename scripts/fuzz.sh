@@ -10,11 +10,15 @@
 #   bash scripts/fuzz.sh 10     # a quick look
 set -euo pipefail
 seconds="${1:-60}"
-[[ "$seconds" =~ ^[1-9][0-9]*$ ]] || { echo "fuzz.sh: SECONDS must be a positive integer, got '$seconds'" >&2; exit 2; }
+[[ "$seconds" =~ ^[1-9][0-9]*$ ]] ||
+  { echo "fuzz.sh: SECONDS must be a positive integer, got '$seconds'" >&2; exit 2; }
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${FUZZ_BUILD_DIR:-$root/build-fuzz}"
 cxx="${FUZZ_CXX:-clang++}"
-command -v "$cxx" >/dev/null || { echo "fuzz.sh: $cxx not found: bash scripts/install-deps.sh (clang, libfuzzer-14-dev)" >&2; exit 2; }
+command -v "$cxx" >/dev/null || {
+  echo "fuzz.sh: $cxx not found: bash scripts/install-deps.sh (clang, libfuzzer-14-dev)" >&2
+  exit 2
+}
 targets=(fuzz_demo_file fuzz_model_file fuzz_plugin_reply fuzz_geometry)
 
 start=$(date +%s)

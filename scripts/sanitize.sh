@@ -10,7 +10,10 @@ root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${ASAN_BUILD_DIR:-$root/build-asan}"
 jobs="$(nproc 2>/dev/null || echo 2)"
 cxx="${SANITIZE_CXX:-clang++}"
-command -v "$cxx" >/dev/null || { echo "sanitize.sh: $cxx not found: bash scripts/install-deps.sh (clang, libfuzzer-14-dev)" >&2; exit 2; }
+command -v "$cxx" >/dev/null || {
+  echo "sanitize.sh: $cxx not found: bash scripts/install-deps.sh (clang, libfuzzer-14-dev)" >&2
+  exit 2
+}
 
 # exitcode=23: a report must not pass for the exit status 1 that the command-line tests expect
 # of a refused input (the sanitizers exit with 1 by default).
@@ -23,8 +26,10 @@ export LSAN_OPTIONS="suppressions=$root/tests/support/lsan.supp:print_suppressio
 
 # Clang: libFuzzer needs it, and one tree then serves the tests and the fuzz targets.
 start=$(date +%s)
-CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_UNITY_BUILD=ON \
-      -DHANDCENTRIC_SANITIZE=address,undefined -DHANDCENTRIC_FUZZ=ON -DHANDCENTRIC_BUILD_BENCH=OFF >/dev/null
+CXX="$cxx" cmake -S "$root" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_UNITY_BUILD=ON \
+      -DHANDCENTRIC_SANITIZE=address,undefined -DHANDCENTRIC_FUZZ=ON -DHANDCENTRIC_BUILD_BENCH=OFF \
+      >/dev/null
 cmake --build "$build_dir" -j "$jobs"
 built=$(date +%s)
 

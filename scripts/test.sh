@@ -33,7 +33,8 @@ cmake --build "$build_dir/downstream" -j "$jobs"
 
 echo "== a second downstream project that asks for core, policy and props only"
 rm -rf "$build_dir/policy_downstream"
-cmake -S "$root/examples/policy_downstream" -B "$build_dir/policy_downstream" -DCMAKE_BUILD_TYPE=Release \
+cmake -S "$root/examples/policy_downstream" -B "$build_dir/policy_downstream" \
+      -DCMAKE_BUILD_TYPE=Release \
       -DCMAKE_PREFIX_PATH="$stage" -DCMAKE_DISABLE_FIND_PACKAGE_OpenCV=TRUE \
       -DCMAKE_DISABLE_FIND_PACKAGE_box2d=TRUE >/dev/null
 cmake --build "$build_dir/policy_downstream" -j "$jobs"

@@ -60,7 +60,8 @@ def hand_centric(T0, poses):
 def encode(history, chunk, hand_points, world_points):
     T0 = history[0]  # history is newest first: index 0 is the hand now
     actions = hand_centric(T0, chunk)  # eqs. (1)-(2)
-    observation = [hand_centric(T0, history), hand_points, hp.relative_points(T0, world_points)]  # eq. (3)
+    observation = [hand_centric(T0, history), hand_points,
+                   hp.relative_points(T0, world_points)]  # eq. (3)
     return actions, observation
 
 

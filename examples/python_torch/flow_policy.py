@@ -91,7 +91,8 @@ class FlowPolicy:
     def train(self, scenes, steps, seed):
         torch.manual_seed(seed)
         n = len(scenes["history"])
-        obs = torch.tensor(np.stack([self.observation(scenes["history"][i], scenes["hand_points"][i])
+        obs = torch.tensor(np.stack([self.observation(scenes["history"][i],
+                                                      scenes["hand_points"][i])
                                      for i in range(n)]), dtype=torch.float32)
         act = torch.tensor(np.stack([self.actions(scenes["history"][i], scenes["chunk"][i])
                                      for i in range(n)]), dtype=torch.float32)
@@ -133,7 +134,8 @@ def find_cli():
                       os.path.join(HERE, "..", "..", "build", "apps", "handcentric")):
         if candidate and os.path.isfile(candidate):
             return candidate
-    sys.exit("flow_policy.py: no `handcentric` program; build it (scripts/build.sh) or set HANDCENTRIC_CLI")
+    sys.exit("flow_policy.py: no `handcentric` program; build it (scripts/build.sh) "
+             "or set HANDCENTRIC_CLI")
 
 
 def train_both(demos=20, steps=1500, seed=0):

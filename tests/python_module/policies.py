@@ -68,7 +68,8 @@ def hand_centric_actions(history, chunk, hand_points, world_points):
 def hand_centric_observation(history, hand_points, world_points):
     T0inv = inverse(history[0])
     world = (world_points - history[0][:3, 3]) @ history[0][:3, :3]  # T_0^-1 q
-    return np.concatenate([pose_vector(T0inv @ T) for T in history] + [hand_points.ravel(), world.ravel()])
+    return np.concatenate([pose_vector(T0inv @ T) for T in history]
+                          + [hand_points.ravel(), world.ravel()])
 
 
 def hand_centric_decode(actions, history, hand_points, world_points):

@@ -34,7 +34,8 @@ def test_world_noise_fails_pointwise_under_rotation_with_a_witness():
     assert "mode='distribution'" in message  # the hint: it may hold in law
 
 
-def test_world_noise_is_equivariant_in_distribution_under_rotation_and_pointwise_under_translation():
+def test_world_noise_is_equivariant_in_distribution_under_rotation_and_pointwise_under_translation(
+):
     policy = make_policy("world_noise")
     handcentric.assert_equivariant(policy, "rotation", mode="distribution", cases=CASES,
                                    views="eye_in_hand")
@@ -53,7 +54,8 @@ def test_history_in_the_wrong_order_is_invisible_to_the_policy_audit():
 
 
 def test_audit_policy_gives_the_json_of_one_policy():
-    result = handcentric.audit_policy(make_policy("world_noise"), groups=("translation", "rotation"),
+    result = handcentric.audit_policy(make_policy("world_noise"),
+                                      groups=("translation", "rotation"),
                                       views="eye_in_hand", cases=CASES)
     assert result["name"] == "python: policy_world_noise"
     summary = result["summary"]["eye_in_hand"]
@@ -82,7 +84,8 @@ def test_hand_centric_representation_is_invariant_everywhere():
     result = handcentric.audit(policies.hand_centric_actions, policies.hand_centric_observation,
                                decode=policies.hand_centric_decode, cases=CASES)
     assert result["injective"] is True
-    assert all(c["invariant"] for c in result["checks"]), [c for c in result["checks"] if not c["invariant"]]
+    assert all(c["invariant"] for c in result["checks"]), (
+        [c for c in result["checks"] if not c["invariant"]])
     components = {c["component"] for c in result["checks"]}
     assert components == {"actions", "observation", "flow_input", "flow_target"}
 
@@ -97,7 +100,8 @@ def test_absolute_actions_fail_under_rotation_with_a_shrunk_witness():
 
 
 def test_assert_invariant_reads_observation_and_flow_components():
-    handcentric.assert_invariant(policies.hand_centric_observation, "se3", "observation", cases=CASES)
+    handcentric.assert_invariant(policies.hand_centric_observation, "se3", "observation",
+                                 cases=CASES)
 
     def world_observation(history, hand_points, world_points):
         return np.concatenate([history[0][:3, 3], hand_points.ravel()])
@@ -127,7 +131,8 @@ def test_in_process_audit_equals_the_pipe_audit():
         pytest.skip("HANDCENTRIC_CLI is not set (ctest sets it)")
     env = dict(os.environ)
     command = "%s %s" % (sys.executable, os.path.join(HERE, "pipe_twin.py"))
-    out = subprocess.run([cli, "audit", "--exec", command, "--json", "--cases", "100", "--seed", "3"],
+    out = subprocess.run([cli, "audit", "--exec", command, "--json", "--cases", "100",
+                          "--seed", "3"],
                          check=True, capture_output=True, text=True, env=env).stdout
     piped = json.loads(out)["representations"][0]
     here = handcentric.audit(policies.hand_centric_actions, policies.hand_centric_observation,
@@ -195,7 +200,8 @@ def test_wrong_shapes_name_the_shape():
     with pytest.raises(handcentric.ShapeError, match="last row"):
         handcentric.audit_policy(bad_last_row, cases=10)
 
-    with pytest.raises(handcentric.ShapeError, match=r"history has shape \(4, 4\); expected \(H\+1, 4, 4\)"):
+    with pytest.raises(handcentric.ShapeError,
+                       match=r"history has shape \(4, 4\); expected \(H\+1, 4, 4\)"):
         handcentric.encode_actions("hand_centric", np.eye(4), np.eye(4)[None])
 
 
@@ -252,9 +258,11 @@ def test_builtin_hand_centric_matches_the_numpy_one_and_decodes():
     chunk = np.stack([random_pose(rng) for _ in range(4)])
     points = rng.normal(size=(2, 3))
     actions = handcentric.encode_actions("hand_centric", history, chunk, points)
-    np.testing.assert_allclose(actions, policies.hand_centric_actions(history, chunk, points, np.zeros((0, 3))),
+    np.testing.assert_allclose(
+        actions, policies.hand_centric_actions(history, chunk, points, np.zeros((0, 3))),
+        atol=1e-12)
+    np.testing.assert_allclose(handcentric.decode("hand_centric", actions, history[0]), chunk,
                                atol=1e-12)
-    np.testing.assert_allclose(handcentric.decode("hand_centric", actions, history[0]), chunk, atol=1e-12)
     observation = handcentric.encode_observation("hand_centric", history, points)
     assert observation.shape == (6 * 3 + 3 * 2,)
     with pytest.raises(ValueError, match="hand_centric"):
@@ -284,7 +292,8 @@ def test_demo_files_load_as_numpy(tmp_path):
     scenes = handcentric.training_scenes(path, history=1, chunk=8)
     steps = sum(len(d["world_T_hand"]) for d in demos)
     assert scenes["history"].shape == (steps, 2, 4, 4)
-    assert scenes["chunk"].shape == (steps, 8, 4, 4) and scenes["hand_points"].shape == (steps, 2, 3)
+    assert (scenes["chunk"].shape == (steps, 8, 4, 4)
+            and scenes["hand_points"].shape == (steps, 2, 3))
     np.testing.assert_array_equal(scenes["history"][0, 0], demos[0]["world_T_hand"][0])
     with pytest.raises(handcentric.Error, match="missing.jsonl"):
         handcentric.load_demos(str(tmp_path / "missing.jsonl"))
@@ -293,5 +302,6 @@ def test_demo_files_load_as_numpy(tmp_path):
 def test_options_may_be_given_by_position_as_documented():
     result = handcentric.audit(policies.hand_centric_actions, None, "se3", "eye_in_hand", 20, 2)
     assert result["checks"][0]["seed"] == 2 and {c["group"] for c in result["checks"]} == {"se3"}
-    policy = handcentric.audit_policy(make_policy(), "c8", "third_person", 20, 3, None, "float32", 64)
+    policy = handcentric.audit_policy(make_policy(), "c8", "third_person", 20, 3, None,
+                                      "float32", 64)
     assert {(c["group"], c["view"]) for c in policy["checks"]} == {("c8", "third_person")}

@@ -64,7 +64,8 @@ check_whole() {
 timed() {
   local start
   start=$(now_ms)
-  "$@" >/dev/null 2>"$dir/last.err" || { cat "$dir/last.err" >&2; fail "an uninterrupted run failed: $*"; }
+  "$@" >/dev/null 2>"$dir/last.err" ||
+    { cat "$dir/last.err" >&2; fail "an uninterrupted run failed: $*"; }
   local took=$(($(now_ms) - start))
   echo $((took < 50 ? 50 : took))
 }
@@ -85,7 +86,8 @@ kill_and_rerun() {
   # The killed runs' "<output>.tmp.<pid>" files: the complete run's write removes them.
   local leftovers
   leftovers="$(find "$(dirname "$output")" -name "$(basename "$output").tmp.*")"
-  [ -z "$leftovers" ] || fail "the re-run of $name left the killed runs' temporary files: $leftovers"
+  [ -z "$leftovers" ] ||
+    fail "the re-run of $name left the killed runs' temporary files: $leftovers"
   echo "$name: $kills kills within $ms ms, every file whole, no temporary file left"
 }
 
@@ -96,7 +98,8 @@ demos_ms=$(timed "$cli" "${demos[@]}" "$dir/reference.jsonl" --seed 3)
 kill_and_rerun demos "$dir/demos.jsonl" "$dir/previous.jsonl" "$dir/reference.jsonl" "$demos_ms" \
   "$cli" "${demos[@]}" "$dir/demos.jsonl" --seed 3
 
-train=(train --demos "$dir/reference.jsonl" --steps 20 --width 16 --layers 1 --batch 8 --quiet --out)
+train=(train --demos "$dir/reference.jsonl" --steps 20 --width 16 --layers 1 --batch 8 --quiet
+       --out)
 "$cli" "${train[@]}" "$dir/previous.hcm" --seed 2 >/dev/null
 train_ms=$(timed "$cli" "${train[@]}" "$dir/reference.hcm" --seed 1)
 kill_and_rerun train "$dir/model.hcm" "$dir/previous.hcm" "$dir/reference.hcm" "$train_ms" \
@@ -109,7 +112,8 @@ files_of() { (cd "$1" && find . -type f ! -name '*.tmp.*' | sort); }
 check_tree() {
   local file
   while read -r file; do
-    [ -e "$dir/table-reference/$file" ] || fail "table1 wrote $file, which an uninterrupted run does not"
+    [ -e "$dir/table-reference/$file" ] ||
+      fail "table1 wrote $file, which an uninterrupted run does not"
     check_whole "$dir/table/$file" "$dir/table-reference/$file"
   done < <(files_of "$dir/table")
 }
@@ -126,5 +130,6 @@ leftovers="$(find "$dir/table" -name '*.tmp.*')"
 [ -z "$leftovers" ] || fail "the resumed table1 left the killed runs' temporary files: $leftovers"
 echo "table1: $kills kills within ${table_ms} ms, each resumed; every file whole, the same bytes at the end"
 
-[ "$mode" = --expect-partial ] && { echo "kill_writers: the planted in-place writer was not caught" >&2; exit 1; }
+[ "$mode" = --expect-partial ] &&
+  { echo "kill_writers: the planted in-place writer was not caught" >&2; exit 1; }
 echo "kill_writers: $((3 * kills)) kills, no partial file"

@@ -16,7 +16,8 @@ grep -q "^\[4/4\]" "$dir/inproc.err" || { echo "no progress line [4/4] on stderr
 "$cli" table1 "${grid[@]}" --out "$dir/plan" --plan
 jobs=$(wc -l < "$dir/plan/jobs.txt")
 [ "$jobs" -eq 4 ] || { echo "jobs.txt has $jobs lines, expected 4" >&2; exit 1; }
-command -v parallel > /dev/null || { echo "GNU parallel is missing: bash scripts/install-deps.sh" >&2; exit 1; }
+command -v parallel > /dev/null ||
+  { echo "GNU parallel is missing: bash scripts/install-deps.sh" >&2; exit 1; }
 parallel --will-cite -j 2 --halt now,fail=1 < "$dir/plan/jobs.txt"
 "$cli" table1 --collect "$dir/plan" > "$dir/plan.out"
 cmp "$dir/inproc/table1.json" "$dir/plan/table1.json" ||
@@ -33,5 +34,6 @@ done_count=$(grep -c ": done " "$dir/resume.err" || true)
 found_count=$(grep -c ": found " "$dir/resume.err" || true)
 [ "$done_count" -eq 1 ] && [ "$found_count" -eq 3 ] ||
   { echo "resume redid $done_count cells and found $found_count, expected 1 and 3" >&2; exit 1; }
-cmp "$dir/before.json" "$dir/inproc/table1.json" || { echo "the resumed table differs" >&2; exit 1; }
+cmp "$dir/before.json" "$dir/inproc/table1.json" ||
+  { echo "the resumed table differs" >&2; exit 1; }
 echo "table1: in process, plan + parallel + collect, and resume agree"
