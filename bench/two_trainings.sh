@@ -9,7 +9,8 @@ here="$(cd "$(dirname "$0")" && pwd)"
 build="${1:-$here/../build}"
 bench="$build/bench/bench_policy"
 if [[ ! -x "$bench" ]]; then
-  echo "two_trainings.sh: $bench not found: build first (cmake --build $build --target bench_policy)" >&2
+  echo "two_trainings.sh: $bench not found: build first" \
+       "(cmake --build $build --target bench_policy)" >&2
   exit 1
 fi
 if [[ "$(nproc)" -lt 2 ]]; then

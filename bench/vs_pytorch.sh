@@ -68,7 +68,9 @@ for threads in 1 2; do
       "$line")"
   fi
 done
-echo "handcentric: train ${ours_rate} samples/s, 10-step Euler sampling at batch 1 ${ours_sample_us} us"
-echo "pytorch: best train ${torch_best} samples/s (1 or 2 threads), sampling ${torch_sample_us} us (1 thread)"
+echo "handcentric: train ${ours_rate} samples/s," \
+     "10-step Euler sampling at batch 1 ${ours_sample_us} us"
+echo "pytorch: best train ${torch_best} samples/s (1 or 2 threads)," \
+     "sampling ${torch_sample_us} us (1 thread)"
 "$python" -c 'import sys; print("ratio: %.3f" % (float(sys.argv[1]) / float(sys.argv[2])))' \
   "$ours_rate" "$torch_best"

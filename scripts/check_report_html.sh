@@ -4,9 +4,15 @@
 # page's top as DIR/screenshot.png to look at. Needs Debian's chromium (apt-get install chromium).
 #   bash scripts/check_report_html.sh DIR
 set -euo pipefail
-dir="$(cd "${1:?usage: check_report_html.sh DIR (a handcentric report --out DIR)}" && pwd)"
+arg="${1:?usage: check_report_html.sh DIR (a handcentric report --out DIR)}"
+[ -d "$arg" ] || {
+  echo "check_report_html: $arg is not a folder: run handcentric report --out $arg first" >&2
+  exit 1
+}
+dir="$(cd "$arg" && pwd)"
 [ -f "$dir/index.html" ] || {
-  echo "check_report_html: $dir/index.html does not exist: run handcentric report --out $dir first" >&2
+  echo "check_report_html: $dir/index.html does not exist:" \
+       "run handcentric report --out $dir first" >&2
   exit 1
 }
 command -v chromium >/dev/null ||
@@ -27,8 +33,11 @@ cat > "$checker" <<'HTML'
 document.getElementById('f').onload = function () {
   var images = Array.from(this.contentDocument.images);
   var broken = images.filter(function (i) { return !i.complete || i.naturalWidth === 0; });
-  document.getElementById('result').textContent = 'RESULT images=' + images.length + ' broken=' + broken.length +
-      (broken.length ? ' ' + broken.map(function (i) { return i.getAttribute('src'); }).join(',') : '');
+  document.getElementById('result').textContent =
+      'RESULT images=' + images.length + ' broken=' + broken.length +
+      (broken.length
+           ? ' ' + broken.map(function (i) { return i.getAttribute('src'); }).join(',')
+           : '');
 };
 </script></body></html>
 HTML
@@ -37,7 +46,8 @@ result="$(timeout 120 chromium "${flags[@]}" --virtual-time-budget=10000 \
           grep -oE 'RESULT images=[0-9]+ broken=[0-9]+[^<]*' || true)"
 timeout 120 chromium "${flags[@]}" --window-size=1400,2400 --screenshot="$dir/screenshot.png" \
   "file://$dir/index.html" >/dev/null 2>&1
-echo "check_report_html: ${result:-no result (the page did not finish loading)}; screenshot: $dir/screenshot.png"
+echo "check_report_html: ${result:-no result (the page did not finish loading)};" \
+     "screenshot: $dir/screenshot.png"
 case "$result" in
   *"broken=0"*) [ "${result#*images=0 }" = "$result" ] ||
                   { echo "check_report_html: the page has no image" >&2; exit 1; } ;;

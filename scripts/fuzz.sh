@@ -74,5 +74,6 @@ for target in "${targets[@]}"; do
     tail -60 "$work/$target.log" >&2
   fi
 done
-echo "fuzz.sh: build $((built - start)) s, runs $((finished - built)) s (${seconds} s per target, 2 at a time)"
+echo "fuzz.sh: build $((built - start)) s, runs $((finished - built)) s" \
+     "(${seconds} s per target, 2 at a time)"
 exit "$failed"

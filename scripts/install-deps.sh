@@ -32,7 +32,8 @@ if [ "$(id -u)" -ne 0 ]; then
   if command -v sudo >/dev/null 2>&1; then
     as_root=(sudo)
   else
-    echo "install-deps: missing packages (${missing[*]}) and not root; install them or run as root" >&2
+    echo "install-deps: missing packages (${missing[*]}) and not root;" \
+         "install them or run as root" >&2
     exit 1
   fi
 fi

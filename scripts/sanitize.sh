@@ -59,5 +59,6 @@ tested=$(date +%s)
 
 FUZZ_BUILD_DIR="$build_dir" FUZZ_CXX="$cxx" bash "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-60}"
 fuzzed=$(date +%s)
-echo "sanitize: build $((built - start)) s, tests $((tested - built)) s (labels unit, property, proofs)," \
+echo "sanitize: build $((built - start)) s, tests $((tested - built)) s" \
+     "(labels unit, property, proofs)," \
      "fuzzing $((fuzzed - tested)) s"

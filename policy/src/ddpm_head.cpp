@@ -18,8 +18,9 @@
 //             by ~2000: without the clip the later steps would start far outside the training
 //             distribution, and even with it the chunk misses the 0.1 cm clearance (0.00
 //             success where sample prediction reaches 0.87; docs/EXPERIMENTS.md). With sample,
-//             eps_hat divides by sqrt(1 - abar) >= sqrt(1 - abar_0) ~ 0.025 only at the last
-//             step, whose x0_hat is the result.
+//             no step divides by sqrt(abar): eps_hat divides by sqrt(1 - abar), at least 0.025
+//             (k = 0; 0.17 at the smallest k of 10 DDIM steps), and the last step returns
+//             x0_hat itself (abar_prev = 1).
 #include <algorithm>
 #include <cmath>
 #include <string>

@@ -128,7 +128,8 @@ diff <(files_of "$dir/table") <(files_of "$dir/table-reference") >&2 ||
 check_tree
 leftovers="$(find "$dir/table" -name '*.tmp.*')"
 [ -z "$leftovers" ] || fail "the resumed table1 left the killed runs' temporary files: $leftovers"
-echo "table1: $kills kills within ${table_ms} ms, each resumed; every file whole, the same bytes at the end"
+echo "table1: $kills kills within ${table_ms} ms, each resumed;" \
+     "every file whole, the same bytes at the end"
 
 [ "$mode" = --expect-partial ] &&
   { echo "kill_writers: the planted in-place writer was not caught" >&2; exit 1; }
