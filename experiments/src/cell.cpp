@@ -6,6 +6,7 @@
 
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
+#include "handcentric/sim/rollout.hpp"
 
 namespace handcentric::experiments {
 
@@ -32,7 +33,7 @@ std::string Cell::model_path() const {
 
 std::string Cell::result_path(SceneSet set, const EvalSettings& eval) const {
   return "results/" + hash + "." + to_string(set) + "-s" + std::to_string(eval.seed(set)) + "-n" +
-         std::to_string(eval.trials) + ".json";
+         std::to_string(eval.trials) + "-r" + std::to_string(sim::kRolloutRulesVersion) + ".json";
 }
 
 std::string digest(const std::string& bytes) {

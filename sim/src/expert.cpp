@@ -112,14 +112,13 @@ bool is_planar(const RigidTransform& pose) {
   return std::abs(M(2, 3)) < 1e-9 && std::abs(M(2, 2) - 1.0) < 1e-9;
 }
 
-/// Every motion between consecutive poses collision-free, and the tip kSuccessDepth deep inside.
+/// Every motion between consecutive poses collision-free, and the last one inserted.
 bool is_valid(const std::vector<RigidTransform>& hole_T_hand, const CollisionChecker& checker) {
   for (std::size_t t = 0; t + 1 < hole_T_hand.size(); ++t) {
     if (checker.motion_collides(hole_T_hand[t], hole_T_hand[t + 1])) return false;
   }
   if (hole_T_hand.size() == 1 && checker.collides(hole_T_hand[0])) return false;
-  const Vec3 tip = tip_in_hole(hole_T_hand.back());
-  return tip.y() <= -kSuccessDepth && std::abs(tip.x()) < 0.5 * checker.geometry().inner_width();
+  return is_inserted(hole_T_hand.back(), checker.geometry());
 }
 
 }  // namespace

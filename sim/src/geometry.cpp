@@ -46,6 +46,12 @@ Eigen::Vector3d tip_in_hole(const RigidTransform& hole_T_hand) {
   return hole_T_hand * Eigen::Vector3d(0.0, -kPegLength, 0.0);
 }
 
+bool is_inserted(const RigidTransform& hole_T_hand, const PegHoleGeometry& geometry) {
+  const Eigen::Vector3d tip = tip_in_hole(hole_T_hand);
+  return tip.y() <= -kSuccessDepth && tip.y() >= -kHoleDepth &&
+         std::abs(tip.x()) < 0.5 * geometry.inner_width();
+}
+
 Eigen::Vector3d planar_coordinates(const RigidTransform& pose) {
   const Eigen::Matrix3d& R = pose.rotation().matrix();
   return Eigen::Vector3d(std::atan2(R(1, 0), R(0, 0)), pose.translation().x(),

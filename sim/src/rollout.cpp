@@ -58,11 +58,6 @@ Scene observation(const RigidTransform& world_T_hole,
   return scene;
 }
 
-bool is_inserted(const RigidTransform& hole_T_hand, const PegHoleGeometry& geometry) {
-  const Eigen::Vector3d tip = tip_in_hole(hole_T_hand);
-  return tip.y() <= -kSuccessDepth && std::abs(tip.x()) < 0.5 * geometry.inner_width();
-}
-
 Rollout rollout(const ChunkPolicy& policy, const TaskScene& scene, const CollisionChecker& checker,
                 std::uint64_t seed, const RolloutOptions& options) {
   options.validate();

@@ -13,6 +13,7 @@
 #include "handcentric/experiments/plot.hpp"
 #include "handcentric/experiments/results.hpp"
 #include "handcentric/experiments/table1.hpp"
+#include "handcentric/sim/rollout.hpp"
 #include "handcentric/experiments/wilson.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "throws.hpp"
@@ -76,9 +77,12 @@ TEST_CASE("a_cell_hash_changes_with_every_input_of_its_model_and_only_with_them"
   CHECK(cell_hash(wider) != base.hash);
   CHECK(base.model_path() == "models/" + base.hash + ".hcm");
   const EvalSettings eval;
-  CHECK(base.result_path(SceneSet::ood, eval) == "results/" + base.hash + ".ood-s101-n100.json");
+  // Results are keyed by the rollout's rules too: outcomes stored under an earlier success test
+  // are evaluated again rather than read.
+  CHECK(sim::kRolloutRulesVersion == 2);
+  CHECK(base.result_path(SceneSet::ood, eval) == "results/" + base.hash + ".ood-s101-n100-r2.json");
   CHECK(base.result_path(SceneSet::paired, eval) ==
-        "results/" + base.hash + ".paired-s100-n100.json");
+        "results/" + base.hash + ".paired-s100-n100-r2.json");
 }
 
 TEST_CASE("the_c8_rows_differ_in_their_centre_and_train_on_the_augmented_budget", "[unit]") {

@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <numbers>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
@@ -135,4 +136,39 @@ TEST_CASE("a_bad_clearance_is_rejected_with_the_value_and_the_fix", "[unit]") {
                     Catch::Matchers::Contains("-0.1") && Catch::Matchers::Contains("0.1"));
   geometry.clearance = std::nan("");
   CHECK_THROWS_AS(CollisionChecker{geometry}, InvalidArgument);
+}
+
+namespace {
+
+// The success test as it was before it had a floor: deep enough and under the opening. A
+// planted fault the test below must catch.
+bool mutant_inserted_without_a_floor(const RigidTransform& hole_T_hand) {
+  const Eigen::Vector3d tip = tip_in_hole(hole_T_hand);
+  return tip.y() <= -kSuccessDepth && std::abs(tip.x()) < 0.5 * PegHoleGeometry().inner_width();
+}
+
+// The hand with the peg's tip at (x, tip_y) of the hole frame, the peg pointing into the hole
+// (upright) or away from it (turned by pi, as a peg that went around the hole comes back).
+RigidTransform hand_with_tip_at(double x, double tip_y, bool turned = false) {
+  return turned ? RigidTransform::planar(std::numbers::pi, x, tip_y - kPegLength)
+                : RigidTransform::planar(0.0, x, tip_y + kPegLength);
+}
+
+}  // namespace
+
+TEST_CASE("only_a_tip_inside_the_hole_deep_enough_is_an_insertion", "[unit]") {
+  const CollisionChecker checker;
+  CHECK(is_inserted(hand_with_tip_at(0.0, -5.5)));
+  CHECK(is_inserted(hand_with_tip_at(0.0, -kHoleDepth)));  // on the floor
+  CHECK_FALSE(is_inserted(hand_with_tip_at(0.0, -4.9)));   // not deep enough
+  CHECK_FALSE(is_inserted(hand_with_tip_at(1.06, -5.5)));  // beside the opening
+
+  // Behind the bottom wall, the peg pointing away from the hole: collision-free, under the
+  // opening and deeper than kSuccessDepth, which is how an absolute policy "succeeded" on
+  // bottom-up holes by going around them.
+  const RigidTransform behind = hand_with_tip_at(0.0, -kHoleDepth - kWallThickness - 1.0, true);
+  REQUIRE(tip_in_hole(behind).y() == Approx(-9.0));
+  CHECK_FALSE(checker.collides(behind));
+  CHECK_FALSE(is_inserted(behind));
+  CHECK(mutant_inserted_without_a_floor(behind));  // the planted fault calls it a success
 }

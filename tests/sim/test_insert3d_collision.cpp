@@ -3,6 +3,7 @@
 // poses are caught. The same cases as the 2D task's test_collision.cpp.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <numbers>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/insert3d/collision.hpp"
@@ -150,4 +151,27 @@ TEST_CASE("insert3d_a_bad_clearance_is_rejected_with_the_value_and_the_fix", "[u
   CHECK_THROWS_AS(CollisionChecker{geometry}, InvalidArgument);
   geometry.clearance_per_side = 2.0;
   CHECK_THROWS_AS(CollisionChecker{geometry}, InvalidArgument);
+}
+
+TEST_CASE("insert3d_only_a_tip_inside_the_slot_deep_enough_is_an_insertion", "[unit]") {
+  const CollisionChecker checker;
+  const BladeSlotGeometry& geometry = checker.geometry();
+  // The hand upright with the tip at depth d: hand at z = kBladeLength - d.
+  CHECK(inserted(geometry, at(0.0, 0.0, kBladeLength - 5.5)));
+  CHECK(inserted(geometry, at(0.0, 0.0, kBladeLength - kSlotDepth)));  // on the floor
+  CHECK_FALSE(inserted(geometry, at(0.0, 0.0, kBladeLength - 4.9)));   // not deep enough
+  CHECK_FALSE(inserted(geometry, at(geometry.inner_half_x() + 0.01, 0.0, kBladeLength - 5.5)));
+
+  // Under the block, the blade turned by pi about x (pointing away from the slot): contact-free,
+  // inside the footprint and deeper than kSuccessDepth, but not inserted.
+  const double tip_z = -kSlotDepth - kSlotWallThickness - 1.0;
+  const RigidTransform under =
+      tilted(Eigen::Vector3d::UnitX(), std::numbers::pi, tip_z - kBladeLength);
+  REQUIRE(tip_in_slot(under).z() == Approx(tip_z));
+  CHECK_FALSE(checker.collides(under));
+  CHECK_FALSE(inserted(geometry, under));
+  // Planted fault: the test without its floor calls that pose a success.
+  const Eigen::Vector3d tip = tip_in_slot(under);
+  CHECK((tip.z() <= -kSuccessDepth && std::abs(tip.x()) < geometry.inner_half_x() &&
+         std::abs(tip.y()) < geometry.inner_half_y()));
 }

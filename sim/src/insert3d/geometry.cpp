@@ -67,8 +67,8 @@ Eigen::Vector3d tip_in_slot(const RigidTransform& slot_T_hand) {
 
 bool inserted(const BladeSlotGeometry& geometry, const RigidTransform& slot_T_hand) {
   const Eigen::Vector3d tip = tip_in_slot(slot_T_hand);
-  return tip.z() <= -kSuccessDepth && std::abs(tip.x()) < geometry.inner_half_x() &&
-         std::abs(tip.y()) < geometry.inner_half_y();
+  return tip.z() <= -kSuccessDepth && tip.z() >= -kSlotDepth &&
+         std::abs(tip.x()) < geometry.inner_half_x() && std::abs(tip.y()) < geometry.inner_half_y();
 }
 
 }  // namespace handcentric::sim::insert3d

@@ -44,8 +44,8 @@ struct Cell {
   /// "hand_centric/flow, 40 demos, train seed 1".
   std::string describe() const;
   std::string model_path() const;  ///< "models/<hash>.hcm"
-  std::string result_path(SceneSet set, const EvalSettings& eval)
-      const;  ///< "results/<hash>.<set>-s<seed>-n<trials>.json"
+  /// "results/<hash>.<set>-s<seed>-n<trials>-r<sim::kRolloutRulesVersion>.json"
+  std::string result_path(SceneSet set, const EvalSettings& eval) const;
 };
 
 /// FNV-1a 64 of `bytes`, as 16 hex digits.

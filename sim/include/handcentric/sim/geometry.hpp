@@ -21,7 +21,7 @@ constexpr double kPegLength = 8.0;
 constexpr double kHoleDepth = 6.0;
 constexpr double kWallThickness = 2.0;
 constexpr double kDefaultClearance = 0.1;  ///< 0.05 per side
-/// Success: the peg tip at least this deep below the opening.
+/// Success: the peg tip at least this deep below the opening, inside the hole (is_inserted).
 constexpr double kSuccessDepth = 5.0;
 
 /// An axis-aligned rectangle [x0, x1] x [y0, y1] in some frame.
@@ -57,6 +57,14 @@ struct PegHoleGeometry {
 
 /// The peg tip (0, -kPegLength) in the hole frame, for the hand at hole_T_hand.
 Eigen::Vector3d tip_in_hole(const RigidTransform& hole_T_hand);
+
+/// Whether the hand at hole_T_hand has the peg tip inside the hole's cavity, at least
+/// kSuccessDepth deep: -kHoleDepth <= y <= -kSuccessDepth and |x| < inner_width / 2. The floor
+/// matters: a tip behind the hole's bottom wall (y < -kHoleDepth - kWallThickness), reached by
+/// going around the hole, lies under the opening too but is not an insertion. Inside the
+/// cavity the peg (longer than the hole is deep) passes through the opening.
+bool is_inserted(const RigidTransform& hole_T_hand,
+                 const PegHoleGeometry& geometry = PegHoleGeometry());
 
 /// The planar coordinates (theta, x, y) of a planar pose (theta from the rotation's first column).
 Eigen::Vector3d planar_coordinates(const RigidTransform& pose);

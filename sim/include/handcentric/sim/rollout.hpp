@@ -8,11 +8,12 @@
 // commanded pose, projected onto the plane (theta from the rotation's first column, z dropped);
 // a command beyond the per-step limits is clipped to them along the straight (theta, x, y) line,
 // and counted. Every motion is checked continuously (collision.hpp) in the hole frame.
-// Outcome: success as soon as the tip is kSuccessDepth deep inside the opening; collision at the
-// first contact; timeout when the replans run out; invalid when the policy returns a non-finite
-// pose or throws NonFiniteAction (core/errors.hpp), which ends the rollout there. An invalid
-// trial is a failure with its own count, so one diverging scene in a long evaluation is reported
-// rather than fatal; RolloutOptions::stop_on_invalid makes it an error instead.
+// Outcome: success as soon as the tip is kSuccessDepth deep inside the hole (is_inserted,
+// geometry.hpp); collision at the first contact; timeout when the replans run out; invalid when
+// the policy returns a non-finite pose or throws NonFiniteAction (core/errors.hpp), which ends
+// the rollout there. An invalid trial is a failure with its own count, so one diverging scene in
+// a long evaluation is reported rather than fatal; RolloutOptions::stop_on_invalid makes it an
+// error instead.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -63,15 +64,17 @@ Scene observation(const RigidTransform& world_T_hole,
                   const std::vector<RigidTransform>& world_T_hand, int history,
                   const PegHoleGeometry& geometry = PegHoleGeometry());
 
-/// Whether the hand at hole_T_hand has its tip kSuccessDepth deep and inside the opening's width.
-bool is_inserted(const RigidTransform& hole_T_hand,
-                 const PegHoleGeometry& geometry = PegHoleGeometry());
-
 /// One rollout; act() call r gets the noise seed stream_seed(seed, r). Throws InvalidArgument
 /// when the policy returns an empty chunk (naming the policy and the replan); a non-finite pose
 /// is Outcome::invalid, or NonFiniteAction with options.stop_on_invalid.
 Rollout rollout(const ChunkPolicy& policy, const TaskScene& scene, const CollisionChecker& checker,
                 std::uint64_t seed, const RolloutOptions& options = RolloutOptions());
+
+/// Bumped whenever a change of the rollout or of its success test can change an outcome, so that
+/// stored outcomes (table1's results/) from an earlier rule are not read as current ones.
+/// 2: is_inserted requires the tip inside the hole (before, a tip behind the hole's bottom wall
+/// counted).
+inline constexpr int kRolloutRulesVersion = 2;
 
 struct RolloutSummary {
   int trials = 0, success = 0, collision = 0, timeout = 0, clipped = 0;

@@ -12,8 +12,8 @@
 //          The block is five axis-aligned boxes in the slot frame: two side plates (x), two end
 //          walls (y) and the bottom, each kSlotWallThickness thick, their tops at z = 0.
 //
-// Success: the blade tip at least kSuccessDepth below the opening, inside the slot's footprint,
-// with no contact at any step.
+// Success: the blade tip inside the slot, at least kSuccessDepth below the opening (and not
+// below the slot's floor), with no contact at any step.
 #include <Eigen/Core>
 
 #include <array>
@@ -75,8 +75,11 @@ struct BladeSlotGeometry {
 /// The blade tip (0, 0, -kBladeLength) in the slot frame, for the hand at slot_T_hand.
 Eigen::Vector3d tip_in_slot(const RigidTransform& slot_T_hand);
 
-/// Whether the hand at slot_T_hand has the blade tip at least kSuccessDepth deep and inside the
-/// slot's footprint (contact is checked separately).
+/// Whether the hand at slot_T_hand has the blade tip inside the slot, at least kSuccessDepth
+/// deep: -kSlotDepth <= z <= -kSuccessDepth and inside the footprint (contact is checked
+/// separately). The floor matters: a tip under the block (z < -kSlotDepth -
+/// kSlotWallThickness), reached by going around it, lies inside the footprint too but is not an
+/// insertion.
 bool inserted(const BladeSlotGeometry& geometry, const RigidTransform& slot_T_hand);
 
 }  // namespace handcentric::sim::insert3d
