@@ -125,8 +125,8 @@ PolicyConfig inner_config(const PolicyConfig& config) {
              "the observation dimension");
   PolicyConfig inner = config;
   inner.head = config.head == HeadKind::c8ddpm ? HeadKind::ddpm : HeadKind::flow;
-  // Epsilon, as [7] (on Diffusion Policy's default): predicting the sample instead took c8_base
-  // from 0.21 to 0.00 at 40 demos on the tuning seeds (docs/EXPERIMENTS.md).
+  // Epsilon, as [7] (on Diffusion Policy's default). On the tuning seeds c8_base scored 0.00 at
+  // 40 demos with either prediction (docs/EXPERIMENTS.md), so faithfulness to [7] decides.
   inner.ddpm_prediction = DdpmPrediction::epsilon;
   inner.action_dimension = action_layout(config).planar_size();
   inner.observation_dimension = observation_layout(config).planar_size();

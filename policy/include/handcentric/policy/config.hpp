@@ -101,7 +101,7 @@ struct PolicyConfig {
   int ddim_steps = 10;         ///< DDIM sampling steps
   /// Head ddpm only. sample by default: on the tuning seeds hand-centric DDPM inserts 0.87 of
   /// the time at 40 demos with it and 0.00 with epsilon, whose first DDIM step divides the
-  /// network's error by sqrt(abar) ~ 5e-4 (docs/EXPERIMENTS.md, "The DDPM and CVAE heads").
+  /// network's error by sqrt(abar) ~ 5e-4 (docs/EXPERIMENTS.md, "Fig. 5's heads").
   /// to_text writes it for head ddpm only, and a ddpm file without it (every one written before
   /// this setting) reads as epsilon, what it was trained with. c8ddpm always predicts epsilon
   /// (c8_planar.hpp).
@@ -121,7 +121,9 @@ struct PolicyConfig {
   /// Throws InvalidArgument naming the first out-of-range field and its valid range.
   void validate() const;
   std::string to_text() const;
-  /// Parses to_text() output; throws InvalidArgument for an unknown key or a bad value.
+  /// Parses to_text() output; throws InvalidArgument for an unknown key or a bad value. Keys
+  /// left out keep their defaults, except a ddpm config without ddpm_prediction, which reads as
+  /// epsilon (what a model file written before the setting was trained with).
   static PolicyConfig from_text(const std::string& text);
 };
 
