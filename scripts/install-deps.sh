@@ -14,6 +14,8 @@ packages=(
   # scripts/fuzz.sh: clang, libFuzzer, and the sanitizer and fuzzer runtimes clang links (only
   # recommended by clang, so not installed under --no-install-recommends without this name)
   clang libfuzzer-14-dev libclang-rt-14-dev
+  # tests/support/check_style.py: the tracked files and their formatting
+  git clang-format
 )
 
 missing=()

@@ -19,7 +19,8 @@ inline double SquaredNorm(std::ptrdiff_t n, const float* g) {
   std::ptrdiff_t i = 0;
   constexpr std::ptrdiff_t kLanes = static_cast<std::ptrdiff_t>(hn::MaxLanes(decltype(dd)()));
   for (; i + 2 * kLanes <= n; i += 2 * kLanes) {  // two chains of additions
-    const auto g0 = hn::PromoteTo(dd, hn::LoadU(df, g + i)), g1 = hn::PromoteTo(dd, hn::LoadU(df, g + i + kLanes));
+    const auto g0 = hn::PromoteTo(dd, hn::LoadU(df, g + i)),
+               g1 = hn::PromoteTo(dd, hn::LoadU(df, g + i + kLanes));
     sum0 = hn::MulAdd(g0, g0, sum0);
     sum1 = hn::MulAdd(g1, g1, sum1);
   }
@@ -53,4 +54,3 @@ inline void Adam(const AdamUpdate& u) {
 
 }  // namespace handcentric::policy::kernels::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
-

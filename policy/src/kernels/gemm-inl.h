@@ -24,8 +24,8 @@ constexpr int kRegisters = HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL ?
 // the contract of gemm.hpp's narrow loop nest ("Narrow products"). The first vector starts
 // `shift` lanes before the data and the last one ends inside its vector: both are masked.
 template <int N, int V>
-void NarrowProduct(int shift, int rows, int k, const float* a, long lda, const float* b, long b_step, long b_stride,
-                   const float* bias, float* c, long ldc) {
+void NarrowProduct(int shift, int rows, int k, const float* a, long lda, const float* b,
+                   long b_step, long b_stride, const float* bias, float* c, long ldc) {
   const FloatTag d;
   const int lanes = shift + rows;  // in kLanes (V - 1) + 1 .. kLanes V
   const auto head = LanesBetween(d, shift, V == 1 ? lanes : kLanes);
@@ -51,7 +51,8 @@ void NarrowProduct(int shift, int rows, int k, const float* a, long lda, const f
     for (int v = 0; v < V; ++v) {
       const auto a_v = load(column + kLanes * v, v);
 #pragma GCC unroll 16
-      for (int j = 0; j < N; ++j) acc[j][v] = hn::MulAdd(a_v, hn::Set(d, b_row[j * b_stride]), acc[j][v]);
+      for (int j = 0; j < N; ++j)
+        acc[j][v] = hn::MulAdd(a_v, hn::Set(d, b_row[j * b_stride]), acc[j][v]);
     }
   }
 #pragma GCC unroll 16
@@ -88,7 +89,8 @@ struct GemmKernel {
   // pack_a<MR> with vector moves: op(A) = A copies two (partial) vectors per k; op(A) = A^T
   // gathers each row panel's k-th column (kLanes rows at stride lda) from rows that stay in L1.
   static void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out) {
-    if (op == Op::transpose && static_cast<long>(lda) * kLanes >= (1L << 29)) {  // offsets beyond int32 bytes
+    // Gather offsets are int32 byte offsets: beyond them, the scalar packing.
+    if (op == Op::transpose && static_cast<long>(lda) * kLanes >= (1L << 29)) {
       kernels::pack_a<MR>(op, a, lda, i0, mc, p0, kc, out);
       return;
     }
@@ -106,7 +108,8 @@ struct GemmKernel {
         }
       } else {
         const auto lanes0 = FirstLanes(d, rows0), lanes1 = FirstLanes(d, rows1);
-        const float* row0 = a + p0 + static_cast<long>(i0 + panel) * lda;  // op(A)(i, p) = a[p + i lda]
+        // op(A)(i, p) = a[p + i lda]
+        const float* row0 = a + p0 + static_cast<long>(i0 + panel) * lda;
         const float* row1 = rows1 > 0 ? row0 + static_cast<long>(kLanes) * lda : row0;
         for (int p = 0; p < kc; ++p) {
           hn::Store(GatherRows(d, row0 + p, row_offsets, lanes0), d, out + p * MR);
@@ -119,8 +122,8 @@ struct GemmKernel {
 
   // The full MR x NR tile of C (gemm.hpp, blocked_gemm).
   template <BLayout layout>
-  static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc, bool accumulate,
-                   const float* bias) {
+  static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc,
+                   bool accumulate, const float* bias) {
     const FloatTag d;
     hn::Vec<FloatTag> acc[NR][2];
 #pragma GCC unroll 32
@@ -130,7 +133,8 @@ struct GemmKernel {
       hwy::Prefetch(a + 8 * MR);
 #pragma GCC unroll 32
       for (int j = 0; j < NR; ++j) {
-        const auto bj = hn::Set(d, layout == BLayout::columns ? b[j * static_cast<long>(ldb)] : b[j]);
+        const auto bj =
+            hn::Set(d, layout == BLayout::columns ? b[j * static_cast<long>(ldb)] : b[j]);
         acc[j][0] = hn::MulAdd(a0, bj, acc[j][0]);
         acc[j][1] = hn::MulAdd(a1, bj, acc[j][1]);
       }
@@ -157,4 +161,3 @@ struct GemmKernel {
 
 }  // namespace handcentric::policy::kernels::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
-

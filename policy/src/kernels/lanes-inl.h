@@ -15,10 +15,11 @@ HWY_BEFORE_NAMESPACE();
 namespace handcentric::policy::kernels::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
-/// Lanes [begin, end) of one vector of D: the mask, and the same lanes as bits for the ASan check.
 /// Whether masked loads are instructions on this target (cheap enough for every k of a product).
-constexpr bool kMaskedLoadInstructions = HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL;
+constexpr bool kMaskedLoadInstructions =
+    HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL;
 
+/// Lanes [begin, end) of one vector of D: the mask, and the same lanes as bits for the ASan check.
 template <class D>
 struct LaneSpan {
   hn::Mask<D> mask;
@@ -30,7 +31,8 @@ struct LaneSpan {
 template <class D>
 HWY_INLINE LaneSpan<D> LanesBetween(D d, std::size_t begin, std::size_t end) {
   const std::uint64_t below_end = end >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << end) - 1;
-  return {hn::AndNot(hn::FirstN(d, begin), hn::FirstN(d, end)), below_end & ~((std::uint64_t{1} << begin) - 1)};
+  return {hn::AndNot(hn::FirstN(d, begin), hn::FirstN(d, end)),
+          below_end & ~((std::uint64_t{1} << begin) - 1)};
 }
 
 /// The first `count` lanes (a tail); count >= Lanes(d) gives every lane.
@@ -45,11 +47,13 @@ HWY_INLINE LaneSpan<D> FirstLanes(D d, std::size_t count) {
 template <class D, typename T = hn::TFromD<D>>
 HWY_INLINE hn::Vec<D> LoadLanes(D d, const LaneSpan<D>& lanes, const T* p) {
   check_lanes(p, lanes.bits, sizeof(T), false);
-#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL  // kMaskedLoadInstructions
+// The condition of kMaskedLoadInstructions.
+#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
   return hn::MaskedLoad(lanes.mask, d, p);
 #else
   constexpr std::size_t kLanes = hn::MaxLanes(D());
-  if (lanes.bits == (kLanes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << kLanes) - 1)) return hn::LoadU(d, p);
+  if (lanes.bits == (kLanes >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << kLanes) - 1))
+    return hn::LoadU(d, p);
   alignas(64) T buffer[kLanes] = {};
   for (std::size_t i = 0; i < kLanes; ++i) {
     if ((lanes.bits >> i) & 1) buffer[i] = p[i];
@@ -102,11 +106,11 @@ HWY_INLINE hn::Vec<D> GatherRows(D d, const float* rows, hn::Vec<hn::RebindToSig
 #if defined(__SANITIZE_ADDRESS__) || defined(HANDCENTRIC_ASAN)
   alignas(64) std::int32_t each[hn::MaxLanes(D())];
   hn::Store(offsets, di, each);
-  for (std::size_t i = 0; i < hn::Lanes(d); ++i) check_lanes(rows + each[i], 1, sizeof(float), false);
+  for (std::size_t i = 0; i < hn::Lanes(d); ++i)
+    check_lanes(rows + each[i], 1, sizeof(float), false);
 #endif
   return hn::IfThenElseZero(lanes.mask, hn::GatherIndex(d, rows, offsets));
 }
 
 }  // namespace handcentric::policy::kernels::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
-

@@ -64,4 +64,3 @@ inline void SiluInPlace(std::ptrdiff_t n, float* x) {
 
 }  // namespace handcentric::policy::kernels::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
-
