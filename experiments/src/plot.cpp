@@ -50,7 +50,7 @@ sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
   cv::rectangle(canvas, px(0, 1), px(x_max, 0), rgb(20, 20, 20), 1);
   text(canvas, "number of demos", cv::Point((left + right) / 2 - 60, height - 15), 0.55);
   text(canvas, "success", cv::Point(8, top - 15), 0.55);
-  text(canvas, "Table 1: closed-loop success (bars: Wilson 95%)", cv::Point(left, 28), 0.65);
+  text(canvas, "Closed-loop success (bars: Wilson 95% intervals)", cv::Point(left, 28), 0.65);
 
   std::vector<std::pair<std::string, std::string>> series;
   for (const Row& r : rows) {
