@@ -210,7 +210,8 @@ void PolicyConfig::validate() const {
   require(ddim_steps >= 1 && ddim_steps <= ddpm_train_steps, "ddim_steps", s(ddim_steps),
           "1..ddpm_train_steps (" + s(ddpm_train_steps) + ")");
   require(cvae_latent >= 1 && cvae_latent <= 4096, "cvae_latent", s(cvae_latent), "1..4096");
-  require(cvae_kl_weight >= 0.0, "cvae_kl_weight", format_number(cvae_kl_weight), ">= 0");
+  require(std::isfinite(cvae_kl_weight) && cvae_kl_weight >= 0.0, "cvae_kl_weight",
+          format_number(cvae_kl_weight), "a finite number >= 0");
   require(std::abs(c8_centre_x) <= 1e6, "c8_centre_x", format_number(c8_centre_x), "[-1e6, 1e6]");
   require(std::abs(c8_centre_y) <= 1e6, "c8_centre_y", format_number(c8_centre_y), "[-1e6, 1e6]");
 }

@@ -36,20 +36,24 @@ def main() -> int:
     parser.add_argument("--clang-format", required=True)
     parser.add_argument("files", nargs="*", type=pathlib.Path)
     args = parser.parse_args()
-    files = args.files or tracked(args.root)
+    files = [p for p in (args.files or tracked(args.root))
+             if (p.suffix in TEXT or p.name in NAMES) and p.is_file()]
     offences = []
     for path in files:
-        if not (path.suffix in TEXT or path.name in NAMES) or not path.is_file():
-            continue
         for number, line in enumerate(path.read_text(errors="replace").splitlines(), 1):
             if len(line) > MAX_COLUMNS:
                 offences.append(f"{path}:{number}: {len(line)} columns (at most {MAX_COLUMNS})")
-    cxx = [str(p) for p in files if p.suffix in CXX and p.is_file()]
+    cxx = [str(p) for p in files if p.suffix in CXX]
     if cxx:
         # The project's .clang-format, also for files outside the tree (the check's own test).
         style = f"--style=file:{args.root.resolve() / '.clang-format'}"
-        result = subprocess.run([args.clang_format, "--dry-run", "--Werror", style, *cxx],
-                                capture_output=True, text=True, cwd=args.root)
+        try:
+            result = subprocess.run([args.clang_format, "--dry-run", "--Werror", style, *cxx],
+                                    capture_output=True, text=True, cwd=args.root)
+        except OSError as e:
+            print(f"check_style: cannot run clang-format '{args.clang_format}': {e}",
+                  file=sys.stderr)
+            return 2
         offences += [line for line in result.stderr.splitlines() if ": error: " in line]
         if result.returncode != 0 and not any(": error: " in o for o in offences):
             offences.append(f"clang-format failed: {result.stderr.strip()}")
