@@ -105,9 +105,28 @@ int gate(const std::vector<props::Classification>& results,
       }
     }
     if (checked == 0) {
-      throw InvalidArgument(
+      const std::string item =
           "--expect " + std::string(e.component ? props::to_string(*e.component) + ":" : "") +
-          props::to_string(e.group) + " matches no check that ran; widen --group or --view");
+          props::to_string(e.group);
+      // Say which part of the item matched nothing: the component, or the group and view.
+      bool component_ran = !e.component.has_value();
+      std::string components_ran;
+      for (const props::Classification& c : results) {
+        for (const props::Verdict& v : c.verdicts) {
+          const std::string name = props::to_string(v.component);
+          if (components_ran.find(name) == std::string::npos)
+            components_ran += (components_ran.empty() ? "" : ", ") + name;
+          if (e.component && v.component == *e.component) component_ran = true;
+        }
+      }
+      if (!component_ran) {
+        throw InvalidArgument(item + " names the component '" + props::to_string(*e.component) +
+                              "', which this audit does not check (it checks " + components_ran +
+                              "); e.g. --expect " +
+                              components_ran.substr(0, components_ran.find(',')) + ":" +
+                              props::to_string(e.group));
+      }
+      throw InvalidArgument(item + " matches no check that ran; widen --group or --view");
     }
   }
   return failed == 0 ? 0 : 1;

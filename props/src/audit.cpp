@@ -84,6 +84,8 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
   classifier.check.cases = options.cases;
   classifier.check.seed = options.seed;
   classifier.check.relative_tolerance = audit_relative_tolerance(options);
+  classifier.check.unit_roundoff =
+      options.precision == Precision::float32 ? kFloat32UnitRoundoff : kFloat64UnitRoundoff;
   classifier.distribution.cases = std::max(10, (options.cases + 99) / 100);
   classifier.injectivity_cases = std::max(100, options.cases / 5);
   return classifier;
@@ -112,6 +114,13 @@ std::vector<Classification> audit_builtins(const std::vector<std::string>& names
 void print_audit(std::ostream& out, const std::vector<Classification>& classifications,
                  const AuditOptions& options, bool witnesses) {
   constexpr std::size_t kLabel = 30, kCell = 14;
+  if (!classifications.empty()) {
+    out << "Each cell: yes or NO, then the largest difference seen between the two sides (f(s) and "
+           "f(g s); for a policy g a(o) and a(g o)):\n  pointwise, an inf-norm in the "
+           "component's units (m, rad, or the map's own numbers); in distribution, the largest "
+           "difference of the two laws' means or covariances when decided exactly, or, marked ~, "
+           "the energy distance between the two samples (a statistic, not a length).\n\n";
+  }
   for (const Classification& classification : classifications) {
     out << classification.name << "\n";
     std::vector<const Verdict*> failing, noted;

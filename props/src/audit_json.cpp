@@ -68,7 +68,15 @@ nlohmann::json witness_json(const Witness& w, Method method) {
     out["tolerance"] = w.tolerance;
   }
   if (!w.detail.empty()) out["detail"] = w.detail;
+  if (method != Method::energy_test && w.length_scale > 0.0) out["length_scale"] = w.length_scale;
+  if (w.rounding_response > 0.0) out["rounding_response"] = w.rounding_response;
+  if (w.off_case) out["off_case"] = true;
   return out;
+}
+
+// What a pointwise decision adds to a check (check.hpp): the cases that sat on a discontinuity.
+void add_rounding_fields(nlohmann::json& check, const Verdict& v) {
+  if (v.mode == Mode::pointwise) check["discontinuities"] = v.discontinuities;
 }
 
 nlohmann::json injectivity_json(const Injectivity& injectivity) {
@@ -134,6 +142,7 @@ std::string audit_json(const std::vector<Classification>& classifications) {
         if (v.method == Method::energy_test) check["min_p_value"] = v.min_p_value;
         if (v.detectable_shift) check["detectable_shift"] = *v.detectable_shift;
       }
+      add_rounding_fields(check, v);
       if (!v.note.empty()) check["note"] = v.note;
       checks.push_back(check);
     }
@@ -177,6 +186,7 @@ std::string policy_audit_json(const std::vector<Classification>& policies) {
         if (v.method == Method::energy_test) check["min_p_value"] = v.min_p_value;
         if (v.detectable_shift) check["detectable_shift"] = *v.detectable_shift;
       }
+      add_rounding_fields(check, v);
       if (!v.note.empty()) check["note"] = v.note;
       checks.push_back(check);
       summary[to_string(v.view)][to_string(v.mode)][to_string(v.group)] = v.invariant;

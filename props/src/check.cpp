@@ -8,6 +8,7 @@
 #include <random>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
@@ -78,6 +79,12 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
     throw InvalidArgument("relative_tolerance must be a positive number, got " +
                           std::to_string(options.relative_tolerance));
   }
+  if (!(options.unit_roundoff > 0.0 && options.unit_roundoff < 1e-3)) {
+    throw InvalidArgument(
+        "unit_roundoff must be in (0, 1e-3) (2^-53 for double, 2^-24 for "
+        "float32), got " +
+        std::to_string(options.unit_roundoff));
+  }
   Verdict verdict;
   verdict.component = component;
   verdict.group = group;
@@ -98,10 +105,14 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
     CaseOutcome outcome;
     try {
       outcome = run_case(scene, g);
-    } catch (const Error&) {
+    } catch (...) {
+      // Not a counterexample: the function under test could not answer (a handcentric::Error,
+      // a Python exception, a missing module). The check stops and the caller sees it.
       error = std::current_exception();
-      return;
     }
+    // Failing the property ends RapidCheck's search at once (its shrinking then sees every
+    // candidate pass, above), so a callable that raises costs one call whatever `cases` is.
+    if (error) RC_FAIL("the function under test could not answer");
     if (searching) {
       const double e = std::isnan(outcome.witness.error) ? std::numeric_limits<double>::infinity()
                                                          : outcome.witness.error;
@@ -111,6 +122,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
         ++verdict.near_identity_cases;
       } else {
         ++verdict.cases;
+        if (outcome.holds && outcome.discontinuity) ++verdict.discontinuities;
       }
     }
     if (!outcome.holds) {
@@ -121,8 +133,79 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   };
   run_silently(property, to_string(component) + " under " + to_string(group), options.seed, cases);
   if (error) std::rethrow_exception(error);
-  verdict.invariant = !verdict.witness.has_value() && verdict.cases >= 1;
+  if (!verdict.witness && verdict.cases == verdict.discontinuities) {
+    // Every case was near the identity (or sat on a discontinuity): nothing was shown either way.
+    throw Error(to_string(component) + " under " + to_string(group) + " (" + to_string(mode) +
+                ", " + to_string(verdict.view) + "): no verdict, " +
+                (verdict.cases == 0
+                     ? "all " + std::to_string(verdict.near_identity_cases) +
+                           " cases had g near the identity, which can show no symmetry"
+                     : "every far case sat on a discontinuity of the map") +
+                "; run more cases (seed " + std::to_string(options.seed) + ")");
+  }
+  verdict.invariant = !verdict.witness.has_value();
+  if (verdict.discontinuities > 0) {
+    verdict.note = std::to_string(verdict.discontinuities) + " of " +
+                   std::to_string(verdict.cases) +
+                   " far cases sat on a discontinuity of the map (a bin edge, where inputs that "
+                   "differ by rounding fall into neighbouring bins): the outputs differed there "
+                   "but agreed with both scenes moved " +
+                   format_number(off_case_scale(options.unit_roundoff)) +
+                   " (1 + L) off the case; not counted as symmetry breaking";
+  }
   return verdict;
+}
+
+CaseOutcome decide_pointwise(const PointwiseSides& sides, const Scene& scene,
+                             const RigidTransform& g, const CheckOptions& options) {
+  constexpr int kRoundingDraws = 2;
+  CaseOutcome outcome;
+  auto measure = [&](const Scene& s, Witness& witness) {
+    const Scene moved = g * s;
+    witness.scene = s;
+    witness.g = g;
+    sides.compare(s, witness);
+    if (std::isnan(witness.error)) witness.error = std::numeric_limits<double>::infinity();
+    witness.length_scale = std::max(length_scale(s), length_scale(moved));
+    witness.tolerance = options.relative_tolerance * (1.0 + witness.length_scale);
+    return moved;
+  };
+  const Scene moved = measure(scene, outcome.witness);
+  Witness& w = outcome.witness;
+  if (w.error <= w.tolerance) return outcome;  // 1. the floor
+  // 2. The map's own rounding: how far each side moves when its inputs move by a few ulps.
+  std::mt19937_64 rng(options.seed ^ 0x6a09e667f3bcc909ULL);
+  double response = 0.0;
+  for (int d = 0; d < kRoundingDraws; ++d) {
+    response = std::max(
+        response, sides.response(scene, rounding_perturbation(scene, options.unit_roundoff, rng)));
+    response = std::max(
+        response, sides.response(moved, rounding_perturbation(moved, options.unit_roundoff, rng)));
+  }
+  if (std::isnan(response)) response = std::numeric_limits<double>::infinity();
+  w.rounding_response = response;
+  const double cap = rounding_cap(options.unit_roundoff, w.length_scale);
+  if (response <= cap && w.error <= kRoundingMultiple * response) return outcome;
+  // 3. Off the case: a bin edge moves away, a symmetry breaking stays.
+  if (options.off_case_draws < 1) {
+    outcome.holds = false;
+    return outcome;
+  }
+  const double eta = off_case_scale(options.unit_roundoff);
+  for (int d = 0; d < options.off_case_draws; ++d) {
+    Witness off;
+    measure(nearby_scene(scene, eta, rng), off);
+    off.rounding_response = response;
+    const double allowed = std::max(off.tolerance, kRoundingMultiple * std::min(response, cap));
+    if (!(off.error <= allowed)) {
+      off.off_case = true;
+      outcome.witness = std::move(off);
+      outcome.holds = false;
+      return outcome;
+    }
+  }
+  outcome.discontinuity = true;
+  return outcome;
 }
 
 }  // namespace detail
@@ -216,18 +299,17 @@ SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint
 
 Verdict check_invariance(const SceneFunction& f, Component component, Group group,
                          const CheckOptions& options) {
-  const double relative = options.relative_tolerance;
-  auto run_case = [&f, relative](const Scene& scene, const RigidTransform& g) {
-    detail::CaseOutcome outcome;
-    const Scene moved = g * scene;
-    outcome.witness.scene = scene;
-    outcome.witness.g = g;
-    outcome.witness.before = f(scene);
-    outcome.witness.after = f(moved);
-    outcome.witness.error = detail::inf_distance(outcome.witness.before, outcome.witness.after);
-    outcome.witness.tolerance = pointwise_tolerance(scene, moved, relative);
-    outcome.holds = outcome.witness.error <= outcome.witness.tolerance;  // false for NaN
-    return outcome;
+  auto run_case = [&f, &options](const Scene& scene, const RigidTransform& g) {
+    detail::PointwiseSides sides;
+    sides.compare = [&f, &g](const Scene& s, Witness& witness) {
+      witness.before = f(s);
+      witness.after = f(g * s);
+      witness.error = detail::inf_distance(witness.before, witness.after);
+    };
+    sides.response = [&f](const Scene& a, const Scene& b) {
+      return detail::inf_distance(f(a), f(b));
+    };
+    return detail::decide_pointwise(sides, scene, g, options);
   };
   return detail::run_check(run_case, component, group, Mode::pointwise, options, options.cases,
                            kPointwiseShrinkBudget);
@@ -239,18 +321,18 @@ double recompute_error(const SceneFunction& f, const Witness& witness) {
 
 Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOptions& options) {
   const std::uint64_t noise_seed = options.noise_seed;
-  const double relative = options.relative_tolerance;
-  auto run_case = [&policy, noise_seed, relative](const Scene& scene, const RigidTransform& g) {
-    detail::CaseOutcome outcome;
-    const Equivariance sides = both_sides(policy, scene, g, noise_seed);
-    outcome.witness.scene = scene;
-    outcome.witness.g = g;
-    outcome.witness.before = detail::flatten(sides.g_a);
-    outcome.witness.after = detail::flatten(sides.a_g);
-    outcome.witness.error = detail::chunk_distance(sides.g_a, sides.a_g);  // eq. (4)
-    outcome.witness.tolerance = pointwise_tolerance(scene, g * scene, relative);
-    outcome.holds = outcome.witness.error <= outcome.witness.tolerance;
-    return outcome;
+  auto run_case = [&policy, noise_seed, &options](const Scene& scene, const RigidTransform& g) {
+    detail::PointwiseSides sides;
+    sides.compare = [&policy, &g, noise_seed](const Scene& s, Witness& witness) {
+      const Equivariance both = both_sides(policy, s, g, noise_seed);
+      witness.before = detail::flatten(both.g_a);
+      witness.after = detail::flatten(both.a_g);
+      witness.error = detail::chunk_distance(both.g_a, both.a_g);  // eq. (4)
+    };
+    sides.response = [&policy, noise_seed](const Scene& a, const Scene& b) {
+      return detail::chunk_distance(policy.act(a, noise_seed), policy.act(b, noise_seed));
+    };
+    return detail::decide_pointwise(sides, scene, g, options);
   };
   return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,
                            options.cases, kPointwiseShrinkBudget);

@@ -15,7 +15,22 @@ namespace handcentric::props::detail {
 struct CaseOutcome {
   Witness witness;  ///< scene, g, outputs, error, tolerance, p-value of this case
   bool holds = true;
+  bool discontinuity = false;  ///< held only because the difference sat on a discontinuity
 };
+
+/// The two sides of a pointwise case, for the decision of check.hpp.
+struct PointwiseSides {
+  /// Sets witness.before, .after and .error for (scene, g * scene), g fixed by the caller.
+  std::function<void(const Scene& scene, Witness& witness)> compare;
+  /// How far one side's output moves between scenes a and b (the same side: f(a) against
+  /// f(b), or a policy's chunks a(a) against a(b)).
+  std::function<double(const Scene& a, const Scene& b)> response;
+};
+
+/// Decides the case (scene, g) as the top of check.hpp says: the floor, the map's own
+/// rounding, then off the case. The witness carries the scene that decided it.
+CaseOutcome decide_pointwise(const PointwiseSides& sides, const Scene& scene,
+                             const RigidTransform& g, const CheckOptions& options);
 
 using CaseFunction = std::function<CaseOutcome(const Scene& scene, const RigidTransform& g)>;
 

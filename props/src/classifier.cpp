@@ -17,6 +17,7 @@ Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
   }
   CheckOptions loose = with_view(options.check, verdict.view);
   loose.relative_tolerance = kFloat32RelativeTolerance;
+  loose.unit_roundoff = kFloat32UnitRoundoff;
   loose.shrink = false;
   if (recheck(loose).invariant) {
     verdict.note =

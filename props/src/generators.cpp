@@ -51,9 +51,34 @@ rc::Gen<Rotation> c8_rotation() {
                       [](int i) { return Rotation::about_z(i * kPi / 4.0); });
 }
 
-rc::Gen<Eigen::Vector3d> translation_with_edges(double max_abs, bool planar) {
+// A length drawn log-uniformly in [kSmallestLength, kLargestLength] (shrinks to the smallest):
+// a leak proportional to a position is then seen at every scale, not only at 10 m, where the
+// tolerance's (1 + L) is largest.
+constexpr double kSmallestLength = 0.01, kLargestLength = 10.0;
+
+rc::Gen<double> log_uniform_length() {
+  return rc::gen::map(unit_interval(), [](double u) {
+    return kSmallestLength * std::pow(kLargestLength / kSmallestLength, u);
+  });
+}
+
+// A vector of log-uniform length in a uniform direction (in the plane z = 0 when planar).
+rc::Gen<Eigen::Vector3d> log_uniform_vector(bool planar) {
+  if (planar) {
+    return rc::gen::map(rc::gen::tuple(log_uniform_length(), unit_interval()), [](const auto& la) {
+      const double angle = 2.0 * kPi * std::get<1>(la);
+      return Eigen::Vector3d(std::get<0>(la) * std::cos(angle), std::get<0>(la) * std::sin(angle),
+                             0.0);
+    });
+  }
+  return rc::gen::map(rc::gen::tuple(log_uniform_length(), unit_axis()), [](const auto& la) {
+    return Eigen::Vector3d(std::get<0>(la) * std::get<1>(la));
+  });
+}
+
+rc::Gen<Eigen::Vector3d> translation_with_edges(bool planar) {
   auto gen = rc::gen::weightedOneOf<Eigen::Vector3d>({
-      {8, translation(max_abs)},
+      {8, log_uniform_vector(planar)},
       {1, rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero())},
       {1, rc::gen::map(unit_axis(),
                        [](const Eigen::Vector3d& axis) -> Eigen::Vector3d { return 1e3 * axis; })},
@@ -79,6 +104,13 @@ rc::Gen<Twist> step_twist(double step, double turn) {
     twist << std::get<0>(vw), std::get<1>(vw);
     return twist;
   });
+}
+
+// A step twist, or, one time in eight, none: a hand at rest, T_k = T_0 exactly, where a map
+// that bins relative poses sits on the bin edge at 0 (a robot pausing in a demo does this).
+rc::Gen<Twist> step_or_rest(double step, double turn) {
+  return rc::gen::weightedOneOf<Twist>(
+      {{7, step_twist(step, turn)}, {1, rc::gen::just<Twist>(Twist::Zero())}});
 }
 
 }  // namespace
@@ -117,19 +149,17 @@ rc::Gen<Eigen::Vector3d> translation(double max_abs) {
 }
 
 rc::Gen<RigidTransform> group_element(Group group) {
-  constexpr double kMaxTranslation = 10.0;
   switch (group) {
     case Group::translation:
-      return combine(rc::gen::just(Rotation::identity()),
-                     translation_with_edges(kMaxTranslation, false));
+      return combine(rc::gen::just(Rotation::identity()), translation_with_edges(false));
     case Group::rotation:
       return combine(rotation(), rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
     case Group::se2:
       return combine(
           rc::gen::weightedOneOf<Rotation>({{4, rotation_about_z()}, {1, z_rotation_edge_cases()}}),
-          translation_with_edges(kMaxTranslation, true));
+          translation_with_edges(true));
     case Group::se3:
-      return combine(rotation(), translation_with_edges(kMaxTranslation, false));
+      return combine(rotation(), translation_with_edges(false));
     case Group::c8:
       return combine(c8_rotation(), rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
   }
@@ -154,32 +184,39 @@ rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, doubl
 }  // namespace
 
 rc::Gen<Scene> scene(SceneShape shape) {
-  auto geometry = rc::gen::apply(
-      [](const RigidTransform& world_T_hand0, const Twist& forward, const Twist& backward,
-         int history, int chunk, const std::vector<Eigen::Vector3d>& hand_points,
-         const std::vector<Eigen::Vector3d>& world_points) {
-        Scene s;
-        // Smooth, rotating motion: a constant body twist per control step, each way from T_0.
-        const RigidTransform step_forward = RigidTransform::exp(forward);
-        const RigidTransform step_backward = RigidTransform::exp(backward);
-        s.world_T_hand_history.push_back(world_T_hand0);
-        for (int h = 1; h <= history; ++h) {
-          s.world_T_hand_history.push_back(s.world_T_hand_history.back() * step_backward);
-        }
-        RigidTransform world_T_handk = world_T_hand0;
-        for (int k = 1; k <= chunk; ++k) {
-          world_T_handk = world_T_handk * step_forward;
-          s.world_T_hand_chunk.push_back(world_T_handk);
-        }
-        s.hand_points = hand_points;
-        s.world_points = world_points;
-        return s;
-      },
-      combine(rotation(), translation(10.0)), step_twist(0.1, 0.3), step_twist(0.1, 0.3),
-      rc::gen::inRange(shape.min_history, shape.max_history + 1),
-      rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
-      points(shape.min_hand_points, shape.max_hand_points, 1.0),
-      points(shape.min_world_points, shape.max_world_points, 10.0));
+  // One length scale per scene, log-uniform in [1 cm, 10 m]: the start pose is that far out, and
+  // steps and points are drawn in proportion (at 10 m: steps up to 0.1 m, hand points within
+  // 1 m, world points within 10 m). Extra poses stay anywhere within 10 m.
+  auto geometry = rc::gen::mapcat(log_uniform_length(), [shape](double scale) {
+    return rc::gen::apply(
+        [](const Rotation& world_R_hand0, const Eigen::Vector3d& direction, double scale,
+           const Twist& forward, const Twist& backward, int history, int chunk,
+           const std::vector<Eigen::Vector3d>& hand_points,
+           const std::vector<Eigen::Vector3d>& world_points) {
+          Scene s;
+          const RigidTransform world_T_hand0(world_R_hand0, scale * direction);
+          // Smooth, rotating motion: a constant body twist per control step, each way from T_0.
+          const RigidTransform step_forward = RigidTransform::exp(forward);
+          const RigidTransform step_backward = RigidTransform::exp(backward);
+          s.world_T_hand_history.push_back(world_T_hand0);
+          for (int h = 1; h <= history; ++h) {
+            s.world_T_hand_history.push_back(s.world_T_hand_history.back() * step_backward);
+          }
+          RigidTransform world_T_handk = world_T_hand0;
+          for (int k = 1; k <= chunk; ++k) {
+            world_T_handk = world_T_handk * step_forward;
+            s.world_T_hand_chunk.push_back(world_T_handk);
+          }
+          s.hand_points = hand_points;
+          s.world_points = world_points;
+          return s;
+        },
+        rotation(), unit_axis(), rc::gen::just(scale), step_or_rest(0.01 * scale, 0.3),
+        step_or_rest(0.01 * scale, 0.3), rc::gen::inRange(shape.min_history, shape.max_history + 1),
+        rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
+        points(shape.min_hand_points, shape.max_hand_points, 0.1 * scale),
+        points(shape.min_world_points, shape.max_world_points, scale));
+  });
   if (shape.extra_pose_names.empty() && shape.scalar_names.empty()) return geometry;
   // Named extras: one random pose per name (anywhere, any orientation), one number per scalar.
   const auto poses = rc::gen::container<std::vector<RigidTransform>>(

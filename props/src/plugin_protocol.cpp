@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "handcentric/core/format.hpp"
+#include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
 namespace {
@@ -146,8 +147,9 @@ bool read_flag(const nlohmann::json& hello, const char* field, int id, const std
   return hello[field].get<bool>();
 }
 
-// A world-frame pose: 16 finite numbers, row-major, last row 0 0 0 1. The rotation block is
-// taken as it is (a float32 plug-in's is orthonormal to ~1e-7 only); distances compare it.
+// A world-frame pose: 16 finite numbers, row-major, last row 0 0 0 1 and a rotation block within
+// kOutputPoseTolerance of a rotation. The block is then taken as it is (a float32 plug-in's is
+// orthonormal to ~1e-7 only); distances compare it.
 RigidTransform read_pose(const nlohmann::json& value, std::size_t k, int id,
                          const std::string& who) {
   const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", id, who);
@@ -155,9 +157,14 @@ RigidTransform read_pose(const nlohmann::json& value, std::size_t k, int id,
     throw PluginError(reply_to(who, id) + " with \"chunk\"[" + std::to_string(k) +
                       "] that is not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)");
   }
-  Eigen::Matrix3d R;
-  R << v(0), v(1), v(2), v(4), v(5), v(6), v(8), v(9), v(10);
-  return RigidTransform::unchecked(R, Eigen::Vector3d(v(3), v(7), v(11)));
+  const Eigen::Matrix4d M =
+      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(v.data());
+  if (const std::string defect = pose_defect(M); !defect.empty()) {
+    throw PluginError(reply_to(who, id) + " with \"chunk\"[" + std::to_string(k) + "] " +
+                      format_matrix(M) + ": " + defect +
+                      "; answer world_T_hand poses [[R, p], [0, 0, 0, 1]]");
+  }
+  return RigidTransform::unchecked(M.topLeftCorner<3, 3>(), M.topRightCorner<3, 1>());
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 
@@ -32,6 +33,23 @@ Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk) {
   return v;
 }
 
+// policy.act(observation, noise), each pose checked: a chunk pose that is not a rigid transform
+// (a rotation block scaled by a bug) cannot be compared as one, so it stops the audit.
+std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& observation,
+                                        const Eigen::VectorXd& noise) {
+  std::vector<RigidTransform> chunk = policy.act(observation, noise);
+  for (std::size_t k = 0; k < chunk.size(); ++k) {
+    const std::string defect = pose_defect(chunk[k].matrix());
+    if (!defect.empty()) {
+      throw InvalidArgument("policy '" + policy.name() + "' returned chunk pose " +
+                            std::to_string(k) + " (T_" + std::to_string(k + 1) + ") " +
+                            format_matrix(chunk[k].matrix()) + ": " + defect +
+                            "; a policy returns world_T_hand poses [[R, p], [0, 0, 0, 1]]");
+    }
+  }
+  return chunk;
+}
+
 }  // namespace
 
 SeededPolicy::SeededPolicy(std::shared_ptr<const ChunkPolicy> policy) : policy_(std::move(policy)) {
@@ -54,19 +72,19 @@ std::vector<RigidTransform> SeededPolicy::act(const Scene& observation,
 Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options) {
   const Eigen::VectorXd noise = fixed_noise(policy.noise_dimension(), options.noise_seed);
-  const double relative = options.relative_tolerance;
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
-    detail::CaseOutcome outcome;
-    const std::vector<RigidTransform> g_a = moved_by(g, policy.act(scene, noise));
-    const std::vector<RigidTransform> a_g = policy.act(g * scene, noise);
-    outcome.witness.scene = scene;
-    outcome.witness.g = g;
-    outcome.witness.before = detail::flatten(g_a);
-    outcome.witness.after = detail::flatten(a_g);
-    outcome.witness.error = detail::chunk_distance(g_a, a_g);  // eq. (4)
-    outcome.witness.tolerance = pointwise_tolerance(scene, g * scene, relative);
-    outcome.holds = outcome.witness.error <= outcome.witness.tolerance;  // false for NaN
-    return outcome;
+    detail::PointwiseSides sides;
+    sides.compare = [&](const Scene& s, Witness& witness) {
+      const std::vector<RigidTransform> g_a = moved_by(g, checked_act(policy, s, noise));
+      const std::vector<RigidTransform> a_g = checked_act(policy, g * s, noise);
+      witness.before = detail::flatten(g_a);
+      witness.after = detail::flatten(a_g);
+      witness.error = detail::chunk_distance(g_a, a_g);  // eq. (4)
+    };
+    sides.response = [&](const Scene& a, const Scene& b) {
+      return detail::chunk_distance(checked_act(policy, a, noise), checked_act(policy, b, noise));
+    };
+    return detail::decide_pointwise(sides, scene, g, options);
   };
   return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,
                            options.cases, kShrinkBudget);
@@ -81,10 +99,10 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
     const Scene moved = g * scene;
     detail::NoisePair pair;
     pair.before = [&policy, &scene, g](const Eigen::VectorXd& noise) {
-      return flatten_affine(moved_by(g, policy.act(scene, noise)));
+      return flatten_affine(moved_by(g, checked_act(policy, scene, noise)));
     };
     pair.after = [&policy, &moved](const Eigen::VectorXd& noise) {
-      return flatten_affine(policy.act(moved, noise));
+      return flatten_affine(checked_act(policy, moved, noise));
     };
     pair.noise_dimension = policy.noise_dimension();
     pair.name = policy.name() + ": the chunk";

@@ -84,11 +84,23 @@ std::string format_witness(const Witness& witness) {
   out << (law ? "mean before: " : "before: ") << vector_text(witness.before) << "\n"
       << (law ? "mean after:  " : "after:  ") << vector_text(witness.after) << "\n";
   if (law) out << witness.detail << "\n";
-  out << "error " << format_number(witness.error);
   if (witness.p_value < 1.0) {
-    out << " (energy distance), p = " << format_number(witness.p_value);
-  } else {
-    out << " > tolerance " << format_number(witness.tolerance);
+    out << "energy distance " << format_number(witness.error)
+        << " (unitless statistic), permutation p = " << format_number(witness.p_value)
+        << " < level " << format_number(witness.tolerance);
+    return out.str();
+  }
+  out << "error " << format_number(witness.error) << " (largest difference; m, rad or the "
+      << "component's units) > tolerance " << format_number(witness.tolerance);
+  if (witness.length_scale > 0.0)
+    out << " = REL (1 + L) with L = " << format_number(witness.length_scale) << " m";
+  if (witness.rounding_response > 0.0) {
+    out << "\nthe map's own rounding response here: " << format_number(witness.rounding_response)
+        << " (its outputs' change when the inputs move by a few units of rounding)";
+  }
+  if (witness.off_case) {
+    out << "\nthis scene is the case drawn, moved off it by a small random amount: the "
+           "difference persists there, so it is no bin edge or rounding";
   }
   return out.str();
 }

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "handcentric/props/tolerance.hpp"
 #include "run_command.hpp"
 
 using namespace handcentric;
@@ -154,7 +155,7 @@ TEST_CASE("float32_rounding_is_named_and_precision_float32_accepts_it", "[unit]"
   for (const auto& check : loose.at("checks")) {
     INFO(check.dump());
     CHECK(check.at("invariant") == true);
-    CHECK(check.at("relative_tolerance") == 1e-4);
+    CHECK(check.at("relative_tolerance") == props::kFloat32RelativeTolerance);
   }
   // The same with the number itself.
   CHECK(audit_plugin(plugin, "--cases 30 --group rotation --tolerance 1e-4")
@@ -295,6 +296,15 @@ TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[
       test::run_command(test::cli() + " audit --repr hand_centric --cases 5 --expect hands:se3");
   CHECK(bad.exit_code == 1);
   CHECK_THAT(bad.err, Contains("'hands'"));
+  // A component the audit does not check (a policy has no actions): the hint names the
+  // component, not --group.
+  const auto wrong_component =
+      test::run_command(test::cli() + " audit --policy-exec '" +
+                        test::test_plugin("policy_hand_centric.py", "world_noise") +
+                        "' --cases 5 --group se3 --view eye_in_hand --expect actions:se3");
+  CHECK(wrong_component.exit_code == 1);
+  CHECK_THAT(wrong_component.err,
+             Contains("names the component 'actions'") && Contains("--expect policy:se3"));
 }
 
 TEST_CASE("audit_model_finds_a_trained_hand_centric_policy_equivariant_and_an_absolute_one_not",

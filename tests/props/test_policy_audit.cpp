@@ -4,9 +4,11 @@
 #include <catch2/catch.hpp>
 #include <memory>
 
+#include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/props/policy_audit.hpp"
 #include "handcentric/props/random_network.hpp"
+#include "handcentric/props/tolerance.hpp"
 #include "mutants.hpp"
 
 using namespace handcentric;
@@ -143,4 +145,28 @@ TEST_CASE("student_t_and_the_paired_mean_test", "[unit]") {
   CHECK(props::paired_mean_test(shifted, 1e-12) < 0.01);
   CHECK(props::paired_mean_test(Eigen::MatrixXd::Constant(4, 3, 0.2), 1e-12) ==
         0.0);  // a constant offset
+}
+
+TEST_CASE("a_chunk_pose_whose_rotation_block_is_not_a_rotation_stops_the_audit", "[unit]") {
+  // The planted fault: a decoder that returns 2 R instead of R. Its chunks cannot be compared as
+  // poses, so no verdict: an error naming the pose and the numbers.
+  class ScaledRotation final : public props::NoisyPolicy {
+   public:
+    std::string name() const override { return "scaled_rotation"; }
+    Eigen::Index noise_dimension() const override { return 1; }
+    std::vector<RigidTransform> act(const Scene& o, const Eigen::VectorXd&) const override {
+      const RigidTransform& T = o.world_T_hand0();
+      return {T, RigidTransform::unchecked(2.0 * T.rotation().matrix(), T.translation())};
+    }
+  };
+  props::CheckOptions options = props::eye_in_hand_options();
+  options.cases = 20;
+  for (Group group : {Group::translation, Group::se3}) {
+    CHECK_THROWS_WITH(props::check_policy_equivariance(ScaledRotation(), group, options),
+                      Catch::Contains("chunk pose 1 (T_2)") && Catch::Contains("not a rotation") &&
+                          Catch::Contains("det R = 8"));
+    CHECK_THROWS_AS(props::check_policy_distribution(ScaledRotation(), group, options),
+                    InvalidArgument);
+  }
+  CHECK(props::pose_defect(Eigen::Matrix4d::Identity()).empty());
 }

@@ -5,8 +5,22 @@
 // group (generators.hpp, edge cases included), and returns a Verdict (verdict.hpp) with a
 // shrunk witness when the check fails. Tolerances and the near-identity rule: tolerance.hpp.
 //
-// Errors thrown by the function under test (a handcentric::Error, e.g. a plug-in that stops
-// answering) are not counterexamples: the check stops and rethrows them.
+// How one case (s, g) is decided, with e the error between the two sides:
+//   1. e <= REL (1 + L), the floor (`relative_tolerance`): holds.
+//   2. else the map's own rounding: r = the largest change of either side's output when its
+//      scene's inputs move by a few units of rounding (rounding_perturbation, two draws per
+//      side). e <= 8 r with r <= sqrt(u) (1 + L): holds (the difference is the map's rounding).
+//   3. else the case is moved slightly off, s' = nearby_scene(s) (three draws), and g s' is
+//      compared with s'. If the difference vanishes on all three (below the floor or 8 r), the
+//      case sat on a discontinuity of the map, a bin edge where inputs 1e-15 apart fall into
+//      neighbouring bins: it holds and is counted (Verdict::discontinuities). If it persists on
+//      any, the case fails, and its witness is that off-edge scene s'.
+// A genuine symmetry breaking persists off the case and is far above the map's rounding, so it
+// fails at step 3; rounding and bin edges do not.
+//
+// Errors thrown by the function under test (a handcentric::Error, a Python exception, a plug-in
+// that stops answering) are not counterexamples: the check stops and rethrows them. A check
+// that ran no case with g far from the identity throws: a verdict needs evidence.
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
@@ -31,6 +45,13 @@ struct CheckOptions {
   /// The pointwise tolerance is relative_tolerance * (1 + L) (tolerance.hpp). 1e-9 suits double
   /// arithmetic; a policy computed in float needs ~1e-4.
   double relative_tolerance = kRelativeTolerance;
+  /// The unit roundoff of the arithmetic the map is computed in (2^-53 double, 2^-24 float32):
+  /// how far rounding_perturbation moves the inputs when a case is above the floor.
+  double unit_roundoff = kFloat64UnitRoundoff;
+  /// Scenes moved slightly off a case above the floor and the map's rounding, to tell a bin
+  /// edge from a symmetry breaking (step 3 above). 0 decides on steps 1 and 2 alone: then every
+  /// such case fails, bin edges included (a test's planted fault).
+  int off_case_draws = 3;
   /// Shrink a failing case to a small witness (false: keep the first failure as it was found,
   /// for a re-check that only needs the yes or no).
   bool shrink = true;

@@ -33,8 +33,8 @@ rc::Gen<Rotation> rotation_near_identity();
 rc::Gen<Eigen::Vector3d> translation(double max_abs);
 
 /// An element of `group`, including that group's edge cases (identity, tiny angles, angles near
-/// pi where the group has them, translations of 1e3 where it has translations). Translations
-/// are otherwise up to 10 (m) per coordinate.
+/// pi where the group has them, zero and 1e3 m translations where it has translations).
+/// Translations are otherwise of log-uniform length in [0.01, 10] m, in a uniform direction.
 rc::Gen<RigidTransform> group_element(Group group);
 
 /// Scene sizes.
@@ -52,9 +52,12 @@ struct SceneShape {
   std::vector<std::string> scalar_names;
 };
 
-/// A scene: a random start pose, a smooth but rotating chunk (constant twist per step with a
-/// random twist), a history the same way backwards, eye-in-hand and world points, and the
-/// extra poses and scalars the shape names.
+/// A scene at a length scale lambda drawn log-uniformly in [0.01, 10] m: a random start pose
+/// lambda from the origin, a smooth but rotating chunk (a constant random twist per step, up to
+/// 0.01 lambda and 0.3 rad per axis; one time in eight none, a hand at rest with T_k = T_0), a
+/// history the same way backwards, eye-in-hand points
+/// within 0.1 lambda and world points within lambda per coordinate, and the extra poses (within
+/// 10 m) and scalars the shape names.
 rc::Gen<Scene> scene(SceneShape shape = {});
 
 }  // namespace handcentric::props

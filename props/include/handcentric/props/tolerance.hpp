@@ -1,16 +1,23 @@
 #pragma once
-// Tolerances of the pointwise checks, and the near-identity rule (docs/AUDIT.md).
+// Tolerances of the pointwise checks, the scene perturbations that measure a map's own
+// rounding, and the near-identity rule (docs/AUDIT.md, "Tolerances and rounding").
 //
-// Rounding grows with the size of the numbers involved, so a pointwise check compares
-//   error = |f(g * s) - f(s)|_inf   against   tolerance = kRelativeTolerance * (1 + L)
+// Rounding grows with the size of the numbers involved, so a pointwise check first compares
+//   error = |f(g * s) - f(s)|_inf   against   floor = REL * (1 + L)
 // with L = the scene's length scale: the largest translation of any pose or point of s and of
 // g * s (in metres). 1e-9 is ~1e7 double epsilons: far above the rounding of the few products
 // a representation takes (~1e-13 at L = 1e3), far below any real symmetry breaking we know of.
+// An error above the floor is not yet a "NO": check.hpp compares it with the map's response to
+// a rounding-level perturbation of the same scenes (rounding_perturbation) and looks whether it
+// survives moving both scenes slightly off the case (nearby_scene): a bin edge does not.
 //
 // Near identity: a transform g with rotation angle + |p~| / (1 + L) below kNearIdentity moves
 // nothing measurably, so a case with such a g cannot show a symmetry. Such cases are still run
 // and must still pass (they catch NaNs and blow-ups at the identity), but they are not counted
 // in a verdict's cases, and a check holds only with at least one far case.
+#include <random>
+#include <string>
+
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/core/scene.hpp"
 
@@ -18,14 +25,35 @@ namespace handcentric::props {
 
 constexpr double kRelativeTolerance = 1e-9;
 
-// float32 rounding (`--precision float32`): 1e-4 is about 1700 units of float32 rounding
-// (2^-24 = 6e-8). A pose pipeline in float32 rounds its inputs and each of a few dozen products
-// at the scene's length scale (~1e-7 (1 + L) each); a rotation vector taken through acos near pi
-// loses up to sqrt(2^-24) = 2.4e-4 in the angle, which 1e-4 (1 + L) covers for L >= 1.4 m (the
-// audit's scenes start up to 17 m out). Real symmetry breaking in the audit's scenes is
-// O(0.01) and above, far over it.
-constexpr double kFloat32RelativeTolerance = 1e-4;
+// Unit roundoff of the arithmetic a map is computed in: what one rounding can do, relative.
+constexpr double kFloat64UnitRoundoff = 0x1p-53;
+constexpr double kFloat32UnitRoundoff = 0x1p-24;
+
+// The float32 floor (`--precision float32`): 64 units of float32 rounding, 3.8e-6 (1 + L). A pose
+// pipeline in float32 rounds its inputs and each of a few products at the scene's length scale
+// (~6e-8 (1 + L) each), which the floor covers; what rounds worse (a rotation vector through
+// acos near pi loses up to sqrt(2^-24) = 2.4e-4 rad, a network that amplifies its input's
+// rounding) is measured per case instead (check.hpp). The floor stays far below a task's
+// clearance (1 mm for the peg): a leak of 0.6 mm at L = 10 m is 14 times over it.
+constexpr double kFloat32RelativeTolerance = 64 * kFloat32UnitRoundoff;
 constexpr double kNearIdentity = 1e-6;
+
+// A case whose error is at most kRoundingMultiple times the map's measured response to a
+// rounding-level perturbation is rounding, provided that response is itself rounding-sized:
+// at most sqrt(u) (1 + L), the worst loss of a well-posed pose pipeline (acos near 0 or pi).
+constexpr double kRoundingMultiple = 8.0;
+// Units of rounding each input coordinate moves by in rounding_perturbation.
+constexpr double kRoundingPerturbationUlps = 4.0;
+
+/// How far a policy's output pose may be from a rigid transform: |R^T R - I|_max, |det R - 1|
+/// and the last row's distance from 0 0 0 1. 1e-5 is ~170 units of float32 rounding, which a
+/// float32 policy's rotations stay well within; a rotation block scaled or sheared by a bug is
+/// off by O(1).
+constexpr double kOutputPoseTolerance = 1e-5;
+
+/// Empty when M = [[R, p], [0, 0, 0, 1]] with R a rotation within kOutputPoseTolerance (and
+/// every entry finite); else one sentence with the offending numbers.
+std::string pose_defect(const Eigen::Matrix4d& M);
 
 /// L: the largest translation norm of any pose or point of the scene (0 for an empty scene).
 double length_scale(const Scene& scene);
@@ -34,6 +62,24 @@ double length_scale(const Scene& scene);
 /// options say otherwise (e.g. 1e-4 for a network computed in float).
 double pointwise_tolerance(const Scene& scene, const Scene& moved,
                            double relative = kRelativeTolerance);
+
+/// The largest response to rounding that still counts as rounding: sqrt(u) (1 + L).
+double rounding_cap(double unit_roundoff, double length_scale);
+
+/// How far nearby_scene moves a scene off a case, relative: max(1e-9, 1e3 u). Far above the
+/// rounding of g * s (a few u (1 + L)), so a case that sat on a bin edge leaves it on both
+/// sides alike; far below any feature a policy resolves (1e-9 m for double, 6e-5 for float32).
+double off_case_scale(double unit_roundoff);
+
+/// `scene` with every input moved by a few units of rounding: each translation and point
+/// coordinate x -> x (1 + 4 u xi) and each rotation R -> R exp(4 u omega) (xi = +-1, |omega| =
+/// 1, random), each scalar likewise. What the map does to it is its own rounding response.
+Scene rounding_perturbation(const Scene& scene, double unit_roundoff, std::mt19937_64& rng);
+
+/// `scene` moved slightly off: each pose T -> T exp(rho, omega) with |rho| = eta (1 + L(s)) and
+/// |omega| = eta, each point by eta (1 + L) and each scalar by eta max(1, |x|), in random
+/// directions. Applied before g, so g * nearby_scene(s) is the moved case.
+Scene nearby_scene(const Scene& scene, double eta, std::mt19937_64& rng);
 
 /// angle(R~) + |p~| / (1 + L(s)): how far g is from the identity, relative to the scene.
 double distance_from_identity(const RigidTransform& g, const Scene& scene);

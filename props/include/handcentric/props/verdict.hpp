@@ -56,9 +56,16 @@ struct Witness {
       after;           ///< f(g * scene)        (policy: a(g * o), flattened; exact law: its mean)
   double error = 0.0;  ///< |after - before|_inf; exact law: max(mean, covariance difference);
                        ///< energy test: the energy distance
-  double tolerance = 0.0;  ///< what error had to stay below (energy test: the level alpha)
-  double p_value = 1.0;    ///< energy test: the permutation p-value (else 1)
-  std::string detail;      ///< exact law: which moment differs and by how much
+  double tolerance = 0.0;     ///< what error had to stay below (energy test: the level alpha)
+  double length_scale = 0.0;  ///< L of the tolerance REL (1 + L): max(L(s), L(g s)), metres
+  /// pointwise: the largest change of either side under a rounding-level perturbation of its
+  /// inputs (check.hpp), 0 when the error was under the floor and it was not measured
+  double rounding_response = 0.0;
+  /// pointwise: the witness is a case moved slightly off the one drawn (check.hpp, step 3), the
+  /// difference having persisted there: a symmetry breaking, not a bin edge
+  bool off_case = false;
+  double p_value = 1.0;  ///< energy test: the permutation p-value (else 1)
+  std::string detail;    ///< exact law: which moment differs and by how much
 };
 
 struct Verdict {
@@ -72,6 +79,9 @@ struct Verdict {
   double min_p_value = 1.0;     ///< distribution mode: smallest p-value seen
   int cases = 0;                ///< cases run with g far from the identity (tolerance.hpp)
   int near_identity_cases = 0;  ///< cases run with g near the identity (run, not counted)
+  /// far cases where the two sides differed only at a discontinuity of the map (a bin edge):
+  /// the difference vanished when the case was moved slightly off it (check.hpp)
+  int discontinuities = 0;
   std::uint64_t seed = 0;
   double relative_tolerance = 0.0;  ///< the REL of the pointwise tolerance REL * (1 + L)
   /// energy_test "yes": the smallest mean shift (Euclidean norm, in the component's units) the
