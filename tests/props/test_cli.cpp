@@ -74,6 +74,14 @@ TEST_CASE("audit_errors_are_one_line_with_exit_code_1_and_usage_errors_exit_2", 
   CHECK(repr.exit_code == 1);
   CHECK_THAT(repr.err, Contains("'nope'"));
   CHECK(test::run_command(test::cli() + " audit --cases").exit_code == 2);
+  // Above props::kMaxCases (also past a 32-bit int): one line naming the value and the bound.
+  for (const std::string cases : {"10000001", "1099511627776"}) {
+    const auto many =
+        test::run_command(test::cli() + " audit --repr hand_centric --cases " + cases);
+    CHECK(many.exit_code == 1);
+    CHECK_THAT(many.err, Contains("--cases " + cases + " is above the bound 10000000"));
+    CHECK(many.err.find('\n') == many.err.size() - 1);
+  }
   CHECK(test::run_command(test::cli() + " audit --repr absolute --exec cat").exit_code == 2);
 }
 
