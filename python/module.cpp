@@ -551,6 +551,7 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
 
 props::ClassifierOptions classifier_for(const CommonOptions& o) {
   props::ClassifierOptions c = props::classifier_options(o.audit);
+  c.float32_advice = "pass precision=\"float32\"";
   c.check.shape.extra_pose_names = o.extra_poses;
   c.check.shape.scalar_names = o.scalars;
   return c;
@@ -568,8 +569,8 @@ std::string describe(const props::Verdict& v, const std::string& name, bool poli
   out << name << ": " << (policy ? "not equivariant" : to_string(v.component) + " not invariant")
       << " under " << props::to_string(v.group) << " (" << props::to_string(v.mode) << ", "
       << props::to_string(v.view) << ", " << props::to_string(v.method) << "); largest error "
-      << v.max_error << ", failed on far case " << v.cases << ", seed " << v.seed << ", tolerance "
-      << v.relative_tolerance << " (1 + L)\n";
+      << v.max_error << ", failed at case " << v.cases + v.near_identity_cases << ", seed "
+      << v.seed << ", tolerance " << v.relative_tolerance << " (1 + L)\n";
   if (!v.note.empty()) out << "  note: " << v.note << "\n";
   if (v.witness) {
     out << "  shrunk witness (poses as rotation vector r and translation p; before/after = "
@@ -709,21 +710,38 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
   props::ClassifierOptions c = classifier_for(o);
   c.in_distribution = mode != "pointwise";
-  props::Classification result =
-      props::classify_policy(std::make_shared<PythonPolicy>(policy, noise, extras), c);
+  const auto python_policy = std::make_shared<PythonPolicy>(policy, noise, extras);
+  props::Classification result = props::classify_policy(python_policy, c);
   if (mode == "distribution") {
     std::erase_if(result.verdicts,
                   [](const props::Verdict& v) { return v.mode != props::Mode::distribution; });
   }
-  const bool pointwise_failed = std::any_of(
-      result.verdicts.begin(), result.verdicts.end(),
-      [](const props::Verdict& v) { return !v.invariant && v.mode == props::Mode::pointwise; });
   std::string hint =
       "replay: the same call with seed=" + std::to_string(seed) + " finds the same witness";
-  if (pointwise_failed && mode == "pointwise") {
-    hint +=
-        "\nA policy equivariant only in law (e.g. noise added in the world frame) passes "
-        "mode='distribution'.";
+  // The hint that the policy may hold in law only where it does: each (group, view) that failed
+  // pointwise is checked in distribution (mode 'both' already did), and named if it holds there.
+  std::string in_law;
+  for (const props::Verdict& v : result.verdicts) {
+    if (v.invariant || v.mode != props::Mode::pointwise) continue;
+    bool holds = false;
+    if (const props::Verdict* law = props::find_verdict(
+            result, props::Component::policy, props::Mode::distribution, v.group, v.view)) {
+      holds = law->invariant;
+    } else {
+      props::CheckOptions check = props::with_view(c.check, v.view);
+      check.shrink = false;  // only the yes or no is wanted
+      holds = props::check_policy_distribution(*python_policy, v.group, check, c.distribution)
+                  .invariant;
+    }
+    if (holds) {
+      in_law += (in_law.empty() ? "" : ", ") + props::to_string(v.group) + " (" +
+                props::to_string(v.view) + ")";
+    }
+  }
+  if (!in_law.empty()) {
+    hint += "\nIn distribution (independent noise for o and g o) it holds for " + in_law +
+            ": equivariant in law but not pointwise (e.g. noise added in the world frame); "
+            "mode='distribution' asserts the law only.";
   }
   assert_all_hold(result, true, hint);
 }

@@ -201,3 +201,59 @@ def test_the_bounds_are_exported_and_their_edges_accepted():
         handcentric.audit(policies.hand_centric_actions, cases=10.5)
     with pytest.raises(ValueError, match="noise=0"):
         handcentric.audit_policy(make_policy(), noise=0)
+
+
+# ---------------------------------------------------------------------------------------------
+# Words
+
+def float32_policy():
+    good = make_policy()
+
+    def policy(history, hand_points, world_points, noise):
+        return good(history, hand_points, world_points, noise).astype(np.float32)
+
+    return policy
+
+
+def test_the_float32_note_names_the_python_argument():
+    with pytest.raises(AssertionError) as failure:
+        handcentric.assert_equivariant(float32_policy(), "rotation", cases=CASES,
+                                       views="eye_in_hand")
+    message = str(failure.value)
+    assert 'precision="float32"' in message and "--precision" not in message, message
+    result = handcentric.audit_policy(float32_policy(), groups="rotation", views="eye_in_hand",
+                                      cases=CASES)
+    notes = [c["note"] for c in result["checks"] if "note" in c]
+    assert notes and all('precision="float32"' in n for n in notes), notes
+
+
+def test_the_in_law_hint_appears_only_when_the_law_holds():
+    # world_noise fails pointwise under rotation but holds in distribution: the hint says so.
+    with pytest.raises(AssertionError) as failure:
+        handcentric.assert_equivariant(make_policy("world_noise"), "rotation", cases=CASES,
+                                       views="eye_in_hand")
+    assert "mode='distribution'" in str(failure.value)
+    # forgets_T0 fails under translation in both modes: no hint that would send the reader to a
+    # mode that fails too.
+    with pytest.raises(AssertionError) as failure:
+        handcentric.assert_equivariant(make_policy("forgets_T0"), "translation", cases=CASES,
+                                       views="eye_in_hand")
+    message = str(failure.value)
+    assert "not equivariant under translation" in message
+    assert "mode='distribution'" not in message and "in law" not in message, message
+
+
+def test_a_failing_cell_says_on_which_case_it_failed():
+    result = handcentric.audit_policy(make_policy("world_noise"), groups=("translation",
+                                                                          "rotation"),
+                                      views="eye_in_hand", cases=CASES)
+    for check in result["checks"]:
+        if check["equivariant"]:
+            assert check["failed_at_case"] is None
+        else:
+            assert check["failed_at_case"] == check["cases"] + check["near_identity_cases"]
+            assert check["failed_at_case"] >= 1
+    representation = handcentric.audit(policies.absolute_actions, groups="rotation",
+                                       views="eye_in_hand", cases=CASES)
+    failing = [c for c in representation["checks"] if not c["invariant"]]
+    assert failing and all(c["failed_at_case"] >= 1 for c in failing)
