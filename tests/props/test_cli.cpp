@@ -93,6 +93,9 @@ TEST_CASE("main_report_opens_with_the_audit_summary_and_matches_the_paper", "[un
                              Contains("hand_centric") && Contains("actionflow") &&
                              Contains("Every cell matches App. A"));
   CHECK(result.out.find("witness:") == std::string::npos);
+  const auto many = test::run_command(test::cli() + " report --cases 1099511627776");
+  CHECK(many.exit_code == 1);
+  CHECK_THAT(many.err, Contains("--cases 1099511627776 is above the bound 10000000"));
   const auto human =
       test::run_command(test::cli() + " audit --repr absolute --group c8 --cases 50");
   CHECK(human.exit_code == 0);
