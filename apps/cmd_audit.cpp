@@ -30,7 +30,7 @@ struct AuditCommandOptions {
   std::vector<std::string> representations;
   std::string group = "all";
   std::string view = "all";
-  int cases = props::kDefaultCases;
+  long long cases = props::kDefaultCases;  // wide: a value past the bound is named, not wrapped
   std::uint64_t seed = 1;
   double timeout = 10.0;
   double tolerance = 0.0;
@@ -158,7 +158,7 @@ int run_audit(const AuditCommandOptions& options) {
   props::AuditOptions audit;
   audit.groups = parse_groups(options.group);
   audit.views = parse_views(options.view);
-  audit.cases = options.cases;
+  audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
   audit.seed = options.seed;
   audit.precision = props::parse_precision(options.precision);
   audit.relative_tolerance = options.tolerance;
@@ -247,7 +247,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
          "move with g) or all")
       ->capture_default_str();
   cmd->add_option("--cases", options->cases,
-                  "cases per pointwise check (in distribution: max(10, cases/100))")
+                  "cases per pointwise check, at most 10^7 (in distribution: max(10, cases/100))")
       ->capture_default_str();
   cmd->add_option("--seed", options->seed,
                   "RapidCheck seed: the same seed gives the same cases and witnesses")

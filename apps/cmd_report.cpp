@@ -27,7 +27,7 @@ namespace handcentric::apps {
 
 int run_audit_section(std::ostream& out, const ReportOptions& options) {
   props::AuditOptions audit;
-  audit.cases = options.cases;
+  audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
   audit.seed = options.seed;
   const props::ClassifierOptions used = props::classifier_options(audit);  // validates --cases
   out << "1. Audit of the built-in representations (handcentric audit; witnesses there)\n"
@@ -206,6 +206,7 @@ void add_report_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--jobs", page->jobs, "with --out: trainings at once (0: one per core)")
       ->capture_default_str();
   cmd->callback([options, page, &exit_code] {
+    (void)props::checked_cases(options->cases);  // before any work: one line, exit 1
     exit_code = page->out.empty() ? run_main_report(std::cout, *options)
                                   : write_report_page(*options, *page);
   });

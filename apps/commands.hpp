@@ -15,7 +15,7 @@ namespace handcentric::apps {
 
 /// What `handcentric report` lets a user set (plain `handcentric` uses the defaults).
 struct ReportOptions {
-  int cases = 1000;        ///< cases per pointwise cell of the audit section
+  long long cases = 1000;  ///< cases per pointwise cell of the audit section (1 to 10^7)
   std::uint64_t seed = 1;  ///< seed of the audit section
 };
 

@@ -10,6 +10,13 @@
 // holding the Python exception) and restored, traceback included, once the C++ call returns.
 // A result of the wrong shape or dtype stops the audit with ShapeError / DtypeError naming what
 // was returned and what was expected. The GIL is held throughout: the checks are sequential.
+//
+// No verdict without evidence. The audits need NumPy to build the callables' arguments: without
+// it they raise ImportError at once, naming the interpreter and the fix, instead of checking
+// anything. Ctrl-C: a signal reaches Python only when PyErr_CheckSignals() runs, so every call
+// of a callable checks first, and a pending KeyboardInterrupt stops the check as the callable's
+// own exception would. cases and noise are read as Python integers and refused above
+// props::kMaxCases and props::kMaxPolicyNoise (the CLI's bounds) with a one-line ValueError.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -252,10 +259,13 @@ py::kwargs extras_kwargs(const Scene& scene, bool wanted) {
   return kw;
 }
 
-/// Calls fn; a Python exception leaves as PythonCallError (see the top of this file).
+/// Calls fn; a Python exception leaves as PythonCallError (see the top of this file), and so
+/// does a KeyboardInterrupt (or any exception a signal handler raises) pending before the call:
+/// a callable written in C runs no Python code that would notice it.
 template <class... Args>
 py::object call(const py::object& fn, Args&&... args) {
   try {
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     return fn(std::forward<Args>(args)...);
   } catch (py::error_already_set& e) {
     throw PythonCallError(std::move(e));
@@ -298,12 +308,18 @@ class Cache {
     return hit == map_.end() ? nullptr : &hit->second;
   }
   const Value& put(std::string key, Value value) {
-    if (map_.size() > 200000) map_.clear();
+    // By count and by key bytes: a policy's key holds its noise vector (up to 512 KiB).
+    if (map_.size() > 200000 || key_bytes_ > (std::size_t{256} << 20)) {
+      map_.clear();
+      key_bytes_ = 0;
+    }
+    key_bytes_ += key.size();
     return map_.insert_or_assign(std::move(key), std::move(value)).first->second;
   }
 
  private:
   std::unordered_map<std::string, Value> map_;
+  std::size_t key_bytes_ = 0;
 };
 
 /// A representation written in Python: actions(history, chunk, hand_points, world_points) and,
@@ -456,19 +472,68 @@ std::vector<props::View> views_of(py::handle value) {
   return out;
 }
 
+/// ImportError, at once, unless NumPy imports: every argument of a callable under audit is a
+/// NumPy array, and without NumPy no case could run (an audit used to report every cell failed
+/// on 0 cases then).
+void require_numpy(const char* function) {
+  static bool found = false;
+  if (found) return;
+  try {
+    (void)py::module_::import("numpy");
+    found = true;
+  } catch (py::error_already_set& e) {
+    const std::string why = py::str(e.value());
+    const std::string executable = py::str(py::module_::import("sys").attr("executable"));
+    const std::string message =
+        "handcentric." + std::string(function) + " needs NumPy, which the interpreter " +
+        executable + " cannot import (" + why +
+        "); nothing was checked. Debian: apt-get install python3-numpy and run /usr/bin/python3 "
+        "(without -S); in a venv: pip install numpy";
+    py::raise_from(e, PyExc_ImportError, message.c_str());
+    throw py::error_already_set();
+  }
+}
+
+/// `value` (a Python int of any size, or anything with __index__ such as a NumPy integer) in
+/// [low, high]: TypeError for a non-integer, a one-line ValueError naming the value and the
+/// bound otherwise, before anything is converted to a C++ int or allocated.
+int bounded_integer(py::handle value, const char* name, long long low, long long high,
+                    const char* bound) {
+  if (!PyIndex_Check(value.ptr()))
+    throw DtypeError(std::string(name) + " must be an integer, got a " + type_name(value));
+  const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long x = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow == 0 && x >= low && x <= high) return static_cast<int>(x);
+  const std::string text = std::string(name) + "=" + std::string(py::str(index));
+  if (overflow < 0 || (overflow == 0 && x < low))
+    throw InvalidArgument(text + " is below the least value, " + std::to_string(low));
+  throw InvalidArgument(text + " is above the bound " + bound + " = " + std::to_string(high) +
+                        " (docs/AUDIT_YOUR_POLICY.md says why)");
+}
+
+int cases_of(py::handle cases) {
+  return bounded_integer(cases, "cases", 1, props::kMaxCases, "handcentric.MAX_CASES");
+}
+
+int noise_of(py::handle noise) {
+  return bounded_integer(noise, "noise", 1, props::kMaxPolicyNoise, "handcentric.MAX_NOISE");
+}
+
 struct CommonOptions {
   props::AuditOptions audit;
   std::vector<std::string> extra_poses, scalars;
 };
 
-CommonOptions common_options(py::handle groups, py::handle views, int cases, std::uint64_t seed,
-                             std::optional<double> tolerance, const std::string& precision,
-                             py::handle extra_poses, py::handle scalars) {
+CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
+                             std::uint64_t seed, std::optional<double> tolerance,
+                             const std::string& precision, py::handle extra_poses,
+                             py::handle scalars) {
   CommonOptions o;
+  o.audit.cases = cases_of(cases);
   o.audit.groups = groups_of(groups);
   o.audit.views = views_of(views);
-  if (cases < 1) throw InvalidArgument("cases must be at least 1, got " + std::to_string(cases));
-  o.audit.cases = cases;
   o.audit.seed = seed;
   o.audit.precision = props::parse_precision(precision);
   if (tolerance) {
@@ -486,6 +551,7 @@ CommonOptions common_options(py::handle groups, py::handle views, int cases, std
 
 props::ClassifierOptions classifier_for(const CommonOptions& o) {
   props::ClassifierOptions c = props::classifier_options(o.audit);
+  c.float32_advice = "pass precision=\"float32\"";
   c.check.shape.extra_pose_names = o.extra_poses;
   c.check.shape.scalar_names = o.scalars;
   return c;
@@ -503,8 +569,8 @@ std::string describe(const props::Verdict& v, const std::string& name, bool poli
   out << name << ": " << (policy ? "not equivariant" : to_string(v.component) + " not invariant")
       << " under " << props::to_string(v.group) << " (" << props::to_string(v.mode) << ", "
       << props::to_string(v.view) << ", " << props::to_string(v.method) << "); largest error "
-      << v.max_error << ", failed on far case " << v.cases << ", seed " << v.seed << ", tolerance "
-      << v.relative_tolerance << " (1 + L)\n";
+      << v.max_error << ", failed at case " << v.cases + v.near_identity_cases << ", seed "
+      << v.seed << ", tolerance " << v.relative_tolerance << " (1 + L)\n";
   if (!v.note.empty()) out << "  note: " << v.note << "\n";
   if (v.witness) {
     out << "  shrunk witness (poses as rotation vector r and translation p; before/after = "
@@ -546,9 +612,10 @@ props::Component component_of(const std::string& name) {
 // The module's functions
 
 py::dict audit(py::object actions, py::object observation, py::handle groups, py::handle views,
-               int cases, std::uint64_t seed, std::optional<double> tolerance,
+               py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
                const std::string& precision, py::object decode, py::handle extra_poses,
                py::handle scalars) {
+  require_numpy("audit");
   if (!PyCallable_Check(actions.ptr()))
     throw DtypeError("actions must be callable, got a " + type_name(actions));
   for (const auto& [what, fn] :
@@ -568,15 +635,14 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
   return json_loads(props::audit_json({result}))["representations"][py::int_(0)];
 }
 
-py::dict audit_policy(py::object policy, py::handle groups, py::handle views, int cases,
+py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py::handle cases,
                       std::uint64_t seed, std::optional<double> tolerance,
-                      const std::string& precision, int noise, py::handle extra_poses,
+                      const std::string& precision, py::handle noise_length, py::handle extra_poses,
                       py::handle scalars) {
+  require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
-  if (noise < 1)
-    throw InvalidArgument("noise must be at least 1 (numbers per call), got " +
-                          std::to_string(noise));
+  const int noise = noise_of(noise_length);
   const CommonOptions o =
       common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
@@ -586,9 +652,10 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, in
 }
 
 void assert_invariant(py::object fn, const std::string& group, const std::string& component_name,
-                      py::object observation, py::handle views, int cases, std::uint64_t seed,
-                      std::optional<double> tolerance, const std::string& precision,
-                      py::handle extra_poses, py::handle scalars) {
+                      py::object observation, py::handle views, py::handle cases,
+                      std::uint64_t seed, std::optional<double> tolerance,
+                      const std::string& precision, py::handle extra_poses, py::handle scalars) {
+  require_numpy("assert_invariant");
   if (!PyCallable_Check(fn.ptr())) throw DtypeError("fn must be callable, got a " + type_name(fn));
   const props::Component component = component_of(component_name);
   const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
@@ -626,14 +693,13 @@ void assert_invariant(py::object fn, const std::string& group, const std::string
 }
 
 void assert_equivariant(py::object policy, const std::string& group, const std::string& mode,
-                        py::handle views, int cases, std::uint64_t seed,
-                        std::optional<double> tolerance, const std::string& precision, int noise,
-                        py::handle extra_poses, py::handle scalars) {
+                        py::handle views, py::handle cases, std::uint64_t seed,
+                        std::optional<double> tolerance, const std::string& precision,
+                        py::handle noise_length, py::handle extra_poses, py::handle scalars) {
+  require_numpy("assert_equivariant");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
-  if (noise < 1)
-    throw InvalidArgument("noise must be at least 1 (numbers per call), got " +
-                          std::to_string(noise));
+  const int noise = noise_of(noise_length);
   if (mode != "pointwise" && mode != "distribution" && mode != "both") {
     throw InvalidArgument("unknown mode '" + mode +
                           "'; use pointwise (the same noise for o and g o), "
@@ -644,21 +710,38 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
   const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
   props::ClassifierOptions c = classifier_for(o);
   c.in_distribution = mode != "pointwise";
-  props::Classification result =
-      props::classify_policy(std::make_shared<PythonPolicy>(policy, noise, extras), c);
+  const auto python_policy = std::make_shared<PythonPolicy>(policy, noise, extras);
+  props::Classification result = props::classify_policy(python_policy, c);
   if (mode == "distribution") {
     std::erase_if(result.verdicts,
                   [](const props::Verdict& v) { return v.mode != props::Mode::distribution; });
   }
-  const bool pointwise_failed = std::any_of(
-      result.verdicts.begin(), result.verdicts.end(),
-      [](const props::Verdict& v) { return !v.invariant && v.mode == props::Mode::pointwise; });
   std::string hint =
       "replay: the same call with seed=" + std::to_string(seed) + " finds the same witness";
-  if (pointwise_failed && mode == "pointwise") {
-    hint +=
-        "\nA policy equivariant only in law (e.g. noise added in the world frame) passes "
-        "mode='distribution'.";
+  // The hint that the policy may hold in law only where it does: each (group, view) that failed
+  // pointwise is checked in distribution (mode 'both' already did), and named if it holds there.
+  std::string in_law;
+  for (const props::Verdict& v : result.verdicts) {
+    if (v.invariant || v.mode != props::Mode::pointwise) continue;
+    bool holds = false;
+    if (const props::Verdict* law = props::find_verdict(
+            result, props::Component::policy, props::Mode::distribution, v.group, v.view)) {
+      holds = law->invariant;
+    } else {
+      props::CheckOptions check = props::with_view(c.check, v.view);
+      check.shrink = false;  // only the yes or no is wanted
+      holds = props::check_policy_distribution(*python_policy, v.group, check, c.distribution)
+                  .invariant;
+    }
+    if (holds) {
+      in_law += (in_law.empty() ? "" : ", ") + props::to_string(v.group) + " (" +
+                props::to_string(v.view) + ")";
+    }
+  }
+  if (!in_law.empty()) {
+    hint += "\nIn distribution (independent noise for o and g o) it holds for " + in_law +
+            ": equivariant in law but not pointwise (e.g. noise added in the world frame); "
+            "mode='distribution' asserts the law only.";
   }
   assert_all_hold(result, true, hint);
 }
@@ -717,6 +800,8 @@ PYBIND11_MODULE(handcentric, m) {
   m.attr("GROUPS") = all_groups;
   m.attr("VIEWS") = both_views;
   m.attr("REPRESENTATIONS") = py::cast(builtin_representation_names());
+  m.attr("MAX_CASES") = props::kMaxCases;        // cases= above it: ValueError
+  m.attr("MAX_NOISE") = props::kMaxPolicyNoise;  // noise= above it: ValueError
 
   m.def("audit", &audit, py::arg("actions"), py::arg("observation") = py::none(),
         py::arg("groups") = all_groups, py::arg("views") = both_views,
@@ -734,7 +819,8 @@ observation(history, hand_points, world_points) -> 1-D array (optional).
 decode(actions, history, hand_points, world_points) -> (K, 4, 4) (optional: lets the audit
 prove the map injective). The flow components are the rectified flow's (eq. 5).
 With extra_poses / scalars (names), every callable also gets extra_poses={name: (4, 4)},
-scalars={name: x}.)doc");
+scalars={name: x}. cases: 1 to MAX_CASES (10**7). Needs NumPy (ImportError at once without it);
+Ctrl-C stops it with KeyboardInterrupt.)doc");
 
   m.def("audit_policy", &audit_policy, py::arg("policy"), py::arg("groups") = all_groups,
         py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
@@ -746,7 +832,7 @@ scalars={name: x}.)doc");
 Returns one policy of `audit --json`.
 policy(history, hand_points, world_points, noise) -> (K, 4, 4), the world-frame chunk
 T_1..T_K; noise is a float64 vector of `noise` standard normals and must be the policy's only
-randomness.)doc");
+randomness. cases: 1 to MAX_CASES (10**7); noise: 1 to MAX_NOISE (65536).)doc");
 
   m.def("assert_invariant", &assert_invariant, py::arg("fn"), py::arg("group"),
         py::arg("component") = "actions", py::kw_only(), py::arg("observation") = py::none(),

@@ -61,6 +61,16 @@ Precision parse_precision(const std::string& name) {
   throw InvalidArgument("unknown --precision '" + name + "'; use float64 (the default) or float32");
 }
 
+int checked_cases(long long cases) {
+  if (cases < 1) throw InvalidArgument("--cases must be at least 1, got " + std::to_string(cases));
+  if (cases > kMaxCases) {
+    throw InvalidArgument("--cases " + std::to_string(cases) + " is above the bound " +
+                          std::to_string(kMaxCases) +
+                          " (10^7 cases already take hours per cell through a plug-in)");
+  }
+  return static_cast<int>(cases);
+}
+
 double audit_relative_tolerance(const AuditOptions& options) {
   const double relative = options.relative_tolerance;
   if (!(relative >= 0.0 && relative < 1.0)) {
@@ -72,9 +82,7 @@ double audit_relative_tolerance(const AuditOptions& options) {
 }
 
 ClassifierOptions classifier_options(const AuditOptions& options) {
-  if (options.cases < 1) {
-    throw InvalidArgument("--cases must be at least 1, got " + std::to_string(options.cases));
-  }
+  (void)checked_cases(options.cases);
   if (options.views.empty() || options.groups.empty()) {
     throw InvalidArgument("an audit needs at least one view and one group");
   }

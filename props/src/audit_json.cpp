@@ -34,6 +34,13 @@ nlohmann::json number_or_inf(double x) {
   return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json("inf");
 }
 
+// A failing check: the number of the case (from 1, near-identity ones included) on which the
+// search first failed, before shrinking; `cases` counts the far cases up to it. null when no
+// case failed.
+nlohmann::json failed_at_case(const Verdict& v) {
+  return v.witness ? nlohmann::json(v.cases + v.near_identity_cases) : nlohmann::json(nullptr);
+}
+
 // A scene as the --exec protocol sends it (extra poses and scalars only when it has them).
 nlohmann::json scene_json(const Scene& scene) {
   nlohmann::json history = nlohmann::json::array(), chunk = nlohmann::json::array();
@@ -133,6 +140,7 @@ std::string audit_json(const std::vector<Classification>& classifications) {
           {"max_error", number_or_inf(v.max_error)},
           {"cases", v.cases},
           {"near_identity_cases", v.near_identity_cases},
+          {"failed_at_case", failed_at_case(v)},
           {"seed", v.seed},
           {"relative_tolerance", v.relative_tolerance},
           {"witness", v.witness ? witness_json(*v.witness, v.method) : nlohmann::json(nullptr)},
@@ -177,6 +185,7 @@ std::string policy_audit_json(const std::vector<Classification>& policies) {
           {"max_error", number_or_inf(v.max_error)},
           {"cases", v.cases},
           {"near_identity_cases", v.near_identity_cases},
+          {"failed_at_case", failed_at_case(v)},
           {"seed", v.seed},
           {"relative_tolerance", v.relative_tolerance},
           {"witness", v.witness ? witness_json(*v.witness, v.method) : nlohmann::json(nullptr)},

@@ -321,10 +321,10 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     capabilities.flow = read_flag(hello, "flow", id, who);
     if (hello.contains("noise") && !hello["noise"].is_null()) {
       if (!hello["noise"].is_number_integer() || hello["noise"].get<long long>() < 1 ||
-          hello["noise"].get<long long>() > 1000000) {
+          hello["noise"].get<long long>() > kMaxPolicyNoise) {
         throw PluginError(reply_to(who, id) + " with a hello whose \"noise\" is " +
-                          one_line(hello["noise"].dump(), 40) +
-                          ", not a length between 1 and 1000000");
+                          one_line(hello["noise"].dump(), 40) + ", not a length between 1 and " +
+                          std::to_string(kMaxPolicyNoise));
       }
       capabilities.noise = hello["noise"].get<int>();
     }

@@ -75,6 +75,14 @@ TEST_CASE("audit_errors_are_one_line_with_exit_code_1_and_usage_errors_exit_2", 
   CHECK(repr.exit_code == 1);
   CHECK_THAT(repr.err, Contains("'nope'"));
   CHECK(test::run_command(test::cli() + " audit --cases").exit_code == 2);
+  // Above props::kMaxCases (also past a 32-bit int): one line naming the value and the bound.
+  for (const std::string cases : {"10000001", "1099511627776"}) {
+    const auto many =
+        test::run_command(test::cli() + " audit --repr hand_centric --cases " + cases);
+    CHECK(many.exit_code == 1);
+    CHECK_THAT(many.err, Contains("--cases " + cases + " is above the bound 10000000"));
+    CHECK(many.err.find('\n') == many.err.size() - 1);
+  }
   CHECK(test::run_command(test::cli() + " audit --repr absolute --exec cat").exit_code == 2);
 }
 
@@ -86,6 +94,9 @@ TEST_CASE("main_report_opens_with_the_audit_summary_and_matches_the_paper", "[un
                              Contains("hand_centric") && Contains("actionflow") &&
                              Contains("Every cell matches App. A"));
   CHECK(result.out.find("witness:") == std::string::npos);
+  const auto many = test::run_command(test::cli() + " report --cases 1099511627776");
+  CHECK(many.exit_code == 1);
+  CHECK_THAT(many.err, Contains("--cases 1099511627776 is above the bound 10000000"));
   const auto human =
       test::run_command(test::cli() + " audit --repr absolute --group c8 --cases 50");
   CHECK(human.exit_code == 0);

@@ -142,6 +142,13 @@ TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
   CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"protocol": 4294967298}})", 0,
                                        RequestKind::encode, who, true),
                     Contains("protocol 4294967298"));
+  // A noise length past props::kMaxPolicyNoise is refused (it would be allocated per request).
+  CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"protocol": 2, "noise": 65537}})", 0,
+                                       RequestKind::policy, who, true),
+                    Contains("\"noise\" is 65537, not a length between 1 and 65536"));
+  CHECK(props::parse_reply(R"({"id": 0, "hello": {"protocol": 2, "noise": 65536}})", 0,
+                           RequestKind::policy, who, true)
+            .hello->noise == 65536);
   CHECK_THROWS_WITH(props::parse_reply(R"({"id": 0, "hello": {"scalars": [1]}})", 0,
                                        RequestKind::encode, who, true),
                     Contains("not a name"));

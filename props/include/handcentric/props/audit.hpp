@@ -29,6 +29,10 @@ struct AuditOptions {
   double relative_tolerance = 0.0;
 };
 
+/// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value
+/// and the bound, in one line. Wide enough to take an unchecked command-line number.
+int checked_cases(long long cases);
+
 /// The REL an audit uses: options.relative_tolerance if set, else the precision's. Throws
 /// InvalidArgument for a negative, non-finite or >= 1 tolerance.
 double audit_relative_tolerance(const AuditOptions& options);

@@ -37,6 +37,9 @@ struct ClassifierOptions {
   /// When a cell fails at a tolerance below float32 rounding, re-check it at
   /// kFloat32RelativeTolerance and say in the verdict's note if it would pass there.
   bool float32_note = true;
+  /// The advice that ends the float32 note, in the caller's words (the Python module says
+  /// precision="float32").
+  std::string float32_advice = "rerun with --precision float32";
 };
 
 struct Classification {

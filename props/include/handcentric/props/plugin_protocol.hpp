@@ -41,6 +41,12 @@ struct PluginCapabilities {
 
 /// The noise a policy request carries unless the plug-in's hello asks for another length.
 constexpr int kPolicyNoise = 256;
+/// The longest noise vector a policy may read (a plug-in's hello "noise", the Python module's
+/// noise=); a longer one is refused with an error naming it. 65536 numbers cover a sampler that
+/// draws fresh noise at every step (100 DDPM steps x 16 poses x 10 numbers = 16000) four times
+/// over, while the in-distribution check's Jacobian of a chunk of K poses, 12 K x noise
+/// doubles, stays at 100 MB for K = 16 (a length of 10^9 would ask for 8 GB per vector).
+constexpr int kMaxPolicyNoise = 65536;
 
 /// The noise and time of a flow request.
 struct FlowQuery {

@@ -21,6 +21,13 @@ namespace handcentric::props {
 constexpr std::uint64_t kDefaultSeed = 20261121;
 /// Cases per property unless RC_PARAMS sets max_success (RapidCheck's own default is 100).
 constexpr int kDefaultCases = 1000;
+/// The most cases an audit's check accepts (`handcentric audit --cases`, `report --cases`, the
+/// Python module's cases=): a larger value is refused with an error naming it. 10^7 cases take
+/// minutes per cell in C++ and hours through a Python callable (two calls per case), which is
+/// past any audit a person or a CI job waits for; and the counts derived from it (cases / 100
+/// in distribution, cases / 5 injectivity pairs, RapidCheck's int counters) stay far from
+/// overflow.
+constexpr int kMaxCases = 10'000'000;
 
 struct PropertyOutcome {
   bool passed = false;
