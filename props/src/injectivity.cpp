@@ -308,8 +308,11 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
   }
   const std::string resolution_text =
       result.resolution ? format_resolution(*result.resolution, result.resolution_unit) : "";
-  const std::string pairs_text = std::to_string(result.cases) + " chunk pairs and " +
-                                 std::to_string(scan_pairs) + " resolution pairs";
+  // Rounding-level collisions (below kSmallestLoss) are named after the verdict.
+  const std::string no_collision =
+      "no collision among " + std::to_string(result.cases) + " chunk pairs and " +
+      std::to_string(scan_pairs) + " resolution pairs" +
+      (result.resolution ? " at changes of " + format_number(kSmallestLoss) + " or more" : "");
 
   if (result.collision) {
     result.injective = false;
@@ -327,10 +330,9 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
   } else if (decodes && !result.round_trip_failure && result.round_trips > 0) {
     result.injective = true;
     result.how = "decode(encode(s)) gave back the chunk on all " +
-                 std::to_string(result.round_trips) + " scenes, and none of " + pairs_text +
-                 " collided";
+                 std::to_string(result.round_trips) + " scenes, and " + no_collision;
   } else {
-    result.how = "none of " + pairs_text + " collided, but " +
+    result.how = no_collision + ", but " +
                  (decodes ? "decode(encode(s)) did not give back the chunk (see round_trip_failure)"
                           : "without a decoder that cannot prove the map injective");
   }
