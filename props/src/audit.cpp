@@ -176,10 +176,24 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
     }
     if (const auto& injectivity = classification.injectivity) {
       if (injectivity->injective == false) {
-        out << "  !!! NOT INJECTIVE: " << injectivity->how
-            << ". Its invariances say nothing useful: a policy "
-            << "trained on it cannot tell these chunks apart.\n"
-            << indent(format_collision(*injectivity->collision), "      ");
+        out << "  !!! NOT INJECTIVE";
+        if (injectivity->collision->search == "resolution") {
+          // Lost below a resolution (a tokenizer, voxels): name it in its unit, both units when
+          // both lose information.
+          out << " below "
+              << format_resolution(*injectivity->resolution, injectivity->resolution_unit);
+          const bool metres = injectivity->resolution_unit == "m";
+          const std::optional<double>& other =
+              metres ? injectivity->rotation_resolution : injectivity->translation_resolution;
+          if (other && *other >= kSmallestLoss)
+            out << " and " << format_resolution(*other, metres ? "rad" : "m");
+          out << ": chunks that differ by less can collide (here " << injectivity->collision->change
+              << " gave the same actions), so a policy trained on it cannot tell them apart.\n";
+        } else {
+          out << ": " << injectivity->how << ". Its invariances say nothing useful: a policy "
+              << "trained on it cannot tell these chunks apart.\n";
+        }
+        out << indent(format_collision(*injectivity->collision), "      ");
       } else {
         out << "  injective: " << (injectivity->injective ? "yes" : "not decided") << " ("
             << injectivity->how << ")\n";

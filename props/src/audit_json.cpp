@@ -94,6 +94,21 @@ nlohmann::json injectivity_json(const Injectivity& injectivity) {
                         {"round_trips", injectivity.round_trips},
                         {"collision", nullptr},
                         {"round_trip_failure", nullptr}};
+  const auto number_or_null = [](const std::optional<double>& x) {
+    return x ? nlohmann::json(*x) : nlohmann::json(nullptr);
+  };
+  out["resolution"] = number_or_null(injectivity.resolution);
+  out["resolution_unit"] = injectivity.resolution ? nlohmann::json(injectivity.resolution_unit)
+                                                  : nlohmann::json(nullptr);
+  out["translation_resolution"] = number_or_null(injectivity.translation_resolution);
+  out["rotation_resolution"] = number_or_null(injectivity.rotation_resolution);
+  out["smallest_loss"] = kSmallestLoss;
+  nlohmann::json scales = nlohmann::json::array();
+  for (const ScaleCollisions& s : injectivity.scales) {
+    scales.push_back(
+        {{"scale", s.scale}, {"unit", s.unit}, {"pairs", s.pairs}, {"collisions", s.collisions}});
+  }
+  out["scales"] = scales;
   if (const auto& c = injectivity.collision) {
     out["collision"] = {{"first", scene_json(c->first)},
                         {"second", scene_json(c->second)},
@@ -101,7 +116,9 @@ nlohmann::json injectivity_json(const Injectivity& injectivity) {
                         {"actions_second", numbers(c->actions_second)},
                         {"chunk_distance", c->chunk_distance},
                         {"action_distance", c->action_distance},
-                        {"tolerance", c->tolerance}};
+                        {"tolerance", c->tolerance},
+                        {"change", c->change},
+                        {"search", c->search}};
   }
   if (const auto& r = injectivity.round_trip_failure) {
     nlohmann::json decoded = nlohmann::json::array();

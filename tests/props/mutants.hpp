@@ -3,6 +3,8 @@
 // run on one of these and must fail there.
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -181,6 +183,81 @@ class Float32HandCentric final : public Representation {
   std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
                                              const RigidTransform& world_T_hand0) const override {
     return HandCentricRepresentation().decode_actions(a, world_T_hand0);
+  }
+};
+
+/// A 256-bin action tokenizer (RT-1 / OpenVLA style) on the hand-centric pose T_0^{-1} T_k: each
+/// translation coordinate binned over [-1, 1] m, each rotation-vector coordinate over [-pi, pi],
+/// clamped at the ends. Bins of 2 m / 256 = 7.8 mm and 2 pi / 256 = 0.025 rad: not injective
+/// below them, and not at all beyond 1 m. Decodes to bin centres (which does not invert it).
+class Tokenizer256 final : public Representation {
+ public:
+  static constexpr int kBins = 256;
+  static constexpr double kPi = 3.141592653589793;
+  std::string name() const override { return "tokenizer_256"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    Eigen::VectorXd out = HandCentricRepresentation().encode_actions(scene);
+    for (Eigen::Index i = 0; i < out.size(); ++i) out(i) = token(out(i), range(i));
+    return out;
+  }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_observation(scene);
+  }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
+                                             const RigidTransform& world_T_hand0) const override {
+    Eigen::VectorXd centres(a.size());
+    for (Eigen::Index i = 0; i < a.size(); ++i)
+      centres(i) = -range(i) + (a(i) + 0.5) * 2.0 * range(i) / kBins;
+    return HandCentricRepresentation().decode_actions(centres, world_T_hand0);
+  }
+
+ private:
+  static double range(Eigen::Index i) { return i % 6 < 3 ? 1.0 : kPi; }
+  static double token(double x, double range) {
+    const double bin = std::floor((x + range) / (2.0 * range) * kBins);
+    return std::clamp(bin, 0.0, kBins - 1.0);
+  }
+};
+
+/// hand_centric discretized as a voxel policy does (PerAct style): the translation of
+/// T_0^{-1} T_k in 1 cm voxels, its rotation as ZYX Euler angles in 5 degree bins (voxel and bin
+/// indices). Not injective below 1 cm and 5 degrees. Decodes to voxel and bin centres.
+class BinnedHandCentric final : public Representation {
+ public:
+  static constexpr double kVoxel = 0.01;
+  static constexpr double kAngleBin = 5.0 * 3.141592653589793 / 180.0;
+  std::string name() const override { return "binned_hand_centric"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    scene.validate();
+    Eigen::VectorXd out(6 * scene.chunk_length());
+    for (int k = 0; k < scene.chunk_length(); ++k) {
+      const RigidTransform hand0_T_handk = scene.world_T_hand0().inverse_compose(
+          scene.world_T_hand_chunk[static_cast<std::size_t>(k)]);
+      const Eigen::Matrix3d& R = hand0_T_handk.rotation().matrix();
+      const Eigen::Vector3d euler(std::atan2(R(1, 0), R(0, 0)),
+                                  std::atan2(-R(2, 0), std::hypot(R(2, 1), R(2, 2))),
+                                  std::atan2(R(2, 1), R(2, 2)));  // yaw, pitch, roll
+      out.segment<3>(6 * k) = (hand0_T_handk.translation() / kVoxel).array().floor().matrix();
+      out.segment<3>(6 * k + 3) = (euler / kAngleBin).array().floor().matrix();
+    }
+    return out;
+  }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    return HandCentricRepresentation().encode_observation(scene);
+  }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& a,
+                                             const RigidTransform& world_T_hand0) const override {
+    std::vector<RigidTransform> chunk;
+    for (Eigen::Index k = 0; 6 * k < a.size(); ++k) {
+      const Eigen::Vector3d p = (a.segment<3>(6 * k).array() + 0.5).matrix() * kVoxel;
+      const Eigen::Vector3d e = (a.segment<3>(6 * k + 3).array() + 0.5).matrix() * kAngleBin;
+      const Eigen::Matrix3d R = (Eigen::AngleAxisd(e(0), Eigen::Vector3d::UnitZ()) *
+                                 Eigen::AngleAxisd(e(1), Eigen::Vector3d::UnitY()) *
+                                 Eigen::AngleAxisd(e(2), Eigen::Vector3d::UnitX()))
+                                    .toRotationMatrix();
+      chunk.push_back(world_T_hand0 * RigidTransform::unchecked(R, p));
+    }
+    return chunk;
   }
 };
 

@@ -27,6 +27,8 @@ TEST_CASE("audit_json_lists_every_check_of_a_builtin", "[unit]") {
   CHECK(actions.at("view") == "eye_in_hand");
   CHECK(relative.at("checks").at(6).at("view") == "third_person");
   CHECK(relative.at("injective") == true);
+  CHECK(relative.at("injectivity").at("resolution").is_null());  // no two chunks collided
+  CHECK(relative.at("injectivity").at("scales").size() == 10);   // 5 decades, m and rad
   CHECK(relative.at("summary")
             .at("eye_in_hand")
             .at("flow_target")
@@ -162,7 +164,9 @@ TEST_CASE("float32_rounding_is_named_and_precision_float32_accepts_it", "[unit]"
     }
   }
   CHECK(noted);
+  CHECK(strict.at("injective") != false);  // rounding at ~1e-6 m is no loss of information
   const auto loose = audit_plugin(plugin, "--cases 60 --precision float32");
+  CHECK(loose.at("injective") != false);
   for (const auto& check : loose.at("checks")) {
     INFO(check.dump());
     CHECK(check.at("invariant") == true);
@@ -261,6 +265,28 @@ TEST_CASE("the_text_audit_warns_loudly_about_a_map_that_is_not_injective", "[uni
                         "' --cases 30 --group se3");
   CHECK(result.exit_code == 0);
   CHECK_THAT(result.out, Contains("NOT INJECTIVE") && Contains("both encode to"));
+}
+
+TEST_CASE("the_audit_names_the_resolution_below_which_a_binned_map_loses_the_chunk", "[unit]") {
+  // 1 cm voxels and 5 degree Euler bins, through the pipe.
+  const std::string plugin = test::test_plugin("binned_hand_centric.py");
+  const std::string arguments = " --cases 30 --group se3 --view eye_in_hand";
+  const auto text = test::run_command(test::cli() + " audit --exec '" + plugin + "'" + arguments);
+  INFO(text.out << text.err);
+  REQUIRE(text.exit_code == 0);
+  CHECK_THAT(text.out, Contains("!!! NOT INJECTIVE below ") &&
+                           Contains("chunks that differ by less can collide") &&
+                           Contains("both encode to"));
+  const auto json = audit_plugin(plugin, arguments);
+  CHECK(json.at("injective") == false);
+  const auto& injectivity = json.at("injectivity");
+  CHECK(injectivity.at("resolution_unit") == "m");
+  CHECK(injectivity.at("resolution").get<double>() >= 5e-3);
+  CHECK(injectivity.at("resolution").get<double>() <= 2e-2);
+  CHECK(injectivity.at("rotation_resolution").get<double>() >= 3e-2);
+  CHECK(injectivity.at("smallest_loss") == 1e-4);
+  CHECK(injectivity.at("scales").size() == 10);
+  CHECK(injectivity.at("collision").at("search") == "resolution");
 }
 
 TEST_CASE("policy_exec_audits_a_whole_policy_and_finds_each_planted_fault", "[unit]") {

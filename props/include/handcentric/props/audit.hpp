@@ -42,7 +42,8 @@ std::vector<std::string> auditable_names();
 
 /// Classifier options for an audit: options.views, options.groups, the tolerance of
 /// audit_relative_tolerance; pointwise cells run options.cases cases, distribution cells
-/// max(10, ceil(cases / 100)), injectivity max(100, cases / 5) chunk pairs.
+/// max(10, ceil(cases / 100)), injectivity max(100, cases / 5) chunk pairs and a resolution
+/// scan on max(10, pairs / 8) scenes.
 ClassifierOptions classifier_options(const AuditOptions& options);
 
 /// Audits the named built-ins (empty = all of auditable_names()). Throws InvalidArgument
@@ -51,7 +52,8 @@ std::vector<Classification> audit_builtins(const std::vector<std::string>& names
                                            const AuditOptions& options);
 
 /// Human output: per classification, one table per view, then notes, injectivity (a loud
-/// warning when a map is not injective) and, with `witnesses`, the failing cells' witnesses.
+/// warning when a map is not injective, naming its resolution when it loses information below
+/// one) and, with `witnesses`, the failing cells' witnesses.
 /// `witnesses` = false prints the tables and the warnings only (the main report).
 void print_audit(std::ostream& out, const std::vector<Classification>& classifications,
                  const AuditOptions& options, bool witnesses = true);
