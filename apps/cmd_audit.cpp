@@ -220,10 +220,11 @@ int run_audit(const AuditCommandOptions& options) {
       << (policies ? "'yes' = equivariant, a(g o, n) = g a(o, n) (eq. 4); pointwise with the same "
                      "noise n, in distribution with n ~ N(0, I). "
                    : "'yes' = invariant. ")
-      << "The number is the largest error seen: pointwise the largest difference; in distribution, "
-         "exactly for maps affine in the noise, the larger difference of the two Gaussian laws' "
-         "means and covariances, else (marked ~) the energy distance of a permutation test at "
-         "level "
+      << "The number is the largest error seen: pointwise the largest difference between the "
+         "two sides, in the component's units (m, rad or the map's own numbers); in "
+         "distribution, exactly for maps affine in the noise, the larger difference of the two "
+         "Gaussian laws' means and covariances, else (marked ~) the energy distance between the "
+         "two samples (a statistic, not a length) of a permutation test at level "
       << used.distribution.family_alpha << " per cell. Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
   return gate(results, expectations);

@@ -122,13 +122,6 @@ std::vector<Classification> audit_builtins(const std::vector<std::string>& names
 void print_audit(std::ostream& out, const std::vector<Classification>& classifications,
                  const AuditOptions& options, bool witnesses) {
   constexpr std::size_t kLabel = 30, kCell = 14;
-  if (!classifications.empty()) {
-    out << "Each cell: yes or NO, then the largest difference seen between the two sides (f(s) and "
-           "f(g s); for a policy g a(o) and a(g o)):\n  pointwise, an inf-norm in the "
-           "component's units (m, rad, or the map's own numbers); in distribution, the largest "
-           "difference of the two laws' means or covariances when decided exactly, or, marked ~, "
-           "the energy distance between the two samples (a statistic, not a length).\n\n";
-  }
   for (const Classification& classification : classifications) {
     out << classification.name << "\n";
     std::vector<const Verdict*> failing, noted;
