@@ -203,9 +203,10 @@ int run_audit(const AuditCommandOptions& options) {
                    : "'yes' = invariant. ")
       << "The number is the largest error seen: pointwise the largest difference; in distribution, "
          "exactly for maps affine in the noise, the larger difference of the two Gaussian laws' "
-         "means and covariances, else (marked ~) the energy distance of a permutation test at "
-         "level "
-      << used.distribution.family_alpha << " per cell. Rules: docs/AUDIT.md\n\n";
+         "means and covariances, else (marked ~: decided wholly or partly by the energy, paired "
+         "mean and scale tests at level "
+      << used.distribution.family_alpha
+      << " per cell) the energy distance of the tested coordinates. Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
   return gate(results, expectations);
 }
