@@ -146,3 +146,126 @@ TEST_CASE("student_t_and_the_paired_mean_test", "[unit]") {
   CHECK(props::paired_mean_test(Eigen::MatrixXd::Constant(4, 3, 0.2), 1e-12) ==
         0.0);  // a constant offset
 }
+
+namespace {
+
+// A hand-centric policy (Theorem 1: T_k = T_0 exp(step)^k) whose sampler adds noise to the
+// positions in the WORLD frame with per-axis scales, as a per-dimension min/max normalizer in
+// world coordinates does to diffusion noise, and whose rotations depend on the noise
+// non-linearly in the hand frame (R_k exp(0.05 tanh(n[3..6]))): equivariant in law on their own.
+// Anisotropic scales make the law of g a(o, n) differ from that of a(g o, n) under rotations in
+// the covariance alone (the means agree); isotropic ones do not (N(0, s^2 I) is rotation
+// invariant). `curved` passes the world noise through n (1 + 0.3 |n|^2) (rotation invariant in
+// law, zero mean), so that no coordinate is affine and only the tests can see it.
+class WorldNoiseHandCentric final : public props::NoisyPolicy {
+ public:
+  WorldNoiseHandCentric(const Eigen::Vector3d& scales, bool curved = false)
+      : scales_(scales), curved_(curved) {}
+  std::string name() const override { return "hand_centric_world_noise"; }
+  Eigen::Index noise_dimension() const override { return 6; }
+  std::vector<RigidTransform> act(const Scene& o, const Eigen::VectorXd& noise) const override {
+    Twist step;
+    step << 0.05, 0.0, 0.01, 0.0, 0.1, 0.0;
+    const Eigen::Vector3d wobble = 0.05 * noise.segment<3>(3).array().tanh().matrix();
+    Eigen::Vector3d n = noise.head<3>();
+    if (curved_) n *= 1.0 + 0.3 * n.squaredNorm();
+    const Eigen::Vector3d shift = scales_.asDiagonal() * n;
+    std::vector<RigidTransform> chunk;
+    RigidTransform T = o.world_T_hand0();
+    for (int k = 0; k < kAuditChunk; ++k) {
+      T = T * RigidTransform::exp(step);
+      chunk.push_back(RigidTransform::unchecked(
+          T.rotation().matrix() * Rotation::exp(wobble).matrix(), T.translation() + shift));
+    }
+    return chunk;
+  }
+
+ private:
+  Eigen::Vector3d scales_;
+  bool curved_;
+};
+
+const Eigen::Vector3d kAnisotropic(0.01, 0.01, 0.03), kIsotropic(0.01, 0.01, 0.01);
+
+}  // namespace
+
+TEST_CASE("anisotropic_world_noise_is_not_equivariant_in_law_and_is_decided_exactly",
+          "[property]") {
+  // The false "yes" this audit once gave: now the positions, affine in the noise, are compared
+  // as Gaussian laws and their covariances differ, on every seed.
+  const WorldNoiseHandCentric anisotropic(kAnisotropic), isotropic(kIsotropic);
+  for (std::uint64_t seed = 1; seed <= 50; ++seed) {
+    props::CheckOptions options = props::eye_in_hand_options();
+    options.seed = seed;
+    for (Group group : {Group::rotation, Group::se3}) {
+      INFO("seed " << seed << ", " << props::to_string(group));
+      const props::Verdict verdict = props::check_policy_distribution(anisotropic, group, options);
+      CHECK_FALSE(verdict.invariant);
+      CHECK(verdict.method == props::Method::partly_exact);
+      REQUIRE(verdict.witness.has_value());
+      CHECK_THAT(verdict.witness->detail, Catch::Matchers::Contains("covariances by"));
+    }
+    INFO("seed " << seed);
+    const props::Verdict same =
+        props::check_policy_distribution(isotropic, Group::rotation, options);
+    CHECK(same.invariant);
+    CHECK(same.method == props::Method::partly_exact);
+    CHECK(same.detectable_scale_ratio.has_value());
+    // A translation turns no axis: world noise of any shape is fine.
+    CHECK(props::check_policy_distribution(anisotropic, Group::translation, options).invariant);
+  }
+}
+
+TEST_CASE("without_the_exact_split_and_the_scale_test_anisotropic_world_noise_passes",
+          "[property]") {
+  // The planted fault: the comparison as it was (every coordinate tested, energy and paired mean
+  // tests only, 32 draws) says "yes", so the new parts are what catch it.
+  const WorldNoiseHandCentric anisotropic(kAnisotropic);
+  props::DistributionOptions blind;
+  blind.exact_affine_part = false;
+  blind.scale_test = false;
+  props::DistributionOptions scale_only;
+  scale_only.exact_affine_part = false;
+  int blind_yes = 0, scale_no = 0;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    props::CheckOptions options = props::eye_in_hand_options();
+    options.seed = seed;
+    const props::Verdict verdict =
+        props::check_policy_distribution(anisotropic, Group::rotation, options, blind);
+    CHECK(verdict.method == props::Method::energy_test);
+    CHECK_FALSE(verdict.detectable_scale_ratio.has_value());
+    blind_yes += verdict.invariant ? 1 : 0;
+    // The scale test alone, all coordinates tested, finds it too.
+    scale_no += props::check_policy_distribution(anisotropic, Group::rotation, options, scale_only)
+                        .invariant
+                    ? 0
+                    : 1;
+  }
+  CHECK(blind_yes == 5);
+  CHECK(scale_no == 5);
+}
+
+TEST_CASE("anisotropic_world_noise_through_a_curve_is_found_by_the_scale_test", "[property]") {
+  // No coordinate is affine in the noise, so nothing is compared exactly: the scale test finds
+  // it, the energy and paired mean tests alone do not.
+  const WorldNoiseHandCentric curved(kAnisotropic, true), isotropic(kIsotropic, true);
+  props::DistributionOptions no_scale;
+  no_scale.scale_test = false;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    props::CheckOptions options = props::eye_in_hand_options();
+    options.seed = seed;
+    INFO("seed " << seed);
+    const props::Verdict verdict =
+        props::check_policy_distribution(curved, Group::rotation, options);
+    CHECK_FALSE(verdict.invariant);
+    CHECK(verdict.method == props::Method::energy_test);
+    REQUIRE(verdict.witness.has_value());
+    CHECK_THAT(verdict.witness->detail, Catch::Matchers::Contains("scale test"));
+    CHECK(props::check_policy_distribution(curved, Group::rotation, options, no_scale).invariant);
+    const props::Verdict same =
+        props::check_policy_distribution(isotropic, Group::rotation, options);
+    CHECK(same.invariant);
+    REQUIRE(same.detectable_scale_ratio.has_value());
+    CHECK(*same.detectable_scale_ratio <= 2.0);
+  }
+}
