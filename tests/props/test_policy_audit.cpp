@@ -3,8 +3,10 @@
 // planted fault it must catch, and the fault that is equivariant in law only.
 #include <catch2/catch.hpp>
 #include <memory>
+#include <sstream>
 
 #include "handcentric/core/representations.hpp"
+#include "handcentric/props/audit.hpp"
 #include "handcentric/props/policy_audit.hpp"
 #include "handcentric/props/random_network.hpp"
 #include "mutants.hpp"
@@ -268,4 +270,32 @@ TEST_CASE("anisotropic_world_noise_through_a_curve_is_found_by_the_scale_test", 
     REQUIRE(same.detectable_scale_ratio.has_value());
     CHECK(*same.detectable_scale_ratio <= 2.0);
   }
+}
+
+TEST_CASE("a_tested_yes_states_the_mean_shift_and_the_scale_ratio_it_would_find", "[unit]") {
+  props::Verdict verdict;
+  verdict.component = props::Component::policy;
+  verdict.mode = props::Mode::distribution;
+  verdict.group = Group::rotation;
+  verdict.view = props::View::eye_in_hand;
+  verdict.method = props::Method::partly_exact;
+  verdict.invariant = true;
+  verdict.detectable_shift = 0.034;
+  verdict.detectable_scale_ratio = 1.99;
+  props::Classification policy;
+  policy.name = "p";
+  policy.verdicts = {verdict};
+  props::AuditOptions options;
+  options.groups = {Group::rotation};
+  options.views = {props::View::eye_in_hand};
+  std::ostringstream text;
+  props::print_audit(text, {policy}, options);
+  CHECK_THAT(text.str(), Catch::Matchers::Contains("a mean shift of 0.034 (Euclidean norm") &&
+                             Catch::Matchers::Contains("m for positions") &&
+                             Catch::Matchers::Contains("changed by a factor 1.99") &&
+                             Catch::Matchers::Contains("with 90% power"));
+  CHECK_THAT(text.str(), Catch::Matchers::Contains("yes  0.0e+00~"));
+  const std::string json = props::policy_audit_json({policy});
+  CHECK_THAT(json, Catch::Matchers::Contains("\"detectable_scale_ratio\": 1.99") &&
+                       Catch::Matchers::Contains("\"method\": \"partly_exact\""));
 }
