@@ -223,9 +223,11 @@ int run_audit(const AuditCommandOptions& options) {
       << "The number is the largest error seen: pointwise the largest difference between the "
          "two sides, in the component's units (m, rad or the map's own numbers); in "
          "distribution, exactly for maps affine in the noise, the larger difference of the two "
-         "Gaussian laws' means and covariances, else (marked ~) the energy distance between the "
-         "two samples (a statistic, not a length) of a permutation test at level "
-      << used.distribution.family_alpha << " per cell. Rules: docs/AUDIT.md\n\n";
+         "Gaussian laws' means and covariances, else (marked ~: decided wholly or partly by the "
+         "energy, paired mean and scale tests at level "
+      << used.distribution.family_alpha
+      << " per cell) the energy distance of the tested coordinates (a statistic, not a length). "
+         "Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
   return gate(results, expectations);
 }

@@ -27,11 +27,13 @@ std::string view_heading(View view) {
 }
 
 // "yes 3.1e-15" / "NO  2.0e+00": the mark and the largest error (in distribution: the larger
-// difference of the laws' moments, or the energy distance, marked '~' for an energy test).
+// difference of the laws' moments, or the energy distance, marked '~' when tests decided all or
+// part of the cell).
 std::string cell_text(const Verdict& verdict) {
   char text[40];
-  std::snprintf(text, sizeof(text), "%-3s %8.1e%s", verdict.invariant ? "yes" : "NO",
-                verdict.max_error, verdict.method == Method::energy_test ? "~" : "");
+  std::snprintf(
+      text, sizeof(text), "%-3s %8.1e%s", verdict.invariant ? "yes" : "NO", verdict.max_error,
+      verdict.method == Method::energy_test || verdict.method == Method::partly_exact ? "~" : "");
   return text;
 }
 
@@ -149,23 +151,35 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
     }
     for (const Verdict* verdict : noted)
       out << "  note: " << cell_name(*verdict) << ": " << verdict->note << "\n";
-    // One line for the energy-test "yes" cells (marked ~): what they could miss.
-    int energy_yes = 0;
-    double largest_shift = 0.0;
+    // One line for the "yes" cells decided (partly) by tests (marked ~): what they could miss.
+    int tested_yes = 0;
+    bool policy = false;
+    double largest_shift = 0.0, largest_ratio = 0.0;
     for (const Verdict& verdict : classification.verdicts) {
-      if (verdict.invariant && verdict.detectable_shift) {
-        ++energy_yes;
-        largest_shift = std::max(largest_shift, *verdict.detectable_shift);
+      if (verdict.invariant && (verdict.detectable_shift || verdict.detectable_scale_ratio)) {
+        ++tested_yes;
+        policy = policy || verdict.component == Component::policy;
+        largest_shift = std::max(largest_shift, verdict.detectable_shift.value_or(0.0));
+        largest_ratio = std::max(largest_ratio, verdict.detectable_scale_ratio.value_or(0.0));
       }
     }
-    if (energy_yes > 0) {
-      char shift[32];
+    if (tested_yes > 0) {
+      char shift[32], ratio[32];
       std::snprintf(shift, sizeof(shift), "%.2g", largest_shift);
-      out << "  note: " << energy_yes
-          << " in-distribution 'yes' cell(s) (marked ~) were decided by an energy test, "
-          << "the output not being affine in the noise: each finds a mean shift of " << shift
-          << " or more (the largest over the cells; per cell in the JSON's detectable_shift) with "
-             "90% power; smaller differences can hide\n";
+      std::snprintf(ratio, sizeof(ratio), "%.3g", largest_ratio);
+      out << "  note: " << tested_yes
+          << " in-distribution 'yes' cell(s) (marked ~) were decided by tests, the output not "
+             "being (wholly) affine in the noise: each finds, with 90% power, a mean shift of "
+          << shift << " (Euclidean norm over the tested coordinates, in "
+          << (policy ? "the chunk's units: m for positions, rotation-matrix entries for rotations"
+                     : "the component's units")
+          << ")";
+      if (largest_ratio > 0.0) {
+        out << " or a standard deviation changed by a factor " << ratio
+            << " (either way) in one coordinate";
+      }
+      out << " (the largest over the cells; per cell in the JSON's detectable_shift and "
+             "detectable_scale_ratio); smaller differences can hide\n";
     }
     if (const auto& injectivity = classification.injectivity) {
       if (injectivity->injective == false) {

@@ -68,7 +68,9 @@ nlohmann::json witness_json(const Witness& w, Method method) {
       {"g", matrix16(w.g)},        {"scene", scene_json(w.scene)},    {"before", numbers(w.before)},
       {"after", numbers(w.after)}, {"error", number_or_inf(w.error)},
   };
-  if (method == Method::energy_test) {
+  // A witness of the tests has a p-value below its level; one of an exact comparison (of every
+  // coordinate, or of the affine ones of a partly_exact cell) has p = 1 and a tolerance.
+  if (method != Method::exact_gaussian && w.p_value < 1.0) {
     out["p_value"] = w.p_value;
     out["alpha"] = w.tolerance;
   } else {
@@ -164,8 +166,9 @@ std::string audit_json(const std::vector<Classification>& classifications) {
       };
       if (v.mode == Mode::distribution) {
         check["method"] = to_string(v.method);
-        if (v.method == Method::energy_test) check["min_p_value"] = v.min_p_value;
+        if (v.method != Method::exact_gaussian) check["min_p_value"] = v.min_p_value;
         if (v.detectable_shift) check["detectable_shift"] = *v.detectable_shift;
+        if (v.detectable_scale_ratio) check["detectable_scale_ratio"] = *v.detectable_scale_ratio;
       }
       add_rounding_fields(check, v);
       if (!v.note.empty()) check["note"] = v.note;
@@ -209,8 +212,9 @@ std::string policy_audit_json(const std::vector<Classification>& policies) {
       };
       if (v.mode == Mode::distribution) {
         check["method"] = to_string(v.method);
-        if (v.method == Method::energy_test) check["min_p_value"] = v.min_p_value;
+        if (v.method != Method::exact_gaussian) check["min_p_value"] = v.min_p_value;
         if (v.detectable_shift) check["detectable_shift"] = *v.detectable_shift;
+        if (v.detectable_scale_ratio) check["detectable_scale_ratio"] = *v.detectable_scale_ratio;
       }
       add_rounding_fields(check, v);
       if (!v.note.empty()) check["note"] = v.note;

@@ -47,20 +47,27 @@ struct NoisePair {
   std::string name;  ///< for errors: what changed length
 };
 
-/// What a check's cases saw, for its verdict: whether any needed the energy test, and the
-/// largest dimension and spread it tested (for the detectable shift).
+/// What a check's cases saw, for its verdict: whether any case was tested whole (energy) or
+/// split into exact and tested coordinates (partial), and, over the cases that reached the
+/// tests, the largest number of coordinates tested and spread (for the detectable shift) and
+/// the largest detectable scale ratio.
 struct LawStatistics {
   bool any_energy = false;
+  bool any_partial = false;
+  int partial_cases = 0;
+  std::string exact_coordinates;  ///< which coordinates the first partial case decided exactly
   Eigen::Index largest_dimension = 0;
   double largest_spread = 0.0;
+  double largest_scale_ratio = 0.0;  ///< 0: no scale test ran
 };
 
-/// One in-distribution case: exact Gaussian laws where both sides are affine in eps, else the
-/// energy test (distribution.hpp). The witness's scene and g are left for the caller.
+/// One in-distribution case: exact Gaussian laws for the coordinates affine in eps on both
+/// sides, the tests for the others (distribution.hpp). The witness's scene and g are left for the
+/// caller.
 CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOptions& options,
                          const DistributionOptions& distribution, LawStatistics& statistics);
 
-/// Sets the verdict's method and, for an energy-test "yes", its detectable shift.
+/// Sets the verdict's method and, for a "yes" by tests, its detectable shift and scale ratio.
 void finish_distribution_verdict(Verdict& verdict, const LawStatistics& statistics,
                                  const DistributionOptions& distribution);
 

@@ -57,6 +57,8 @@ std::string to_string(Method method) {
       return "exact_gaussian";
     case Method::energy_test:
       return "energy_test";
+    case Method::partly_exact:
+      return "partly_exact";
   }
   return "?";
 }

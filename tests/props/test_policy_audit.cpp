@@ -3,9 +3,11 @@
 // planted fault it must catch, and the fault that is equivariant in law only.
 #include <catch2/catch.hpp>
 #include <memory>
+#include <sstream>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/props/audit.hpp"
 #include "handcentric/props/policy_audit.hpp"
 #include "handcentric/props/random_network.hpp"
 #include "handcentric/props/tolerance.hpp"
@@ -128,9 +130,11 @@ TEST_CASE("a_mean_moved_by_a_frame_mix_up_is_caught_in_law_by_the_paired_mean_te
   props::CheckOptions options = props::eye_in_hand_options();
   const props::Verdict law = props::check_policy_distribution(mixed, Group::rotation, options);
   CHECK_FALSE(law.invariant);
-  CHECK(law.method == props::Method::energy_test);
+  // The rotations do not depend on the noise (affine: compared exactly); the positions do.
+  CHECK(law.method == props::Method::partly_exact);
   REQUIRE(law.witness.has_value());
   CHECK_THAT(law.witness->detail, Catch::Matchers::Contains("paired mean test"));
+  CHECK_THAT(law.witness->detail, Catch::Matchers::Contains("affine in eps"));
 }
 
 TEST_CASE("student_t_and_the_paired_mean_test", "[unit]") {
@@ -169,4 +173,155 @@ TEST_CASE("a_chunk_pose_whose_rotation_block_is_not_a_rotation_stops_the_audit",
                     InvalidArgument);
   }
   CHECK(props::pose_defect(Eigen::Matrix4d::Identity()).empty());
+}
+
+namespace {
+
+// A hand-centric policy (Theorem 1: T_k = T_0 exp(step)^k) whose sampler adds noise to the
+// positions in the WORLD frame with per-axis scales, as a per-dimension min/max normalizer in
+// world coordinates does to diffusion noise, and whose rotations depend on the noise
+// non-linearly in the hand frame (R_k exp(0.05 tanh(n[3..6]))): equivariant in law on their own.
+// Anisotropic scales make the law of g a(o, n) differ from that of a(g o, n) under rotations in
+// the covariance alone (the means agree); isotropic ones do not (N(0, s^2 I) is rotation
+// invariant). `curved` passes the world noise through n (1 + 0.3 |n|^2) (rotation invariant in
+// law, zero mean), so that no coordinate is affine and only the tests can see it.
+class WorldNoiseHandCentric final : public props::NoisyPolicy {
+ public:
+  WorldNoiseHandCentric(const Eigen::Vector3d& scales, bool curved = false)
+      : scales_(scales), curved_(curved) {}
+  std::string name() const override { return "hand_centric_world_noise"; }
+  Eigen::Index noise_dimension() const override { return 6; }
+  std::vector<RigidTransform> act(const Scene& o, const Eigen::VectorXd& noise) const override {
+    Twist step;
+    step << 0.05, 0.0, 0.01, 0.0, 0.1, 0.0;
+    const Eigen::Vector3d wobble = 0.05 * noise.segment<3>(3).array().tanh().matrix();
+    Eigen::Vector3d n = noise.head<3>();
+    if (curved_) n *= 1.0 + 0.3 * n.squaredNorm();
+    const Eigen::Vector3d shift = scales_.asDiagonal() * n;
+    std::vector<RigidTransform> chunk;
+    RigidTransform T = o.world_T_hand0();
+    for (int k = 0; k < kAuditChunk; ++k) {
+      T = T * RigidTransform::exp(step);
+      chunk.push_back(RigidTransform::unchecked(
+          T.rotation().matrix() * Rotation::exp(wobble).matrix(), T.translation() + shift));
+    }
+    return chunk;
+  }
+
+ private:
+  Eigen::Vector3d scales_;
+  bool curved_;
+};
+
+const Eigen::Vector3d kAnisotropic(0.01, 0.01, 0.03), kIsotropic(0.01, 0.01, 0.01);
+
+}  // namespace
+
+TEST_CASE("anisotropic_world_noise_is_not_equivariant_in_law_and_is_decided_exactly",
+          "[property]") {
+  // The false "yes" this audit once gave: now the positions, affine in the noise, are compared
+  // as Gaussian laws and their covariances differ, on every seed.
+  const WorldNoiseHandCentric anisotropic(kAnisotropic), isotropic(kIsotropic);
+  for (std::uint64_t seed = 1; seed <= 50; ++seed) {
+    props::CheckOptions options = props::eye_in_hand_options();
+    options.seed = seed;
+    for (Group group : {Group::rotation, Group::se3}) {
+      INFO("seed " << seed << ", " << props::to_string(group));
+      const props::Verdict verdict = props::check_policy_distribution(anisotropic, group, options);
+      CHECK_FALSE(verdict.invariant);
+      CHECK(verdict.method == props::Method::partly_exact);
+      REQUIRE(verdict.witness.has_value());
+      CHECK_THAT(verdict.witness->detail, Catch::Matchers::Contains("covariances by"));
+    }
+    INFO("seed " << seed);
+    const props::Verdict same =
+        props::check_policy_distribution(isotropic, Group::rotation, options);
+    CHECK(same.invariant);
+    CHECK(same.method == props::Method::partly_exact);
+    CHECK(same.detectable_scale_ratio.has_value());
+    // A translation turns no axis: world noise of any shape is fine.
+    CHECK(props::check_policy_distribution(anisotropic, Group::translation, options).invariant);
+  }
+}
+
+TEST_CASE("without_the_exact_split_and_the_scale_test_anisotropic_world_noise_passes",
+          "[property]") {
+  // The planted fault: the comparison as it was (every coordinate tested, energy and paired mean
+  // tests only, 32 draws) says "yes", so the new parts are what catch it.
+  const WorldNoiseHandCentric anisotropic(kAnisotropic);
+  props::DistributionOptions blind;
+  blind.exact_affine_part = false;
+  blind.scale_test = false;
+  props::DistributionOptions scale_only;
+  scale_only.exact_affine_part = false;
+  int blind_yes = 0, scale_no = 0;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    props::CheckOptions options = props::eye_in_hand_options();
+    options.seed = seed;
+    const props::Verdict verdict =
+        props::check_policy_distribution(anisotropic, Group::rotation, options, blind);
+    CHECK(verdict.method == props::Method::energy_test);
+    CHECK_FALSE(verdict.detectable_scale_ratio.has_value());
+    blind_yes += verdict.invariant ? 1 : 0;
+    // The scale test alone, all coordinates tested, finds it too.
+    scale_no += props::check_policy_distribution(anisotropic, Group::rotation, options, scale_only)
+                        .invariant
+                    ? 0
+                    : 1;
+  }
+  CHECK(blind_yes == 5);
+  CHECK(scale_no == 5);
+}
+
+TEST_CASE("anisotropic_world_noise_through_a_curve_is_found_by_the_scale_test", "[property]") {
+  // No coordinate is affine in the noise, so nothing is compared exactly: the scale test finds
+  // it, the energy and paired mean tests alone do not.
+  const WorldNoiseHandCentric curved(kAnisotropic, true), isotropic(kIsotropic, true);
+  props::DistributionOptions no_scale;
+  no_scale.scale_test = false;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    props::CheckOptions options = props::eye_in_hand_options();
+    options.seed = seed;
+    INFO("seed " << seed);
+    const props::Verdict verdict =
+        props::check_policy_distribution(curved, Group::rotation, options);
+    CHECK_FALSE(verdict.invariant);
+    CHECK(verdict.method == props::Method::energy_test);
+    REQUIRE(verdict.witness.has_value());
+    CHECK_THAT(verdict.witness->detail, Catch::Matchers::Contains("scale test"));
+    CHECK(props::check_policy_distribution(curved, Group::rotation, options, no_scale).invariant);
+    const props::Verdict same =
+        props::check_policy_distribution(isotropic, Group::rotation, options);
+    CHECK(same.invariant);
+    REQUIRE(same.detectable_scale_ratio.has_value());
+    CHECK(*same.detectable_scale_ratio <= 2.0);
+  }
+}
+
+TEST_CASE("a_tested_yes_states_the_mean_shift_and_the_scale_ratio_it_would_find", "[unit]") {
+  props::Verdict verdict;
+  verdict.component = props::Component::policy;
+  verdict.mode = props::Mode::distribution;
+  verdict.group = Group::rotation;
+  verdict.view = props::View::eye_in_hand;
+  verdict.method = props::Method::partly_exact;
+  verdict.invariant = true;
+  verdict.detectable_shift = 0.034;
+  verdict.detectable_scale_ratio = 1.99;
+  props::Classification policy;
+  policy.name = "p";
+  policy.verdicts = {verdict};
+  props::AuditOptions options;
+  options.groups = {Group::rotation};
+  options.views = {props::View::eye_in_hand};
+  std::ostringstream text;
+  props::print_audit(text, {policy}, options);
+  CHECK_THAT(text.str(), Catch::Matchers::Contains("a mean shift of 0.034 (Euclidean norm") &&
+                             Catch::Matchers::Contains("m for positions") &&
+                             Catch::Matchers::Contains("changed by a factor 1.99") &&
+                             Catch::Matchers::Contains("with 90% power"));
+  CHECK_THAT(text.str(), Catch::Matchers::Contains("yes  0.0e+00~"));
+  const std::string json = props::policy_audit_json({policy});
+  CHECK_THAT(json, Catch::Matchers::Contains("\"detectable_scale_ratio\": 1.99") &&
+                       Catch::Matchers::Contains("\"method\": \"partly_exact\""));
 }

@@ -4,24 +4,38 @@
 // target R_k^T (p_k - eps) (eq. 29) is, for rotations about the origin (N(0, I) is rotation
 // invariant), though not pointwise; it is not, for translations.
 //
-// Per case (s, g), two ways to decide, chosen by what the component is:
-//   exact_gaussian: when f(s, eps) is affine in eps, f(s, eps) = f(s, 0) + J eps (probed at
-//     eps = 0 and the unit vectors, then verified at random eps), its law is N(f(s, 0), J J^T).
-//     Two Gaussian laws are equal iff their means and covariances are: compared up to rounding.
-//     This covers the rectified flow of every representation (a - eps, t a + (1 - t) eps) and
-//     ActionFlow's target: the question has an exact answer, so no test is run.
-//   energy_test: otherwise, two tests at half the level each (or p = 1 when f(g s, eps_i) =
-//     f(s, eps_i) on every shared draw): the energy distance (Szekely & Rizzo) between
-//     f(s, eps_i) and f(g s, eps'_i) with its permutation p-value, and a paired test of the mean
-//     of f(s, eps_i) - f(g s, eps_i), which equal laws make zero. A "yes" then means "no
-//     difference found", and the verdict states the smallest mean shift the energy test alone
-//     finds with 90% power (energy_test_detectable_shift; the pair finds at least as much).
+// Per case (s, g), each output coordinate is decided one of two ways (the verdict's method says
+// which were used):
+//   exact: a coordinate that is affine in eps on both sides, f_j(s, eps) = f_j(s, 0) + J_j eps
+//     (probed at eps = 0 and the unit vectors, then verified at random eps, per coordinate). The
+//     affine coordinates have the Gaussian law N(f_A(s, 0), J_A J_A^T), and two Gaussian laws
+//     are equal iff their means and covariances are: compared up to rounding, no test is run.
+//     exact_gaussian: every coordinate affine (the rectified flow of every representation, and
+//     ActionFlow's target). partly_exact: some are; they must be the same coordinates on both
+//     sides (else all are tested), a difference in their mean or covariance is a "NO" proven
+//     exactly, and the other coordinates go to the tests below.
+//   tests (energy_test, or the tested part of partly_exact): p = 1 when f(g s, eps_i) =
+//     f(s, eps_i) on every shared draw. Else three tests at a third of the case's level each:
+//     the energy distance (Szekely & Rizzo) between f(s, eps_i) and f(g s, eps'_i) with its
+//     permutation p-value (an omnibus test, weak against a small mean shift in many dimensions);
+//     a paired test of the mean of f(s, eps_i) - f(g s, eps_i), which equal laws make zero; and a
+//     permutation test of scale (absolute deviations from the pooled median, the largest
+//     standardized difference over the coordinates), which finds a changed variance the other
+//     two miss: world-frame noise with per-axis scales turned by g has the same mean and a
+//     different covariance. The permutation tests have their level for any law. The scale test
+//     draws enough samples to find a standard deviation changed by a factor 2 in one coordinate
+//     with 90% power (samples_for_scale_ratio). A "yes" then means "no difference found", and
+//     the verdict states the smallest mean shift (energy_test_detectable_shift) and the smallest
+//     standard-deviation ratio (scale_test_detectable_ratio) found with 90% power.
+// The coordinates decided exactly are compared as a Gaussian law, the others by the tests: how
+// the two parts depend on each other is not compared.
 // docs/AUDIT.md has the numbers (samples, permutations, level) and why.
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/props/check.hpp"
@@ -47,11 +61,21 @@ TwoSampleResult energy_test(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, 
                             std::uint64_t seed, double stop_above = 0.0);
 
 struct DistributionOptions {
-  int cases = 10;    ///< (scene, g) pairs tested
-  int samples = 32;  ///< energy test: eps draws per scene (each sample has this many rows)
-  double family_alpha = 0.01;  ///< energy test: per check, split evenly over the cases (Bonferroni)
+  int cases = 10;  ///< (scene, g) pairs tested
+  /// eps draws per scene for the energy test, and the fewest any test draws (the paired mean and
+  /// scale tests draw more when scale_ratio asks for it)
+  int samples = 32;
+  double family_alpha = 0.01;  ///< tests: per check, split evenly over the cases (Bonferroni)
   int shrink_budget = 20;      ///< evaluations spent shrinking a witness
   int affinity_checks = 2;     ///< random eps at which an affine law is verified, per scene
+  /// The paired mean and scale tests draw max(samples, samples_for_scale_ratio(coordinates
+  /// tested, level of the scale test, scale_ratio)) so that the scale test finds a standard
+  /// deviation changed by this factor in one coordinate with 90% power.
+  double scale_ratio = 2.0;
+  /// Both on in every audit. Off only to show what each catches (tests): the exact comparison
+  /// of the affine coordinates of a partly affine output, and the scale test (off: 32 draws).
+  bool exact_affine_part = true;
+  bool scale_test = true;
 };
 
 /// Permutations used for a per-case level alpha: enough that p can fall below it twice over.
@@ -94,12 +118,81 @@ LawDifference law_difference(const GaussianLaw& a, const GaussianLaw& b);
 /// of isotropic Gaussian noise in `dimension` dimensions, at level `alpha`. Measured by
 /// simulation (100 tests per shift, bisection; deterministic), with the dimension rounded up
 /// to a power of two (power falls with dimension, so the figure errs on the large side).
-/// Cached per (dimension, samples, alpha). Costs about a second the first time.
+/// Tabulated at the audit's defaults (samples 32, alpha kDefaultTestLevel, dimension up to 1024);
+/// otherwise simulated once and cached per (dimension, samples, alpha), which costs 1 to 15 s.
 double energy_test_detectable_shift(Eigen::Index dimension, int samples, double alpha);
 
+/// The simulation behind energy_test_detectable_shift, run every time (no table, no cache).
+double simulated_energy_test_detectable_shift(Eigen::Index dimension, int samples, double alpha);
+
+/// The level of each test in a case at the default DistributionOptions: 0.01 per check over 10
+/// cases, a third to each of the three tests.
+inline constexpr double kDefaultTestLevel = 0.01 / 10 / 3.0;
+
+/// The laws of the coordinates of f that are affine in eps: f_j(eps) = mean_j + J_j eps for the
+/// coordinates j with affine[j] (law.noise_map's other rows mean nothing).
+struct PartlyAffineLaw {
+  GaussianLaw law;
+  std::vector<bool> affine;  ///< per output coordinate
+  bool all_affine() const;
+};
+
+/// affine_law per coordinate: f at eps = 0, then an additivity check per coordinate at two
+/// normal draws (a coordinate that fails it is not affine), then, if any coordinate is left,
+/// the n unit vectors and `checks` verifications at normal eps, per coordinate, within
+/// `tolerance`. The same evaluations and draws as affine_law, which returns a law exactly when
+/// every coordinate here is affine. Returns nullopt when f changes length.
+std::optional<PartlyAffineLaw> partly_affine_law(
+    const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f, Eigen::Index n,
+    double tolerance, std::uint64_t seed, int checks = 2);
+
+struct ScaleTestResult {
+  double statistic = 0.0;        ///< the largest standardized difference over the coordinates
+  Eigen::Index coordinate = -1;  ///< where it is (-1: no coordinate with spread)
+  double sd_ratio = 1.0;         ///< sd of y over sd of x in that coordinate
+  double p_value = 1.0;          ///< (1 + #{permuted >= observed}) / (1 + permutations)
+};
+
+/// Permutation test of "x and y come from the same distribution" aimed at a change of scale in
+/// one coordinate: per coordinate j, z = |w - median_j| over the pooled sample w (so z is
+/// exchangeable when the laws are equal), and the statistic is the largest over j of
+/// |mean of z over x - mean of z over y| / (sd_j sqrt(1/n + 1/m)), sd_j the pooled sd of z.
+/// A permutation test: its level is exact for any law, with no correction for the number of
+/// coordinates (the maximum is permuted). Coordinates whose pooled sd is at most `tolerance`
+/// (constants, up to rounding) are left out. Deterministic given `seed`; stop_above as for
+/// energy_test.
+ScaleTestResult scale_test(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y, int permutations,
+                           std::uint64_t seed, double stop_above = 0.0, double tolerance = 0.0);
+
+/// The permutations scale_test gets at level alpha in a check: permutations_for(alpha), as the
+/// energy test. Rejecting when p < alpha then has level alpha / 2 (permutation_level): the
+/// power figures and the draws rule use that level. Five times as many permutations would bring
+/// it to 0.9 alpha for a few draws fewer, at five times the cost of every rejection.
+int scale_test_permutations(double alpha);
+
+/// The level of "reject when p < alpha" for a permutation p-value (1 + exceedances) /
+/// (1 + permutations) under equal laws: (ceil(alpha (permutations + 1)) - 1) / (permutations + 1).
+double permutation_level(double alpha, int permutations);
+
+/// The power of scale_test, at level alpha (its permutation_level), between two samples of
+/// `samples` rows of `dimension` independent standard normal coordinates, one of which has its sd
+/// multiplied by `ratio` in the second sample (equal means). The normal approximation of each
+/// coordinate's statistic with the Bonferroni critical value z(alpha / (2 dimension)), which the
+/// permuted maximum's is at most (up to the approximation): tests/props checks it by simulation.
+double scale_test_power(double ratio, Eigen::Index dimension, int samples, double alpha);
+
+/// The smallest sd ratio (> 1; its inverse is found as well) that scale_test detects with 90%
+/// power in one of `dimension` coordinates at `samples` rows and level alpha (closed form,
+/// bisection to 1e-6).
+double scale_test_detectable_ratio(Eigen::Index dimension, int samples, double alpha);
+
+/// The fewest rows per sample at which scale_test detects an sd ratio `ratio` (> 1) in one of
+/// `dimension` coordinates with 90% power at level alpha.
+int samples_for_scale_ratio(Eigen::Index dimension, double alpha, double ratio);
+
 /// The flow target's `component` (flow_input or flow_target) is invariant in distribution
-/// under `group` (exactly where it is affine in eps, by the energy test elsewhere: see the top
-/// of this file). Uses options.seed (cases), options.noise_seed (eps draws), options.flow_time,
+/// under `group` (exactly where it is affine in eps, by the tests elsewhere: see the top of
+/// this file). Uses options.seed (cases), options.noise_seed (eps draws), options.flow_time,
 /// options.shape, options.relative_tolerance. The verdict's method says how it was decided.
 Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, Component component,
                                       Group group, const CheckOptions& options = {},

@@ -9,9 +9,11 @@
 //                     outer hand-centric policy passes for any network.
 //   in distribution : n ~ N(0, I) drawn independently: the law of g a(o, n) against the law of
 //                     a(g o, n), each pose flattened as [p, R] (on which g acts affinely).
-//                     Exactly where both are affine in n (distribution.hpp), else by the energy
-//                     test with its detectable shift. A policy that adds isotropic noise in the
-//                     world frame is equivariant in distribution under rotations, not pointwise.
+//                     Exactly on the coordinates affine in n on both sides (distribution.hpp),
+//                     by the energy, paired mean and scale tests on the others, with what they
+//                     can miss. A policy that adds isotropic noise in the world frame is
+//                     equivariant in distribution under rotations, not pointwise; one that adds
+//                     noise with per-axis scales in the world frame is neither.
 // Both views and all groups, as for representations (classifier.hpp).
 #include <Eigen/Core>
 #include <memory>
@@ -40,7 +42,7 @@ class NoisyPolicy {
 /// A ChunkPolicy, whose noise comes from a seed, as a NoisyPolicy: the noise vector's bits are
 /// hashed into the seed, so one vector gives one chunk, and different vectors independent
 /// chunks. Its output is not affine in that vector, so in distribution it is decided by the
-/// energy test.
+/// tests.
 class SeededPolicy final : public NoisyPolicy {
  public:
   /// Throws InvalidArgument for a null policy.
@@ -61,7 +63,7 @@ Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options = {});
 
 /// eq. (4) in distribution (see the top of this file). The witness's before/after are the
-/// laws' means (exact) or first samples (energy test), each pose flattened to [p, R row-major].
+/// laws' means (exact) or first samples (tests), each pose flattened to [p, R row-major].
 Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options = {},
                                   const DistributionOptions& distribution = {});

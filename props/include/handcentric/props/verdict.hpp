@@ -33,9 +33,13 @@ enum class View { eye_in_hand, third_person };
 /// How an in-distribution verdict was decided (pointwise checks compare values: `compared`).
 ///   exact_gaussian: the component is affine in eps on every case (checked), so its law is the
 ///                   Gaussian N(f(0), J J^T); the two laws were compared exactly, up to rounding.
-///   energy_test   : some case was not affine in eps; a permutation test of the energy distance
-///                   decided, and a "yes" only means no difference was found (detectable_shift).
-enum class Method { compared, exact_gaussian, energy_test };
+///   partly_exact  : on some case only some coordinates were affine in eps (the same ones on
+///                   both sides): their Gaussian laws were compared exactly, the other
+///                   coordinates by the tests of energy_test; no case was tested whole.
+///   energy_test   : some case had no coordinate compared exactly; the energy, paired mean and
+///                   scale tests decided, and a "yes" only means no difference was found
+///                   (detectable_shift, detectable_scale_ratio).
+enum class Method { compared, exact_gaussian, energy_test, partly_exact };
 
 /// "actions", "observation", "flow_input", "flow_target", "policy".
 std::string to_string(Component component);
@@ -43,7 +47,7 @@ std::string to_string(Component component);
 std::string to_string(Mode mode);
 /// "eye_in_hand", "third_person".
 std::string to_string(View view);
-/// "compared", "exact_gaussian", "energy_test".
+/// "compared", "exact_gaussian", "energy_test", "partly_exact".
 std::string to_string(Method method);
 
 /// A counterexample: the scene, g, and the two outputs compared.
@@ -56,7 +60,7 @@ struct Witness {
       after;           ///< f(g * scene)        (policy: a(g * o), flattened; exact law: its mean)
   double error = 0.0;  ///< |after - before|_inf; exact law: max(mean, covariance difference);
                        ///< energy test: the energy distance
-  double tolerance = 0.0;     ///< what error had to stay below (energy test: the level alpha)
+  double tolerance = 0.0;     ///< what error had to stay below (tests: the case's level alpha)
   double length_scale = 0.0;  ///< L of the tolerance REL (1 + L): max(L(s), L(g s)), metres
   /// pointwise: the largest change of either side under a rounding-level perturbation of its
   /// inputs (check.hpp), 0 when the error was under the floor and it was not measured
@@ -64,7 +68,7 @@ struct Witness {
   /// pointwise: the witness is a case moved slightly off the one drawn (check.hpp, step 3), the
   /// difference having persisted there: a symmetry breaking, not a bin edge
   bool off_case = false;
-  double p_value = 1.0;  ///< energy test: the permutation p-value (else 1)
+  double p_value = 1.0;  ///< tests: 3 x the smallest of their p-values (exact laws: 1)
   std::string detail;    ///< exact law: which moment differs and by how much
 };
 
@@ -84,9 +88,13 @@ struct Verdict {
   int discontinuities = 0;
   std::uint64_t seed = 0;
   double relative_tolerance = 0.0;  ///< the REL of the pointwise tolerance REL * (1 + L)
-  /// energy_test "yes": the smallest mean shift (Euclidean norm, in the component's units) the
-  /// test detects with 90% power at this sample size and level (distribution.hpp).
+  /// In-distribution "yes" decided (partly) by tests: the smallest mean shift (Euclidean norm
+  /// over the tested coordinates, in the component's units) the energy test detects with 90%
+  /// power at its sample size and level (distribution.hpp), the largest over the cases.
   std::optional<double> detectable_shift;
+  /// Likewise the smallest factor (> 1, either way) by which the standard deviation of one
+  /// tested coordinate can change and the scale test detect it with 90% power.
+  std::optional<double> detectable_scale_ratio;
   /// A remark the reader needs, e.g. that a failure would pass at float32 rounding.
   std::string note;
   std::optional<Witness> witness;  ///< present when !invariant
