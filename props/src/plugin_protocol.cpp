@@ -1,6 +1,7 @@
 #include "handcentric/props/plugin_protocol.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <set>
 #include <cstdio>
@@ -12,10 +13,12 @@
 namespace handcentric::props {
 namespace {
 
+// The shortest text that reads back as the same double (std::to_chars): exact like "%.17g", and
+// several times faster, which matters when each request carries hundreds of numbers.
 void append_number(std::string& out, double value) {
   char text[32];
-  std::snprintf(text, sizeof(text), "%.17g", value);
-  out += text;
+  const auto end = std::to_chars(text, text + sizeof(text), value).ptr;
+  out.append(text, end);
 }
 
 void append_matrix(std::string& out, const RigidTransform& T) {
