@@ -10,6 +10,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "handcentric/props/batch.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 #include "rapidcheck/detail/TestListenerAdapter.h"
@@ -71,8 +72,51 @@ void run_silently(const std::function<void()>& property, const std::string& desc
   rc::detail::checkTestable(property, metadata, params, silent);
 }
 
+namespace {
+
+// Prefetch passes (batch.hpp): each runs every case not yet answered in full, as far as its
+// cached answers go; a pass stops starting cases once it has recorded kMaxPendingPerPass inputs
+// (memory), and after kMaxPrefetchPasses the real pass evaluates what is left one at a time.
+constexpr std::size_t kMaxPendingPerPass = std::size_t{1} << 15;
+constexpr int kMaxPrefetchPasses = 64;
+
+void run_prefetch_passes(const CaseFunction& run_case, Group group, const SceneShape& shape,
+                         const std::string& description, std::uint64_t seed, int cases) {
+  PrefetchPasses passes;
+  std::vector<char> done(static_cast<std::size_t>(cases), 0);
+  // The real pass stops at its first failing case and shrinks it one input at a time: cases
+  // after the first one known to fail need no answers.
+  std::size_t first_failure = done.size();
+  for (int p = 0; p < kMaxPrefetchPasses; ++p) {
+    std::size_t index = 0;
+    passes.pass([&] {
+      run_silently(
+          [&] {
+            // Generated in every pass whether run or not: RapidCheck then gives every case the
+            // same scene and g as in the real pass.
+            const Scene scene = *props::scene(shape);
+            const RigidTransform g = *group_element(group);
+            const std::size_t k = index++;
+            if (k >= first_failure || done[k] || passes.recorded() >= kMaxPendingPerPass) return;
+            try {
+              if (!run_case(scene, g).holds) first_failure = k;
+              done[k] = 1;
+            } catch (const PendingEvaluation&) {
+            } catch (...) {
+              done[k] = 1;  // the real pass meets the error again and stops there
+            }
+          },
+          description, seed, cases);
+    });
+    if (passes.flush() == 0) return;
+  }
+}
+
+}  // namespace
+
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
-                  const CheckOptions& options, int cases, int shrink_budget) {
+                  const CheckOptions& options, int cases, int shrink_budget,
+                  const std::function<void()>& before_real_pass) {
   if (cases < 1)
     throw InvalidArgument("a check needs at least 1 case, got " + std::to_string(cases));
   if (!(options.relative_tolerance > 0.0) || !std::isfinite(options.relative_tolerance)) {
@@ -84,6 +128,11 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
         "unit_roundoff must be in (0, 1e-3) (2^-53 for double, 2^-24 for "
         "float32), got " +
         std::to_string(options.unit_roundoff));
+  }
+  const std::string description = to_string(component) + " under " + to_string(group);
+  if (options.prefetch) {
+    run_prefetch_passes(run_case, group, options.shape, description, options.seed, cases);
+    if (before_real_pass) before_real_pass();
   }
   Verdict verdict;
   verdict.component = component;
@@ -131,7 +180,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
       RC_FAIL("not invariant");
     }
   };
-  run_silently(property, to_string(component) + " under " + to_string(group), options.seed, cases);
+  run_silently(property, description, options.seed, cases);
   if (error) std::rethrow_exception(error);
   if (!verdict.witness && verdict.cases == verdict.discontinuities) {
     // Every case was near the identity (or sat on a discontinuity): nothing was shown either way.
@@ -170,18 +219,30 @@ CaseOutcome decide_pointwise(const PointwiseSides& sides, const Scene& scene,
     witness.tolerance = options.relative_tolerance * (1.0 + witness.length_scale);
     return moved;
   };
+  auto ask_all = [&sides](const std::vector<Scene>& scenes) {
+    prefetch(scenes, [&sides](const Scene& s) {
+      sides.ask(s);
+      return 0;
+    });
+  };
+  if (prefetching()) ask_all({scene, g * scene});
   const Scene moved = measure(scene, outcome.witness);
   Witness& w = outcome.witness;
   if (w.error <= w.tolerance) return outcome;  // 1. the floor
   // 2. The map's own rounding: how far each side moves when its inputs move by a few ulps.
   std::mt19937_64 rng(options.seed ^ 0x6a09e667f3bcc909ULL);
-  double response = 0.0;
+  std::vector<std::pair<const Scene*, Scene>> perturbed;  // (side, perturbed side), in draw order
   for (int d = 0; d < kRoundingDraws; ++d) {
-    response = std::max(
-        response, sides.response(scene, rounding_perturbation(scene, options.unit_roundoff, rng)));
-    response = std::max(
-        response, sides.response(moved, rounding_perturbation(moved, options.unit_roundoff, rng)));
+    perturbed.emplace_back(&scene, rounding_perturbation(scene, options.unit_roundoff, rng));
+    perturbed.emplace_back(&moved, rounding_perturbation(moved, options.unit_roundoff, rng));
   }
+  if (prefetching()) {
+    std::vector<Scene> asked;
+    for (const auto& [side, p] : perturbed) asked.push_back(p);
+    ask_all(asked);
+  }
+  double response = 0.0;
+  for (const auto& [side, p] : perturbed) response = std::max(response, sides.response(*side, p));
   if (std::isnan(response)) response = std::numeric_limits<double>::infinity();
   w.rounding_response = response;
   const double cap = rounding_cap(options.unit_roundoff, w.length_scale);
@@ -192,9 +253,19 @@ CaseOutcome decide_pointwise(const PointwiseSides& sides, const Scene& scene,
     return outcome;
   }
   const double eta = off_case_scale(options.unit_roundoff);
+  std::vector<Scene> nearby;
+  for (int d = 0; d < options.off_case_draws; ++d) nearby.push_back(nearby_scene(scene, eta, rng));
+  if (prefetching()) {
+    std::vector<Scene> asked;
+    for (const Scene& s : nearby) {
+      asked.push_back(s);
+      asked.push_back(g * s);
+    }
+    ask_all(asked);
+  }
   for (int d = 0; d < options.off_case_draws; ++d) {
     Witness off;
-    measure(nearby_scene(scene, eta, rng), off);
+    measure(nearby[static_cast<std::size_t>(d)], off);
     off.rounding_response = response;
     const double allowed = std::max(off.tolerance, kRoundingMultiple * std::min(response, cap));
     if (!(off.error <= allowed)) {
@@ -309,6 +380,7 @@ Verdict check_invariance(const SceneFunction& f, Component component, Group grou
     sides.response = [&f](const Scene& a, const Scene& b) {
       return detail::inf_distance(f(a), f(b));
     };
+    sides.ask = [&f](const Scene& s) { (void)f(s); };
     return detail::decide_pointwise(sides, scene, g, options);
   };
   return detail::run_check(run_case, component, group, Mode::pointwise, options, options.cases,
@@ -332,6 +404,7 @@ Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOp
     sides.response = [&policy, noise_seed](const Scene& a, const Scene& b) {
       return detail::chunk_distance(policy.act(a, noise_seed), policy.act(b, noise_seed));
     };
+    sides.ask = [&policy, noise_seed](const Scene& s) { (void)policy.act(s, noise_seed); };
     return detail::decide_pointwise(sides, scene, g, options);
   };
   return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,

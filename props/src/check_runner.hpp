@@ -25,6 +25,9 @@ struct PointwiseSides {
   /// How far one side's output moves between scenes a and b (the same side: f(a) against
   /// f(b), or a policy's chunks a(a) against a(b)).
   std::function<double(const Scene& a, const Scene& b)> response;
+  /// Asks the map for one scene's output and drops it (a policy: its chunk at the case's noise),
+  /// so that a prefetch pass (batch.hpp) records every scene a step needs at once.
+  std::function<void(const Scene& scene)> ask;
 };
 
 /// Decides the case (scene, g) as the top of check.hpp says: the floor, the map's own
@@ -36,8 +39,11 @@ using CaseFunction = std::function<CaseOutcome(const Scene& scene, const RigidTr
 
 /// Runs `cases` cases; after the first failure, RapidCheck shrinks for at most `shrink_budget`
 /// evaluations (then every further candidate passes, and the last failure is the witness).
+/// With options.prefetch, the prefetch passes of batch.hpp run first; `before_real_pass` then
+/// resets what run_case accumulates across cases (they ran it too).
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
-                  const CheckOptions& options, int cases, int shrink_budget);
+                  const CheckOptions& options, int cases, int shrink_budget,
+                  const std::function<void()>& before_real_pass = nullptr);
 
 /// Two functions of the noise whose laws (eps ~ N(0, I)) a distribution check compares:
 /// f(s, .) and f(g s, .) for a flow; g * a(o, .) and a(g o, .) for a policy.

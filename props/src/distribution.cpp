@@ -13,6 +13,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "handcentric/props/batch.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 
@@ -214,15 +215,21 @@ std::optional<PartlyAffineLaw> partly_affine_law(
   PartlyAffineLaw out;
   GaussianLaw& law = out.law;
   Eigen::VectorXd eps = Eigen::VectorXd::Zero(n);
-  law.mean = f(eps);
-  const Eigen::Index width = law.mean.size();
-  out.affine.assign(static_cast<std::size_t>(width), true);
   std::mt19937_64 rng(seed);
   auto normals = [&rng, n] {
     Eigen::VectorXd v(n);
     for (Eigen::Index j = 0; j < n; ++j) v(j) = standard_normal(rng);
     return v;
   };
+  // Every input of a phase is drawn before the first is evaluated, so that a prefetch pass
+  // (batch.hpp) asks for them together; the draws are in the same order either way.
+  const Eigen::VectorXd u = normals(), v = normals();
+  std::vector<Eigen::VectorXd> checked;
+  for (int c = 0; c < checks; ++c) checked.push_back(normals());
+  prefetch(std::vector<Eigen::VectorXd>{eps, u, v, u + v}, f);
+  law.mean = f(eps);
+  const Eigen::Index width = law.mean.size();
+  out.affine.assign(static_cast<std::size_t>(width), true);
   // Mark coordinate j not affine when `deviation` (what an affine map makes zero) exceeds
   // `bound` there (or is NaN).
   auto keep_where = [&out, width](const Eigen::VectorXd& deviation, double bound) {
@@ -234,7 +241,6 @@ std::optional<PartlyAffineLaw> partly_affine_law(
   // additive about f(0). Most maps that are not affine (a sampler through a network) fail it in
   // every coordinate, and then nothing is probed.
   {
-    const Eigen::VectorXd u = normals(), v = normals();
     const Eigen::VectorXd fu = f(u), fv = f(v), fuv = f(u + v);
     if (fu.size() != width || fv.size() != width || fuv.size() != width) return std::nullopt;
     keep_where(fuv - fu - fv + law.mean, 2.0 * tolerance);
@@ -242,6 +248,11 @@ std::optional<PartlyAffineLaw> partly_affine_law(
   law.noise_map = Eigen::MatrixXd::Zero(width, n);
   if (width > 0 && std::none_of(out.affine.begin(), out.affine.end(), [](bool a) { return a; }))
     return out;
+  if (prefetching()) {
+    std::vector<Eigen::VectorXd> probes = checked;
+    for (Eigen::Index j = 0; j < n; ++j) probes.push_back(Eigen::VectorXd::Unit(n, j));
+    prefetch(probes, f);
+  }
   for (Eigen::Index j = 0; j < n; ++j) {
     eps(j) = 1.0;
     const Eigen::VectorXd column = f(eps);
@@ -250,8 +261,8 @@ std::optional<PartlyAffineLaw> partly_affine_law(
     law.noise_map.col(j) = column - law.mean;
   }
   // Affine maps agree with mean + J eps everywhere; verify it where nothing was probed.
-  for (int c = 0; c < checks; ++c) {
-    eps = normals();
+  for (const Eigen::VectorXd& at : checked) {
+    eps = at;
     const Eigen::VectorXd value = f(eps);
     if (value.size() != width) return std::nullopt;
     const Eigen::VectorXd predicted = law.mean + law.noise_map * eps;
@@ -667,8 +678,12 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   // x: before(eps_i); same_eps: after(eps_i) (the same draws); y: after(eps'_i) (fresh draws).
   Eigen::MatrixXd x, same_eps;
   auto draw_shared = [&](int from, int to) {
+    std::vector<Eigen::VectorXd> drawn;
+    for (int i = from; i < to; ++i) drawn.push_back(draw(shared));
+    prefetch(drawn, pair.before);
+    prefetch(drawn, pair.after);
     for (int i = from; i < to; ++i) {
-      const Eigen::VectorXd eps = draw(shared);
+      const Eigen::VectorXd& eps = drawn[static_cast<std::size_t>(i - from)];
       const Eigen::VectorXd u = pair.before(eps);
       const Eigen::VectorXd v = pair.after(eps);
       if (i == 0) {
@@ -745,7 +760,11 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   //    see only when it is large).
   if (draws > samples) draw_shared(samples, draws);
   Eigen::MatrixXd y(draws, same_eps.cols());
-  for (int i = 0; i < draws; ++i) y.row(i) = pair.after(draw(fresh)).transpose();
+  std::vector<Eigen::VectorXd> fresh_draws;
+  for (int i = 0; i < draws; ++i) fresh_draws.push_back(draw(fresh));
+  prefetch(fresh_draws, pair.after);
+  for (int i = 0; i < draws; ++i)
+    y.row(i) = pair.after(fresh_draws[static_cast<std::size_t>(i)]).transpose();
   const Eigen::MatrixXd before = columns_of(x, tested), after = columns_of(y, tested);
   const TwoSampleResult test = energy_test(before.topRows(samples), after.topRows(samples),
                                            permutations_for(level), options.seed, level);
@@ -842,8 +861,9 @@ Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, 
     outcome.witness.g = g;
     return outcome;
   };
-  Verdict verdict = detail::run_check(run_case, component, group, Mode::distribution, options,
-                                      distribution.cases, distribution.shrink_budget);
+  Verdict verdict =
+      detail::run_check(run_case, component, group, Mode::distribution, options, distribution.cases,
+                        distribution.shrink_budget, [&statistics] { statistics = {}; });
   detail::finish_distribution_verdict(verdict, statistics, distribution);
   return verdict;
 }

@@ -84,6 +84,7 @@ Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
     sides.response = [&](const Scene& a, const Scene& b) {
       return detail::chunk_distance(checked_act(policy, a, noise), checked_act(policy, b, noise));
     };
+    sides.ask = [&](const Scene& s) { (void)policy.act(s, noise); };
     return detail::decide_pointwise(sides, scene, g, options);
   };
   return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,
@@ -114,7 +115,8 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
     return outcome;
   };
   Verdict verdict = detail::run_check(run_case, Component::policy, group, Mode::distribution,
-                                      options, distribution.cases, distribution.shrink_budget);
+                                      options, distribution.cases, distribution.shrink_budget,
+                                      [&statistics] { statistics = {}; });
   detail::finish_distribution_verdict(verdict, statistics, distribution);
   return verdict;
 }

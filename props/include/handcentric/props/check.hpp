@@ -55,6 +55,10 @@ struct CheckOptions {
   /// Shrink a failing case to a small witness (false: keep the first failure as it was found,
   /// for a re-check that only needs the yes or no).
   bool shrink = true;
+  /// Run the prefetch passes of batch.hpp before the check, so that a batched map
+  /// (BatchedPolicy, BatchedRepresentation) is asked for many inputs at once. The verdict is the
+  /// same; for a map that is not batched it only costs time.
+  bool prefetch = false;
 };
 
 /// Eye-in-hand scenes (no world points): Theorem 1's assumption.

@@ -1,0 +1,240 @@
+#pragma once
+// The map under audit evaluated on many inputs at once (a Python callable on stacked arrays, a
+// plug-in answering many scenes per line), with verdicts the same bit for bit as one call at a
+// time.
+//
+// How. A check's cases, and the inputs each case asks for, follow from its seed; only a case's
+// next question can depend on an answer (the floor, then the map's rounding, then off the case;
+// the affine probes, then the draws). So with CheckOptions::prefetch, run_check first runs
+// prefetch passes over its cases: in such a pass a BatchedPolicy or BatchedRepresentation asked
+// for an input it has no answer for records it and throws PendingEvaluation, which stops that
+// case only (cases where several questions are known at once ask them all first: prefetch()).
+// The recorded inputs are then evaluated together, in batches of at most batch_size inputs of
+// one shape, and the next pass goes a question further. When a pass records nothing new, the
+// real pass runs: it asks the same questions in the same order as an unbatched check and finds
+// every answer cached, so its verdict, witness and JSON are those of the unbatched check, bit
+// for bit, provided the map's answer for one input does not depend on the other inputs of its
+// batch. The prefetch passes may ask for inputs the real pass never reaches (cases after the
+// first failure); shrinking a failure asks one input at a time.
+#include <Eigen/Core>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "handcentric/core/representation.hpp"
+#include "handcentric/core/rigid_transform.hpp"
+#include "handcentric/core/scene.hpp"
+#include "handcentric/props/policy_audit.hpp"
+
+namespace handcentric::props {
+
+/// The largest batch_size a batched map takes (one batch of a policy holds batch_size noise
+/// vectors, up to kMaxPolicyNoise numbers each).
+inline constexpr int kMaxBatchSize = 1 << 16;
+
+/// Thrown, during a prefetch pass only, by a batched map asked for an input it has not evaluated
+/// yet (the input is recorded). Deliberately not a std::exception: only the check runner and
+/// prefetch() catch it.
+struct PendingEvaluation {};
+
+/// Something that records inputs during a prefetch pass and then evaluates them together.
+class Prefetcher {
+ public:
+  virtual ~Prefetcher() = default;
+  /// Evaluates the recorded inputs; returns how many it evaluated.
+  virtual std::size_t flush() = 0;
+};
+
+/// True while a prefetch pass runs on this thread.
+bool prefetching();
+
+/// During a prefetch pass, calls ask(input) for every input, catching PendingEvaluation, so that
+/// a case records every question it will ask before it needs the first answer. Outside a
+/// prefetch pass it does nothing (the questions are asked when the case gets to them).
+template <class Input, class Ask>
+void prefetch(const std::vector<Input>& inputs, const Ask& ask) {
+  if (!prefetching()) return;
+  for (const Input& input : inputs) {
+    try {
+      (void)ask(input);
+    } catch (const PendingEvaluation&) {
+    }
+  }
+}
+
+namespace detail {
+
+/// Called by a prefetcher for each input it records in this thread's current prefetch pass.
+void enlist(Prefetcher& prefetcher);
+
+/// The prefetch passes of one check (check_runner.hpp): while alive, prefetching() is true
+/// during pass(); flush() evaluates what the pass recorded. Nested checks keep their own state.
+class PrefetchPasses {
+ public:
+  PrefetchPasses();
+  ~PrefetchPasses();
+  PrefetchPasses(const PrefetchPasses&) = delete;
+  PrefetchPasses& operator=(const PrefetchPasses&) = delete;
+  /// Runs one prefetch pass.
+  void pass(const std::function<void()>& body);
+  /// Evaluates the inputs the last pass recorded; returns how many.
+  std::size_t flush();
+  /// Inputs recorded since the last flush.
+  std::size_t recorded() const { return recorded_; }
+
+ private:
+  bool prefetching_ = false;
+  std::size_t recorded_ = 0;
+  std::vector<Prefetcher*> enlisted_;
+  PrefetchPasses* outer_ = nullptr;
+  friend bool props::prefetching();
+  friend void enlist(Prefetcher& prefetcher);
+};
+
+/// The bytes of a scene's observation (its chunk too when `with_chunk`): a cache key.
+std::string scene_key(const Scene& scene, bool with_chunk);
+
+/// What must agree for scenes to be stacked in one batch: the history and chunk lengths and the
+/// numbers of points (extra poses and scalars are the audit's, the same for every scene).
+std::string shape_key(const Scene& scene, bool with_chunk);
+
+}  // namespace detail
+
+/// A policy that answers many observations at once (a Python callable on stacked arrays, a
+/// plug-in over the pipe).
+class BatchPolicy {
+ public:
+  virtual ~BatchPolicy() = default;
+  virtual std::string name() const = 0;
+  virtual Eigen::Index noise_dimension() const = 0;
+  /// One world-frame chunk per (observations[i], noises[i]). Every observation has the same
+  /// shape (detail::shape_key); at most the BatchedPolicy's batch_size of them.
+  virtual std::vector<std::vector<RigidTransform>> act_batch(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const = 0;
+};
+
+/// A representation that encodes many scenes at once.
+class BatchRepresentation {
+ public:
+  virtual ~BatchRepresentation() = default;
+  virtual std::string name() const = 0;
+  /// True when it has an observation map (else encode_observation gives empty vectors).
+  virtual bool has_observation() const = 0;
+  /// The action vector of each scene (each with its chunk), all of one shape.
+  virtual std::vector<Eigen::VectorXd> encode_actions_batch(
+      const std::vector<const Scene*>& scenes) const = 0;
+  /// The observation vector of each scene, all of one shape.
+  virtual std::vector<Eigen::VectorXd> encode_observation_batch(
+      const std::vector<const Scene*>& scenes) const = 0;
+  virtual bool can_decode() const { return false; }
+  /// The world chunk that `actions` encode in `observation` (one at a time: only the
+  /// injectivity round trips ask).
+  virtual std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
+                                                      const Scene& observation) const;
+};
+
+/// Answers by key, bounded by entries and bytes (cleared when full: the checks ask the same
+/// scenes again across groups and components, but never need everything at once).
+template <class Value>
+class AnswerCache {
+ public:
+  const Value* find(const std::string& key) const {
+    const auto hit = map_.find(key);
+    return hit == map_.end() ? nullptr : &hit->second;
+  }
+  const Value& put(std::string key, Value value) {
+    if (map_.size() >= kMaxEntries || bytes_ > kMaxBytes) {
+      map_.clear();
+      bytes_ = 0;
+    }
+    bytes_ += key.size();
+    return map_.insert_or_assign(std::move(key), std::move(value)).first->second;
+  }
+
+ private:
+  static constexpr std::size_t kMaxEntries = 400000;
+  static constexpr std::size_t kMaxBytes = std::size_t{512} << 20;
+  std::unordered_map<std::string, Value> map_;
+  std::size_t bytes_ = 0;
+};
+
+/// The NoisyPolicy the checks call, around a BatchPolicy: answers from its cache; asked for a
+/// new input during a prefetch pass, records it (PendingEvaluation); flush() evaluates the
+/// recorded inputs in batches of at most batch_size; outside a prefetch pass, a new input is
+/// evaluated alone. Every chunk must have the same length (else InvalidArgument).
+class BatchedPolicy final : public NoisyPolicy, public Prefetcher {
+ public:
+  /// Throws InvalidArgument for a null policy or batch_size outside [1, kMaxBatchSize].
+  BatchedPolicy(std::shared_ptr<const BatchPolicy> policy, int batch_size);
+  std::string name() const override { return policy_->name(); }
+  Eigen::Index noise_dimension() const override { return noise_dimension_; }
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  const Eigen::VectorXd& noise) const override;
+  std::size_t flush() override;
+  /// Calls of act_batch so far, and the inputs they carried (for benchmarks and tests).
+  std::size_t batches() const { return batches_; }
+  std::size_t evaluations() const { return evaluations_; }
+
+ private:
+  struct Pending {
+    Scene observation;
+    Eigen::VectorXd noise;
+    std::string key;
+  };
+  void evaluate(const std::vector<const Pending*>& inputs) const;
+
+  std::shared_ptr<const BatchPolicy> policy_;
+  int batch_size_;
+  Eigen::Index noise_dimension_;
+  mutable AnswerCache<std::vector<RigidTransform>> cache_;
+  mutable std::vector<Pending> pending_;
+  mutable std::unordered_map<std::string, bool> pending_keys_;
+  mutable std::size_t chunk_length_ = 0;
+  mutable std::size_t batches_ = 0, evaluations_ = 0;
+};
+
+/// The Representation the checks call, around a BatchRepresentation, as BatchedPolicy is for a
+/// policy (actions and observation cached and batched separately).
+class BatchedRepresentation final : public Representation, public Prefetcher {
+ public:
+  /// Throws InvalidArgument for a null representation or batch_size outside [1, kMaxBatchSize].
+  BatchedRepresentation(std::shared_ptr<const BatchRepresentation> representation, int batch_size);
+  std::string name() const override { return representation_->name(); }
+  bool has_observation() const { return representation_->has_observation(); }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override;
+  Eigen::VectorXd encode_observation(const Scene& scene) const override;
+  bool can_decode() const override { return representation_->can_decode(); }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& actions,
+                                             const RigidTransform& world_T_hand0) const override;
+  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
+                                              const Scene& observation) const override;
+  std::size_t flush() override;
+  std::size_t batches() const { return batches_; }
+  std::size_t evaluations() const { return evaluations_; }
+
+ private:
+  struct Pending {
+    Scene scene;
+    std::string key;
+  };
+  struct Side {  // actions or observation
+    bool with_chunk = true;
+    mutable AnswerCache<Eigen::VectorXd> cache;
+    mutable std::vector<Pending> pending;
+    mutable std::unordered_map<std::string, bool> pending_keys;
+  };
+  Eigen::VectorXd encode(const Side& side, const Scene& scene) const;
+  void evaluate(const Side& side, const std::vector<const Pending*>& inputs) const;
+  std::size_t flush(Side& side);
+
+  std::shared_ptr<const BatchRepresentation> representation_;
+  int batch_size_;
+  Side actions_, observation_;
+  mutable std::size_t batches_ = 0, evaluations_ = 0;
+};
+
+}  // namespace handcentric::props

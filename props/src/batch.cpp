@@ -1,0 +1,285 @@
+#include "handcentric/props/batch.hpp"
+
+#include <algorithm>
+#include <map>
+
+#include "handcentric/core/errors.hpp"
+
+namespace handcentric::props {
+namespace {
+
+thread_local detail::PrefetchPasses* current_passes = nullptr;
+
+void require_batch_size(int batch_size) {
+  if (batch_size < 1 || batch_size > kMaxBatchSize) {
+    throw InvalidArgument("batch_size=" + std::to_string(batch_size) + " is outside [1, " +
+                          std::to_string(kMaxBatchSize) +
+                          "]; 32 to 1024 suits a network on a CPU or GPU");
+  }
+}
+
+void append(std::string& key, const RigidTransform& T) {
+  key.append(reinterpret_cast<const char*>(T.rotation().matrix().data()), 9 * sizeof(double));
+  key.append(reinterpret_cast<const char*>(T.translation().data()), 3 * sizeof(double));
+}
+
+void append_count(std::string& key, std::size_t n) {
+  key.append(reinterpret_cast<const char*>(&n), sizeof(n));
+}
+
+// The pending inputs in groups of one shape and at most batch_size each, in the order they were
+// recorded within a shape (so the batches, and the order of the callable's calls, are the same
+// on every run).
+template <class Pending, class ShapeOf>
+std::vector<std::vector<const Pending*>> batches_of(const std::vector<Pending>& pending,
+                                                    int batch_size, const ShapeOf& shape_of) {
+  std::map<std::string, std::vector<const Pending*>> by_shape;
+  std::vector<std::string> order;
+  for (const Pending& p : pending) {
+    const std::string shape = shape_of(p);
+    auto [at, inserted] = by_shape.try_emplace(shape);
+    if (inserted) order.push_back(shape);
+    at->second.push_back(&p);
+  }
+  std::vector<std::vector<const Pending*>> out;
+  const auto size = static_cast<std::size_t>(batch_size);
+  for (const std::string& shape : order) {
+    const std::vector<const Pending*>& all = by_shape[shape];
+    for (std::size_t from = 0; from < all.size(); from += size) {
+      out.emplace_back(
+          all.begin() + static_cast<std::ptrdiff_t>(from),
+          all.begin() + static_cast<std::ptrdiff_t>(std::min(all.size(), from + size)));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool prefetching() {
+  return current_passes != nullptr && current_passes->prefetching_;
+}
+
+namespace detail {
+
+void enlist(Prefetcher& prefetcher) {
+  if (current_passes == nullptr) return;
+  ++current_passes->recorded_;
+  auto& enlisted = current_passes->enlisted_;
+  if (std::find(enlisted.begin(), enlisted.end(), &prefetcher) == enlisted.end())
+    enlisted.push_back(&prefetcher);
+}
+
+PrefetchPasses::PrefetchPasses() : outer_(current_passes) {
+  current_passes = this;
+}
+
+PrefetchPasses::~PrefetchPasses() {
+  current_passes = outer_;
+}
+
+void PrefetchPasses::pass(const std::function<void()>& body) {
+  prefetching_ = true;
+  try {
+    body();
+  } catch (...) {
+    prefetching_ = false;
+    throw;
+  }
+  prefetching_ = false;
+}
+
+std::size_t PrefetchPasses::flush() {
+  std::vector<Prefetcher*> enlisted;
+  enlisted.swap(enlisted_);
+  recorded_ = 0;
+  std::size_t evaluated = 0;
+  for (Prefetcher* p : enlisted) evaluated += p->flush();
+  return evaluated;
+}
+
+std::string scene_key(const Scene& scene, bool with_chunk) {
+  std::string key;
+  key.reserve(96 * (scene.world_T_hand_history.size() + scene.world_T_hand_chunk.size()) + 64);
+  append_count(key, scene.world_T_hand_history.size());
+  for (const RigidTransform& T : scene.world_T_hand_history) append(key, T);
+  append_count(key, with_chunk ? scene.world_T_hand_chunk.size() : 0);
+  if (with_chunk)
+    for (const RigidTransform& T : scene.world_T_hand_chunk) append(key, T);
+  for (const auto* points : {&scene.hand_points, &scene.world_points}) {
+    append_count(key, points->size());
+    for (const Eigen::Vector3d& q : *points)
+      key.append(reinterpret_cast<const char*>(q.data()), 3 * sizeof(double));
+  }
+  for (const auto& [name, T] : scene.extra_poses) append(key, T);
+  for (const auto& [name, x] : scene.scalars)
+    key.append(reinterpret_cast<const char*>(&x), sizeof(x));
+  return key;
+}
+
+std::string shape_key(const Scene& scene, bool with_chunk) {
+  std::string key;
+  append_count(key, scene.world_T_hand_history.size());
+  append_count(key, with_chunk ? scene.world_T_hand_chunk.size() : 0);
+  append_count(key, scene.hand_points.size());
+  append_count(key, scene.world_points.size());
+  return key;
+}
+
+}  // namespace detail
+
+std::vector<RigidTransform> BatchRepresentation::decode_in_scene(const Eigen::VectorXd&,
+                                                                 const Scene&) const {
+  throw InvalidArgument(name() + " has no decode function");
+}
+
+// ---------------------------------------------------------------------------------------------
+// BatchedPolicy
+
+BatchedPolicy::BatchedPolicy(std::shared_ptr<const BatchPolicy> policy, int batch_size)
+    : policy_(std::move(policy)), batch_size_(batch_size) {
+  if (!policy_) throw InvalidArgument("BatchedPolicy needs a policy, got null");
+  require_batch_size(batch_size);
+  noise_dimension_ = policy_->noise_dimension();
+}
+
+std::vector<RigidTransform> BatchedPolicy::act(const Scene& observation,
+                                               const Eigen::VectorXd& noise) const {
+  observation.validate_observation();
+  std::string key = detail::scene_key(observation, false);
+  key.append(reinterpret_cast<const char*>(noise.data()),
+             sizeof(double) * static_cast<std::size_t>(noise.size()));
+  if (const auto* hit = cache_.find(key)) return *hit;
+  if (prefetching()) {
+    if (pending_keys_.emplace(key, true).second) {
+      pending_.push_back({observation, noise, std::move(key)});
+      detail::enlist(const_cast<BatchedPolicy&>(*this));
+    }
+    throw PendingEvaluation{};
+  }
+  const Pending one{observation, noise, key};
+  evaluate({&one});
+  return *cache_.find(key);
+}
+
+void BatchedPolicy::evaluate(const std::vector<const Pending*>& inputs) const {
+  std::vector<const Scene*> observations;
+  std::vector<const Eigen::VectorXd*> noises;
+  for (const Pending* p : inputs) {
+    observations.push_back(&p->observation);
+    noises.push_back(&p->noise);
+  }
+  std::vector<std::vector<RigidTransform>> chunks = policy_->act_batch(observations, noises);
+  ++batches_;
+  evaluations_ += inputs.size();
+  if (chunks.size() != inputs.size()) {
+    throw InvalidArgument("policy " + name() + " returned " + std::to_string(chunks.size()) +
+                          " chunks for a batch of " + std::to_string(inputs.size()) +
+                          " observations; it must return one chunk per observation");
+  }
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if (chunk_length_ == 0) chunk_length_ = chunks[i].size();
+    if (chunks[i].size() != chunk_length_) {
+      throw InvalidArgument("policy " + name() + " returned " + std::to_string(chunks[i].size()) +
+                            " poses after " + std::to_string(chunk_length_) +
+                            " earlier; the chunk length K must not change");
+    }
+    cache_.put(inputs[i]->key, std::move(chunks[i]));
+  }
+}
+
+std::size_t BatchedPolicy::flush() {
+  std::vector<Pending> pending;
+  pending.swap(pending_);
+  pending_keys_.clear();
+  const auto batches = batches_of(pending, batch_size_, [](const Pending& p) {
+    return detail::shape_key(p.observation, false);
+  });
+  for (const auto& batch : batches) evaluate(batch);
+  return pending.size();
+}
+
+// ---------------------------------------------------------------------------------------------
+// BatchedRepresentation
+
+BatchedRepresentation::BatchedRepresentation(
+    std::shared_ptr<const BatchRepresentation> representation, int batch_size)
+    : representation_(std::move(representation)), batch_size_(batch_size) {
+  if (!representation_) throw InvalidArgument("BatchedRepresentation needs a representation");
+  require_batch_size(batch_size);
+  observation_.with_chunk = false;
+}
+
+Eigen::VectorXd BatchedRepresentation::encode_actions(const Scene& scene) const {
+  scene.validate();
+  return encode(actions_, scene);
+}
+
+Eigen::VectorXd BatchedRepresentation::encode_observation(const Scene& scene) const {
+  if (!has_observation()) return {};
+  scene.validate_observation();
+  return encode(observation_, scene);
+}
+
+Eigen::VectorXd BatchedRepresentation::encode(const Side& side, const Scene& scene) const {
+  std::string key = detail::scene_key(scene, side.with_chunk);
+  if (const auto* hit = side.cache.find(key)) return *hit;
+  if (prefetching()) {
+    if (side.pending_keys.emplace(key, true).second) {
+      side.pending.push_back({scene, std::move(key)});
+      detail::enlist(const_cast<BatchedRepresentation&>(*this));
+    }
+    throw PendingEvaluation{};
+  }
+  const Pending one{scene, key};
+  evaluate(side, {&one});
+  return *side.cache.find(key);
+}
+
+void BatchedRepresentation::evaluate(const Side& side,
+                                     const std::vector<const Pending*>& inputs) const {
+  std::vector<const Scene*> scenes;
+  for (const Pending* p : inputs) scenes.push_back(&p->scene);
+  std::vector<Eigen::VectorXd> out = side.with_chunk
+                                         ? representation_->encode_actions_batch(scenes)
+                                         : representation_->encode_observation_batch(scenes);
+  ++batches_;
+  evaluations_ += inputs.size();
+  if (out.size() != inputs.size()) {
+    throw InvalidArgument(name() + " returned " + std::to_string(out.size()) + " " +
+                          (side.with_chunk ? "action" : "observation") +
+                          " vectors for a batch of " + std::to_string(inputs.size()) +
+                          " scenes; it must return one per scene");
+  }
+  for (std::size_t i = 0; i < inputs.size(); ++i) side.cache.put(inputs[i]->key, std::move(out[i]));
+}
+
+std::size_t BatchedRepresentation::flush(Side& side) {
+  std::vector<Pending> pending;
+  pending.swap(side.pending);
+  side.pending_keys.clear();
+  const bool with_chunk = side.with_chunk;
+  const auto batches = batches_of(pending, batch_size_, [with_chunk](const Pending& p) {
+    return detail::shape_key(p.scene, with_chunk);
+  });
+  for (const auto& batch : batches) evaluate(side, batch);
+  return pending.size();
+}
+
+std::size_t BatchedRepresentation::flush() {
+  return flush(actions_) + flush(observation_);
+}
+
+std::vector<RigidTransform> BatchedRepresentation::decode_actions(
+    const Eigen::VectorXd& actions, const RigidTransform& world_T_hand0) const {
+  Scene observation;
+  observation.world_T_hand_history = {world_T_hand0};
+  return decode_in_scene(actions, observation);
+}
+
+std::vector<RigidTransform> BatchedRepresentation::decode_in_scene(const Eigen::VectorXd& actions,
+                                                                   const Scene& observation) const {
+  return representation_->decode_in_scene(actions, observation);
+}
+
+}  // namespace handcentric::props
