@@ -23,6 +23,8 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <chrono>
+#include <iomanip>
 #include <cmath>
 #include <cstring>
 #include <memory>
@@ -44,392 +46,11 @@
 #include "handcentric/props/policy_audit.hpp"
 #include "handcentric/props/verdict.hpp"
 #include "handcentric/sim/demos.hpp"
-
-namespace py = pybind11;
+#include "arrays.hpp"
+#include "callables.hpp"
 
 namespace handcentric::python {
 namespace {
-
-// ---------------------------------------------------------------------------------------------
-// Errors
-
-/// A Python exception raised inside a callable under audit, carried through the C++ checks.
-class PythonCallError : public Error {
- public:
-  explicit PythonCallError(py::error_already_set error)
-      : Error("a Python callable raised an exception"),
-        error(std::make_shared<py::error_already_set>(std::move(error))) {}
-  std::shared_ptr<py::error_already_set> error;
-};
-
-/// An array of the wrong shape (argument or result): Python ValueError subclass ShapeError.
-class ShapeError : public InvalidArgument {
- public:
-  using InvalidArgument::InvalidArgument;
-};
-
-/// Something that is not an array of real numbers: Python TypeError.
-class DtypeError : public InvalidArgument {
- public:
-  using InvalidArgument::InvalidArgument;
-};
-
-std::string shape_of(const py::array& a) {
-  std::ostringstream out;
-  out << "(";
-  for (py::ssize_t i = 0; i < a.ndim(); ++i) out << (i ? ", " : "") << a.shape(i);
-  out << (a.ndim() == 1 ? ",)" : ")");
-  return out.str();
-}
-
-std::string type_name(py::handle value) {
-  return py::str(py::type::handle_of(value).attr("__name__"));
-}
-
-/// `value` as a C-contiguous float64 array; DtypeError for anything that is not real numbers
-/// (lists, tuples, NumPy arrays of any integer or float dtype and objects with __array__, such
-/// as CPU torch tensors without grad, are fine).
-using RealArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-RealArray real_array(py::handle value, const std::string& what) {
-  if (value.is_none()) throw DtypeError(what + " is None; expected an array of real numbers");
-  py::array any = py::array::ensure(value);
-  if (!any) {
-    throw DtypeError(what + " is a " + type_name(value) +
-                     " that NumPy cannot read as an array of real numbers");
-  }
-  const char kind = any.dtype().kind();
-  if (kind != 'f' && kind != 'i' && kind != 'u') {
-    throw DtypeError(what + " has dtype " + std::string(py::str(any.dtype())) +
-                     "; expected real numbers (float64, float32 or integers)");
-  }
-  return RealArray::ensure(any);
-}
-
-void require_finite(const double* data, py::ssize_t n, const std::string& what) {
-  for (py::ssize_t i = 0; i < n; ++i) {
-    if (!std::isfinite(data[i])) {
-      throw InvalidArgument(what + " holds a non-finite number (" + std::to_string(data[i]) +
-                            ") at flat index " + std::to_string(i) +
-                            "; every entry must be finite");
-    }
-  }
-}
-
-Eigen::VectorXd vector_from(py::handle value, const std::string& what) {
-  const auto a = real_array(value, what);
-  if (a.ndim() != 1)
-    throw ShapeError(what + " has shape " + shape_of(a) + "; expected a 1-D array (n,)");
-  require_finite(a.data(), a.size(), what);
-  return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
-}
-
-Eigen::Vector3d vector3_from(py::handle value, const std::string& what) {
-  const Eigen::VectorXd v = vector_from(value, what);
-  if (v.size() != 3)
-    throw ShapeError(what + " has shape (" + std::to_string(v.size()) + ",); expected (3,)");
-  return v;
-}
-
-Eigen::Matrix4d matrix4(const double* m) {
-  Eigen::Matrix4d M;
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) M(r, c) = m[4 * r + c];
-  return M;
-}
-
-/// A stack of poses (n, 4, 4), n >= 1; each validated as a rigid transform unless `loose`, where
-/// the rotation block is taken as it is (a float32 policy's is orthonormal to ~1e-7 only, as for
-/// the --policy-exec pipe) and only the last row is checked (to 1e-6).
-std::vector<RigidTransform> poses_from(py::handle value, const std::string& what,
-                                       bool loose = false, const char* expected = "(n, 4, 4)") {
-  const auto a = real_array(value, what);
-  if (a.ndim() != 3 || a.shape(1) != 4 || a.shape(2) != 4 || a.shape(0) < 1) {
-    throw ShapeError(what + " has shape " + shape_of(a) + "; expected " + expected +
-                     " with at least one pose");
-  }
-  require_finite(a.data(), a.size(), what);
-  std::vector<RigidTransform> out;
-  out.reserve(static_cast<std::size_t>(a.shape(0)));
-  for (py::ssize_t k = 0; k < a.shape(0); ++k) {
-    const Eigen::Matrix4d M = matrix4(a.data() + 16 * k);
-    if (!loose) {
-      out.push_back(RigidTransform::from_matrix(M));
-      continue;
-    }
-    const double row =
-        std::abs(M(3, 0)) + std::abs(M(3, 1)) + std::abs(M(3, 2)) + std::abs(M(3, 3) - 1.0);
-    if (!(row <= 1e-6)) {
-      throw ShapeError(what + "[" + std::to_string(k) + "] has last row (" +
-                       std::to_string(M(3, 0)) + ", " + std::to_string(M(3, 1)) + ", " +
-                       std::to_string(M(3, 2)) + ", " + std::to_string(M(3, 3)) +
-                       "); a pose is [[R, p], [0, 0, 0, 1]]");
-    }
-    out.push_back(RigidTransform::unchecked(M.topLeftCorner<3, 3>(), M.topRightCorner<3, 1>()));
-  }
-  return out;
-}
-
-Eigen::Matrix4d matrix4_from(py::handle value, const std::string& what) {
-  const auto a = real_array(value, what);
-  if (a.ndim() != 2 || a.shape(0) != 4 || a.shape(1) != 4) {
-    throw ShapeError(what + " has shape " + shape_of(a) + "; expected (4, 4)");
-  }
-  require_finite(a.data(), a.size(), what);
-  return matrix4(a.data());
-}
-
-std::vector<Eigen::Vector3d> points_from(py::handle value, const std::string& what) {
-  if (value.is_none()) return {};
-  const auto a = real_array(value, what);
-  if (a.size() == 0) return {};
-  if (a.ndim() != 2 || a.shape(1) != 3)
-    throw ShapeError(what + " has shape " + shape_of(a) + "; expected (n, 3)");
-  require_finite(a.data(), a.size(), what);
-  std::vector<Eigen::Vector3d> out(static_cast<std::size_t>(a.shape(0)));
-  for (py::ssize_t i = 0; i < a.shape(0); ++i)
-    out[static_cast<std::size_t>(i)] = Eigen::Vector3d(a.data() + 3 * i);
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------------
-// C++ -> NumPy
-
-py::array_t<double> array_of(const Eigen::Matrix4d& M) {
-  py::array_t<double> a({4, 4});
-  double* out = a.mutable_data();
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) out[4 * r + c] = M(r, c);
-  return a;
-}
-
-py::array_t<double> array_of(const std::vector<RigidTransform>& poses) {
-  py::array_t<double> a({static_cast<py::ssize_t>(poses.size()), py::ssize_t{4}, py::ssize_t{4}});
-  double* out = a.mutable_data();
-  for (const RigidTransform& T : poses) {
-    const Eigen::Matrix3d& R = T.rotation().matrix();
-    const Eigen::Vector3d& p = T.translation();
-    for (int r = 0; r < 3; ++r) {
-      out[0] = R(r, 0), out[1] = R(r, 1), out[2] = R(r, 2), out[3] = p(r);
-      out += 4;
-    }
-    out[0] = 0.0, out[1] = 0.0, out[2] = 0.0, out[3] = 1.0;
-    out += 4;
-  }
-  return a;
-}
-
-/// Always (n, 3), also for n = 0, so that user code can index columns without a special case.
-py::array_t<double> array_of(const std::vector<Eigen::Vector3d>& points) {
-  py::array_t<double> a({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
-  double* out = a.mutable_data();
-  for (const Eigen::Vector3d& q : points) {
-    out[0] = q(0), out[1] = q(1), out[2] = q(2);
-    out += 3;
-  }
-  return a;
-}
-
-py::array_t<double> array_of(const Eigen::VectorXd& v) {
-  py::array_t<double> a(v.size());
-  std::memcpy(a.mutable_data(), v.data(), sizeof(double) * static_cast<std::size_t>(v.size()));
-  return a;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Callables under audit
-
-/// The name a report shows for a callable: a function's qualified name, else its class's (an
-/// object with __call__, e.g. a torch module), so that the name does not change between runs.
-std::string callable_name(const py::object& fn) {
-  if (py::hasattr(fn, "__qualname__")) return py::str(fn.attr("__qualname__"));
-  return py::str(py::type::handle_of(fn).attr("__qualname__"));
-}
-
-/// The keyword arguments extra_poses={name: (4, 4)} and scalars={name: float}, when the audit
-/// was asked for any (as handcentric_plugin.serve gives them).
-py::kwargs extras_kwargs(const Scene& scene, bool wanted) {
-  py::kwargs kw;
-  if (!wanted) return kw;
-  py::dict poses, scalars;
-  for (const auto& [name, pose] : scene.extra_poses) poses[py::str(name)] = array_of(pose.matrix());
-  for (const auto& [name, x] : scene.scalars) scalars[py::str(name)] = x;
-  kw["extra_poses"] = poses;
-  kw["scalars"] = scalars;
-  return kw;
-}
-
-/// Calls fn; a Python exception leaves as PythonCallError (see the top of this file), and so
-/// does a KeyboardInterrupt (or any exception a signal handler raises) pending before the call:
-/// a callable written in C runs no Python code that would notice it.
-template <class... Args>
-py::object call(const py::object& fn, Args&&... args) {
-  try {
-    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    return fn(std::forward<Args>(args)...);
-  } catch (py::error_already_set& e) {
-    throw PythonCallError(std::move(e));
-  }
-}
-
-/// The bytes of a scene's observation (and chunk, when asked): a cache key.
-void append(std::string& key, const RigidTransform& T) {
-  key.append(reinterpret_cast<const char*>(T.rotation().matrix().data()), 9 * sizeof(double));
-  key.append(reinterpret_cast<const char*>(T.translation().data()), 3 * sizeof(double));
-}
-
-std::string scene_key(const Scene& scene, bool with_chunk) {
-  std::string key;
-  key.reserve(96 * (scene.world_T_hand_history.size() + scene.world_T_hand_chunk.size()) + 64);
-  auto count = [&key](std::size_t n) { key.append(reinterpret_cast<const char*>(&n), sizeof(n)); };
-  count(scene.world_T_hand_history.size());
-  for (const RigidTransform& T : scene.world_T_hand_history) append(key, T);
-  count(with_chunk ? scene.world_T_hand_chunk.size() : 0);
-  if (with_chunk)
-    for (const RigidTransform& T : scene.world_T_hand_chunk) append(key, T);
-  for (const auto* points : {&scene.hand_points, &scene.world_points}) {
-    count(points->size());
-    for (const Eigen::Vector3d& q : *points)
-      key.append(reinterpret_cast<const char*>(q.data()), 3 * sizeof(double));
-  }
-  for (const auto& [name, T] : scene.extra_poses) append(key, T);
-  for (const auto& [name, x] : scene.scalars)
-    key.append(reinterpret_cast<const char*>(&x), sizeof(x));
-  return key;
-}
-
-/// A bounded cache: the checks ask the same scene many times (every component of a cell, and
-/// an exact in-distribution check n + 3 times), a Python call costs microseconds.
-template <class Value>
-class Cache {
- public:
-  const Value* find(const std::string& key) const {
-    const auto hit = map_.find(key);
-    return hit == map_.end() ? nullptr : &hit->second;
-  }
-  const Value& put(std::string key, Value value) {
-    // By count and by key bytes: a policy's key holds its noise vector (up to 512 KiB).
-    if (map_.size() > 200000 || key_bytes_ > (std::size_t{256} << 20)) {
-      map_.clear();
-      key_bytes_ = 0;
-    }
-    key_bytes_ += key.size();
-    return map_.insert_or_assign(std::move(key), std::move(value)).first->second;
-  }
-
- private:
-  std::unordered_map<std::string, Value> map_;
-  std::size_t key_bytes_ = 0;
-};
-
-/// A representation written in Python: actions(history, chunk, hand_points, world_points) and,
-/// optionally, observation(history, hand_points, world_points) and decode(actions, history,
-/// hand_points, world_points) -> (K, 4, 4).
-class PythonRepresentation final : public Representation {
- public:
-  PythonRepresentation(py::object actions, py::object observation, py::object decode, bool extras)
-      : actions_(std::move(actions)),
-        observation_(std::move(observation)),
-        decode_(std::move(decode)),
-        extras_(extras),
-        name_("python: " + callable_name(actions_)) {}
-
-  std::string name() const override { return name_; }
-  bool has_observation() const { return !observation_.is_none(); }
-
-  Eigen::VectorXd encode_actions(const Scene& scene) const override {
-    scene.validate();
-    std::string key = scene_key(scene, true);
-    if (const auto* hit = actions_cache_.find(key)) return *hit;
-    py::object result = call(actions_, array_of(scene.world_T_hand_history),
-                             array_of(scene.world_T_hand_chunk), array_of(scene.hand_points),
-                             array_of(scene.world_points), **extras_kwargs(scene, extras_));
-    return actions_cache_.put(std::move(key),
-                              vector_from(result, "the result of actions function " + name_));
-  }
-
-  Eigen::VectorXd encode_observation(const Scene& scene) const override {
-    if (!has_observation()) return {};
-    scene.validate_observation();
-    std::string key = scene_key(scene, false);
-    if (const auto* hit = observation_cache_.find(key)) return *hit;
-    py::object result =
-        call(observation_, array_of(scene.world_T_hand_history), array_of(scene.hand_points),
-             array_of(scene.world_points), **extras_kwargs(scene, extras_));
-    return observation_cache_.put(
-        std::move(key),
-        vector_from(result, "the result of observation function " + callable_name(observation_)));
-  }
-
-  bool can_decode() const override { return !decode_.is_none(); }
-
-  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& actions,
-                                             const RigidTransform& world_T_hand0) const override {
-    Scene observation;
-    observation.world_T_hand_history = {world_T_hand0};
-    return decode_in_scene(actions, observation);
-  }
-
-  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
-                                              const Scene& observation) const override {
-    if (!can_decode())
-      throw InvalidArgument(name_ + " has no decode function: pass decode= to audit it");
-    py::object result = call(decode_, array_of(actions), array_of(observation.world_T_hand_history),
-                             array_of(observation.hand_points), array_of(observation.world_points),
-                             **extras_kwargs(observation, extras_));
-    return poses_from(result, "the result of decode function " + callable_name(decode_), true,
-                      "(K, 4, 4)");
-  }
-
- private:
-  py::object actions_, observation_, decode_;
-  bool extras_;
-  std::string name_;
-  mutable Cache<Eigen::VectorXd> actions_cache_, observation_cache_;
-};
-
-/// A whole policy written in Python: policy(history, hand_points, world_points, noise) -> the
-/// world-frame chunk T_1..T_K, (K, 4, 4). The noise is its only randomness.
-class PythonPolicy final : public props::NoisyPolicy {
- public:
-  PythonPolicy(py::object policy, Eigen::Index noise, bool extras)
-      : policy_(std::move(policy)),
-        noise_(noise),
-        extras_(extras),
-        name_("python: " + callable_name(policy_)) {}
-
-  std::string name() const override { return name_; }
-  Eigen::Index noise_dimension() const override { return noise_; }
-
-  std::vector<RigidTransform> act(const Scene& observation,
-                                  const Eigen::VectorXd& noise) const override {
-    observation.validate_observation();
-    std::string key = scene_key(observation, false);
-    key.append(reinterpret_cast<const char*>(noise.data()),
-               sizeof(double) * static_cast<std::size_t>(noise.size()));
-    if (const auto* hit = cache_.find(key)) return *hit;
-    py::object result = call(policy_, array_of(observation.world_T_hand_history),
-                             array_of(observation.hand_points), array_of(observation.world_points),
-                             array_of(noise), **extras_kwargs(observation, extras_));
-    std::vector<RigidTransform> chunk =
-        poses_from(result, "the chunk returned by policy " + name_, true, "(K, 4, 4)");
-    if (chunk_length_ == 0) chunk_length_ = chunk.size();
-    if (chunk.size() != chunk_length_) {
-      throw ShapeError("policy " + name_ + " returned " + std::to_string(chunk.size()) +
-                       " poses after " + std::to_string(chunk_length_) +
-                       " earlier; the chunk length K must not change");
-    }
-    return cache_.put(std::move(key), std::move(chunk));
-  }
-
- private:
-  py::object policy_;
-  Eigen::Index noise_;
-  bool extras_;
-  std::string name_;
-  mutable std::size_t chunk_length_ = 0;
-  mutable Cache<std::vector<RigidTransform>> cache_;
-};
 
 // ---------------------------------------------------------------------------------------------
 // Options
@@ -513,6 +134,9 @@ int bounded_integer(py::handle value, const char* name, long long low, long long
                         " (docs/AUDIT_YOUR_POLICY.md says why)");
 }
 
+/// The largest fixed history length, number of points or chunk length a caller may ask for.
+constexpr long long kMaxSceneSize = 64;
+
 int cases_of(py::handle cases) {
   return bounded_integer(cases, "cases", 1, props::kMaxCases, "handcentric.MAX_CASES");
 }
@@ -521,15 +145,54 @@ int noise_of(py::handle noise) {
   return bounded_integer(noise, "noise", 1, props::kMaxPolicyNoise, "handcentric.MAX_NOISE");
 }
 
+/// The keywords every audit takes besides its groups, views, cases and tolerance: how the
+/// callable is called (batch_size, array, device), the progress line, and the scene sizes a
+/// network with fixed inputs needs (None: the audit's ranges).
+struct Setup {
+  py::handle batch_size = py::none();
+  std::string array = "numpy";
+  py::handle device = py::none();
+  bool quiet = false;
+  py::handle history = py::none(), hand_points = py::none(), world_points = py::none(),
+             chunk = py::none();
+};
+
+/// The docstring part about Setup's keywords.
+constexpr const char* kSetupDoc = R"doc(
+Every keyword argument a callable receives: with extra_poses / scalars (names), extra_poses=
+{name: (4, 4)} and scalars={name: float}. cases: 1 to MAX_CASES (10**7).
+batch_size=B (1 to MAX_BATCH_SIZE): the callables are called on stacked arrays with a leading
+batch axis of at most B: history (B, H+1, 4, 4), chunk (B, K, 4, 4), hand_points (B, n, 3),
+world_points (B, m, 3), noise (B, d), each extra pose (B, 4, 4) and scalar (B,); they return
+(B, a) (a representation's actions or observation) or (B, K, 4, 4) (a policy). Each row must
+depend on its own inputs only; then the verdicts are those of batch_size=None (one scene per
+call) bit for bit. Scenes of one shape share a batch: history=, hand_points=, world_points=
+(third-person view) and chunk= fix the sizes (None: the audit draws them per case).
+array="torch" passes float64 torch tensors (on device=, e.g. "cuda"), array="numpy" (default)
+NumPy arrays; results may be either, on any device, with or without grad.
+A progress line with the time left goes to stderr after 3 s (quiet=True: none). Needs NumPy
+(ImportError at once without it); Ctrl-C stops it with KeyboardInterrupt.)doc";
+
 struct CommonOptions {
   props::AuditOptions audit;
   std::vector<std::string> extra_poses, scalars;
+  std::optional<int> batch_size;  ///< none: one scene per call
+  CallOptions call;
+  bool quiet = false;
+  std::optional<int> history, hand_points, world_points, chunk;
 };
+
+/// An optional integer keyword in [low, high] (None: not given).
+std::optional<int> optional_integer(py::handle value, const char* name, long long low,
+                                    long long high, const char* bound) {
+  if (value.is_none()) return std::nullopt;
+  return bounded_integer(value, name, low, high, bound);
+}
 
 CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
                              std::uint64_t seed, std::optional<double> tolerance,
                              const std::string& precision, py::handle extra_poses,
-                             py::handle scalars) {
+                             py::handle scalars, const Setup& setup) {
   CommonOptions o;
   o.audit.cases = cases_of(cases);
   o.audit.groups = groups_of(groups);
@@ -546,14 +209,81 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
   (void)props::audit_relative_tolerance(o.audit);  // validates the tolerance
   o.extra_poses = names_of(extra_poses, "extra_poses");
   o.scalars = names_of(scalars, "scalars");
+  o.batch_size = optional_integer(setup.batch_size, "batch_size", 1, props::kMaxBatchSize,
+                                  "handcentric.MAX_BATCH_SIZE");
+  o.call.stacked = o.batch_size.has_value();
+  o.call.arrays = array_kind_of(setup.array, setup.device);
+  o.call.extras = !o.extra_poses.empty() || !o.scalars.empty();
+  o.quiet = setup.quiet;
+  o.history = optional_integer(setup.history, "history", 0, kMaxSceneSize, "64");
+  o.hand_points = optional_integer(setup.hand_points, "hand_points", 0, kMaxSceneSize, "64");
+  o.world_points = optional_integer(setup.world_points, "world_points", 1, kMaxSceneSize, "64");
+  o.chunk = optional_integer(setup.chunk, "chunk", 1, kMaxSceneSize, "64");
   return o;
 }
+
+/// Prints "handcentric.audit_policy: 12 of 20 checks, 6.1 s, about 4 s left" on stderr (the
+/// same line again on a terminal, a new line at most every 5 s otherwise) once an audit has run
+/// for 3 s, and lets a pending Ctrl-C stop it between checks too.
+class ProgressLine {
+ public:
+  ProgressLine(std::string function, bool quiet)
+      : function_(std::move(function)), quiet_(quiet), start_(Clock::now()) {}
+  ~ProgressLine() {
+    if (!printed_ || !tty_) return;
+    try {
+      write("\n");
+    } catch (...) {
+    }
+  }
+  void operator()(int done, int total) {
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (quiet_) return;
+    const double elapsed = seconds_since(start_);
+    if (elapsed < 3.0 || done <= 0) return;
+    if (!printed_) tty_ = py::module_::import("sys").attr("stderr").attr("isatty")().cast<bool>();
+    if (printed_ && seconds_since(last_) < (tty_ ? 1.0 : 5.0) && done < total) return;
+    const double left = elapsed / done * (total - done);
+    std::ostringstream line;
+    line.precision(2);
+    line << std::fixed << (tty_ ? "\r" : "") << "handcentric." << function_ << ": " << done
+         << " of " << total << " checks, " << std::setprecision(1) << elapsed << " s"
+         << (done < total ? ", about " + std::to_string(static_cast<long>(left + 0.5)) + " s left"
+                          : std::string(", done"))
+         << (tty_ ? "   " : "\n");
+    write(line.str());
+    printed_ = true;
+    last_ = Clock::now();
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  static double seconds_since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  }
+  static void write(const std::string& text) {
+    py::object err = py::module_::import("sys").attr("stderr");
+    err.attr("write")(text);
+    err.attr("flush")();
+  }
+  std::string function_;
+  bool quiet_;
+  Clock::time_point start_, last_;
+  bool printed_ = false, tty_ = false;
+};
 
 props::ClassifierOptions classifier_for(const CommonOptions& o) {
   props::ClassifierOptions c = props::classifier_options(o.audit);
   c.float32_advice = "pass precision=\"float32\"";
-  c.check.shape.extra_pose_names = o.extra_poses;
-  c.check.shape.scalar_names = o.scalars;
+  props::SceneShape& shape = c.check.shape;
+  shape.extra_pose_names = o.extra_poses;
+  shape.scalar_names = o.scalars;
+  if (o.history) shape.min_history = shape.max_history = *o.history;
+  if (o.hand_points) shape.min_hand_points = shape.max_hand_points = *o.hand_points;
+  if (o.world_points) shape.min_world_points = shape.max_world_points = *o.world_points;
+  if (o.chunk) shape.min_chunk = shape.max_chunk = *o.chunk;
+  // Batched calls: prefetch passes ask each check's inputs together (props/batch.hpp).
+  c.check.prefetch = o.batch_size.has_value();
   return c;
 }
 
@@ -611,10 +341,36 @@ props::Component component_of(const std::string& name) {
 // ---------------------------------------------------------------------------------------------
 // The module's functions
 
+/// The callables as the checks see them (props/batch.hpp): answers cached, and batched when the
+/// caller gave batch_size.
+std::shared_ptr<props::BatchedRepresentation> batched_representation(py::object actions,
+                                                                     py::object observation,
+                                                                     py::object decode,
+                                                                     const CommonOptions& o) {
+  return std::make_shared<props::BatchedRepresentation>(
+      std::make_shared<PythonRepresentation>(std::move(actions), std::move(observation),
+                                             std::move(decode), o.call),
+      o.batch_size.value_or(1));
+}
+
+std::shared_ptr<props::BatchedPolicy> batched_policy(py::object policy, int noise,
+                                                     const CommonOptions& o) {
+  // One batch's noise is batch_size x noise numbers: bounded, as one array must fit in memory.
+  constexpr long long kMaxBatchNumbers = 1LL << 24;
+  if (o.batch_size && static_cast<long long>(*o.batch_size) * noise > kMaxBatchNumbers) {
+    throw InvalidArgument(
+        "batch_size=" + std::to_string(*o.batch_size) + " with noise=" + std::to_string(noise) +
+        " makes a noise array of " + std::to_string(static_cast<long long>(*o.batch_size) * noise) +
+        " numbers, above 2**24; use batch_size <= " + std::to_string(kMaxBatchNumbers / noise));
+  }
+  return std::make_shared<props::BatchedPolicy>(
+      std::make_shared<PythonPolicy>(std::move(policy), noise, o.call), o.batch_size.value_or(1));
+}
+
 py::dict audit(py::object actions, py::object observation, py::handle groups, py::handle views,
                py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
                const std::string& precision, py::object decode, py::handle extra_poses,
-               py::handle scalars) {
+               py::handle scalars, const Setup& setup) {
   require_numpy("audit");
   if (!PyCallable_Check(actions.ptr()))
     throw DtypeError("actions must be callable, got a " + type_name(actions));
@@ -625,12 +381,12 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
     }
   }
   const CommonOptions o =
-      common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
-  const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
-  auto representation =
-      std::make_shared<PythonRepresentation>(actions, observation, decode, extras);
+      common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars, setup);
+  auto representation = batched_representation(actions, observation, decode, o);
   props::ClassifierOptions c = classifier_for(o);
   c.observation = representation->has_observation();
+  ProgressLine progress("audit", o.quiet);
+  c.progress = std::ref(progress);
   const props::Classification result = props::classify_representation(representation, c);
   return json_loads(props::audit_json({result}))["representations"][py::int_(0)];
 }
@@ -638,35 +394,38 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
 py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py::handle cases,
                       std::uint64_t seed, std::optional<double> tolerance,
                       const std::string& precision, py::handle noise_length, py::handle extra_poses,
-                      py::handle scalars) {
+                      py::handle scalars, const Setup& setup) {
   require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
   const int noise = noise_of(noise_length);
   const CommonOptions o =
-      common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars);
-  const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
-  const props::Classification result = props::classify_policy(
-      std::make_shared<PythonPolicy>(policy, noise, extras), classifier_for(o));
+      common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars, setup);
+  props::ClassifierOptions c = classifier_for(o);
+  ProgressLine progress("audit_policy", o.quiet);
+  c.progress = std::ref(progress);
+  const props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
   return json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
 }
 
 void assert_invariant(py::object fn, const std::string& group, const std::string& component_name,
                       py::object observation, py::handle views, py::handle cases,
                       std::uint64_t seed, std::optional<double> tolerance,
-                      const std::string& precision, py::handle extra_poses, py::handle scalars) {
+                      const std::string& precision, py::handle extra_poses, py::handle scalars,
+                      const Setup& setup) {
   require_numpy("assert_invariant");
   if (!PyCallable_Check(fn.ptr())) throw DtypeError("fn must be callable, got a " + type_name(fn));
   const props::Component component = component_of(component_name);
   const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
-                                         extra_poses, scalars);
-  const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
+                                         extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
+  ProgressLine progress("assert_invariant", o.quiet);
+  c.progress = std::ref(progress);
   props::Classification result;
   if (component == props::Component::observation) {
     // fn is the observation function; the actions are never asked for.
-    auto representation = std::make_shared<PythonRepresentation>(
-        py::cpp_function([](py::args) { return py::none(); }), fn, py::none(), extras);
+    auto representation = batched_representation(
+        py::cpp_function([](py::args) { return py::none(); }), fn, py::none(), o);
     result.name = "python: " + callable_name(fn);
     for (props::View view : c.views) {
       const props::CheckOptions check = props::with_view(c.check, view);
@@ -678,8 +437,7 @@ void assert_invariant(py::object fn, const std::string& group, const std::string
           }));
     }
   } else {
-    auto representation =
-        std::make_shared<PythonRepresentation>(fn, observation, py::none(), extras);
+    auto representation = batched_representation(fn, observation, py::none(), o);
     c.observation = false;
     c.injectivity = false;
     c.flow = component != props::Component::actions;
@@ -695,7 +453,8 @@ void assert_invariant(py::object fn, const std::string& group, const std::string
 void assert_equivariant(py::object policy, const std::string& group, const std::string& mode,
                         py::handle views, py::handle cases, std::uint64_t seed,
                         std::optional<double> tolerance, const std::string& precision,
-                        py::handle noise_length, py::handle extra_poses, py::handle scalars) {
+                        py::handle noise_length, py::handle extra_poses, py::handle scalars,
+                        const Setup& setup) {
   require_numpy("assert_equivariant");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -706,11 +465,12 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                           "distribution (independent noise) or both");
   }
   const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
-                                         extra_poses, scalars);
-  const bool extras = !o.extra_poses.empty() || !o.scalars.empty();
+                                         extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
   c.in_distribution = mode != "pointwise";
-  const auto python_policy = std::make_shared<PythonPolicy>(policy, noise, extras);
+  ProgressLine progress("assert_equivariant", o.quiet);
+  c.progress = std::ref(progress);
+  const auto python_policy = batched_policy(policy, noise, o);
   props::Classification result = props::classify_policy(python_policy, c);
   if (mode == "distribution") {
     std::erase_if(result.verdicts,
@@ -800,16 +560,37 @@ PYBIND11_MODULE(handcentric, m) {
   m.attr("GROUPS") = all_groups;
   m.attr("VIEWS") = both_views;
   m.attr("REPRESENTATIONS") = py::cast(builtin_representation_names());
-  m.attr("MAX_CASES") = props::kMaxCases;        // cases= above it: ValueError
-  m.attr("MAX_NOISE") = props::kMaxPolicyNoise;  // noise= above it: ValueError
+  m.attr("MAX_CASES") = props::kMaxCases;           // cases= above it: ValueError
+  m.attr("MAX_NOISE") = props::kMaxPolicyNoise;     // noise= above it: ValueError
+  m.attr("MAX_BATCH_SIZE") = props::kMaxBatchSize;  // batch_size= above it: ValueError
 
-  m.def("audit", &audit, py::arg("actions"), py::arg("observation") = py::none(),
-        py::arg("groups") = all_groups, py::arg("views") = both_views,
-        py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
-        py::arg("tolerance") = py::none(), py::arg("precision") = "float64", py::kw_only(),
-        py::arg("decode") = py::none(), py::arg("extra_poses") = py::tuple(),
-        py::arg("scalars") = py::tuple(),
-        R"doc(Audit a representation written in Python.
+  // The keywords of Setup, the same on every audit.
+#define HANDCENTRIC_SETUP_PARAMETERS                                              \
+  py::handle batch_size, const std::string &array, py::handle device, bool quiet, \
+      py::handle history, py::handle hand_points, py::handle world_points, py::handle chunk
+#define HANDCENTRIC_SETUP_VALUE \
+  Setup{batch_size, array, device, quiet, history, hand_points, world_points, chunk}
+#define HANDCENTRIC_SETUP_ARGUMENTS                                                               \
+  py::arg("batch_size") = py::none(), py::arg("array") = "numpy", py::arg("device") = py::none(), \
+  py::arg("quiet") = false, py::arg("history") = py::none(), py::arg("hand_points") = py::none(), \
+  py::arg("world_points") = py::none(), py::arg("chunk") = py::none()
+
+  m.def(
+      "audit",
+      [](py::object actions, py::object observation, py::handle groups, py::handle views,
+         py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
+         const std::string& precision, py::object decode, py::handle extra_poses,
+         py::handle scalars, HANDCENTRIC_SETUP_PARAMETERS) {
+        return audit(std::move(actions), std::move(observation), groups, views, cases, seed,
+                     tolerance, precision, std::move(decode), extra_poses, scalars,
+                     HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("actions"), py::arg("observation") = py::none(), py::arg("groups") = all_groups,
+      py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+      py::arg("tolerance") = py::none(), py::arg("precision") = "float64", py::kw_only(),
+      py::arg("decode") = py::none(), py::arg("extra_poses") = py::tuple(),
+      py::arg("scalars") = py::tuple(), HANDCENTRIC_SETUP_ARGUMENTS,
+      (std::string(R"doc(Audit a representation written in Python.
 
 Returns one representation of `handcentric audit --json`.
 actions(history, chunk, hand_points, world_points) -> 1-D array, with history (H+1, 4, 4)
@@ -817,48 +598,88 @@ actions(history, chunk, hand_points, world_points) -> 1-D array, with history (H
 in the hand frame at T_0, world_points (m, 3) in the world frame; every pose is world_T_hand.
 observation(history, hand_points, world_points) -> 1-D array (optional).
 decode(actions, history, hand_points, world_points) -> (K, 4, 4) (optional: lets the audit
-prove the map injective). The flow components are the rectified flow's (eq. 5).
-With extra_poses / scalars (names), every callable also gets extra_poses={name: (4, 4)},
-scalars={name: x}. cases: 1 to MAX_CASES (10**7). Needs NumPy (ImportError at once without it);
-Ctrl-C stops it with KeyboardInterrupt.)doc");
+prove the map injective; always called one scene at a time). The flow components are the
+rectified flow's (eq. 5).
+)doc") +
+       kSetupDoc)
+          .c_str());
 
-  m.def("audit_policy", &audit_policy, py::arg("policy"), py::arg("groups") = all_groups,
-        py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
-        py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
-        py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
-        py::arg("scalars") = py::tuple(),
-        R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
+  m.def(
+      "audit_policy",
+      [](py::object policy, py::handle groups, py::handle views, py::handle cases,
+         std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
+         py::handle noise, py::handle extra_poses, py::handle scalars,
+         HANDCENTRIC_SETUP_PARAMETERS) {
+        return audit_policy(std::move(policy), groups, views, cases, seed, tolerance, precision,
+                            noise, extra_poses, scalars, HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
+      py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+      py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
+      py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
+      py::arg("scalars") = py::tuple(), HANDCENTRIC_SETUP_ARGUMENTS,
+      (std::string(R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
 Returns one policy of `audit --json`.
 policy(history, hand_points, world_points, noise) -> (K, 4, 4), the world-frame chunk
 T_1..T_K; noise is a float64 vector of `noise` standard normals and must be the policy's only
-randomness. cases: 1 to MAX_CASES (10**7); noise: 1 to MAX_NOISE (65536).)doc");
+randomness. noise: 1 to MAX_NOISE (65536).
+)doc") +
+       kSetupDoc)
+          .c_str());
 
-  m.def("assert_invariant", &assert_invariant, py::arg("fn"), py::arg("group"),
-        py::arg("component") = "actions", py::kw_only(), py::arg("observation") = py::none(),
-        py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
-        py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
-        py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
-        R"doc(Raise AssertionError unless `component` is invariant under `group`.
+  m.def(
+      "assert_invariant",
+      [](py::object fn, const std::string& group, const std::string& component,
+         py::object observation, py::handle views, py::handle cases, std::uint64_t seed,
+         std::optional<double> tolerance, const std::string& precision, py::handle extra_poses,
+         py::handle scalars, HANDCENTRIC_SETUP_PARAMETERS) {
+        assert_invariant(std::move(fn), group, component, std::move(observation), views, cases,
+                         seed, tolerance, precision, extra_poses, scalars, HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("fn"), py::arg("group"), py::arg("component") = "actions", py::kw_only(),
+      py::arg("observation") = py::none(), py::arg("views") = both_views,
+      py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+      py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
+      py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
+      HANDCENTRIC_SETUP_ARGUMENTS,
+      (std::string(R"doc(Raise AssertionError unless `component` is invariant under `group`.
 
 The error carries the shrunk witness.
 component "actions": fn is the actions function; "observation": fn is the observation
 function; "flow_input" / "flow_target": fn is the actions function, observation= the
 observation function, and the rectified flow is checked pointwise and in distribution.
-Every view in `views` must hold.)doc");
+Every view in `views` must hold.
+)doc") +
+       kSetupDoc)
+          .c_str());
 
-  m.def("assert_equivariant", &assert_equivariant, py::arg("policy"), py::arg("group"),
-        py::kw_only(), py::arg("mode") = "pointwise", py::arg("views") = both_views,
-        py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
-        py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
-        py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
-        py::arg("scalars") = py::tuple(),
-        R"doc(Raise AssertionError unless policy(g o, n) = g policy(o, n) under `group`.
+  m.def(
+      "assert_equivariant",
+      [](py::object policy, const std::string& group, const std::string& mode, py::handle views,
+         py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
+         const std::string& precision, py::handle noise, py::handle extra_poses, py::handle scalars,
+         HANDCENTRIC_SETUP_PARAMETERS) {
+        assert_equivariant(std::move(policy), group, mode, views, cases, seed, tolerance, precision,
+                           noise, extra_poses, scalars, HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("policy"), py::arg("group"), py::kw_only(), py::arg("mode") = "pointwise",
+      py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+      py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
+      py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
+      py::arg("scalars") = py::tuple(), HANDCENTRIC_SETUP_ARGUMENTS,
+      (std::string(R"doc(Raise AssertionError unless policy(g o, n) = g policy(o, n) under `group`.
 
 The error carries the shrunk witness.
 mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which
 implies the law's), "distribution" (independent noise: the laws compared) or "both".
-Every view in `views` must hold.)doc");
+Every view in `views` must hold.
+)doc") +
+       kSetupDoc)
+          .c_str());
+#undef HANDCENTRIC_SETUP_PARAMETERS
+#undef HANDCENTRIC_SETUP_VALUE
+#undef HANDCENTRIC_SETUP_ARGUMENTS
 
   m.def(
       "encode_actions",

@@ -31,7 +31,8 @@ Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
 namespace {
 
 void classify_flow(const std::shared_ptr<const FlowTarget>& target,
-                   const ClassifierOptions& options, View view, Classification& out) {
+                   const ClassifierOptions& options, View view, Classification& out,
+                   const std::function<void()>& tick) {
   const CheckOptions check = with_view(options.check, view);
   for (Component component : {Component::flow_input, Component::flow_target}) {
     const auto f = [&](std::uint64_t noise_seed, double t) {
@@ -43,6 +44,7 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target,
       out.verdicts.push_back(with_float32_note(
           check_invariance(fn, component, group, check), options,
           [&](const CheckOptions& o) { return check_invariance(fn, component, group, o); }));
+      tick();
     }
   }
   if (!options.in_distribution) return;
@@ -53,6 +55,7 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target,
           options, [&](const CheckOptions& o) {
             return check_distribution_invariance(target, component, group, o, options.distribution);
           }));
+      tick();
     }
   }
 }
@@ -64,6 +67,11 @@ const std::vector<Group> kRotations = {Group::rotation, Group::c8};
 }  // namespace
 
 CheckOptions with_view(CheckOptions check, View view) {
+  // A fixed count of world points the caller chose (a network with fixed inputs) is kept for
+  // the third-person view.
+  const bool fixed = check.shape.min_world_points >= 1 &&
+                     check.shape.min_world_points == check.shape.max_world_points;
+  if (view == View::third_person && fixed) return check;
   const SceneShape shape = shape_for(view);
   check.shape.min_world_points = shape.min_world_points;
   check.shape.max_world_points = shape.max_world_points;
@@ -78,6 +86,15 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
   Classification out;
   out.name = representation->name();
   if (!flow) flow = std::make_shared<RectifiedFlow>(representation);
+  const int groups = static_cast<int>(options.groups.size());
+  const int per_view = groups * (options.observation ? 2 : 1) +
+                       (options.flow ? 2 * groups * (options.in_distribution ? 2 : 1) : 0);
+  const int total =
+      static_cast<int>(options.views.size()) * per_view + (options.injectivity ? 1 : 0);
+  auto tick = [&] {
+    if (options.progress)
+      options.progress(static_cast<int>(out.verdicts.size()) + (out.injectivity ? 1 : 0), total);
+  };
   for (View view : options.views) {
     const CheckOptions check = with_view(options.check, view);
     std::vector<std::pair<Component, SceneFunction>> parts = {
@@ -92,14 +109,16 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
         out.verdicts.push_back(with_float32_note(
             check_invariance(f, component, group, check), options,
             [&](const CheckOptions& o) { return check_invariance(f, component, group, o); }));
+        tick();
       }
     }
-    if (options.flow) classify_flow(flow, options, view, out);
+    if (options.flow) classify_flow(flow, options, view, out, tick);
   }
   if (options.injectivity) {
     CheckOptions pairs = with_view(options.check, View::third_person);
     pairs.cases = options.injectivity_cases;
     out.injectivity = check_injectivity(representation, pairs);
+    tick();
   }
   return out;
 }
@@ -109,7 +128,12 @@ Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
   if (!target) throw InvalidArgument("classify_flow_target needs a flow target, got null");
   Classification out;
   out.name = target->name();
-  for (View view : options.views) classify_flow(target, options, view, out);
+  const int total = static_cast<int>(options.views.size() * options.groups.size()) * 2 *
+                    (options.in_distribution ? 2 : 1);
+  auto tick = [&] {
+    if (options.progress) options.progress(static_cast<int>(out.verdicts.size()), total);
+  };
+  for (View view : options.views) classify_flow(target, options, view, out, tick);
   return out;
 }
 

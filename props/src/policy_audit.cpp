@@ -126,12 +126,18 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
   if (!policy) throw InvalidArgument("classify_policy needs a policy, got null");
   Classification out;
   out.name = policy->name();
+  const int total = static_cast<int>(options.views.size() * options.groups.size()) *
+                    (options.in_distribution ? 2 : 1);
+  auto tick = [&] {
+    if (options.progress) options.progress(static_cast<int>(out.verdicts.size()), total);
+  };
   for (View view : options.views) {
     const CheckOptions check = with_view(options.check, view);
     for (Group group : options.groups) {
       out.verdicts.push_back(with_float32_note(
           check_policy_equivariance(*policy, group, check), options,
           [&](const CheckOptions& o) { return check_policy_equivariance(*policy, group, o); }));
+      tick();
     }
     if (!options.in_distribution) continue;
     for (Group group : options.groups) {
@@ -140,6 +146,7 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
           [&](const CheckOptions& o) {
             return check_policy_distribution(*policy, group, o, options.distribution);
           }));
+      tick();
     }
   }
   return out;

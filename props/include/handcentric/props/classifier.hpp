@@ -40,6 +40,9 @@ struct ClassifierOptions {
   /// The advice that ends the float32 note, in the caller's words (the Python module says
   /// precision="float32").
   std::string float32_advice = "rerun with --precision float32";
+  /// Called after each verdict (and the injectivity check) with how many are done of how many
+  /// the classification runs: a progress line. May throw to stop the classification.
+  std::function<void(int done, int total)> progress;
 };
 
 struct Classification {
@@ -63,7 +66,8 @@ Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
 Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
                           const std::function<Verdict(const CheckOptions&)>& recheck);
 
-/// `check` with the scenes of `view` (its world-point counts), everything else kept.
+/// `check` with the scenes of `view` (its world-point counts), everything else kept; a fixed
+/// count of world points (min = max >= 1) in `check` is kept for the third-person view.
 CheckOptions with_view(CheckOptions check, View view);
 
 /// The groups whose verdict for (component, mode, view) held, in all_groups() order.

@@ -1,0 +1,176 @@
+#include "callables.hpp"
+
+#include <utility>
+
+namespace handcentric::python {
+namespace {
+
+/// Calls fn; a Python exception, or a signal's pending one, leaves as PythonCallError.
+template <class... Args>
+py::object call(const py::object& fn, Args&&... args) {
+  try {
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    return fn(std::forward<Args>(args)...);
+  } catch (py::error_already_set& e) {
+    throw PythonCallError(std::move(e));
+  }
+}
+
+/// extra_poses={name: (4, 4) or (B, 4, 4)} and scalars={name: float or (B,)}, when wanted.
+py::kwargs extras_kwargs(const std::vector<const Scene*>& scenes, const CallOptions& options) {
+  py::kwargs kw;
+  if (!options.extras || scenes.empty()) return kw;
+  py::dict poses, scalars;
+  const Scene& first = *scenes.front();
+  for (std::size_t i = 0; i < first.extra_poses.size(); ++i) {
+    poses[py::str(first.extra_poses[i].first)] =
+        options.stacked
+            ? for_callable(stacked_extra_pose(scenes, i), options.arrays)
+            : for_callable(array_of(first.extra_poses[i].second.matrix()), options.arrays);
+  }
+  for (std::size_t i = 0; i < first.scalars.size(); ++i) {
+    scalars[py::str(first.scalars[i].first)] =
+        options.stacked ? for_callable(stacked_scalar(scenes, i), options.arrays)
+                        : py::object(py::float_(first.scalars[i].second));
+  }
+  kw["extra_poses"] = poses;
+  kw["scalars"] = scalars;
+  return kw;
+}
+
+/// The rows of a stacked result (B, a), B = `rows`.
+std::vector<Eigen::VectorXd> rows_of(py::handle result, std::size_t rows, const std::string& what) {
+  const auto a = real_array(result, what);
+  if (a.ndim() != 2 || a.shape(0) != static_cast<py::ssize_t>(rows)) {
+    throw ShapeError(what + " has shape " + shape_of(a) + " for a batch of " +
+                     std::to_string(rows) + " scenes; expected (" + std::to_string(rows) +
+                     ", n), one row per scene");
+  }
+  require_finite(a.data(), a.size(), what);
+  std::vector<Eigen::VectorXd> out;
+  out.reserve(rows);
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    out.emplace_back(Eigen::Map<const Eigen::VectorXd>(a.data() + i * a.shape(1), a.shape(1)));
+  return out;
+}
+
+}  // namespace
+
+std::string callable_name(const py::object& fn) {
+  if (py::hasattr(fn, "__qualname__")) return py::str(fn.attr("__qualname__"));
+  return py::str(py::type::handle_of(fn).attr("__qualname__"));
+}
+
+PythonRepresentation::PythonRepresentation(py::object actions, py::object observation,
+                                           py::object decode, CallOptions options)
+    : actions_(std::move(actions)),
+      observation_(std::move(observation)),
+      decode_(std::move(decode)),
+      options_(std::move(options)),
+      name_("python: " + callable_name(actions_)) {}
+
+std::vector<Eigen::VectorXd> PythonRepresentation::encode(const py::object& fn, bool with_chunk,
+                                                          const std::vector<const Scene*>& scenes,
+                                                          const std::string& what) const {
+  const ArrayKind& kind = options_.arrays;
+  if (options_.stacked) {
+    py::object result = with_chunk ? call(fn, for_callable(stacked_history(scenes), kind),
+                                          for_callable(stacked_chunk(scenes), kind),
+                                          for_callable(stacked_hand_points(scenes), kind),
+                                          for_callable(stacked_world_points(scenes), kind),
+                                          **extras_kwargs(scenes, options_))
+                                   : call(fn, for_callable(stacked_history(scenes), kind),
+                                          for_callable(stacked_hand_points(scenes), kind),
+                                          for_callable(stacked_world_points(scenes), kind),
+                                          **extras_kwargs(scenes, options_));
+    return rows_of(result, scenes.size(), what);
+  }
+  std::vector<Eigen::VectorXd> out;
+  for (const Scene* s : scenes) {
+    const std::vector<const Scene*> one = {s};
+    py::object result =
+        with_chunk
+            ? call(fn, for_callable(array_of(s->world_T_hand_history), kind),
+                   for_callable(array_of(s->world_T_hand_chunk), kind),
+                   for_callable(array_of(s->hand_points), kind),
+                   for_callable(array_of(s->world_points), kind), **extras_kwargs(one, options_))
+            : call(fn, for_callable(array_of(s->world_T_hand_history), kind),
+                   for_callable(array_of(s->hand_points), kind),
+                   for_callable(array_of(s->world_points), kind), **extras_kwargs(one, options_));
+    out.push_back(vector_from(result, what));
+  }
+  return out;
+}
+
+std::vector<Eigen::VectorXd> PythonRepresentation::encode_actions_batch(
+    const std::vector<const Scene*>& scenes) const {
+  return encode(actions_, true, scenes, "the result of actions function " + name_);
+}
+
+std::vector<Eigen::VectorXd> PythonRepresentation::encode_observation_batch(
+    const std::vector<const Scene*>& scenes) const {
+  return encode(observation_, false, scenes,
+                "the result of observation function " + callable_name(observation_));
+}
+
+std::vector<RigidTransform> PythonRepresentation::decode_in_scene(const Eigen::VectorXd& actions,
+                                                                  const Scene& observation) const {
+  if (!can_decode())
+    throw InvalidArgument(name_ + " has no decode function: pass decode= to audit it");
+  const ArrayKind& kind = options_.arrays;
+  const std::vector<const Scene*> one = {&observation};
+  CallOptions single = options_;
+  single.stacked = false;
+  py::object result =
+      call(decode_, for_callable(array_of(actions), kind),
+           for_callable(array_of(observation.world_T_hand_history), kind),
+           for_callable(array_of(observation.hand_points), kind),
+           for_callable(array_of(observation.world_points), kind), **extras_kwargs(one, single));
+  return poses_from(result, "the result of decode function " + callable_name(decode_), true,
+                    "(K, 4, 4)");
+}
+
+PythonPolicy::PythonPolicy(py::object policy, Eigen::Index noise, CallOptions options)
+    : policy_(std::move(policy)),
+      noise_(noise),
+      options_(std::move(options)),
+      name_("python: " + callable_name(policy_)) {}
+
+std::vector<std::vector<RigidTransform>> PythonPolicy::act_batch(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  const ArrayKind& kind = options_.arrays;
+  const std::string what = "the chunk returned by policy " + name_;
+  std::vector<std::vector<RigidTransform>> out;
+  if (!options_.stacked) {
+    for (std::size_t i = 0; i < observations.size(); ++i) {
+      const Scene& o = *observations[i];
+      py::object result = call(
+          policy_, for_callable(array_of(o.world_T_hand_history), kind),
+          for_callable(array_of(o.hand_points), kind), for_callable(array_of(o.world_points), kind),
+          for_callable(array_of(*noises[i]), kind), **extras_kwargs({&o}, options_));
+      out.push_back(poses_from(result, what, true, "(K, 4, 4)"));
+    }
+    return out;
+  }
+  py::object result =
+      call(policy_, for_callable(stacked_history(observations), kind),
+           for_callable(stacked_hand_points(observations), kind),
+           for_callable(stacked_world_points(observations), kind),
+           for_callable(stacked_vectors(noises), kind), **extras_kwargs(observations, options_));
+  const auto a = real_array(result, what);
+  const auto B = static_cast<py::ssize_t>(observations.size());
+  if (a.ndim() != 4 || a.shape(0) != B || a.shape(1) < 1 || a.shape(2) != 4 || a.shape(3) != 4) {
+    throw ShapeError(what + " has shape " + shape_of(a) + " for a batch of " + std::to_string(B) +
+                     " observations; expected (" + std::to_string(B) +
+                     ", K, 4, 4), one chunk per observation");
+  }
+  require_finite(a.data(), a.size(), what);
+  for (py::ssize_t i = 0; i < B; ++i) {
+    out.push_back(loose_poses(a.data() + i * a.shape(1) * 16, a.shape(1),
+                              what + "[" + std::to_string(i) + "]"));
+  }
+  return out;
+}
+
+}  // namespace handcentric::python

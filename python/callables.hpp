@@ -1,0 +1,77 @@
+#pragma once
+// The Python callables under audit, as the library's batch interfaces (props/batch.hpp): a
+// representation (actions, observation, decode functions) and a whole policy. Called one scene
+// at a time (the arrays of one scene) or, when the caller gave batch_size, on stacked arrays
+// with a leading batch axis; NumPy arrays or torch tensors (ArrayKind). The library's
+// BatchedRepresentation / BatchedPolicy around them cache the answers and form the batches.
+//
+// A Python exception inside a callable leaves as PythonCallError, and so does a KeyboardInterrupt
+// pending before a call (a signal reaches Python only when PyErr_CheckSignals() runs: every call
+// checks first, so Ctrl-C stops an audit within one call or one batch).
+#include <pybind11/pybind11.h>
+
+#include <string>
+#include <vector>
+
+#include "arrays.hpp"
+#include "handcentric/props/batch.hpp"
+
+namespace handcentric::python {
+
+/// How a callable is called.
+struct CallOptions {
+  bool stacked = false;  ///< stacked arrays (B, ...) instead of one scene's
+  ArrayKind arrays;      ///< NumPy arrays or torch tensors
+  bool extras = false;   ///< pass extra_poses= and scalars= keywords (the audit asked for some)
+};
+
+/// The name a report shows for a callable: a function's qualified name, else its class's (an
+/// object with __call__, e.g. a torch module), so that the name does not change between runs.
+std::string callable_name(const py::object& fn);
+
+/// A representation written in Python: actions(history, chunk, hand_points, world_points) and,
+/// optionally, observation(history, hand_points, world_points) and decode(actions, history,
+/// hand_points, world_points) -> (K, 4, 4) (decode is always called one scene at a time).
+class PythonRepresentation final : public props::BatchRepresentation {
+ public:
+  PythonRepresentation(py::object actions, py::object observation, py::object decode,
+                       CallOptions options);
+  std::string name() const override { return name_; }
+  bool has_observation() const override { return !observation_.is_none(); }
+  std::vector<Eigen::VectorXd> encode_actions_batch(
+      const std::vector<const Scene*>& scenes) const override;
+  std::vector<Eigen::VectorXd> encode_observation_batch(
+      const std::vector<const Scene*>& scenes) const override;
+  bool can_decode() const override { return !decode_.is_none(); }
+  std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
+                                              const Scene& observation) const override;
+
+ private:
+  std::vector<Eigen::VectorXd> encode(const py::object& fn, bool with_chunk,
+                                      const std::vector<const Scene*>& scenes,
+                                      const std::string& what) const;
+  py::object actions_, observation_, decode_;
+  CallOptions options_;
+  std::string name_;
+};
+
+/// A whole policy written in Python: policy(history, hand_points, world_points, noise) -> the
+/// world-frame chunk T_1..T_K, (K, 4, 4); stacked: (B, K, 4, 4) for noise (B, d). The noise is
+/// its only randomness.
+class PythonPolicy final : public props::BatchPolicy {
+ public:
+  PythonPolicy(py::object policy, Eigen::Index noise, CallOptions options);
+  std::string name() const override { return name_; }
+  Eigen::Index noise_dimension() const override { return noise_; }
+  std::vector<std::vector<RigidTransform>> act_batch(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override;
+
+ private:
+  py::object policy_;
+  Eigen::Index noise_;
+  CallOptions options_;
+  std::string name_;
+};
+
+}  // namespace handcentric::python
