@@ -1,10 +1,12 @@
 #include "handcentric/props/check.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <iostream>
 #include <sstream>
 #include <limits>
+#include <optional>
 #include <random>
 
 #include "handcentric/core/errors.hpp"
@@ -74,42 +76,67 @@ void run_silently(const std::function<void()>& property, const std::string& desc
 
 namespace {
 
-// Prefetch passes (batch.hpp): each runs every case not yet answered in full, as far as its
-// cached answers go; a pass stops starting cases once it has recorded kMaxPendingPerPass inputs
-// (memory), and after kMaxPrefetchPasses the real pass evaluates what is left one at a time.
+// Prefetch passes (batch.hpp). The first generates the cases (RapidCheck, as the real pass
+// will) and keeps them; the others run the kept cases not yet answered in full, as far as their
+// cached answers go. A pass stops starting cases once it has recorded kMaxPendingPerPass inputs
+// (memory); only the first kMaxPrefetchCases cases are kept and prefetched, and after
+// kMaxPrefetchPasses the real pass evaluates what is left one input at a time.
 constexpr std::size_t kMaxPendingPerPass = std::size_t{1} << 15;
+constexpr std::size_t kMaxPrefetchCases = std::size_t{1} << 14;
 constexpr int kMaxPrefetchPasses = 64;
 
-void run_prefetch_passes(const CaseFunction& run_case, Group group, const SceneShape& shape,
-                         const std::string& description, std::uint64_t seed, int cases) {
+struct PrefetchedCases {
+  std::vector<std::pair<Scene, RigidTransform>> cases;  ///< in RapidCheck's order
+  std::vector<std::optional<CaseOutcome>> outcomes;     ///< each decided case's, when final
+  bool complete = false;  ///< every case is kept and was answered in full
+  bool failed = false;    ///< some case failed (or raised): the real pass must shrink it
+};
+
+PrefetchedCases run_prefetch_passes(const CaseFunction& run_case, Group group,
+                                    const SceneShape& shape, const std::string& description,
+                                    std::uint64_t seed, int cases) {
   PrefetchPasses passes;
-  std::vector<char> done(static_cast<std::size_t>(cases), 0);
+  PrefetchedCases out;
+  const std::size_t kept = std::min(static_cast<std::size_t>(cases), kMaxPrefetchCases);
+  std::vector<char> done(kept, 0);
+  out.outcomes.resize(kept);
   // The real pass stops at its first failing case and shrinks it one input at a time: cases
   // after the first one known to fail need no answers.
-  std::size_t first_failure = done.size();
-  for (int p = 0; p < kMaxPrefetchPasses; ++p) {
-    std::size_t index = 0;
+  std::size_t first_failure = kept;
+  auto run = [&](std::size_t k) {
+    if (k >= first_failure || done[k] || passes.recorded() >= kMaxPendingPerPass) return;
+    try {
+      CaseOutcome outcome = run_case(out.cases[k].first, out.cases[k].second);
+      if (!outcome.holds) first_failure = k;
+      if (!outcome.provisional) out.outcomes[k] = std::move(outcome);
+      done[k] = 1;
+    } catch (const PendingEvaluation&) {
+    } catch (...) {
+      first_failure = std::min(first_failure, k);  // the real pass meets the error again
+      done[k] = 1;
+    }
+  };
+  passes.pass([&] {
+    run_silently(
+        [&] {
+          const Scene scene = *props::scene(shape);
+          const RigidTransform g = *group_element(group);
+          if (out.cases.size() >= kept) return;
+          out.cases.emplace_back(scene, g);
+          run(out.cases.size() - 1);
+        },
+        description, seed, cases);
+  });
+  int pass = 1;
+  for (; pass < kMaxPrefetchPasses && passes.flush() > 0; ++pass)
     passes.pass([&] {
-      run_silently(
-          [&] {
-            // Generated in every pass whether run or not: RapidCheck then gives every case the
-            // same scene and g as in the real pass.
-            const Scene scene = *props::scene(shape);
-            const RigidTransform g = *group_element(group);
-            const std::size_t k = index++;
-            if (k >= first_failure || done[k] || passes.recorded() >= kMaxPendingPerPass) return;
-            try {
-              if (!run_case(scene, g).holds) first_failure = k;
-              done[k] = 1;
-            } catch (const PendingEvaluation&) {
-            } catch (...) {
-              done[k] = 1;  // the real pass meets the error again and stops there
-            }
-          },
-          description, seed, cases);
+      for (std::size_t k = 0; k < out.cases.size(); ++k) run(k);
     });
-    if (passes.flush() == 0) return;
-  }
+  out.failed = first_failure < kept;
+  out.complete = kept == static_cast<std::size_t>(cases) && pass < kMaxPrefetchPasses &&
+                 out.cases.size() == kept &&
+                 std::all_of(done.begin(), done.end(), [](char d) { return d != 0; });
+  return out;
 }
 
 }  // namespace
@@ -130,8 +157,10 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
         std::to_string(options.unit_roundoff));
   }
   const std::string description = to_string(component) + " under " + to_string(group);
+  PrefetchedCases prefetched;
   if (options.prefetch) {
-    run_prefetch_passes(run_case, group, options.shape, description, options.seed, cases);
+    prefetched =
+        run_prefetch_passes(run_case, group, options.shape, description, options.seed, cases);
     if (before_real_pass) before_real_pass();
   }
   Verdict verdict;
@@ -145,23 +174,17 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   std::exception_ptr error;
   const SceneShape shape = options.shape;
   int shrink_evaluations = 0;
-  auto property = [&] {
-    if (error) return;  // a broken function under test: let RapidCheck finish at once
-    if (!searching && ++shrink_evaluations > (options.shrink ? shrink_budget : 0))
-      return;  // budget spent: keep the witness
-    const Scene scene = *props::scene(shape);
-    const RigidTransform g = *group_element(group);
-    CaseOutcome outcome;
+  // One case of the search: false when it failed (or raised: `error`).
+  auto search_case = [&](const Scene& scene, const RigidTransform& g, CaseOutcome& outcome,
+                         bool decided = false) {
     try {
-      outcome = run_case(scene, g);
+      if (!decided) outcome = run_case(scene, g);
     } catch (...) {
       // Not a counterexample: the function under test could not answer (a handcentric::Error,
       // a Python exception, a missing module). The check stops and the caller sees it.
       error = std::current_exception();
+      return false;
     }
-    // Failing the property ends RapidCheck's search at once (its shrinking then sees every
-    // candidate pass, above), so a callable that raises costs one call whatever `cases` is.
-    if (error) RC_FAIL("the function under test could not answer");
     if (searching) {
       const double e = std::isnan(outcome.witness.error) ? std::numeric_limits<double>::infinity()
                                                          : outcome.witness.error;
@@ -174,13 +197,45 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
         if (outcome.holds && outcome.discontinuity) ++verdict.discontinuities;
       }
     }
-    if (!outcome.holds) {
+    return outcome.holds;
+  };
+  const Verdict before_search = verdict;
+  bool searched = false;
+  if (prefetched.complete && !prefetched.failed) {
+    // Every case held in the prefetch passes: the search is the kept cases in RapidCheck's
+    // order, answered from the cache, with no shrinking to do (and no need to generate them a
+    // third time). Should one fail after all (a map whose answers changed), RapidCheck reruns.
+    searched = true;
+    for (std::size_t k = 0; k < prefetched.cases.size(); ++k) {
+      std::optional<CaseOutcome>& kept = prefetched.outcomes[k];
+      CaseOutcome outcome = kept ? std::move(*kept) : CaseOutcome{};
+      if (!search_case(prefetched.cases[k].first, prefetched.cases[k].second, outcome,
+                       kept.has_value())) {
+        searched = false;
+        break;
+      }
+    }
+    if (error) std::rethrow_exception(error);
+    if (!searched) verdict = before_search;
+  }
+  auto property = [&] {
+    if (error) return;  // a broken function under test: let RapidCheck finish at once
+    if (!searching && ++shrink_evaluations > (options.shrink ? shrink_budget : 0))
+      return;  // budget spent: keep the witness
+    const Scene scene = *props::scene(shape);
+    const RigidTransform g = *group_element(group);
+    CaseOutcome outcome;
+    const bool holds = search_case(scene, g, outcome);
+    // Failing the property ends RapidCheck's search at once (its shrinking then sees every
+    // candidate pass, above), so a callable that raises costs one call whatever `cases` is.
+    if (error) RC_FAIL("the function under test could not answer");
+    if (!holds) {
       searching = false;
       verdict.witness = std::move(outcome.witness);  // the last failure is the shrunk one
       RC_FAIL("not invariant");
     }
   };
-  run_silently(property, description, options.seed, cases);
+  if (!searched) run_silently(property, description, options.seed, cases);
   if (error) std::rethrow_exception(error);
   if (!verdict.witness && verdict.cases == verdict.discontinuities) {
     // Every case was near the identity (or sat on a discontinuity): nothing was shown either way.

@@ -16,6 +16,8 @@ struct CaseOutcome {
   Witness witness;  ///< scene, g, outputs, error, tolerance, p-value of this case
   bool holds = true;
   bool discontinuity = false;  ///< held only because the difference sat on a discontinuity
+  /// Decided in a prefetch pass without its statistical tests (batch.hpp): to be run again.
+  bool provisional = false;
 };
 
 /// The two sides of a pointwise case, for the decision of check.hpp.

@@ -669,6 +669,8 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
     statistics.any_energy = true;
   }
   const Eigen::Index noise = pair.noise_dimension;
+  // A prefetch pass (batch.hpp) only gathers the draws; the tests run once, in the real pass.
+  const bool gathering = prefetching();
   std::mt19937_64 shared(options.noise_seed), fresh(options.noise_seed ^ 0x9e3779b97f4a7c15ULL);
   auto draw = [noise](std::mt19937_64& rng) {
     Eigen::VectorXd eps(noise);
@@ -716,29 +718,49 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
     return outcome;
   }
   const auto dimension = static_cast<Eigen::Index>(tested.size());
+  outcome.provisional = gathering;
   // The draws the tests need: enough for the scale test to find scale_ratio with 90% power.
   const int scale_permutations = scale_test_permutations(level);
   const double scale_level = permutation_level(level, scale_permutations);
-  const int draws = distribution.scale_test && dimension > 0
-                        ? std::max(samples, samples_for_scale_ratio(dimension, scale_level,
-                                                                    distribution.scale_ratio))
-                        : samples;
+  // Both power computations bisect over many evaluations of the power: kept per thread, as
+  // every case of a check asks the same ones.
+  thread_local std::map<std::tuple<Eigen::Index, double, double, int>, double> powers;
+  auto remembered = [](std::tuple<Eigen::Index, double, double, int> key, const auto& compute) {
+    const auto hit = powers.find(key);
+    if (hit != powers.end()) return hit->second;
+    const double value = compute();
+    if (powers.size() > 4096) powers.clear();
+    powers.emplace(key, value);
+    return value;
+  };
+  const int draws =
+      distribution.scale_test && dimension > 0
+          ? std::max(samples, static_cast<int>(remembered(
+                                  {dimension, scale_level, distribution.scale_ratio, -1},
+                                  [&] {
+                                    return static_cast<double>(samples_for_scale_ratio(
+                                        dimension, scale_level, distribution.scale_ratio));
+                                  })))
+          : samples;
   statistics.largest_dimension = std::max(statistics.largest_dimension, dimension);
   const Eigen::MatrixXd x_tested = columns_of(x, tested);
-  if (dimension > 0) {
+  if (dimension > 0 && !gathering) {
     const Eigen::RowVectorXd mean = x_tested.colwise().mean();
     const double variance = (x_tested.rowwise() - mean).squaredNorm() /
                             (static_cast<double>(samples - 1) * static_cast<double>(dimension));
     statistics.largest_spread = std::max(statistics.largest_spread, std::sqrt(variance));
     if (distribution.scale_test) {
-      statistics.largest_scale_ratio =
-          std::max(statistics.largest_scale_ratio,
-                   scale_test_detectable_ratio(dimension, draws, scale_level));
+      statistics.largest_scale_ratio = std::max(
+          statistics.largest_scale_ratio, remembered({dimension, scale_level, 0.0, draws}, [&] {
+            return scale_test_detectable_ratio(dimension, draws, scale_level);
+          }));
     }
   }
   const double pointwise =
       dimension > 0 ? (x_tested - columns_of(same_eps, tested)).lpNorm<Eigen::Infinity>() : 0.0;
+  outcome.provisional = gathering;
   if (pointwise <= tolerance) {
+    if (gathering) return outcome;
     // The same value on every shared draw: the two distributions are the same one, no test needed.
     outcome.witness.after = same_eps.row(0).transpose();
     outcome.witness.error =
@@ -765,6 +787,7 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   prefetch(fresh_draws, pair.after);
   for (int i = 0; i < draws; ++i)
     y.row(i) = pair.after(fresh_draws[static_cast<std::size_t>(i)]).transpose();
+  if (gathering) return outcome;
   const Eigen::MatrixXd before = columns_of(x, tested), after = columns_of(y, tested);
   const TwoSampleResult test = energy_test(before.topRows(samples), after.topRows(samples),
                                            permutations_for(level), options.seed, level);
