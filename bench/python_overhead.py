@@ -12,7 +12,7 @@
      views, pointwise and in distribution, injectivity. The goal is under 5 s.
 
 Run from the repository after building (module, CLI):
-    PYTHONPATH=build/python:python /usr/bin/python3 bench/python_overhead.py build/apps/handcentric
+    PYTHONPATH=build/python /usr/bin/python3 bench/python_overhead.py build/apps/handcentric
 """
 import json
 import os

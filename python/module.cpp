@@ -528,7 +528,7 @@ py::dict demo_dict(const sim::Demo& demo) {
 }  // namespace
 }  // namespace handcentric::python
 
-PYBIND11_MODULE(handcentric, m) {
+PYBIND11_MODULE(_core, m) {
   using namespace handcentric;
   using namespace handcentric::python;
   namespace props = handcentric::props;

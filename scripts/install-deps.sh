@@ -9,6 +9,8 @@ packages=(
   libeigen3-dev catch2 librapidcheck-dev libbox2d-dev libfcl-dev libopencv-dev libginac-dev
   libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev
   python3-numpy python3-pytest time
+  # tests/python_package: `pip install --no-build-isolation .` into a venv of Debian's Python
+  python3-venv python3-pip python3-setuptools python3-wheel
   parallel
   python3-dev pybind11-dev python3-torch
   # scripts/fuzz.sh: clang, libFuzzer, and the sanitizer and fuzzer runtimes clang links (only

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The hand-centric representation of policies.py served over the --exec pipe, so that a test can
 compare `handcentric audit --exec` with the in-process handcentric.audit on the same code.
-Needs PYTHONPATH with the module (build/python) and the helper (python/)."""
+Needs PYTHONPATH with the package and the helper (build/python holds both)."""
 import os
 import sys
 

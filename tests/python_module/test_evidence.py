@@ -18,7 +18,8 @@ from policies import make_policy
 
 CASES = 200
 HERE = os.path.dirname(os.path.realpath(__file__))
-MODULE_DIR = os.path.dirname(os.path.realpath(handcentric.__file__))
+# The folder that holds the package handcentric (handcentric/__init__.py, handcentric/_core...).
+MODULE_DIR = os.path.dirname(os.path.dirname(os.path.realpath(handcentric.__file__)))
 
 
 def run_python(script, *flags, **popen):

@@ -1,0 +1,208 @@
+"""`python -m handcentric`: the in-process audit of a representation or a policy written in
+Python, from the shell.
+
+    python -m handcentric audit my_repr.py:actions --observation my_repr.py:observation
+    python -m handcentric audit-policy my_package.policies:policy --groups se3 --cases 500
+
+MODULE:FUNCTION names the callable: MODULE is a dotted module name (importable from the current
+directory or sys.path) or the path of a .py file (its folder is put on sys.path, so that it
+imports its neighbours); FUNCTION may be dotted (Class.method). The callables take what
+handcentric.audit and handcentric.audit_policy pass them (help(handcentric.audit)).
+
+Prints one line per verdict (view, component, mode, group, yes/NO, largest error) and exits 0;
+--json FILE also writes the full result (the dict handcentric.audit / audit_policy returns).
+Bad arguments: one line on stderr, exit 2. An exception raised by the callable under audit
+propagates with its traceback (exit 1)."""
+import argparse
+import importlib
+import importlib.util
+import json
+import os
+import sys
+
+import handcentric
+
+PROG = "python -m handcentric"
+
+
+class BadTarget(Exception):
+    """MODULE:FUNCTION names nothing callable (a usage error; not LookupError, which the
+    callable under audit may raise itself)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        # One line, as the C++ command's usage errors (README.md: "a usage error exits 2").
+        self.exit(2, "%s: error: %s (see --help)\n" % (self.prog, message))
+
+
+def _bounded(low, high):
+    def parse(text):
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError("not an integer: %r" % text) from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError("%d is not in %d..%d" % (value, low, high))
+        return value
+    return parse
+
+
+def _load_module(spec):
+    if spec.endswith(".py") or os.sep in spec:
+        path = os.path.abspath(spec)
+        if not os.path.isfile(path):
+            raise BadTarget("no such file: %s" % spec)
+        folder, name = os.path.split(path)
+        name = os.path.splitext(name)[0]
+        if name in sys.modules and getattr(sys.modules[name], "__file__", None) == path:
+            return sys.modules[name]
+        sys.path.insert(0, folder)
+        loader = importlib.util.spec_from_file_location(name, path)
+        module = importlib.util.module_from_spec(loader)
+        sys.modules[name] = module  # before running it, as `import` does
+        loader.loader.exec_module(module)
+        return module
+    if "" not in sys.path and os.getcwd() not in sys.path:
+        sys.path.insert(0, os.getcwd())
+    try:
+        return importlib.import_module(spec)
+    except ModuleNotFoundError as e:
+        if e.name and spec.split(".")[0] == e.name.split(".")[0]:
+            raise BadTarget("no module named %r" % e.name) from None
+        raise  # the module exists and failed to import something itself: its traceback
+
+
+def load_callable(text):
+    """The callable named by MODULE:FUNCTION; BadTarget with a one-line reason otherwise."""
+    module_name, colon, attribute = text.rpartition(":")
+    if not colon or not module_name or not attribute:
+        raise BadTarget("%r is not MODULE:FUNCTION" % text)
+    value = _load_module(module_name)
+    for part in attribute.split("."):
+        try:
+            value = getattr(value, part)
+        except AttributeError:
+            raise BadTarget("%s has no %r" % (module_name, attribute)) from None
+    if not callable(value):
+        raise BadTarget("%s is not callable" % text)
+    return value
+
+
+def make_parser():
+    parser = _Parser(prog=PROG, description=__doc__,
+                     formatter_class=argparse.RawDescriptionHelpFormatter,
+                     epilog="Each subcommand has its own --help. What the verdicts mean: "
+                            "docs/AUDIT.md; from Python: docs/AUDIT_YOUR_POLICY.md.")
+    parser.add_argument("--version", action="version", version=handcentric.__version__)
+    commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND",
+                                     parser_class=_Parser)
+
+    def common(sub, what):
+        sub.add_argument("target", metavar="MODULE:FUNCTION", help=what)
+        sub.add_argument("--groups", nargs="+", choices=handcentric.GROUPS, metavar="GROUP",
+                         help="among %s (default: all)" % ", ".join(handcentric.GROUPS))
+        sub.add_argument("--views", nargs="+", choices=handcentric.VIEWS, metavar="VIEW",
+                         help="among %s (default: both)" % ", ".join(handcentric.VIEWS))
+        sub.add_argument("--cases", type=_bounded(1, handcentric.MAX_CASES), metavar="N",
+                         help="cases per check, 1 to %d" % handcentric.MAX_CASES)
+        sub.add_argument("--seed", type=int, metavar="S", help="RapidCheck's seed (default 1)")
+        sub.add_argument("--precision", choices=("float64", "float32"),
+                         help="the arithmetic of the callable, for the tolerance "
+                              "(default float64)")
+        sub.add_argument("--batch-size", type=_bounded(1, handcentric.MAX_CASES), metavar="B",
+                         help="cases per call of the callable (passed as batch_size=B)")
+        sub.add_argument("--json", metavar="FILE",
+                         help="also write the whole result as JSON to FILE")
+
+    audit = commands.add_parser(
+        "audit", help="audit a representation (handcentric.audit)",
+        description="Audit a representation written in Python (handcentric.audit): which "
+                    "groups leave its actions, observation and flow invariant.")
+    common(audit, "the actions function (history, chunk, hand_points, world_points) -> 1-D")
+    audit.add_argument("--observation", metavar="MODULE:FUNCTION",
+                       help="the observation function (history, hand_points, world_points)")
+    audit.add_argument("--decode", metavar="MODULE:FUNCTION",
+                       help="the decoder (actions, history, hand_points, world_points) -> "
+                            "(K, 4, 4)")
+    policy = commands.add_parser(
+        "audit-policy", help="audit a whole policy, eq. (4) (handcentric.audit_policy)",
+        description="Audit a whole policy (handcentric.audit_policy): a(g o, n) = g a(o, n), "
+                    "pointwise and in distribution.")
+    common(policy, "the policy (history, hand_points, world_points, noise) -> (K, 4, 4)")
+    policy.add_argument("--noise", type=_bounded(1, handcentric.MAX_NOISE), metavar="N",
+                        help="standard normals per call, 1 to %d" % handcentric.MAX_NOISE)
+    return parser
+
+
+def _keywords(args):
+    """Only the options given: the module's defaults stay the single source of the others."""
+    out = {}
+    for option in ("groups", "views", "cases", "seed", "precision", "batch_size", "noise"):
+        value = getattr(args, option, None)
+        if value is not None:
+            out[option] = tuple(value) if isinstance(value, list) else value
+    return out
+
+
+def _error_text(error):
+    value = error.get("max_error") if isinstance(error, dict) else error
+    if value is None:
+        return "-"
+    return value if isinstance(value, str) else "%.3g" % value
+
+
+def summary_lines(result):
+    """One line per verdict of an audit's result, plus a header (and injectivity when given)."""
+    checks = result.get("checks", [])
+    # A representation's checks name their component; a policy's have one verdict per cell.
+    components = any("component" in check for check in checks)
+    header = ("view",) + (("component",) if components else ()) + (
+        "mode", "group", "holds", "largest error")
+    rows = []
+    for check in checks:
+        verdict = check.get("invariant", check.get("equivariant"))
+        rows.append((check.get("view", "-"),) + ((check.get("component", "-"),) if components
+                                                 else ()) +
+                    (check.get("mode", "-"), check.get("group", "-"),
+                     "yes" if verdict else "NO", _error_text(check)))
+    widths = [max(len(str(row[i])) for row in [header] + rows) for i in range(len(header))]
+    lines = ["  ".join(str(cell).ljust(width) for cell, width in zip(row, widths)).rstrip()
+             for row in [header] + rows]
+    if "injective" in result:
+        lines.append("injective: %s" % ("yes" if result["injective"] else "NO"))
+    return lines
+
+
+def main(argv=None):
+    parser = make_parser()
+    args = parser.parse_args(argv)
+    try:
+        target = load_callable(args.target)
+        keywords = _keywords(args)
+        if args.command == "audit":
+            for option in ("observation", "decode"):
+                if getattr(args, option):
+                    keywords[option] = load_callable(getattr(args, option))
+            result = handcentric.audit(target, **keywords)
+        else:
+            result = handcentric.audit_policy(target, **keywords)
+    except BadTarget as e:
+        parser.error(str(e))
+    except (handcentric.Error, handcentric.ShapeError) as e:
+        # Wrong shapes, bad tolerances and the like: the module's message is the diagnosis.
+        print("%s: %s" % (PROG, e), file=sys.stderr)
+        return 1
+    name = result.get("name", args.target)
+    print("%s %s (%s)" % (args.command, name, args.target))
+    for line in summary_lines(result):
+        print("  " + line)
+    if args.json:
+        with open(args.json, "w") as out:
+            json.dump(result, out, indent=1)
+            out.write("\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
