@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <iomanip>
 #include <cmath>
 #include <cstring>
@@ -228,7 +229,10 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
 class ProgressLine {
  public:
   ProgressLine(std::string function, bool quiet)
-      : function_(std::move(function)), quiet_(quiet), start_(Clock::now()) {}
+      : function_(std::move(function)), quiet_(quiet), start_(Clock::now()) {
+    // HANDCENTRIC_PROGRESS_AFTER=S: print from S seconds on (a test's 0).
+    if (const char* after = std::getenv("HANDCENTRIC_PROGRESS_AFTER")) after_ = std::atof(after);
+  }
   ~ProgressLine() {
     if (!printed_ || !tty_) return;
     try {
@@ -240,7 +244,7 @@ class ProgressLine {
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
     if (quiet_) return;
     const double elapsed = seconds_since(start_);
-    if (elapsed < 3.0 || done <= 0) return;
+    if (elapsed < after_ || done <= 0) return;
     if (!printed_) tty_ = py::module_::import("sys").attr("stderr").attr("isatty")().cast<bool>();
     if (printed_ && seconds_since(last_) < (tty_ ? 1.0 : 5.0) && done < total) return;
     const double left = elapsed / done * (total - done);
@@ -270,6 +274,7 @@ class ProgressLine {
   bool quiet_;
   Clock::time_point start_, last_;
   bool printed_ = false, tty_ = false;
+  double after_ = 3.0;
 };
 
 props::ClassifierOptions classifier_for(const CommonOptions& o) {
