@@ -110,8 +110,21 @@ def make_parser():
         sub.add_argument("--precision", choices=("float64", "float32"),
                          help="the arithmetic of the callable, for the tolerance "
                               "(default float64)")
-        sub.add_argument("--batch-size", type=_bounded(1, handcentric.MAX_CASES), metavar="B",
-                         help="cases per call of the callable (passed as batch_size=B)")
+        sub.add_argument("--batch-size", type=_bounded(1, handcentric.MAX_BATCH_SIZE),
+                         metavar="B",
+                         help="call the callable on stacked arrays of up to B scenes "
+                              "(batch_size=B; the same verdicts, fewer calls)")
+        sub.add_argument("--array", choices=("numpy", "torch"),
+                         help="the callable's arguments: NumPy arrays (default) or torch tensors")
+        sub.add_argument("--device", metavar="DEVICE",
+                         help="the torch device of the arguments (with --array torch)")
+        for name, low, what in (("history", 0, "past poses H"),
+                                ("hand-points", 0, "eye-in-hand points n"),
+                                ("world-points", 1, "world points m of the third-person view")):
+            sub.add_argument("--" + name, type=_bounded(low, 64), metavar="N",
+                             help="fix the number of %s (default: drawn per case)" % what)
+        sub.add_argument("--quiet", action="store_true", default=None,
+                         help="no progress line on stderr")
         sub.add_argument("--json", metavar="FILE",
                          help="also write the whole result as JSON to FILE")
 
@@ -122,6 +135,8 @@ def make_parser():
     common(audit, "the actions function (history, chunk, hand_points, world_points) -> 1-D")
     audit.add_argument("--observation", metavar="MODULE:FUNCTION",
                        help="the observation function (history, hand_points, world_points)")
+    audit.add_argument("--chunk", type=_bounded(1, 64), metavar="K",
+                       help="fix the chunk length K (default: drawn per case)")
     audit.add_argument("--decode", metavar="MODULE:FUNCTION",
                        help="the decoder (actions, history, hand_points, world_points) -> "
                             "(K, 4, 4)")
@@ -138,7 +153,9 @@ def make_parser():
 def _keywords(args):
     """Only the options given: the module's defaults stay the single source of the others."""
     out = {}
-    for option in ("groups", "views", "cases", "seed", "precision", "batch_size", "noise"):
+    for option in ("groups", "views", "cases", "seed", "precision", "batch_size", "noise",
+                   "array", "device", "history", "hand_points", "world_points", "chunk",
+                   "quiet"):
         value = getattr(args, option, None)
         if value is not None:
             out[option] = tuple(value) if isinstance(value, list) else value
