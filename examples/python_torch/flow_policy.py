@@ -110,18 +110,28 @@ class FlowPolicy:
 
     @torch.no_grad()
     def __call__(self, history, hand_points, world_points, noise):
-        """The audit's signature: the world-frame chunk (K, 4, 4) for an observation and noise."""
-        if len(hand_points) < 2:  # the demos have two eye-in-hand points; pad shorter scenes
-            hand_points = np.concatenate([hand_points, np.zeros((2 - len(hand_points), 3))])
-        o = torch.tensor(self.observation(history, hand_points), dtype=torch.float32)[None]
-        x = torch.from_numpy(noise[:6 * K]).float()[None]               # the audit's noise: eps
-        for i in range(EULER_STEPS):
-            t = torch.full((1, 1), i / EULER_STEPS)
-            x = x + self.field(x, t, o) / EULER_STEPS
-        chunk = poses(x.reshape(K, 6))
+        """The audit's batched signature (batch_size=B, array="torch"): float64 tensors history
+        (B, 1, 4, 4), hand_points (B, 2, 3) (the audit is given history=0, hand_points=2, the
+        demos' sizes) and noise (B, d) -> the world-frame chunks (B, K, 4, 4)."""
+        B = len(history)
         if self.hand_centric:
-            chunk = torch.from_numpy(history[0]).float() @ chunk        # T_k = T_0 hand0_T_handk
-        return chunk.numpy()
+            o = hand_points[:, :2].reshape(B, -1).float()                # invariant by construction
+        else:
+            o = torch.tensor(np.stack([self.observation(h, p) for h, p in
+                                       zip(history.numpy(), hand_points.numpy())]),
+                             dtype=torch.float32)
+        x = noise[:, :6 * K].float()                                     # the audit's noise: eps
+        for i in range(EULER_STEPS):
+            t = torch.full((B, 1), i / EULER_STEPS)
+            x = x + self.field(x, t, o) / EULER_STEPS
+        chunk = poses(x.reshape(B * K, 6)).reshape(B, K, 4, 4)
+        if self.hand_centric:
+            chunk = history[:, :1].float() @ chunk                     # T_k = T_0 hand0_T_handk
+        return chunk
+
+
+# How the audit calls FlowPolicy: stacked torch tensors, the demos' sizes (one pose, two points).
+AUDIT = dict(batch_size=256, array="torch", history=0, hand_points=2)
 
 
 def make_demos(path, n, cli):
@@ -164,10 +174,12 @@ def main():
     torch.set_num_threads(1)  # deterministic and quick at batch 1
     hand_centric, absolute = train_both(args.demos, args.steps)
     for group in handcentric.GROUPS:
-        handcentric.assert_equivariant(hand_centric, group, precision="float32", cases=args.cases)
+        handcentric.assert_equivariant(hand_centric, group, precision="float32", cases=args.cases,
+                                       **AUDIT)
         print("hand_centric: equivariant under %s (float32 precision, both views)" % group)
     try:
-        handcentric.assert_equivariant(absolute, "se3", precision="float32", cases=args.cases)
+        handcentric.assert_equivariant(absolute, "se3", precision="float32", cases=args.cases,
+                                       **AUDIT)
     except AssertionError as failure:
         print("absolute: not equivariant:\n%s" % failure)
     else:

@@ -20,18 +20,21 @@ def policies():
 
 @pytest.mark.parametrize("group", handcentric.GROUPS)
 def test_hand_centric_flow_policy_is_equivariant_at_float32(policies, group):
-    handcentric.assert_equivariant(policies[0], group, precision="float32", cases=CASES)
+    handcentric.assert_equivariant(policies[0], group, precision="float32", cases=CASES,
+                                   **flow_policy.AUDIT)
 
 
 def test_hand_centric_flow_policy_is_not_exact_at_float64(policies):
     # Its decoder runs in float32: the float64 tolerance must see that, and say so.
     with pytest.raises(AssertionError, match="float32"):
-        handcentric.assert_equivariant(policies[0], "rotation", cases=CASES, views="eye_in_hand")
+        handcentric.assert_equivariant(policies[0], "rotation", cases=CASES, views="eye_in_hand",
+                                       **flow_policy.AUDIT)
 
 
 @pytest.mark.parametrize("group", ["translation", "rotation", "se3"])
 def test_absolute_flow_policy_fails_with_a_witness(policies, group):
     with pytest.raises(AssertionError) as failure:
-        handcentric.assert_equivariant(policies[1], group, precision="float32", cases=CASES)
+        handcentric.assert_equivariant(policies[1], group, precision="float32", cases=CASES,
+                                       **flow_policy.AUDIT)
     assert "shrunk witness" in str(failure.value)
     assert "python: FlowPolicy: not equivariant under " + group in str(failure.value)
