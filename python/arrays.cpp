@@ -1,5 +1,6 @@
 #include "arrays.hpp"
 
+#include <pybind11/stl.h>
 #include <cmath>
 #include <cstring>
 

@@ -1,5 +1,6 @@
 #include "callables.hpp"
 
+#include <pybind11/stl.h>
 #include <utility>
 
 namespace handcentric::python {

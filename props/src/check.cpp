@@ -119,9 +119,11 @@ PrefetchedCases run_prefetch_passes(const CaseFunction& run_case, Group group,
   passes.pass([&] {
     run_silently(
         [&] {
+          // Beyond the kept cases, failing ends RapidCheck's run at once (a case that generated
+          // nothing has nothing to shrink): generating them all would only cost time.
+          if (out.cases.size() >= kept) RC_FAIL("the cases to prefetch are kept");
           const Scene scene = *props::scene(shape);
           const RigidTransform g = *group_element(group);
-          if (out.cases.size() >= kept) return;
           out.cases.emplace_back(scene, g);
           run(out.cases.size() - 1);
         },

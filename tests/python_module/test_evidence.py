@@ -133,6 +133,15 @@ INTERRUPTED_AUDIT = """
             time.sleep(0.01)
             return good(history, hand_points, world_points, noise)
         handcentric.audit_policy(slow_policy, cases=CASES)
+    elif kind == "batched":
+        good = make_policy()
+        def slow_batch(history, hand_points, world_points, noise):
+            announce()
+            time.sleep(0.05)
+            return np.stack([good(*(a[i] for a in (history, hand_points, world_points, noise)))
+                             for i in range(len(history))])
+        handcentric.audit_policy(slow_batch, cases=CASES, batch_size=64, history=1,
+                                 hand_points=1)
     else:
         # A callable written in C (as a compiled policy is): no Python bytecode runs between the
         # calls, so only the audit itself can notice the signal.
@@ -143,7 +152,7 @@ INTERRUPTED_AUDIT = """
 """
 
 
-@pytest.mark.parametrize("kind", ["python", "compiled"])
+@pytest.mark.parametrize("kind", ["python", "batched", "compiled"])
 def test_ctrl_c_stops_an_audit_within_seconds(kind):
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([MODULE_DIR, HERE]))
     process = subprocess.Popen(

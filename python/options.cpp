@@ -1,0 +1,188 @@
+#include "options.hpp"
+
+#include <pybind11/stl.h>
+#include <cstdlib>
+#include <iomanip>
+#include <sstream>
+
+#include "arrays.hpp"
+#include "handcentric/core/errors.hpp"
+#include "handcentric/props/plugin_protocol.hpp"
+
+namespace handcentric::python {
+namespace {
+
+/// A name or a sequence of names.
+std::vector<std::string> names_of(py::handle value, const std::string& what) {
+  if (py::isinstance<py::str>(value)) return {value.cast<std::string>()};
+  try {
+    return value.cast<std::vector<std::string>>();
+  } catch (const py::cast_error&) {
+    throw DtypeError(what + " must be a name or a sequence of names, got a " + type_name(value));
+  }
+}
+
+std::vector<props::Group> groups_of(py::handle value) {
+  std::vector<props::Group> out;
+  for (const std::string& name : names_of(value, "groups")) {
+    if (name == "all") return props::all_groups();
+    out.push_back(props::parse_group(name));  // InvalidArgument naming the valid names
+  }
+  if (out.empty())
+    throw InvalidArgument(
+        "groups is empty; name at least one of translation, rotation, se2, se3, c8");
+  return out;
+}
+
+std::vector<props::View> views_of(py::handle value) {
+  std::vector<props::View> out;
+  for (const std::string& name : names_of(value, "views")) {
+    if (name == "all") return {props::View::eye_in_hand, props::View::third_person};
+    if (name == "eye_in_hand") {
+      out.push_back(props::View::eye_in_hand);
+    } else if (name == "third_person") {
+      out.push_back(props::View::third_person);
+    } else {
+      throw InvalidArgument("unknown view '" + name + "'; use eye_in_hand, third_person or all");
+    }
+  }
+  if (out.empty()) throw InvalidArgument("views is empty; name eye_in_hand, third_person or both");
+  return out;
+}
+
+/// `value` (a Python int of any size, or anything with __index__ such as a NumPy integer) in
+/// [low, high]: TypeError for a non-integer, a one-line ValueError naming the value and the
+/// bound otherwise, before anything is converted to a C++ int or allocated.
+int bounded_integer(py::handle value, const char* name, long long low, long long high,
+                    const char* bound) {
+  if (!PyIndex_Check(value.ptr()))
+    throw DtypeError(std::string(name) + " must be an integer, got a " + type_name(value));
+  const auto index = py::reinterpret_steal<py::object>(PyNumber_Index(value.ptr()));
+  if (!index) throw py::error_already_set();
+  int overflow = 0;
+  const long long x = PyLong_AsLongLongAndOverflow(index.ptr(), &overflow);
+  if (overflow == 0 && x >= low && x <= high) return static_cast<int>(x);
+  const std::string text = std::string(name) + "=" + std::string(py::str(index));
+  if (overflow < 0 || (overflow == 0 && x < low))
+    throw InvalidArgument(text + " is below the least value, " + std::to_string(low));
+  throw InvalidArgument(text + " is above the bound " + bound + " = " + std::to_string(high) +
+                        " (docs/AUDIT_YOUR_POLICY.md says why)");
+}
+
+/// The largest fixed history length, number of points or chunk length a caller may ask for.
+constexpr long long kMaxSceneSize = 64;
+
+int cases_of(py::handle cases) {
+  return bounded_integer(cases, "cases", 1, props::kMaxCases, "handcentric.MAX_CASES");
+}
+
+/// An optional integer keyword in [low, high] (None: not given).
+std::optional<int> optional_integer(py::handle value, const char* name, long long low,
+                                    long long high, const char* bound) {
+  if (value.is_none()) return std::nullopt;
+  return bounded_integer(value, name, low, high, bound);
+}
+
+}  // namespace
+
+/// ImportError, at once, unless NumPy imports: every argument of a callable under audit is a
+/// NumPy array, and without NumPy no case could run (an audit used to report every cell failed
+/// on 0 cases then).
+void require_numpy(const char* function) {
+  static bool found = false;
+  if (found) return;
+  try {
+    (void)py::module_::import("numpy");
+    found = true;
+  } catch (py::error_already_set& e) {
+    const std::string why = py::str(e.value());
+    const std::string executable = py::str(py::module_::import("sys").attr("executable"));
+    const std::string message =
+        "handcentric." + std::string(function) + " needs NumPy, which the interpreter " +
+        executable + " cannot import (" + why +
+        "); nothing was checked. Debian: apt-get install python3-numpy and run /usr/bin/python3 "
+        "(without -S); in a venv: pip install numpy";
+    py::raise_from(e, PyExc_ImportError, message.c_str());
+    throw py::error_already_set();
+  }
+}
+
+int noise_of(py::handle noise) {
+  return bounded_integer(noise, "noise", 1, props::kMaxPolicyNoise, "handcentric.MAX_NOISE");
+}
+
+CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
+                             std::uint64_t seed, std::optional<double> tolerance,
+                             const std::string& precision, py::handle extra_poses,
+                             py::handle scalars, const Setup& setup) {
+  CommonOptions o;
+  o.audit.cases = cases_of(cases);
+  o.audit.groups = groups_of(groups);
+  o.audit.views = views_of(views);
+  o.audit.seed = seed;
+  o.audit.precision = props::parse_precision(precision);
+  if (tolerance) {
+    if (!(*tolerance > 0.0)) {
+      throw InvalidArgument("tolerance must be in (0, 1), got " + std::to_string(*tolerance) +
+                            "; or leave it None for the precision's (1e-9 float64, 1e-4 float32)");
+    }
+    o.audit.relative_tolerance = *tolerance;
+  }
+  (void)props::audit_relative_tolerance(o.audit);  // validates the tolerance
+  o.extra_poses = names_of(extra_poses, "extra_poses");
+  o.scalars = names_of(scalars, "scalars");
+  o.batch_size = optional_integer(setup.batch_size, "batch_size", 1, props::kMaxBatchSize,
+                                  "handcentric.MAX_BATCH_SIZE");
+  o.call.stacked = o.batch_size.has_value();
+  o.call.arrays = array_kind_of(setup.array, setup.device);
+  o.call.extras = !o.extra_poses.empty() || !o.scalars.empty();
+  o.quiet = setup.quiet;
+  o.history = optional_integer(setup.history, "history", 0, kMaxSceneSize, "64");
+  o.hand_points = optional_integer(setup.hand_points, "hand_points", 0, kMaxSceneSize, "64");
+  o.world_points = optional_integer(setup.world_points, "world_points", 1, kMaxSceneSize, "64");
+  o.chunk = optional_integer(setup.chunk, "chunk", 1, kMaxSceneSize, "64");
+  return o;
+}
+
+props::ClassifierOptions classifier_for(const CommonOptions& o) {
+  props::ClassifierOptions c = props::classifier_options(o.audit);
+  c.float32_advice = "pass precision=\"float32\"";
+  props::SceneShape& shape = c.check.shape;
+  shape.extra_pose_names = o.extra_poses;
+  shape.scalar_names = o.scalars;
+  if (o.history) shape.min_history = shape.max_history = *o.history;
+  if (o.hand_points) shape.min_hand_points = shape.max_hand_points = *o.hand_points;
+  if (o.world_points) shape.min_world_points = shape.max_world_points = *o.world_points;
+  if (o.chunk) shape.min_chunk = shape.max_chunk = *o.chunk;
+  // Batched calls: prefetch passes ask each check's inputs together (props/batch.hpp).
+  c.check.prefetch = o.batch_size.has_value();
+  return c;
+}
+
+/// The callables as the checks see them (props/batch.hpp): answers cached, and batched when the
+/// caller gave batch_size.
+std::shared_ptr<props::BatchedRepresentation> batched_representation(py::object actions,
+                                                                     py::object observation,
+                                                                     py::object decode,
+                                                                     const CommonOptions& o) {
+  return std::make_shared<props::BatchedRepresentation>(
+      std::make_shared<PythonRepresentation>(std::move(actions), std::move(observation),
+                                             std::move(decode), o.call),
+      o.batch_size.value_or(1));
+}
+
+std::shared_ptr<props::BatchedPolicy> batched_policy(py::object policy, int noise,
+                                                     const CommonOptions& o) {
+  // One batch's noise is batch_size x noise numbers: bounded, as one array must fit in memory.
+  constexpr long long kMaxBatchNumbers = 1LL << 24;
+  if (o.batch_size && static_cast<long long>(*o.batch_size) * noise > kMaxBatchNumbers) {
+    throw InvalidArgument(
+        "batch_size=" + std::to_string(*o.batch_size) + " with noise=" + std::to_string(noise) +
+        " makes a noise array of " + std::to_string(static_cast<long long>(*o.batch_size) * noise) +
+        " numbers, above 2**24; use batch_size <= " + std::to_string(kMaxBatchNumbers / noise));
+  }
+  return std::make_shared<props::BatchedPolicy>(
+      std::make_shared<PythonPolicy>(std::move(policy), noise, o.call), o.batch_size.value_or(1));
+}
+
+}  // namespace handcentric::python

@@ -1,0 +1,139 @@
+#pragma once
+// The audits' options from Python arguments: groups, views, cases, tolerance, the keywords of
+// Setup (batch_size, array, device, quiet, fixed scene sizes), each checked at once with a one-line
+// error naming the value and its bound; the progress line; the callables wrapped as the checks
+// call them (props/batch.hpp).
+#include <pybind11/pybind11.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <iomanip>
+#include <sstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "callables.hpp"
+#include "handcentric/props/audit.hpp"
+#include "handcentric/props/batch.hpp"
+#include "handcentric/props/classifier.hpp"
+
+namespace handcentric::python {
+
+/// The keywords every audit takes besides its groups, views, cases and tolerance: how the
+/// callable is called (batch_size, array, device), the progress line, and the scene sizes a
+/// network with fixed inputs needs (None: the audit's ranges).
+struct Setup {
+  py::handle batch_size = py::none();
+  std::string array = "numpy";
+  py::handle device = py::none();
+  bool quiet = false;
+  py::handle history = py::none(), hand_points = py::none(), world_points = py::none(),
+             chunk = py::none();
+};
+
+/// The docstring part about Setup's keywords.
+inline constexpr const char* kSetupDoc = R"doc(
+Every keyword argument a callable receives: with extra_poses / scalars (names), extra_poses=
+{name: (4, 4)} and scalars={name: float}. cases: 1 to MAX_CASES (10**7).
+batch_size=B (1 to MAX_BATCH_SIZE): the callables are called on stacked arrays with a leading
+batch axis of at most B: history (B, H+1, 4, 4), chunk (B, K, 4, 4), hand_points (B, n, 3),
+world_points (B, m, 3), noise (B, d), each extra pose (B, 4, 4) and scalar (B,); they return
+(B, a) (a representation's actions or observation) or (B, K, 4, 4) (a policy). Each row must
+depend on its own inputs only; then the verdicts are those of batch_size=None (one scene per
+call) bit for bit. Scenes of one shape share a batch: history=, hand_points=, world_points=
+(third-person view) and chunk= fix the sizes (None: the audit draws them per case).
+array="torch" passes float64 torch tensors (on device=, e.g. "cuda"), array="numpy" (default)
+NumPy arrays; results may be either, on any device, with or without grad.
+A progress line with the time left goes to stderr after 3 s (quiet=True: none). Needs NumPy
+(ImportError at once without it); Ctrl-C stops it with KeyboardInterrupt.)doc";
+
+struct CommonOptions {
+  props::AuditOptions audit;
+  std::vector<std::string> extra_poses, scalars;
+  std::optional<int> batch_size;  ///< none: one scene per call
+  CallOptions call;
+  bool quiet = false;
+  std::optional<int> history, hand_points, world_points, chunk;
+};
+
+/// ImportError, at once, unless NumPy imports: every argument of a callable under audit is a
+/// NumPy array, and without NumPy no case could run (an audit used to report every cell failed
+/// on 0 cases then).
+void require_numpy(const char* function);
+
+/// `noise` in [1, MAX_NOISE].
+int noise_of(py::handle noise);
+
+CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
+                             std::uint64_t seed, std::optional<double> tolerance,
+                             const std::string& precision, py::handle extra_poses,
+                             py::handle scalars, const Setup& setup);
+
+props::ClassifierOptions classifier_for(const CommonOptions& o);
+
+/// Prints "handcentric.audit_policy: 12 of 20 checks, 6.1 s, about 4 s left" on stderr (the
+/// same line again on a terminal, a new line at most every 5 s otherwise) once an audit has run
+/// for 3 s, and lets a pending Ctrl-C stop it between checks too.
+class ProgressLine {
+ public:
+  ProgressLine(std::string function, bool quiet)
+      : function_(std::move(function)), quiet_(quiet), start_(Clock::now()) {
+    // HANDCENTRIC_PROGRESS_AFTER=S: print from S seconds on (a test's 0).
+    if (const char* after = std::getenv("HANDCENTRIC_PROGRESS_AFTER")) after_ = std::atof(after);
+  }
+  ~ProgressLine() {
+    if (!printed_ || !tty_) return;
+    try {
+      write("\n");
+    } catch (...) {
+    }
+  }
+  void operator()(int done, int total) {
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    if (quiet_) return;
+    const double elapsed = seconds_since(start_);
+    if (elapsed < after_ || done <= 0) return;
+    if (!printed_) tty_ = py::module_::import("sys").attr("stderr").attr("isatty")().cast<bool>();
+    if (printed_ && seconds_since(last_) < (tty_ ? 1.0 : 5.0) && done < total) return;
+    const double left = elapsed / done * (total - done);
+    std::ostringstream line;
+    line.precision(2);
+    line << std::fixed << (tty_ ? "\r" : "") << "handcentric." << function_ << ": " << done
+         << " of " << total << " checks, " << std::setprecision(1) << elapsed << " s"
+         << (done < total ? ", about " + std::to_string(static_cast<long>(left + 0.5)) + " s left"
+                          : std::string(", done"))
+         << (tty_ ? "   " : "\n");
+    write(line.str());
+    printed_ = true;
+    last_ = Clock::now();
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  static double seconds_since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  }
+  static void write(const std::string& text) {
+    py::object err = py::module_::import("sys").attr("stderr");
+    err.attr("write")(text);
+    err.attr("flush")();
+  }
+  std::string function_;
+  bool quiet_;
+  Clock::time_point start_, last_;
+  bool printed_ = false, tty_ = false;
+  double after_ = 3.0;
+};
+
+/// The callables as the checks see them (props/batch.hpp): answers cached, and batched when the
+/// caller gave batch_size (InvalidArgument when batch_size x noise is above 2**24 numbers).
+std::shared_ptr<props::BatchedRepresentation> batched_representation(py::object actions,
+                                                                     py::object observation,
+                                                                     py::object decode,
+                                                                     const CommonOptions& o);
+std::shared_ptr<props::BatchedPolicy> batched_policy(py::object policy, int noise,
+                                                     const CommonOptions& o);
+
+}  // namespace handcentric::python
