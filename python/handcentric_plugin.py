@@ -349,9 +349,8 @@ def _encoded_rows(result, B):
 def _chunks(result, B):
     """A batched policy's result, (B,K,4,4) or (B,K,16) -> B chunks of K lists of 16 numbers."""
     a = np.asarray(result)
-    if a.dtype.kind not in "biuf" or a.ndim != 4 and a.ndim != 3 or a.shape[0] != B \
-            or a.shape[-2:] != (4, 4) and not (a.ndim == 3 and a.shape[2] == 16) \
-            or a.shape[1] == 0:
+    shaped = a.ndim == 4 and a.shape[2:] == (4, 4) or a.ndim == 3 and a.shape[2] == 16
+    if a.dtype.kind not in "biuf" or not shaped or a.shape[0] != B or a.shape[1] == 0:
         raise _BadResult("the policy returned an array of shape %s and dtype %s for a batch of "
                          "%d observations; it must be (%d, K, 4, 4)"
                          % (a.shape, a.dtype, B, B))
