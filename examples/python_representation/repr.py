@@ -71,12 +71,16 @@ def encode(history, chunk, hand_points, world_points):
 def encode_batch(history, chunk, hand_points, world_points):
     """encode() on B scenes of one shape at once: history (B,H+1,4,4), chunk (B,K,4,4), points
     (B,n,3), (B,m,3) -> actions (B,6K), observation (B,o), row b equal to encode() on scene b."""
-    B, T0 = len(history), history[:, 0]
-    actions = hp.pose_vector(hp.batch_relative_pose(T0, chunk)).reshape(B, -1)
+    B, K, T0 = len(history), chunk.shape[1], history[:, 0]
+    # Chunk and history poses relative to T_0, as one stack: one pass of the rotation vector
+    # (most of a call's time is NumPy's per-call overhead, not the arithmetic).
+    relative = np.concatenate([hp.batch_relative_pose(T0, chunk),
+                               hp.batch_relative_pose(T0, history)], axis=1)
+    vectors = hp.pose_vector(relative)  # (B, K + H + 1, 6)
+    actions = vectors[:, :K].reshape(B, -1)
     observation = np.concatenate(
-        [hp.pose_vector(hp.batch_relative_pose(T0, history)).reshape(B, -1),
-         hand_points.reshape(B, -1), hp.batch_relative_points(T0, world_points).reshape(B, -1)],
-        axis=1)
+        [vectors[:, K:].reshape(B, -1), hand_points.reshape(B, -1),
+         hp.batch_relative_points(T0, world_points).reshape(B, -1)], axis=1)
     return actions, observation
 
 
