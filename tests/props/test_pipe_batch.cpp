@@ -80,8 +80,7 @@ TEST_CASE("a_batched_exec_audit_gives_the_unbatched_json_byte_for_byte", "[unit]
   const std::string example = test::python_example();
   const std::string options = " --cases 60 --seed 5";
   const std::string one_at_a_time = audit_json("--exec '" + example + "'" + options);
-  CHECK(audit_json("--exec '" + example + " --batched'" + options, " --batched") ==
-        one_at_a_time);
+  CHECK(audit_json("--exec '" + example + " --batched'" + options, " --batched") == one_at_a_time);
   // Fewer requests: the example answers up to 256 scenes per line.
   const props::PipeRepresentation plugin(example + " --batched", 10.0);
   CHECK(plugin.batch_size() == 256);
@@ -118,7 +117,8 @@ TEST_CASE("a_wrong_batched_answer_is_a_plugin_error_naming_request_item_and_fix"
              Contains("batched request 2 (item 1 of 3) without \"actions\""));
   CHECK_THAT(batch_error("unbatched"), Contains("without a \"batch\" list"));
   CHECK(policy_batch_error("right").empty());
-  CHECK_THAT(policy_batch_error("short"), Contains("batched request 2 with 2 answers for 3 scenes"));
+  CHECK_THAT(policy_batch_error("short"),
+             Contains("batched request 2 with 2 answers for 3 scenes"));
   CHECK_THAT(policy_batch_error("item_shape"),
              Contains("batched request 2 (item 1 of 3), a policy request, without a \"chunk\""));
   // Through the CLI: the audit stops with the message.
