@@ -155,3 +155,22 @@ def test_a_batched_policy_returning_a_wrong_shape_exits_1():
     _, status, err = run_serve([dict(PROBE, noise=[0.0]), line], None, batched=True,
                                _policy=lambda h, *a: np.zeros((len(h), 4, 4)), _noise=1)
     assert status == 1 and "must be (2, K, 4, 4)" in err
+
+
+def test_flow_and_decode_requests_stay_single_in_batched_mode():
+    scene = scenes(1, H=1, K=2)[0]
+
+    def encode_batch(history, chunk, hand_points, world_points):
+        return np.zeros((len(history), 6 * chunk.shape[1]))
+
+    flow_request = request(scene, 1, eps=[1.0] * 12, t=0.5)
+    decode_request = request(scene, 2, decode=[0.0] * 12)
+    del decode_request["chunk"]
+    answers, status, err = run_serve(
+        [PROBE, flow_request, decode_request], encode_batch, batched=True,
+        flow=lambda h, c, hp_, wp, eps, t: (eps * t, eps),
+        decode=lambda a, h, hp_, wp: np.stack([h[0]] * 2))
+    assert status == 0, err
+    assert answers[1] == {"id": 1, "actions": [0.0] * 12, "flow_input": [0.5] * 12,
+                          "flow_target": [1.0] * 12}
+    assert answers[2] == {"id": 2, "chunk": [scene["history"][0].ravel().tolist()] * 2}
