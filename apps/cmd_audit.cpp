@@ -19,6 +19,7 @@
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
+#include "handcentric/props/batch.hpp"
 #include "handcentric/props/pipe_policy.hpp"
 #include "handcentric/props/pipe_representation.hpp"
 #include "handcentric/props/policy_audit.hpp"
@@ -177,7 +178,14 @@ int run_audit(const AuditCommandOptions& options) {
     classifier.check.shape.scalar_names = capabilities.scalar_names;
     std::shared_ptr<const FlowTarget> flow;
     if (capabilities.flow) flow = std::make_shared<props::PipeFlowTarget>(plugin);
-    results.push_back(props::classify_representation(plugin, classifier, flow));
+    std::shared_ptr<const Representation> audited = plugin;
+    if (capabilities.batch > 0) {
+      // Prefetch passes gather each check's scenes so that they go in batched requests; the
+      // verdicts and the JSON are those of the audit one scene at a time (batch.hpp).
+      audited = std::make_shared<props::BatchedRepresentation>(plugin, capabilities.batch);
+      classifier.check.prefetch = true;
+    }
+    results.push_back(props::classify_representation(audited, classifier, flow));
   } else if (!options.policy_exec.empty()) {
     auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout,
                                                       options.extra_poses, options.scalars);
@@ -185,7 +193,12 @@ int run_audit(const AuditCommandOptions& options) {
     props::ClassifierOptions classifier = props::classifier_options(audit);
     classifier.check.shape.extra_pose_names = capabilities.extra_pose_names;
     classifier.check.shape.scalar_names = capabilities.scalar_names;
-    results.push_back(props::classify_policy(plugin, classifier));
+    std::shared_ptr<const props::NoisyPolicy> audited = plugin;
+    if (capabilities.batch > 0) {  // as for --exec
+      audited = std::make_shared<props::BatchedPolicy>(plugin, capabilities.batch);
+      classifier.check.prefetch = true;
+    }
+    results.push_back(props::classify_policy(audited, classifier));
     policies = true;
   } else if (!options.model.empty()) {
     if (plugin_names)

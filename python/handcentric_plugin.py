@@ -38,6 +38,16 @@ Protocol v2 (the audit adds "protocol": 2 to every request; v1 audits do not; we
                flow(history, chunk, hand_points, world_points, eps, t) returning the pair
                (flow_input, flow_target).
 
+Batched (serve(encode, batched=True, batch_size=256), serve_policy(policy, batched=True)): the
+hello also says "batch": batch_size, and the audit then sends the scenes of one shape together,
+{"id": n, "batch": [{"history", "chunk", ...}, ...]} (each item the fields of one request),
+answered {"id": n, "batch": [{"actions", "observation"}, ...]} in the same order. encode gets
+stacked arrays with a leading batch axis, history (B,H+1,4,4), chunk (B,K,4,4), hand_points
+(B,n,3), world_points (B,m,3) (extra_poses={name: (B,4,4)}, scalars={name: (B,)}), and returns
+actions (B,a), or (actions, observation (B,o)), or a dict of them; a policy gets noise (B,d) and
+returns (B,K,4,4). decode and flow stay functions of one scene (their requests are not batched);
+a flow request's actions come from encode on a batch of one. Batched mode needs NumPy.
+
 The functions get NumPy float64 arrays when NumPy imports (empty point lists have shape (0,3)),
 nested Python lists otherwise ((H+1) x 4 x 4, K x 4 x 4, n x 3). They may return NumPy arrays of
 any real dtype (float32 too), lists or tuples, nested or flat: everything is flattened to Python
@@ -55,7 +65,8 @@ stdout in an 8 KiB buffer and the audit would wait for an answer that never come
 function runs, print() goes to stderr, so debugging output cannot corrupt the protocol.
 
 The geometry helpers below (rotation_vector, rotation_matrix, inverse, relative_pose,
-relative_points, pose_vector, pose_matrix) need NumPy; serve() does not.
+relative_points, pose_vector, pose_matrix, and for batched plug-ins batch_relative_pose and
+batch_relative_points) need NumPy; serve() does not (unless batched).
 """
 import contextlib
 import json
@@ -237,23 +248,140 @@ def _chunk(result):
     return chunk
 
 
+# ----------------------------------------------------------------------------- batched requests
+
+MAX_BATCH = 65536  # the audit's bound on a hello's "batch"
+
+
+def _item(i, read, item):
+    """read(item), a malformed item named by its index."""
+    try:
+        return read(item)
+    except _Malformed as error:
+        raise _Malformed("batch[%d]: %s" % (i, error))
+
+
+def _stacked(items, key, width, tail):
+    """The items' `key` stacked along a new leading axis: (B, rows) + tail. width: numbers per
+    row (None for a flat vector, the noise). One np.array on the nested lists when they are
+    plain finite numbers of one shape; else each item is read as a single request is, so that
+    the message names the item and the field."""
+    B = len(items)
+    values = [item.get(key) for item in items]
+    if not _fast_array.has_booleans:
+        try:
+            a = np.array(values, dtype=np.float64)
+        except (TypeError, ValueError):
+            a = None
+        if a is not None and np.isfinite(a).all():
+            if width is None and a.ndim == 2 and a.shape[1] > 0:
+                return a
+            if width is not None and a.ndim == 3 and a.shape[2] == width and \
+                    (width == 3 or a.shape[1] > 0):
+                return a.reshape((B, a.shape[1]) + tail)
+            if width == 3 and a.ndim == 2 and a.shape[1] == 0:  # no points in any scene
+                return np.zeros((B, 0, 3))
+    if width is None:
+        def read(item):
+            value = item.get(key)
+            if not isinstance(value, list) or not value or not all(map(_is_number, value)):
+                raise _Malformed("'%s' must be a non-empty list of numbers" % key)
+            return np.array(value, dtype=np.float64)
+    else:
+        def read(item):
+            return _matrices(item, key) if width == 16 else _points(item, key)
+    rows = [_item(i, read, item) for i, item in enumerate(items)]
+    if any(r.shape != rows[0].shape for r in rows):
+        shapes = sorted(set(r.shape for r in rows))
+        raise _Malformed("the scenes of one batch differ in the shape of '%s' (%s); a batch "
+                         "holds scenes of one shape" % (key, ", ".join(map(str, shapes))))
+    return np.stack(rows)
+
+
+def _stack_named(named):
+    """Per-scene ({pose name: (4,4)}, {scalar name: float}) -> ({name: (B,4,4)}, {name: (B,)})."""
+    poses, values = named[0]
+    return ({name: np.stack([n[0][name] for n in named]) for name in poses},
+            {name: np.array([n[1][name] for n in named], dtype=np.float64) for name in values})
+
+
+def _rows(value, B, field, function):
+    """A batched result -> (B, n) float64, every number finite."""
+    a = np.asarray(value)
+    if a.dtype.kind not in "biuf":
+        raise _BadResult("%s returned '%s' as an array of dtype %s; it must hold real numbers"
+                         % (function, field, a.dtype))
+    if a.ndim == 0 or a.shape[0] != B:
+        raise _BadResult("%s returned '%s' of shape %s for a batch of %d scenes; return an "
+                         "array with one row per scene, (%d, ...)"
+                         % (function, field, a.shape, B, B))
+    a = a.astype(np.float64).reshape(B, -1)
+    bad = np.argwhere(~np.isfinite(a))
+    if len(bad):
+        i, j = bad[0]
+        raise _BadResult("'%s' of batch item %d has a non-finite number at index %d: %r"
+                         % (field, i, j, a[i, j]))
+    return a
+
+
+def _encoded_rows(result, B):
+    """A batched encode's result -> B answers {"actions": [...], "observation": [...]}."""
+    if isinstance(result, dict):
+        unknown = set(result) - {"actions", "observation"}
+        if "actions" not in result or unknown:
+            raise _BadResult("encode returned a dict with keys %s; it needs 'actions' and may "
+                             "have 'observation'" % sorted(result))
+        actions, observation = result["actions"], result.get("observation")
+    elif isinstance(result, tuple) and len(result) == 2:
+        actions, observation = result
+    else:
+        actions, observation = result, None
+    actions = _rows(actions, B, "actions", "encode")
+    if actions.shape[1] == 0:
+        raise _BadResult("encode returned no actions")
+    if observation is None:
+        return [{"actions": row} for row in actions.tolist()]
+    observation = _rows(observation, B, "observation", "encode")
+    return [{"actions": a, "observation": o}
+            for a, o in zip(actions.tolist(), observation.tolist())]
+
+
+def _chunks(result, B):
+    """A batched policy's result, (B,K,4,4) or (B,K,16) -> B chunks of K lists of 16 numbers."""
+    a = np.asarray(result)
+    shaped = a.ndim == 4 and a.shape[2:] == (4, 4) or a.ndim == 3 and a.shape[2] == 16
+    if a.dtype.kind not in "biuf" or not shaped or a.shape[0] != B or a.shape[1] == 0:
+        raise _BadResult("the policy returned an array of shape %s and dtype %s for a batch of "
+                         "%d observations; it must be (%d, K, 4, 4)"
+                         % (a.shape, a.dtype, B, B))
+    a = _rows(a, B, "chunk", "the policy").reshape(B, -1, 16)
+    off = np.abs(a[:, :, 12:] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=2) > 1e-9
+    if off.any():
+        i, k = np.argwhere(off)[0]
+        raise _BadResult("the policy's pose %d of batch item %d has last row %s, not "
+                         "[0, 0, 0, 1]" % (k, i, a[i, k, 12:].tolist()))
+    return a.tolist()
+
+
 # ----------------------------------------------------------------------------- the loop
 
-def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, stdin=None,
-                 stdout=None):
+def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, batched=False,
+                 batch_size=256, stdin=None, stdout=None):
     """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
 
     policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
     noise: the standard normals the request carries (256 unless `noise=n` asks for n); use them
         as the policy's only randomness, so that one noise vector gives one chunk.
+    batched: policy(history (B,H+1,4,4), hand_points (B,n,3), world_points (B,m,3), noise (B,d))
+        -> (B,K,4,4), on up to batch_size observations of one shape per call (needs NumPy).
     extra_poses, scalars, hello, stdin, stdout: as for serve().
     """
-    serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, stdin=stdin, stdout=stdout,
-          _policy=policy, _noise=noise)
+    serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, batched=batched,
+          batch_size=batch_size, stdin=stdin, stdout=stdout, _policy=policy, _noise=noise)
 
 
 def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=None,
-          stdin=None, stdout=None, _policy=None, _noise=None):
+          batched=False, batch_size=256, stdin=None, stdout=None, _policy=None, _noise=None):
     """Answer the audit's requests until end of input (see the module docstring).
 
     encode(history, chunk, hand_points, world_points) -> actions | (actions, observation) | dict
@@ -262,8 +390,23 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
     extra_poses, scalars: names the requests must carry; the functions then get the keyword
         arguments extra_poses={name: (4,4)} and scalars={name: float}.
     hello: None = send the v2 hello when any of the above is declared; True / False force it.
+    batched: encode gets up to batch_size scenes of one shape at once, stacked along a leading
+        axis: history (B,H+1,4,4), chunk (B,K,4,4), hand_points (B,n,3), world_points (B,m,3),
+        extra_poses={name: (B,4,4)}, scalars={name: (B,)}, and returns actions (B,a), or
+        (actions, observation (B,o)), or a dict; decode and flow stay per scene. Needs NumPy.
     stdin, stdout: text streams (default sys.stdin, sys.stdout).
     """
+    if batched:
+        if np is None:
+            _die(1, "handcentric_plugin: serve(..., batched=True) needs NumPy, which does not "
+                    "import in %s (Debian: python3-numpy); or serve unbatched" % sys.executable)
+        if isinstance(batch_size, bool) or not isinstance(batch_size, int) \
+                or not 1 <= batch_size <= MAX_BATCH:
+            raise ValueError("batch_size must be an integer from 1 to %d, got %r"
+                             % (MAX_BATCH, batch_size))
+        if hello is False:
+            raise ValueError("batched=True needs the hello (it declares the batch size)")
+        hello = True
     stdin = sys.stdin if stdin is None else stdin
     out = sys.stdout if stdout is None else stdout  # taken now: print() is redirected below
     extra_poses, scalars = tuple(extra_poses), tuple(scalars)
@@ -274,6 +417,8 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                   "scalars": list(scalars), "decode": decode is not None, "flow": flow is not None}
     if _noise is not None:
         hello_body["noise"] = int(_noise)
+    if batched:
+        hello_body["batch"] = batch_size
 
     def call(function, request_id, args, named):
         kwargs = {"extra_poses": named[0], "scalars": named[1]} if declared else {}
@@ -304,6 +449,10 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                 raise _Malformed("'noise' must be a non-empty list of numbers")
             noise = (np.array(value, dtype=np.float64) if np is not None
                      else [float(x) for x in value])
+            if batched:  # a batch of one
+                stacked = (history[None], hand_points[None], world_points[None], noise[None])
+                return {"id": rid, "chunk": _chunks(call(_policy, rid, stacked,
+                                                         _stack_named([named])), 1)[0]}
             return {"id": rid,
                     "chunk": _chunk(call(_policy, rid,
                                          (history, hand_points, world_points, noise), named))}
@@ -319,13 +468,18 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             return {"id": rid, "chunk": _chunk(call(decode, rid, (actions, history, hand_points,
                                                      world_points), named))}
         chunk = _matrices(request, "chunk")
-        encoded = call(encode, rid, (history, chunk, hand_points, world_points), named)
-        actions, observation = _split_encoded(encoded)
-        reply = {"id": rid, "actions": _flatten(actions, "actions")}
-        if not reply["actions"]:
-            raise _BadResult("encode returned no actions")
-        if observation is not None:
-            reply["observation"] = _flatten(observation, "observation")
+        if batched:  # a batch of one
+            stacked = (history[None], chunk[None], hand_points[None], world_points[None])
+            reply = {"id": rid}
+            reply.update(_encoded_rows(call(encode, rid, stacked, _stack_named([named])), 1)[0])
+        else:
+            encoded = call(encode, rid, (history, chunk, hand_points, world_points), named)
+            actions, observation = _split_encoded(encoded)
+            reply = {"id": rid, "actions": _flatten(actions, "actions")}
+            if not reply["actions"]:
+                raise _BadResult("encode returned no actions")
+            if observation is not None:
+                reply["observation"] = _flatten(observation, "observation")
         if "eps" in request or "t" in request:
             if flow is None:
                 raise _Malformed("a flow request (eps, t), but the plug-in declared no flow")
@@ -340,6 +494,31 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             reply["flow_input"] = _flatten(pair[0], "flow_input")
             reply["flow_target"] = _flatten(pair[1], "flow_target")
         return reply
+
+    def answer_batch(request):
+        rid, items = request["id"], request["batch"]
+        if not isinstance(items, list) or not items or not all(isinstance(i, dict)
+                                                               for i in items):
+            raise _Malformed("'batch' must be a non-empty list of request objects")
+        if len(items) > batch_size:
+            raise _Malformed("a batch of %d scenes, more than the %d the hello declared"
+                             % (len(items), batch_size))
+        B = len(items)
+        history = _stacked(items, "history", 16, (4, 4))
+        hand_points = _stacked(items, "hand_points", 3, (3,))
+        world_points = _stacked(items, "world_points", 3, (3,))
+        named = _stack_named([_item(i, lambda item: (
+            _named(item, "extra_poses", extra_poses, _matrix),
+            _named(item, "scalars", scalars, _scalar)), items[i]) for i in range(B)])
+        if _policy is not None:
+            noise = _stacked(items, "noise", None, ())
+            result = call(_policy, rid, (history, hand_points, world_points, noise), named)
+            return {"id": rid, "batch": [{"chunk": c} for c in _chunks(result, B)]}
+        if any("decode" in item or "eps" in item or "t" in item for item in items):
+            raise _Malformed("decode and flow requests are not batched")
+        chunk = _stacked(items, "chunk", 16, (4, 4))
+        result = call(encode, rid, (history, chunk, hand_points, world_points), named)
+        return {"id": rid, "batch": _encoded_rows(result, B)}
 
     line_number = 0
     first = True
@@ -356,6 +535,11 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             rid = request["id"]
             if first and hello:
                 reply = {"id": rid, "hello": hello_body}
+            elif "batch" in request:
+                if not batched:
+                    raise _Malformed("a batched request, but the plug-in declared no batch "
+                                     "(serve(..., batched=True) does)")
+                reply = answer_batch(request)
             else:
                 reply = answer(request)
         except _Malformed as error:
@@ -453,6 +637,26 @@ def relative_pose(T0, T):
     out[..., :3, 3] = (T[..., :3, 3] - T0[:3, 3]) @ T0[:3, :3]
     out[..., 3, 3] = 1
     return out
+
+
+def batch_relative_pose(T0, T):
+    """relative_pose for a batch: T0 (B,4,4) and T (B,n,4,4) -> (B,n,4,4), row b is
+    relative_pose(T0[b], T[b]) with the same operations (a batched plug-in answers as the
+    unbatched one does, to the last bit)."""
+    _need_numpy()
+    T0, T = _real(T0), _real(T)
+    out = np.zeros(T.shape, dtype=np.result_type(T0, T))
+    out[..., :3, :3] = np.swapaxes(T0[:, :3, :3], -1, -2)[:, None] @ T[..., :3, :3]
+    out[..., :3, 3] = (T[..., :3, 3] - T0[:, None, :3, 3]) @ T0[:, :3, :3]
+    out[..., 3, 3] = 1
+    return out
+
+
+def batch_relative_points(T0, points):
+    """relative_points for a batch: T0 (B,4,4), points (B,n,3) -> (B,n,3)."""
+    _need_numpy()
+    T0, points = _real(T0), _real(points)
+    return (points - T0[:, None, :3, 3]) @ T0[:, :3, :3]
 
 
 def relative_points(T0, points):

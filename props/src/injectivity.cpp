@@ -5,11 +5,15 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
+#include "handcentric/props/batch.hpp"
 #include "handcentric/props/generators.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
@@ -31,6 +35,21 @@ constexpr double kPairMargin = 4.0;
 constexpr double kGrowth = 1.333521432163324;
 
 enum class Change { one_translation, one_rotation, whole_chunk, other_chunk };
+
+// With CheckOptions::prefetch (a batched representation, batch.hpp): runs `property` in
+// prefetch passes, each followed by `reset` (a pass's cases stop at their first unanswered
+// question, so what they accumulated is not the check's) and by the evaluation of the scenes it
+// recorded, until a pass records nothing new; the real run then asks the same questions in the
+// same order and finds them answered. At most 64 passes, as for the other checks.
+void run_prefetch_passes(const std::function<void()>& property, const std::function<void()>& reset,
+                         const std::string& description, std::uint64_t seed, int cases) {
+  detail::PrefetchPasses passes;
+  for (int p = 0; p < 64; ++p) {
+    passes.pass([&] { detail::run_silently(property, description, seed, cases); });
+    reset();
+    if (passes.flush() == 0) return;
+  }
+}
 
 const char* describe(Change change) {
   switch (change) {
@@ -172,53 +191,96 @@ std::optional<Collision> collide(const Representation& representation, const Sce
 
 Scan scan_resolution(const Representation& representation, const CheckOptions& options,
                      const std::vector<double>& decades, int scenes) {
-  Scan out;
-  for (double decade : decades) {
-    out.scales.push_back(ScaleCollisions{decade, "m", 0, 0});
-    out.scales.push_back(ScaleCollisions{decade, "rad", 0, 0});
-  }
+  auto fresh = [&decades] {
+    Scan out;
+    for (double decade : decades) {
+      out.scales.push_back(ScaleCollisions{decade, "m", 0, 0});
+      out.scales.push_back(ScaleCollisions{decade, "rad", 0, 0});
+    }
+    return out;
+  };
+  Scan out = fresh();
   const double largest_size = 10.0 * *std::max_element(decades.begin(), decades.end());
   std::exception_ptr error;
+  struct Pair {
+    ScanChange change;
+    std::size_t unit;
+    double size;
+    std::size_t k;
+    Eigen::Vector3d u;
+  };
   auto property = [&] {
     if (error) return;
     const Scene first = *scene(options.shape);
+    // Every pair's draws first, in the order of the loop below, so that a prefetch pass can ask
+    // for all the pairs' scenes at once.
+    std::vector<Pair> pairs;
+    for (std::size_t i = 0; i < decades.size(); ++i) {
+      for (int c = 0; c < kScanChanges; ++c) {
+        const auto change = static_cast<ScanChange>(c);
+        const std::size_t unit = in_metres(change) ? 0 : 1;
+        const double size = decades[i] * std::pow(10.0, unit_fraction());
+        const auto k = static_cast<std::size_t>(*rc::gen::inRange(0, first.chunk_length()));
+        const Eigen::Vector3d u = *haar_rotation() * Eigen::Vector3d::UnitX();
+        pairs.push_back({change, unit, size, k, u});
+      }
+    }
     try {
+      if (prefetching()) {
+        std::vector<Scene> asked = {first};
+        for (const Pair& pair : pairs) {
+          Scene second = first;
+          second.world_T_hand_chunk =
+              scaled_change(first.world_T_hand_chunk, pair.change, pair.k, pair.u, pair.size);
+          if (pair.size >
+              kPairMargin * pointwise_tolerance(first, second, options.relative_tolerance))
+            asked.push_back(std::move(second));
+        }
+        prefetch(asked, [&](const Scene& s) { return representation.encode_actions(s); });
+      }
       const Eigen::VectorXd a = representation.encode_actions(first);
-      for (std::size_t i = 0; i < decades.size(); ++i) {
-        for (int c = 0; c < kScanChanges; ++c) {
-          const auto change = static_cast<ScanChange>(c);
-          const std::size_t unit = in_metres(change) ? 0 : 1;
-          const double size = decades[i] * std::pow(10.0, unit_fraction());
-          const auto k = static_cast<std::size_t>(*rc::gen::inRange(0, first.chunk_length()));
-          const Eigen::Vector3d u = *haar_rotation() * Eigen::Vector3d::UnitX();
-          bool tried = false;
-          std::optional<Collision> collision = collide(representation, first, a, change, k, u, size,
-                                                       options.relative_tolerance, tried);
-          ScaleCollisions& counts = out.scales[2 * i + unit];
-          counts.pairs += tried ? 1 : 0;
-          if (!collision) continue;
-          ++counts.collisions;
-          // Regrow the pair past the largest size found so far while it still collides.
-          double at = size;
-          for (double next = std::max(size, out.largest[unit]) * kGrowth; next <= largest_size;
-               next *= kGrowth) {
-            std::optional<Collision> grown = collide(representation, first, a, change, k, u, next,
-                                                     options.relative_tolerance, tried);
-            if (!grown) break;
-            at = next;
-            collision = std::move(grown);
-          }
-          if (at > out.largest[unit]) {
-            out.largest[unit] = at;
-            out.at_largest[unit] = std::move(collision);
-          }
+      for (std::size_t p = 0; p < pairs.size(); ++p) {
+        const Pair& pair = pairs[p];
+        bool tried = false;
+        std::optional<Collision> collision =
+            collide(representation, first, a, pair.change, pair.k, pair.u, pair.size,
+                    options.relative_tolerance, tried);
+        ScaleCollisions& counts = out.scales[2 * (p / kScanChanges) + pair.unit];
+        counts.pairs += tried ? 1 : 0;
+        if (!collision) continue;
+        ++counts.collisions;
+        // Regrow the pair past the largest size found so far while it still collides.
+        double at = pair.size;
+        for (double next = std::max(pair.size, out.largest[pair.unit]) * kGrowth;
+             next <= largest_size; next *= kGrowth) {
+          std::optional<Collision> grown = collide(representation, first, a, pair.change, pair.k,
+                                                   pair.u, next, options.relative_tolerance, tried);
+          if (!grown) break;
+          at = next;
+          collision = std::move(grown);
+        }
+        if (at > out.largest[pair.unit]) {
+          out.largest[pair.unit] = at;
+          out.at_largest[pair.unit] = std::move(collision);
         }
       }
+    } catch (const PendingEvaluation&) {
+      // A prefetch pass: this scene's next question is recorded; the next pass goes on.
     } catch (const Error&) {
       error = std::current_exception();
     }
   };
-  detail::run_silently(property, "resolution of " + representation.name(), options.seed, scenes);
+  const std::string description = "resolution of " + representation.name();
+  if (options.prefetch) {
+    run_prefetch_passes(
+        property,
+        [&] {
+          out = fresh();
+          error = nullptr;
+        },
+        description, options.seed, scenes);
+  }
+  detail::run_silently(property, description, options.seed, scenes);
   if (error) std::rethrow_exception(error);
   return out;
 }
@@ -253,6 +315,22 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
     const Rotation R = *rotation();
     Scene second = first;
     second.world_T_hand_chunk = changed_chunk(first, change, index, v, w, R);
+    if (prefetching()) {
+      // Both scenes the case asks for (the second only if it is a pair, as below); the decode
+      // round trip is asked one at a time.
+      const double apart = chunk_distance(first.world_T_hand_chunk, second.world_T_hand_chunk);
+      const double scale = 1.0 + std::max(length_scale(first), length_scale(second));
+      std::vector<Scene> asked = {first};
+      if (apart >=
+          std::max(1e-6 * scale, kPairMargin * pointwise_tolerance(first, second, relative)))
+        asked.push_back(second);
+      try {
+        prefetch(asked, [&](const Scene& s) { return representation->encode_actions(s); });
+      } catch (const Error&) {
+        // the real run meets it again and reports it
+      }
+      return;
+    }
     try {
       const Eigen::VectorXd a = representation->encode_actions(first);
       if (searching && decodes && !result.round_trip_failure) {
@@ -281,8 +359,11 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
       error = std::current_exception();
     }
   };
-  detail::run_silently(property, "injectivity of " + representation->name(), options.seed,
-                       options.cases);
+  const std::string description = "injectivity of " + representation->name();
+  if (options.prefetch)
+    run_prefetch_passes(
+        property, [] {}, description, options.seed, options.cases);
+  detail::run_silently(property, description, options.seed, options.cases);
   if (error) std::rethrow_exception(error);
 
   Scan scan;

@@ -1,5 +1,9 @@
 #include "handcentric/props/pipe_policy.hpp"
 
+#include <algorithm>
+#include <map>
+#include <tuple>
+
 namespace handcentric::props {
 
 PipePolicy::PipePolicy(std::string command, double timeout_seconds,
@@ -34,8 +38,10 @@ const PluginCapabilities& PipePolicy::capabilities() const {
   capabilities_ = capabilities;
   if (reply.hello) {
     const Eigen::VectorXd asked = fixed_noise(capabilities.noise, 1);
-    reply = connection_.exchange(RequestKind::policy,
-                                 policy_request_body(with_extras(probe), asked), false);
+    const std::string body = policy_request_body(with_extras(probe), asked);
+    reply = capabilities.batch == 0
+                ? connection_.exchange(RequestKind::policy, body, false)
+                : std::move(connection_.exchange_batch(RequestKind::policy, {body}).front());
   }
   chunk_length_ = reply.chunk.size();
   return *capabilities_;
@@ -45,25 +51,97 @@ Eigen::Index PipePolicy::noise_dimension() const {
   return capabilities().noise;
 }
 
-std::vector<RigidTransform> PipePolicy::act(const Scene& observation,
-                                            const Eigen::VectorXd& noise) const {
-  capabilities();
+std::string PipePolicy::body(const Scene& observation, const Eigen::VectorXd& noise) const {
   observation.validate_observation();
   if (noise.size() != noise_dimension()) {
     throw InvalidArgument(name() + " reads " + std::to_string(noise_dimension()) +
                           " noise numbers, got " + std::to_string(noise.size()));
   }
-  const std::string body = policy_request_body(observation, noise);
-  if (const auto hit = cache_.find(body); hit != cache_.end()) return hit->second;
-  PluginReply reply = connection_.exchange(RequestKind::policy, body, false);
+  return policy_request_body(observation, noise);
+}
+
+const std::vector<RigidTransform>& PipePolicy::remember(std::string body, PluginReply reply,
+                                                        const std::string& where) const {
   if (reply.chunk.size() != chunk_length_) {
-    connection_.fail(
-        connection_.who() + " answered policy request " + std::to_string(connection_.last_id()) +
-        " with " + std::to_string(reply.chunk.size()) + " poses after " +
-        std::to_string(chunk_length_) + " for the probe; the chunk length K must not change");
+    connection_.fail(connection_.who() + " answered policy " + where + " with " +
+                     std::to_string(reply.chunk.size()) + " poses after " +
+                     std::to_string(chunk_length_) +
+                     " for the probe; the chunk length K must not change");
   }
   if (cache_.size() > 200000) cache_.clear();  // bounded memory over long audits
-  return cache_.emplace(body, std::move(reply.chunk)).first->second;
+  return cache_.insert_or_assign(std::move(body), std::move(reply.chunk)).first->second;
+}
+
+std::vector<RigidTransform> PipePolicy::act(const Scene& observation,
+                                            const Eigen::VectorXd& noise) const {
+  capabilities();
+  std::string request = body(observation, noise);
+  if (const auto hit = cache_.find(request); hit != cache_.end()) return hit->second;
+  PluginReply reply =
+      capabilities_->batch == 0
+          ? connection_.exchange(RequestKind::policy, request, false)
+          : std::move(connection_.exchange_batch(RequestKind::policy, {request}).front());
+  return remember(std::move(request), std::move(reply),
+                  "request " + std::to_string(connection_.last_id()));
+}
+
+std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  if (observations.size() != noises.size()) {
+    throw InvalidArgument(name() + ": act_batch needs one noise vector per observation, got " +
+                          std::to_string(noises.size()) + " for " +
+                          std::to_string(observations.size()));
+  }
+  const int batch = batch_size();  // runs the handshake
+  std::vector<std::vector<RigidTransform>> out(observations.size());
+  if (batch == 0) {  // one request per observation, as act asks
+    for (std::size_t i = 0; i < observations.size(); ++i)
+      out[i] = act(*observations[i], *noises[i]);
+    return out;
+  }
+  // The inputs not cached, each once, grouped by shape, in the order they come.
+  struct Missing {
+    std::string body;
+    std::vector<std::size_t> at;  // indices into `observations`
+  };
+  std::vector<Missing> missing;
+  std::unordered_map<std::string, std::size_t> missing_index;
+  std::map<std::tuple<int, std::size_t, std::size_t>, std::vector<std::size_t>> by_shape;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    const Scene& observation = *observations[i];
+    std::string request = body(observation, *noises[i]);
+    if (const auto hit = cache_.find(request); hit != cache_.end()) {
+      out[i] = hit->second;
+      continue;
+    }
+    const auto [at, inserted] = missing_index.try_emplace(request, missing.size());
+    if (inserted) {
+      by_shape[{observation.history_length(), observation.hand_points.size(),
+                observation.world_points.size()}]
+          .push_back(missing.size());
+      missing.push_back({std::move(request), {}});
+    }
+    missing[at->second].at.push_back(i);
+  }
+  for (const auto& [shape, indices] : by_shape) {
+    for (std::size_t from = 0; from < indices.size(); from += static_cast<std::size_t>(batch)) {
+      const std::size_t to = std::min(indices.size(), from + static_cast<std::size_t>(batch));
+      std::vector<std::string> bodies;
+      for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[indices[j]].body);
+      std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::policy, bodies);
+      const std::string id = std::to_string(connection_.last_id());
+      for (std::size_t j = from; j < to; ++j) {
+        Missing& m = missing[indices[j]];
+        const std::vector<RigidTransform>& chunk =
+            remember(std::move(m.body), std::move(replies[j - from]),
+                     "request " + id + " (item " + std::to_string(j - from) + " of " +
+                         std::to_string(to - from) + ")");
+        for (std::size_t i : m.at) out[i] = chunk;
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace handcentric::props

@@ -1,9 +1,10 @@
 #include "handcentric/props/pipe_representation.hpp"
 
+#include <algorithm>
+
 #include "handcentric/core/format.hpp"
 
 namespace handcentric::props {
-namespace {}  // namespace
 
 PipeRepresentation::PipeRepresentation(std::string command, double timeout_seconds,
                                        std::vector<std::string> extra_pose_names,
@@ -22,7 +23,8 @@ std::string PipeRepresentation::name() const {
   return "exec: " + command_;
 }
 
-void PipeRepresentation::check_lengths(const Scene& scene, const PluginReply& reply, int id) const {
+void PipeRepresentation::check_lengths(const Scene& scene, const PluginReply& reply,
+                                       const std::string& where) const {
   const auto shape = std::make_tuple(scene.history_length(), scene.chunk_length(),
                                      static_cast<int>(scene.hand_points.size()),
                                      static_cast<int>(scene.world_points.size()));
@@ -39,7 +41,7 @@ void PipeRepresentation::check_lengths(const Scene& scene, const PluginReply& re
                      std::to_string(std::get<0>(known->second)) + " then " +
                      std::to_string(reply.actions.size()) + " numbers, observation " +
                      std::to_string(std::get<1>(known->second)) + " then " +
-                     std::to_string(reply.observation.size()) + " (request " + std::to_string(id) +
+                     std::to_string(reply.observation.size()) + " (" + where +
                      "); a length may depend on the scene's shape only");
   }
 }
@@ -66,9 +68,9 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   capabilities_ = capabilities;
   if (reply.hello) {
     asked = with_extras(probe);
-    reply = connection_.exchange(RequestKind::encode, encode_request_body(asked), false);
+    reply = exchange_one(RequestKind::encode, encode_request_body(asked));
   }
-  check_lengths(asked, reply, connection_.last_id());
+  check_lengths(asked, reply, "request " + std::to_string(connection_.last_id()));
   has_observation_ = reply.has_observation;
   std::string key(1, 'e');
   key += encode_request_body(asked);
@@ -129,13 +131,98 @@ const PluginReply& PipeRepresentation::ask(const Scene& scene, RequestKind kind,
   capabilities();
   if (const auto hit = cache_.find(key); hit != cache_.end())
     return hit->second;  // the probe itself
-  PluginReply reply = connection_.exchange(kind, body, false);
-  if (kind != RequestKind::decode) check_lengths(scene, reply, connection_.last_id());
+  PluginReply reply = exchange_one(kind, body);
+  if (kind != RequestKind::decode)
+    check_lengths(scene, reply, "request " + std::to_string(connection_.last_id()));
+  return remember(std::move(key), std::move(reply));
+}
+
+PluginReply PipeRepresentation::exchange_one(RequestKind kind, const std::string& body) const {
+  if (kind != RequestKind::encode || capabilities_->batch == 0)
+    return connection_.exchange(kind, body, false);
+  return std::move(connection_.exchange_batch(kind, {body}).front());
+}
+
+const PluginReply& PipeRepresentation::remember(std::string key, PluginReply reply) const {
   if (cache_.size() > 200000) {  // bounded memory over long audits
     cache_.clear();
     last_reply_ = nullptr;
   }
-  return cache_.emplace(key, std::move(reply)).first->second;
+  return cache_.insert_or_assign(std::move(key), std::move(reply)).first->second;
+}
+
+std::vector<Eigen::VectorXd> PipeRepresentation::encode_batch(
+    const std::vector<const Scene*>& scenes, bool actions) const {
+  const int batch = batch_size();  // runs the handshake
+  std::vector<Eigen::VectorXd> out(scenes.size());
+  auto answer = [actions](const PluginReply& reply) {
+    return actions ? reply.actions : reply.observation;
+  };
+  if (batch == 0) {  // one request per scene, as encode_actions asks
+    for (std::size_t i = 0; i < scenes.size(); ++i) {
+      scenes[i]->validate_observation();
+      out[i] = answer(encoded(*scenes[i]));
+    }
+    return out;
+  }
+  // The scenes not cached, each once, grouped by shape (the observation side may mix chunk
+  // lengths), in the order they come.
+  struct Missing {
+    std::string body;
+    const Scene* scene;
+    std::vector<std::size_t> at;  // indices into `scenes`
+  };
+  std::vector<Missing> missing;
+  std::unordered_map<std::string, std::size_t> missing_index;
+  std::map<std::tuple<int, int, std::size_t, std::size_t>, std::vector<std::size_t>> by_shape;
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const Scene& scene = *scenes[i];
+    scene.validate_observation();
+    std::string body = encode_request_body(scene);
+    std::string key = 'e' + body;
+    if (const auto hit = cache_.find(key); hit != cache_.end()) {
+      out[i] = answer(hit->second);
+      continue;
+    }
+    const auto [at, inserted] = missing_index.try_emplace(std::move(key), missing.size());
+    if (inserted) {
+      by_shape[{scene.history_length(), scene.chunk_length(), scene.hand_points.size(),
+                scene.world_points.size()}]
+          .push_back(missing.size());
+      missing.push_back({std::move(body), &scene, {}});
+    }
+    missing[at->second].at.push_back(i);
+  }
+  for (const auto& [shape, indices] : by_shape) {
+    for (std::size_t from = 0; from < indices.size(); from += static_cast<std::size_t>(batch)) {
+      const std::size_t to = std::min(indices.size(), from + static_cast<std::size_t>(batch));
+      std::vector<std::string> bodies;
+      for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[indices[j]].body);
+      std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::encode, bodies);
+      const std::string id = std::to_string(connection_.last_id());
+      for (std::size_t j = from; j < to; ++j) {
+        Missing& m = missing[indices[j]];
+        PluginReply& reply = replies[j - from];
+        check_lengths(*m.scene, reply,
+                      "request " + id + " (item " + std::to_string(j - from) + " of " +
+                          std::to_string(to - from) + ")");
+        for (std::size_t i : m.at) out[i] = answer(reply);
+        remember('e' + std::move(m.body), std::move(reply));
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<Eigen::VectorXd> PipeRepresentation::encode_actions_batch(
+    const std::vector<const Scene*>& scenes) const {
+  for (const Scene* scene : scenes) scene->validate();
+  return encode_batch(scenes, true);
+}
+
+std::vector<Eigen::VectorXd> PipeRepresentation::encode_observation_batch(
+    const std::vector<const Scene*>& scenes) const {
+  return encode_batch(scenes, false);
 }
 
 Eigen::VectorXd PipeRepresentation::encode_actions(const Scene& scene) const {
@@ -172,7 +259,10 @@ std::vector<RigidTransform> PipeRepresentation::decode_in_scene(const Eigen::Vec
         "' is a plug-in that did not declare \"decode\" in a hello: it encodes only");
   }
   observation.validate_observation();
-  return ask(observation, RequestKind::decode, decode_request_body(actions, observation)).chunk;
+  // The extras the plug-in reads (a caller's bare observation, e.g. BatchedRepresentation's
+  // decode_actions, has none).
+  const Scene asked = with_extras(observation);
+  return ask(asked, RequestKind::decode, decode_request_body(actions, asked)).chunk;
 }
 
 FlowSample PipeRepresentation::flow(const Scene& scene, const Eigen::VectorXd& eps,

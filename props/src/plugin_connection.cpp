@@ -56,12 +56,18 @@ void PluginConnection::fail_exited(const std::string& when) {
   fail(who() + " " + exit.describe() + " " + when);
 }
 
-PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body,
-                                       bool hello_allowed) {
+std::string PluginConnection::round_trip(const std::string& body, int scenes) {
   if (dead_) throw PluginError(who() + " failed earlier and was stopped");
   const int id = next_id_++;
+  // --timeout is per answer: a batch of n scenes has n times as long (to be read and answered).
+  const double timeout = timeout_seconds_ * scenes;
+  const std::string allowed =
+      seconds_text(timeout) + (scenes > 1
+                                   ? " s (--timeout " + seconds_text(timeout_seconds_) +
+                                         " s per scene, " + std::to_string(scenes) + " scenes)"
+                                   : " s");
   const auto started = Clock::now();
-  switch (process_.write_all(request_line(id, body), timeout_seconds_)) {
+  switch (process_.write_all(request_line(id, body), timeout)) {
     case Subprocess::Outcome::done:
       break;
     case Subprocess::Outcome::closed:
@@ -70,12 +76,12 @@ PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body
       break;  // writing has no line limit
     case Subprocess::Outcome::timed_out:
       process_.kill();
-      fail(who() + " did not read request " + std::to_string(id) + " within " +
-           seconds_text(timeout_seconds_) + " s; raise --timeout if it is just slow");
+      fail(who() + " did not read request " + std::to_string(id) + " within " + allowed +
+           "; raise --timeout if it is just slow");
   }
   const auto written = Clock::now();
   std::string line;
-  switch (process_.read_line(line, timeout_seconds_)) {
+  switch (process_.read_line(line, timeout)) {
     case Subprocess::Outcome::done:
       break;
     case Subprocess::Outcome::closed:
@@ -84,24 +90,45 @@ PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body
       process_.kill();
       fail(who() + " answered request " + std::to_string(id) + " with a line longer than " +
            std::to_string(Subprocess::kMaxLineBytes >> 20) +
-           " MiB; answers are one line of JSON, far shorter");
+           " MiB; answers are one line of JSON, " +
+           (scenes > 1 ? "far shorter (or declare a smaller \"batch\" in the hello)"
+                       : "far shorter"));
     case Subprocess::Outcome::timed_out:
       process_.kill();
-      fail(who() + " gave no answer to request " + std::to_string(id) + " within " +
-           seconds_text(timeout_seconds_) +
-           " s; a plug-in must write one line per request and flush it (Python: print(..., "
+      fail(who() + " gave no answer to request " + std::to_string(id) + " within " + allowed +
+           "; a plug-in must write one line per request and flush it (Python: print(..., "
            "flush=True) or sys.stdout.flush(), or run it as python3 -u: a pipe is block-buffered), "
            "or raise --timeout if it is just slow");
   }
   seconds_waiting_ += std::chrono::duration<double>(Clock::now() - written).count();
+  started_ = started;
+  return line;
+}
+
+PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body,
+                                       bool hello_allowed) {
+  const std::string line = round_trip(body, 1);
   PluginReply reply;
   try {
-    reply = parse_reply(line, id, kind, who(), hello_allowed);
+    reply = parse_reply(line, last_id(), kind, who(), hello_allowed);
   } catch (const PluginError& e) {
     fail(e.what());
   }
-  seconds_asking_ += std::chrono::duration<double>(Clock::now() - started).count();
+  seconds_asking_ += std::chrono::duration<double>(Clock::now() - started_).count();
   return reply;
+}
+
+std::vector<PluginReply> PluginConnection::exchange_batch(RequestKind kind,
+                                                          const std::vector<std::string>& bodies) {
+  const std::string line = round_trip(batch_request_body(bodies), static_cast<int>(bodies.size()));
+  std::vector<PluginReply> replies;
+  try {
+    replies = parse_batch_reply(line, last_id(), kind, who(), bodies.size());
+  } catch (const PluginError& e) {
+    fail(e.what());
+  }
+  seconds_asking_ += std::chrono::duration<double>(Clock::now() - started_).count();
+  return replies;
 }
 
 }  // namespace handcentric::props

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "handcentric/core/format.hpp"
+#include "handcentric/props/batch.hpp"
 #include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
@@ -103,22 +104,21 @@ std::string reply_to(const std::string& who, int id) {
   return who + " answered request " + std::to_string(id);
 }
 
-Eigen::VectorXd read_numbers(const nlohmann::json& value, const std::string& field, int id,
-                             const std::string& who) {
+// `answered`: "plug-in 'X' answered request n" (and the item of a batch), for messages.
+Eigen::VectorXd read_numbers(const nlohmann::json& value, const std::string& field,
+                             const std::string& answered) {
   if (!value.is_array())
-    throw PluginError(reply_to(who, id) + " with \"" + field +
-                      "\" that is not an array of numbers");
+    throw PluginError(answered + " with \"" + field + "\" that is not an array of numbers");
   Eigen::VectorXd v(static_cast<Eigen::Index>(value.size()));
   for (std::size_t i = 0; i < value.size(); ++i) {
     if (!value[i].is_number()) {
-      throw PluginError(reply_to(who, id) + " with \"" + field + "\"[" + std::to_string(i) +
+      throw PluginError(answered + " with \"" + field + "\"[" + std::to_string(i) +
                         "] = " + one_line(value[i].dump(), 40) + ", not a number");
     }
     const double x = value[i].get<double>();
     if (!std::isfinite(x)) {
-      throw PluginError(reply_to(who, id) + " with a non-finite \"" + field + "\"[" +
-                        std::to_string(i) + "] = " + format_number(x) +
-                        "; send finite numbers only");
+      throw PluginError(answered + " with a non-finite \"" + field + "\"[" + std::to_string(i) +
+                        "] = " + format_number(x) + "; send finite numbers only");
     }
     v(static_cast<Eigen::Index>(i)) = x;
   }
@@ -153,19 +153,17 @@ bool read_flag(const nlohmann::json& hello, const char* field, int id, const std
 // A world-frame pose: 16 finite numbers, row-major, last row 0 0 0 1 and a rotation block within
 // kOutputPoseTolerance of a rotation. The block is then taken as it is (a float32 plug-in's is
 // orthonormal to ~1e-7 only); distances compare it.
-RigidTransform read_pose(const nlohmann::json& value, std::size_t k, int id,
-                         const std::string& who) {
-  const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", id, who);
+RigidTransform read_pose(const nlohmann::json& value, std::size_t k, const std::string& answered) {
+  const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", answered);
   if (v.size() != 16 || v(12) != 0.0 || v(13) != 0.0 || v(14) != 0.0 || v(15) != 1.0) {
-    throw PluginError(reply_to(who, id) + " with \"chunk\"[" + std::to_string(k) +
+    throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) +
                       "] that is not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)");
   }
   const Eigen::Matrix4d M =
       Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(v.data());
   if (const std::string defect = pose_defect(M); !defect.empty()) {
-    throw PluginError(reply_to(who, id) + " with \"chunk\"[" + std::to_string(k) + "] " +
-                      format_matrix(M) + ": " + defect +
-                      "; answer world_T_hand poses [[R, p], [0, 0, 0, 1]]");
+    throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) + "] " + format_matrix(M) +
+                      ": " + defect + "; answer world_T_hand poses [[R, p], [0, 0, 0, 1]]");
   }
   return RigidTransform::unchecked(M.topLeftCorner<3, 3>(), M.topRightCorner<3, 1>());
 }
@@ -247,13 +245,30 @@ std::string policy_request_body(const Scene& observation, const Eigen::VectorXd&
   return out;
 }
 
+std::string batch_request_body(const std::vector<std::string>& bodies) {
+  std::size_t size = 16;
+  for (const std::string& body : bodies) size += body.size() + 4;
+  std::string out;
+  out.reserve(size);
+  out += "\"batch\": [";
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    out += i > 0 ? ", {" : "{";
+    out += bodies[i];
+    out += '}';
+  }
+  out += ']';
+  return out;
+}
+
 std::string request_line(int id, const std::string& body) {
   return "{\"id\": " + std::to_string(id) + ", \"protocol\": " + std::to_string(kProtocolVersion) +
          ", " + body + "}\n";
 }
 
-PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
-                        bool hello_allowed) {
+namespace {
+
+// The reply line as JSON, with the id of request `id`.
+nlohmann::json parse_line(const std::string& line, int id, const std::string& who) {
   // Nesting first, outside strings: a parser recursing into 10^6 brackets would overflow the stack.
   int depth = 0, deepest = 0;
   bool in_string = false;
@@ -299,6 +314,49 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     throw PluginError(reply_to(who, id) + " with id " + one_line(json["id"].dump(), 40) +
                       "; answer each request, in order, with its own id");
   }
+  return json;
+}
+
+// The fields of one answer (a whole reply, or one item of a batched one) for a request of `kind`;
+// `answered` begins each message, which quotes `text` (the line, or the item).
+PluginReply read_answer(const nlohmann::json& json, RequestKind kind, const std::string& answered,
+                        const std::string& text) {
+  PluginReply reply;
+  if (kind == RequestKind::decode || kind == RequestKind::policy) {
+    if (!json.contains("chunk") || !json["chunk"].is_array() || json["chunk"].empty()) {
+      throw PluginError(
+          answered + (kind == RequestKind::decode ? ", a decode request," : ", a policy request,") +
+          " without a \"chunk\" of poses: '" + one_line(text, 120) + "'");
+    }
+    for (std::size_t k = 0; k < json["chunk"].size(); ++k)
+      reply.chunk.push_back(read_pose(json["chunk"][k], k, answered));
+    return reply;
+  }
+  if (!json.contains("actions"))
+    throw PluginError(answered + " without \"actions\": '" + one_line(text, 120) + "'");
+  reply.actions = read_numbers(json["actions"], "actions", answered);
+  if (reply.actions.size() == 0) throw PluginError(answered + " with no actions");
+  reply.has_observation = json.contains("observation") && !json["observation"].is_null();
+  if (reply.has_observation)
+    reply.observation = read_numbers(json["observation"], "observation", answered);
+  if (kind == RequestKind::flow) {
+    if (!json.contains("flow_input") || !json.contains("flow_target")) {
+      throw PluginError(answered +
+                        ", a flow request (it carries eps and t), without \"flow_input\" and "
+                        "\"flow_target\"; answer them, or do not declare \"flow\" in the hello");
+    }
+    reply.flow_input = read_numbers(json["flow_input"], "flow_input", answered);
+    reply.flow_target = read_numbers(json["flow_target"], "flow_target", answered);
+    reply.has_flow = true;
+  }
+  return reply;
+}
+
+}  // namespace
+
+PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
+                        bool hello_allowed) {
+  const nlohmann::json json = parse_line(line, id, who);
   PluginReply reply;
   if (json.contains("hello")) {
     const nlohmann::json& hello = json["hello"];
@@ -331,38 +389,52 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
       }
       capabilities.noise = hello["noise"].get<int>();
     }
+    if (hello.contains("batch") && !hello["batch"].is_null()) {
+      if (!hello["batch"].is_number_integer() || hello["batch"].get<long long>() < 1 ||
+          hello["batch"].get<long long>() > kMaxBatchSize) {
+        throw PluginError(reply_to(who, id) + " with a hello whose \"batch\" is " +
+                          one_line(hello["batch"].dump(), 40) +
+                          ", not a number of scenes per request between 1 and " +
+                          std::to_string(kMaxBatchSize) + " (256 suits most plug-ins)");
+      }
+      capabilities.batch = hello["batch"].get<int>();
+    }
     reply.hello = capabilities;
     return reply;
   }
-  if (kind == RequestKind::decode || kind == RequestKind::policy) {
-    if (!json.contains("chunk") || !json["chunk"].is_array() || json["chunk"].empty()) {
-      throw PluginError(
-          reply_to(who, id) +
-          (kind == RequestKind::decode ? ", a decode request," : ", a policy request,") +
-          " without a \"chunk\" of poses: '" + one_line(line, 120) + "'");
-    }
-    for (std::size_t k = 0; k < json["chunk"].size(); ++k)
-      reply.chunk.push_back(read_pose(json["chunk"][k], k, id, who));
-    return reply;
+  return read_answer(json, kind, reply_to(who, id), line);
+}
+
+std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, RequestKind kind,
+                                           const std::string& who, std::size_t count) {
+  const nlohmann::json json = parse_line(line, id, who);
+  const std::string answered = who + " answered batched request " + std::to_string(id);
+  const std::string form = "; answer {\"id\": " + std::to_string(id) +
+                           ", \"batch\": [answer, ...]} with one answer per scene of the "
+                           "request's \"batch\", in its order";
+  if (!json.contains("batch") || !json["batch"].is_array()) {
+    throw PluginError(answered + " (" + std::to_string(count) +
+                      " scenes) without a \"batch\" list" + form +
+                      " (its hello declared \"batch\"): '" + one_line(line, 120) + "'");
   }
-  if (!json.contains("actions"))
-    throw PluginError(reply_to(who, id) + " without \"actions\": '" + one_line(line, 120) + "'");
-  reply.actions = read_numbers(json["actions"], "actions", id, who);
-  if (reply.actions.size() == 0) throw PluginError(reply_to(who, id) + " with no actions");
-  reply.has_observation = json.contains("observation") && !json["observation"].is_null();
-  if (reply.has_observation)
-    reply.observation = read_numbers(json["observation"], "observation", id, who);
-  if (kind == RequestKind::flow) {
-    if (!json.contains("flow_input") || !json.contains("flow_target")) {
-      throw PluginError(reply_to(who, id) +
-                        ", a flow request (it carries eps and t), without \"flow_input\" and "
-                        "\"flow_target\"; answer them, or do not declare \"flow\" in the hello");
-    }
-    reply.flow_input = read_numbers(json["flow_input"], "flow_input", id, who);
-    reply.flow_target = read_numbers(json["flow_target"], "flow_target", id, who);
-    reply.has_flow = true;
+  const nlohmann::json& items = json["batch"];
+  if (items.size() != count) {
+    throw PluginError(answered + " with " + std::to_string(items.size()) + " answers for " +
+                      std::to_string(count) + " scenes" + form);
   }
-  return reply;
+  std::vector<PluginReply> replies;
+  replies.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::string item =
+        answered + " (item " + std::to_string(i) + " of " + std::to_string(count) + ")";
+    if (!items[i].is_object()) {
+      throw PluginError(item + " with " + one_line(items[i].dump(), 40) +
+                        ", not an object; each item is what the single request's answer would "
+                        "be, without the id, e.g. {\"actions\": [...]}");
+    }
+    replies.push_back(read_answer(items[i], kind, item, items[i].dump()));
+  }
+  return replies;
 }
 
 }  // namespace handcentric::props

@@ -15,6 +15,10 @@ argv[1] picks a planted fault (the audit must find each):
   forgets_T0    decodes without T_0 (T_k = hand0_T_handk): equivariant under nothing
   world_velocity feeds the network the world-frame step p_0 - p_-1 (history order matters):
                 translation-equivariant only
+--batched (after the fault, if any): the same policy served batched, row by row (each row as
+the unbatched call computes it, so the audit's JSON must not change); --batched row_bias adds
+1e-7 times the row's index in its batch to every translation (an answer that depends on its
+batch: the planted fault of the batched-equals-unbatched test).
 """
 import os
 import sys
@@ -24,7 +28,10 @@ sys.path.insert(0, os.path.normpath(os.path.join(HERE, "..", "..", "..", "python
 import numpy as np  # noqa: E402
 import handcentric_plugin as hp  # noqa: E402
 
-FAULT = sys.argv[1] if len(sys.argv) > 1 else ""
+ARGS = sys.argv[1:]
+BATCHED = "--batched" in ARGS
+ROW_BIAS = "row_bias" in ARGS
+FAULT = ([a for a in ARGS if a not in ("--batched", "row_bias")] or [""])[0]
 K = 4
 RNG = np.random.default_rng(7)
 W1 = RNG.normal(size=(32, 6 + 3 + 8)) * 0.3
@@ -51,5 +58,15 @@ def policy(history, hand_points, world_points, noise):
     return chunk
 
 
+def policy_batch(history, hand_points, world_points, noise):
+    chunks = np.stack([policy(*row) for row in zip(history, hand_points, world_points, noise)])
+    if ROW_BIAS:
+        chunks[:, :, :3, 3] += 1e-7 * np.arange(len(chunks))[:, None, None]
+    return chunks
+
+
 if __name__ == "__main__":
-    hp.serve_policy(policy)
+    if BATCHED:
+        hp.serve_policy(policy_batch, batched=True, batch_size=64)
+    else:
+        hp.serve_policy(policy)

@@ -4,16 +4,22 @@
 // back the world chunk T_1..T_K (plugin_protocol.hpp, "policy"). The first request is a probe; a
 // hello may name extra poses and scalars and ask for a noise length other than 256. Answers are
 // cached by request. Not thread-safe.
+//
+// It is also a BatchPolicy (batch.hpp): a plug-in whose hello declares "batch": B gets the
+// observations of an act_batch call not yet answered in batched requests of up to B of one
+// shape, and, after the hello, every request as a batched one (act() sends a batch of one).
+// Without "batch", act_batch asks one observation at a time, as act does.
 #include <string>
 #include <unordered_map>
 #include <vector>
 
+#include "handcentric/props/batch.hpp"
 #include "handcentric/props/plugin_connection.hpp"
 #include "handcentric/props/policy_audit.hpp"
 
 namespace handcentric::props {
 
-class PipePolicy final : public NoisyPolicy {
+class PipePolicy final : public NoisyPolicy, public BatchPolicy {
  public:
   /// Starts `command`; names as PipeRepresentation's. Throws InvalidArgument for an empty
   /// command, a timeout <= 0 or a repeated name; PluginError if it cannot start.
@@ -26,6 +32,14 @@ class PipePolicy final : public NoisyPolicy {
   /// Throws PluginError for a chunk whose length changes between observations.
   std::vector<RigidTransform> act(const Scene& observation,
                                   const Eigen::VectorXd& noise) const override;
+  /// The chunk of each (observation, noise): cached ones from the cache, the others asked in
+  /// batches of batch_size() observations of one shape (one at a time when the plug-in does not
+  /// batch).
+  std::vector<std::vector<RigidTransform>> act_batch(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override;
+  /// The hello's "batch" (the most observations per request), 0 when the plug-in does not batch.
+  int batch_size() const { return capabilities().batch; }
 
   /// The handshake's result (runs it if it has not run).
   const PluginCapabilities& capabilities() const;
@@ -33,6 +47,11 @@ class PipePolicy final : public NoisyPolicy {
 
  private:
   Scene with_extras(const Scene& scene) const;
+  /// The request body of (observation, noise), after checking both.
+  std::string body(const Scene& observation, const Eigen::VectorXd& noise) const;
+  /// Checks the chunk length of the answer to `where` and caches it.
+  const std::vector<RigidTransform>& remember(std::string body, PluginReply reply,
+                                              const std::string& where) const;
 
   std::vector<std::string> forced_extra_poses_, forced_scalars_;
   mutable PluginConnection connection_;

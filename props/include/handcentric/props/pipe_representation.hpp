@@ -14,6 +14,13 @@
 //
 // Answers are cached by request, so a scene is sent once however many checks read it. Not
 // thread-safe.
+//
+// It is also a BatchRepresentation (batch.hpp): a plug-in whose hello declares "batch": B gets
+// the scenes of one encode_*_batch call not yet answered in batched requests of up to B scenes
+// of one shape, and, after the hello, every encode request as a batched one (a single scene is
+// a batch of one); decode and flow requests stay one per request. Without "batch",
+// encode_*_batch asks one scene at a time, as encode_actions does. The audit wraps a batching
+// plug-in in a BatchedRepresentation with CheckOptions::prefetch.
 #include <map>
 #include <memory>
 #include <optional>
@@ -25,12 +32,13 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representation.hpp"
+#include "handcentric/props/batch.hpp"
 #include "handcentric/props/plugin_connection.hpp"
 #include "handcentric/props/plugin_protocol.hpp"
 
 namespace handcentric::props {
 
-class PipeRepresentation final : public Representation {
+class PipeRepresentation final : public Representation, public BatchRepresentation {
  public:
   /// Starts `command`. Throws InvalidArgument for an empty command, a timeout <= 0 or an
   /// empty or repeated name; PluginError if the process cannot be started. Nothing is sent
@@ -48,6 +56,17 @@ class PipeRepresentation final : public Representation {
   Eigen::VectorXd encode_observation(const Scene& scene) const override;
   /// Whether the plug-in declared "decode" in its hello.
   bool can_decode() const override;
+  /// provides_observation().
+  bool has_observation() const override { return provides_observation(); }
+  /// The actions of each scene: cached ones from the cache, the others asked in batches of
+  /// batch_size() scenes of one shape (one at a time when the plug-in does not batch).
+  std::vector<Eigen::VectorXd> encode_actions_batch(
+      const std::vector<const Scene*>& scenes) const override;
+  /// As encode_actions_batch (an encode request answers both).
+  std::vector<Eigen::VectorXd> encode_observation_batch(
+      const std::vector<const Scene*>& scenes) const override;
+  /// The hello's "batch" (the most scenes per request), 0 when the plug-in does not batch.
+  int batch_size() const { return capabilities().batch; }
   /// The plug-in's decode answer for T_0 alone (a scene with history {T_0} and no points).
   std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& actions,
                                              const RigidTransform& world_T_hand0) const override;
@@ -72,8 +91,14 @@ class PipeRepresentation final : public Representation {
 
  private:
   const PluginReply& ask(const Scene& scene, RequestKind kind, const std::string& body) const;
+  /// One request; a batch of one when the plug-in batches and `kind` is encode.
+  PluginReply exchange_one(RequestKind kind, const std::string& body) const;
+  const PluginReply& remember(std::string key, PluginReply reply) const;
+  std::vector<Eigen::VectorXd> encode_batch(const std::vector<const Scene*>& scenes,
+                                            bool actions) const;
   const PluginReply& encoded(const Scene& scene) const;
-  void check_lengths(const Scene& scene, const PluginReply& reply, int id) const;
+  /// `where`: the request ("request 12", "request 12 (item 3 of 256)").
+  void check_lengths(const Scene& scene, const PluginReply& reply, const std::string& where) const;
   Scene with_extras(const Scene& scene) const;
 
   std::string command_;

@@ -4,7 +4,9 @@
 // way the plug-in can misbehave into a PluginError. The first line of the message says what
 // happened; when the plug-in wrote on stderr, its last 20 lines follow, indented. After a
 // failure the connection refuses further requests. Not thread-safe.
+#include <chrono>
 #include <string>
+#include <vector>
 
 #include "handcentric/props/plugin_protocol.hpp"
 #include "handcentric/props/subprocess.hpp"
@@ -19,6 +21,10 @@ class PluginConnection {
 
   /// Sends request `body` (the next id) and returns its parsed, validated answer.
   PluginReply exchange(RequestKind kind, const std::string& body, bool hello_allowed);
+  /// Sends one batched request (plugin_protocol.hpp, "batch") holding `bodies`, each the body
+  /// of a single request, and returns the answers in their order. The deadline is the timeout
+  /// times the number of scenes.
+  std::vector<PluginReply> exchange_batch(RequestKind kind, const std::vector<std::string>& bodies);
   /// Throws PluginError(what + the stderr tail) and refuses further requests.
   [[noreturn]] void fail(const std::string& what);
 
@@ -36,6 +42,8 @@ class PluginConnection {
 
  private:
   [[noreturn]] void fail_exited(const std::string& when);
+  /// Writes request `body` (the next id) answering for `scenes` scenes, and reads its line.
+  std::string round_trip(const std::string& body, int scenes);
 
   std::string command_;
   double timeout_seconds_;
@@ -43,6 +51,7 @@ class PluginConnection {
   int next_id_ = 0;
   bool dead_ = false;
   double seconds_asking_ = 0.0, seconds_waiting_ = 0.0;
+  std::chrono::steady_clock::time_point started_;  ///< when the last round trip began
 };
 
 }  // namespace handcentric::props

@@ -12,7 +12,11 @@
 //             "noise": [numbers]} -> {"id", "chunk": [[16], ...]}   (a whole policy, eq. 4)
 //   hello  : a plug-in may answer the first request it reads with
 //            {"id", "hello": {"protocol": 2, "extra_poses": [names], "scalars": [names],
-//             "decode": bool, "flow": bool, "noise": n}} instead; the audit then asks again.
+//             "decode": bool, "flow": bool, "noise": n, "batch": B}} instead; the audit then
+//            asks again.
+//   batch  : after a hello with "batch": B, every encode and policy request (not decode, not
+//            flow) is {"id", "protocol", "batch": [{fields of one request}, ...]} with 1 to B
+//            scenes of one shape -> {"id", "batch": [{fields of one answer}, ...]}, in order.
 // Matrices are 16 numbers, row-major 4x4.
 #include <Eigen/Core>
 #include <optional>
@@ -37,6 +41,7 @@ struct PluginCapabilities {
   bool decode = false;
   bool flow = false;
   int noise = 0;  ///< a policy's noise length; 0: the default (kPolicyNoise)
+  int batch = 0;  ///< the most scenes per batched request; 0: one request per scene
 };
 
 /// The noise a policy request carries unless the plug-in's hello asks for another length.
@@ -61,6 +66,9 @@ std::string encode_request_body(const Scene& scene,
 std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& observation);
 /// The body of a policy request: the observation (no chunk) and the noise.
 std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise);
+/// The body of a batched request: "batch": [{body}, {body}, ...], each body as the single
+/// request's.
+std::string batch_request_body(const std::vector<std::string>& bodies);
 /// The whole line: {"id": id, "protocol": 2, <body>}\n.
 std::string request_line(int id, const std::string& body);
 
@@ -80,6 +88,11 @@ enum class RequestKind { encode, flow, decode, policy };
 /// is not 16 finite numbers with last row 0 0 0 1.
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
                         bool hello_allowed);
+/// Parses the reply to batched request `id` of `count` scenes: {"id", "batch": [answers]}, each
+/// answer checked as parse_reply checks one, a message naming the item. Throws PluginError for
+/// a reply without "batch", a count other than `count`, or a bad item.
+std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, RequestKind kind,
+                                           const std::string& who, std::size_t count);
 
 /// Throws InvalidArgument naming `flag` for an empty or repeated name.
 void require_distinct_names(const std::vector<std::string>& names, const std::string& flag);
