@@ -39,9 +39,11 @@ Protocol v2 (the audit adds "protocol": 2 to every request; v1 audits do not; we
                (flow_input, flow_target).
 
 Batched (serve(encode, batched=True, batch_size=256), serve_policy(policy, batched=True)): the
-hello also says "batch": batch_size, and the audit then sends the scenes of one shape together,
-{"id": n, "batch": [{"history", "chunk", ...}, ...]} (each item the fields of one request),
-answered {"id": n, "batch": [{"actions", "observation"}, ...]} in the same order. encode gets
+hello also says "batch": batch_size, and the audit then sends up to batch_size scenes together,
+{"id": n, "batch": [{"history", "chunk", ...}, ...]} (each item the fields of one request, of
+any shapes), answered {"id": n, "batch": [{"actions", "observation"}, ...]} in the same order.
+serve calls the function once per shape among the items (scenes with the same numbers of poses
+and points), so that it always gets stacked arrays. encode gets
 stacked arrays with a leading batch axis, history (B,H+1,4,4), chunk (B,K,4,4), hand_points
 (B,n,3), world_points (B,m,3) (extra_poses={name: (B,4,4)}, scalars={name: (B,)}), and returns
 actions (B,a), or (actions, observation (B,o)), or a dict of them; a policy gets noise (B,d) and
@@ -251,6 +253,8 @@ def _chunk(result):
 # ----------------------------------------------------------------------------- batched requests
 
 MAX_BATCH = 65536  # the audit's bound on a hello's "batch"
+# What makes two scenes of a batched request stackable: their numbers of poses and points.
+_SHAPE_FIELDS = ("history", "chunk", "hand_points", "world_points")
 
 
 def _item(i, read, item):
@@ -503,6 +507,20 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         if len(items) > batch_size:
             raise _Malformed("a batch of %d scenes, more than the %d the hello declared"
                              % (len(items), batch_size))
+        # The items may be of several shapes: the function is called once per shape (its
+        # arrays must be stacked), and the answers go back in the request's order.
+        groups = {}
+        for i, item in enumerate(items):
+            groups.setdefault(tuple(len(item.get(key) or ()) for key in _SHAPE_FIELDS),
+                              []).append(i)
+        answers = [None] * len(items)
+        for indices in groups.values():
+            for i, answer in zip(indices, answer_group(rid, [items[i] for i in indices])):
+                answers[i] = answer
+        return {"id": rid, "batch": answers}
+
+    def answer_group(rid, items):
+        """The answers to items of one shape, in order."""
         B = len(items)
         history = _stacked(items, "history", 16, (4, 4))
         hand_points = _stacked(items, "hand_points", 3, (3,))
@@ -513,12 +531,12 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         if _policy is not None:
             noise = _stacked(items, "noise", None, ())
             result = call(_policy, rid, (history, hand_points, world_points, noise), named)
-            return {"id": rid, "batch": [{"chunk": c} for c in _chunks(result, B)]}
+            return [{"chunk": c} for c in _chunks(result, B)]
         if any("decode" in item or "eps" in item or "t" in item for item in items):
             raise _Malformed("decode and flow requests are not batched")
         chunk = _stacked(items, "chunk", 16, (4, 4))
         result = call(encode, rid, (history, chunk, hand_points, world_points), named)
-        return {"id": rid, "batch": _encoded_rows(result, B)}
+        return _encoded_rows(result, B)
 
     line_number = 0
     first = True

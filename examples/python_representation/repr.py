@@ -13,7 +13,7 @@ invariant even in a third-person view (the built-in copies them raw and is not).
 
 Run:  handcentric audit --exec 'python3 examples/python_representation/repr.py'
       handcentric audit --exec 'python3 examples/python_representation/repr.py --batched'
-With --batched it answers up to 256 scenes of one shape per request (encode_batch() on stacked
+With --batched it answers up to 256 scenes per request, of any shapes (encode_batch() on stacked
 arrays; the audit's verdicts and JSON are the same, in a fraction of the time).
 Copy this file and change encode() (or encode_batch()) to audit your own representation.
 """

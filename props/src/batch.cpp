@@ -192,8 +192,9 @@ std::size_t BatchedPolicy::flush() {
   std::vector<Pending> pending;
   pending.swap(pending_);
   pending_keys_.clear();
-  const auto batches = batches_of(pending, batch_size_, [](const Pending& p) {
-    return detail::shape_key(p.observation, false);
+  const bool mixed = policy_->mixed_shapes();
+  const auto batches = batches_of(pending, batch_size_, [mixed](const Pending& p) {
+    return mixed ? std::string() : detail::shape_key(p.observation, false);
   });
   for (const auto& batch : batches) evaluate(batch);
   return pending.size();
@@ -258,9 +259,9 @@ std::size_t BatchedRepresentation::flush(Side& side) {
   std::vector<Pending> pending;
   pending.swap(side.pending);
   side.pending_keys.clear();
-  const bool with_chunk = side.with_chunk;
-  const auto batches = batches_of(pending, batch_size_, [with_chunk](const Pending& p) {
-    return detail::shape_key(p.scene, with_chunk);
+  const bool with_chunk = side.with_chunk, mixed = representation_->mixed_shapes();
+  const auto batches = batches_of(pending, batch_size_, [with_chunk, mixed](const Pending& p) {
+    return mixed ? std::string() : detail::shape_key(p.scene, with_chunk);
   });
   for (const auto& batch : batches) evaluate(side, batch);
   return pending.size();

@@ -1,8 +1,6 @@
 #include "handcentric/props/pipe_policy.hpp"
 
 #include <algorithm>
-#include <map>
-#include <tuple>
 
 namespace handcentric::props {
 
@@ -100,14 +98,15 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
       out[i] = act(*observations[i], *noises[i]);
     return out;
   }
-  // The inputs not cached, each once, grouped by shape, in the order they come.
+  // The inputs not cached, each once, in the order they come: a batched line may mix shapes
+  // (the plug-in's helper calls its function once per shape).
   struct Missing {
     std::string body;
     std::vector<std::size_t> at;  // indices into `observations`
   };
   std::vector<Missing> missing;
   std::unordered_map<std::string, std::size_t> missing_index;
-  std::map<std::tuple<int, std::size_t, std::size_t>, std::vector<std::size_t>> by_shape;
+  std::vector<std::size_t> order;  // indices into `missing`
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const Scene& observation = *observations[i];
     std::string request = body(observation, *noises[i]);
@@ -117,28 +116,24 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
     }
     const auto [at, inserted] = missing_index.try_emplace(request, missing.size());
     if (inserted) {
-      by_shape[{observation.history_length(), observation.hand_points.size(),
-                observation.world_points.size()}]
-          .push_back(missing.size());
+      order.push_back(missing.size());
       missing.push_back({std::move(request), {}});
     }
     missing[at->second].at.push_back(i);
   }
-  for (const auto& [shape, indices] : by_shape) {
-    for (std::size_t from = 0; from < indices.size(); from += static_cast<std::size_t>(batch)) {
-      const std::size_t to = std::min(indices.size(), from + static_cast<std::size_t>(batch));
-      std::vector<std::string> bodies;
-      for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[indices[j]].body);
-      std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::policy, bodies);
-      const std::string id = std::to_string(connection_.last_id());
-      for (std::size_t j = from; j < to; ++j) {
-        Missing& m = missing[indices[j]];
-        const std::vector<RigidTransform>& chunk =
-            remember(std::move(m.body), std::move(replies[j - from]),
-                     "request " + id + " (item " + std::to_string(j - from) + " of " +
-                         std::to_string(to - from) + ")");
-        for (std::size_t i : m.at) out[i] = chunk;
-      }
+  for (std::size_t from = 0; from < order.size(); from += static_cast<std::size_t>(batch)) {
+    const std::size_t to = std::min(order.size(), from + static_cast<std::size_t>(batch));
+    std::vector<std::string> bodies;
+    for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[order[j]].body);
+    std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::policy, bodies);
+    const std::string id = std::to_string(connection_.last_id());
+    for (std::size_t j = from; j < to; ++j) {
+      Missing& m = missing[order[j]];
+      const std::vector<RigidTransform>& chunk =
+          remember(std::move(m.body), std::move(replies[j - from]),
+                   "request " + id + " (item " + std::to_string(j - from) + " of " +
+                       std::to_string(to - from) + ")");
+      for (std::size_t i : m.at) out[i] = chunk;
     }
   }
   return out;

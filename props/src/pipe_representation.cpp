@@ -165,8 +165,8 @@ std::vector<Eigen::VectorXd> PipeRepresentation::encode_batch(
     }
     return out;
   }
-  // The scenes not cached, each once, grouped by shape (the observation side may mix chunk
-  // lengths), in the order they come.
+  // The scenes not cached, each once, in the order they come: a batched line may mix
+  // shapes (the plug-in's helper calls its function once per shape).
   struct Missing {
     std::string body;
     const Scene* scene;
@@ -174,7 +174,7 @@ std::vector<Eigen::VectorXd> PipeRepresentation::encode_batch(
   };
   std::vector<Missing> missing;
   std::unordered_map<std::string, std::size_t> missing_index;
-  std::map<std::tuple<int, int, std::size_t, std::size_t>, std::vector<std::size_t>> by_shape;
+  std::vector<std::size_t> order;  // indices into `missing`
   for (std::size_t i = 0; i < scenes.size(); ++i) {
     const Scene& scene = *scenes[i];
     scene.validate_observation();
@@ -186,29 +186,25 @@ std::vector<Eigen::VectorXd> PipeRepresentation::encode_batch(
     }
     const auto [at, inserted] = missing_index.try_emplace(std::move(key), missing.size());
     if (inserted) {
-      by_shape[{scene.history_length(), scene.chunk_length(), scene.hand_points.size(),
-                scene.world_points.size()}]
-          .push_back(missing.size());
+      order.push_back(missing.size());
       missing.push_back({std::move(body), &scene, {}});
     }
     missing[at->second].at.push_back(i);
   }
-  for (const auto& [shape, indices] : by_shape) {
-    for (std::size_t from = 0; from < indices.size(); from += static_cast<std::size_t>(batch)) {
-      const std::size_t to = std::min(indices.size(), from + static_cast<std::size_t>(batch));
-      std::vector<std::string> bodies;
-      for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[indices[j]].body);
-      std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::encode, bodies);
-      const std::string id = std::to_string(connection_.last_id());
-      for (std::size_t j = from; j < to; ++j) {
-        Missing& m = missing[indices[j]];
-        PluginReply& reply = replies[j - from];
-        check_lengths(*m.scene, reply,
-                      "request " + id + " (item " + std::to_string(j - from) + " of " +
-                          std::to_string(to - from) + ")");
-        for (std::size_t i : m.at) out[i] = answer(reply);
-        remember('e' + std::move(m.body), std::move(reply));
-      }
+  for (std::size_t from = 0; from < order.size(); from += static_cast<std::size_t>(batch)) {
+    const std::size_t to = std::min(order.size(), from + static_cast<std::size_t>(batch));
+    std::vector<std::string> bodies;
+    for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[order[j]].body);
+    std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::encode, bodies);
+    const std::string id = std::to_string(connection_.last_id());
+    for (std::size_t j = from; j < to; ++j) {
+      Missing& m = missing[order[j]];
+      PluginReply& reply = replies[j - from];
+      check_lengths(*m.scene, reply,
+                    "request " + id + " (item " + std::to_string(j - from) + " of " +
+                        std::to_string(to - from) + ")");
+      for (std::size_t i : m.at) out[i] = answer(reply);
+      remember('e' + std::move(m.body), std::move(reply));
     }
   }
   return out;

@@ -108,8 +108,6 @@ def test_bad_batched_results_exit_1_with_one_line(result, message):
 @pytest.mark.parametrize("lines, kwargs, message", [
     ([PROBE, batched(1, scenes(3))], {"batch_size": 2}, "more than the 2 the hello declared"),
     ([PROBE, {"id": 1, "batch": []}], {}, "non-empty list"),
-    ([PROBE, {"id": 1, "batch": [item(s) for s in scenes(1, K=2) + scenes(1, K=3)]}], {},
-     "differ in the shape of 'chunk'"),
 ])
 def test_bad_batched_requests_exit_2_with_one_line(lines, kwargs, message):
     _, status, err = run_serve(lines, lambda h, *a: np.zeros((len(h), 6)), batched=True, **kwargs)
@@ -174,3 +172,41 @@ def test_flow_and_decode_requests_stay_single_in_batched_mode():
     assert answers[1] == {"id": 1, "actions": [0.0] * 12, "flow_input": [0.5] * 12,
                           "flow_target": [1.0] * 12}
     assert answers[2] == {"id": 2, "chunk": [scene["history"][0].ravel().tolist()] * 2}
+
+
+def test_a_batch_of_several_shapes_calls_the_function_once_per_shape_in_order():
+    # The audit sends up to batch_size scenes of any shapes in one line; the helper stacks the
+    # scenes of each shape and answers in the request's order, each answer the unbatched one.
+    mixed = [s for pair in zip(scenes(3, seed=2, H=1, K=2), scenes(3, seed=3, H=0, K=5))
+             for s in pair]
+    calls = []
+
+    def recording(history, chunk, hand_points, world_points):
+        calls.append((history.shape[:2], chunk.shape[:2]))
+        return repr_py.encode_batch(history, chunk, hand_points, world_points)
+    answers, status, err = run_serve([PROBE, batched(1, mixed)], recording, batched=True)
+    single = [run_serve([request(s, 7)], repr_py.encode)[0][0] for s in mixed]
+    for a in single:
+        del a["id"]
+    assert status == 0, err
+    assert answers[1] == {"id": 1, "batch": single}
+    assert sorted(calls) == [((3, 1), (3, 5)), ((3, 2), (3, 2))]  # (B, H+1), (B, K)
+
+
+def test_mutant_that_answers_a_mixed_batch_in_shape_order_is_caught(monkeypatch):
+    # The planted fault: the answers grouped by shape instead of put back in the request's order.
+    mixed = [s for pair in zip(scenes(2, seed=2, K=2), scenes(2, seed=3, K=5)) for s in pair]
+    single = [run_serve([request(s, 7)], repr_py.encode)[0][0] for s in mixed]
+    for a in single:
+        del a["id"]
+    rows = hp._encoded_rows
+    order = []
+
+    def grouped(result, B):
+        out = rows(result, B)
+        order.extend(out)
+        return out
+    monkeypatch.setattr(hp, "_encoded_rows", grouped)
+    answers, status, _ = run_serve([PROBE, batched(1, mixed)], repr_py.encode_batch, batched=True)
+    assert answers[1]["batch"] == single           # the helper itself puts them back in order
+    assert order != single                         # which the shape order alone would not

@@ -3,19 +3,19 @@
 // plug-in answering many scenes per line), with verdicts the same bit for bit as one call at a
 // time.
 //
-// How. A check's cases, and the inputs each case asks for, follow from its seed; only a case's
-// next question can depend on an answer (the floor, then the map's rounding, then off the case;
-// the affine probes, then the draws). So with CheckOptions::prefetch, run_check first runs
-// prefetch passes over its cases: in such a pass a BatchedPolicy or BatchedRepresentation asked
-// for an input it has no answer for records it and throws PendingEvaluation, which stops that
-// case only (cases where several questions are known at once ask them all first: prefetch()).
-// The recorded inputs are then evaluated together, in batches of at most batch_size inputs of
-// one shape, and the next pass goes a question further. When a pass records nothing new, the
-// real pass runs: it asks the same questions in the same order as an unbatched check and finds
-// every answer cached, so its verdict, witness and JSON are those of the unbatched check, bit
-// for bit, provided the map's answer for one input does not depend on the other inputs of its
-// batch. The prefetch passes may ask for inputs the real pass never reaches (cases after the
-// first failure); shrinking a failure asks one input at a time.
+// How. A check's cases, and the inputs each case asks for, follow from its seed; only a case's next
+// question can depend on an answer (the floor, then the map's rounding, then off the case; the
+// affine probes, then the draws). So with CheckOptions::prefetch, run_check first runs prefetch
+// passes over its cases: in such a pass a BatchedPolicy or BatchedRepresentation asked for an input
+// it has no answer for records it and throws PendingEvaluation, which stops that case only (cases
+// where several questions are known at once ask them all first: prefetch()). The recorded inputs
+// are then evaluated together, in batches of at most batch_size inputs (of one shape unless the map
+// takes mixed shapes), and the next pass goes a question further. When a pass records nothing new,
+// the real pass runs: it asks the same questions in the same order as an unbatched check and finds
+// every answer cached, so its verdict, witness and JSON are those of the unbatched check, bit for
+// bit, provided the map's answer for one input does not depend on the other inputs of its batch.
+// The prefetch passes may ask for inputs the real pass never reaches (cases after the first
+// failure); shrinking a failure asks one input at a time.
 #include <Eigen/Core>
 #include <cstddef>
 #include <functional>
@@ -111,10 +111,13 @@ class BatchPolicy {
   virtual std::string name() const = 0;
   virtual Eigen::Index noise_dimension() const = 0;
   /// One world-frame chunk per (observations[i], noises[i]). Every observation has the same
-  /// shape (detail::shape_key); at most the BatchedPolicy's batch_size of them.
+  /// shape (detail::shape_key) unless mixed_shapes(); at most the BatchedPolicy's batch_size.
   virtual std::vector<std::vector<RigidTransform>> act_batch(
       const std::vector<const Scene*>& observations,
       const std::vector<const Eigen::VectorXd*>& noises) const = 0;
+  /// True when act_batch takes observations of several shapes in one call (a plug-in whose
+  /// helper splits them): then a batch is any batch_size inputs, in the order recorded.
+  virtual bool mixed_shapes() const { return false; }
 };
 
 /// A representation that encodes many scenes at once.
@@ -124,13 +127,16 @@ class BatchRepresentation {
   virtual std::string name() const = 0;
   /// True when it has an observation map (else encode_observation gives empty vectors).
   virtual bool has_observation() const = 0;
-  /// The action vector of each scene (each with its chunk), all of one shape.
+  /// The action vector of each scene (each with its chunk), all of one shape unless
+  /// mixed_shapes().
   virtual std::vector<Eigen::VectorXd> encode_actions_batch(
       const std::vector<const Scene*>& scenes) const = 0;
-  /// The observation vector of each scene, all of one shape.
+  /// The observation vector of each scene, all of one shape unless mixed_shapes().
   virtual std::vector<Eigen::VectorXd> encode_observation_batch(
       const std::vector<const Scene*>& scenes) const = 0;
   virtual bool can_decode() const { return false; }
+  /// As BatchPolicy::mixed_shapes.
+  virtual bool mixed_shapes() const { return false; }
   /// The world chunk that `actions` encode in `observation` (one at a time: only the
   /// injectivity round trips ask).
   virtual std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,

@@ -6,8 +6,9 @@
 // cached by request. Not thread-safe.
 //
 // It is also a BatchPolicy (batch.hpp): a plug-in whose hello declares "batch": B gets the
-// observations of an act_batch call not yet answered in batched requests of up to B of one
-// shape, and, after the hello, every request as a batched one (act() sends a batch of one).
+// observations of an act_batch call not yet answered in batched requests of up to B, of any
+// shapes (mixed_shapes(): the plug-in's helper calls its function once per shape), and, after
+// the hello, every request as a batched one (act() sends a batch of one).
 // Without "batch", act_batch asks one observation at a time, as act does.
 #include <string>
 #include <unordered_map>
@@ -33,8 +34,10 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   std::vector<RigidTransform> act(const Scene& observation,
                                   const Eigen::VectorXd& noise) const override;
   /// The chunk of each (observation, noise): cached ones from the cache, the others asked in
-  /// batches of batch_size() observations of one shape (one at a time when the plug-in does not
+  /// batches of batch_size() observations of any shapes (one at a time when the plug-in does not
   /// batch).
+  /// A batched line may mix shapes (docs/AUDIT.md, "--exec"): fewer round trips.
+  bool mixed_shapes() const override { return true; }
   std::vector<std::vector<RigidTransform>> act_batch(
       const std::vector<const Scene*>& observations,
       const std::vector<const Eigen::VectorXd*>& noises) const override;

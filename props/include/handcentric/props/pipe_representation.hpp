@@ -58,8 +58,10 @@ class PipeRepresentation final : public Representation, public BatchRepresentati
   bool can_decode() const override;
   /// provides_observation().
   bool has_observation() const override { return provides_observation(); }
+  /// A batched line may mix shapes (docs/AUDIT.md, "--exec"): fewer round trips.
+  bool mixed_shapes() const override { return true; }
   /// The actions of each scene: cached ones from the cache, the others asked in batches of
-  /// batch_size() scenes of one shape (one at a time when the plug-in does not batch).
+  /// batch_size() scenes of any shapes (one at a time when the plug-in does not batch).
   std::vector<Eigen::VectorXd> encode_actions_batch(
       const std::vector<const Scene*>& scenes) const override;
   /// As encode_actions_batch (an encode request answers both).
