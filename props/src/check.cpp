@@ -218,7 +218,12 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
       }
     }
     if (error) std::rethrow_exception(error);
-    if (!searched) verdict = before_search;
+    if (!searched) {
+      // A case failed in the real decision that the prefetch passes had only gathered for (an
+      // in-distribution case's tests): RapidCheck searches again, to shrink it, from scratch.
+      verdict = before_search;
+      if (before_real_pass) before_real_pass();
+    }
   }
   auto property = [&] {
     if (error) return;  // a broken function under test: let RapidCheck finish at once
