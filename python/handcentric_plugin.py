@@ -70,6 +70,8 @@ The geometry helpers below (rotation_vector, rotation_matrix, inverse, relative_
 relative_points, pose_vector, pose_matrix, and for batched plug-ins batch_relative_pose and
 batch_relative_points) need NumPy; serve() does not (unless batched).
 """
+import base64
+import binascii
 import contextlib
 import json
 import math
@@ -257,6 +259,19 @@ MAX_BATCH = 65536  # the audit's bound on a hello's "batch"
 _SHAPE_FIELDS = ("history", "chunk", "hand_points", "world_points")
 
 
+def _rows_of(value):
+    """The number of rows of a field, to group the items of a batch: a list's or a decoded
+    array's length; -1 for anything else (reading the field then says what is wrong)."""
+    if isinstance(value, (list, np.ndarray)):
+        return len(value)
+    if value is None:
+        return 0
+    shape = value.get("shape") if isinstance(value, dict) else None
+    if isinstance(shape, list) and shape and isinstance(shape[0], int):
+        return shape[0]
+    return -1
+
+
 def _item(i, read, item):
     """read(item), a malformed item named by its index."""
     try:
@@ -265,13 +280,17 @@ def _item(i, read, item):
         raise _Malformed("batch[%d]: %s" % (i, error))
 
 
-def _stacked(items, key, width, tail):
+def _stacked(items, key, width, tail, at=None):
     """The items' `key` stacked along a new leading axis: (B, rows) + tail. width: numbers per
-    row (None for a flat vector, the noise). One np.array on the nested lists when they are
-    plain finite numbers of one shape; else each item is read as a single request is, so that
-    the message names the item and the field."""
+    row (None for a flat vector, the noise). Encoded arrays are decoded into one buffer, and
+    JSON numbers read by one np.array on the nested lists, when they are plain finite numbers
+    of one shape; else each item is read as a single request is, so that the message names the
+    item (by at[i], its index in the line, when the items are a group of it) and the field."""
     B = len(items)
     values = [item.get(key) for item in items]
+    least = 0 if width == 3 else 1  # rows: points may have none
+    if all(isinstance(v, np.ndarray) for v in values):  # decoded by _decoded_items
+        return values[0][None] if B == 1 else np.stack(values)
     if not _fast_array.has_booleans:
         try:
             a = np.array(values, dtype=np.float64)
@@ -285,16 +304,20 @@ def _stacked(items, key, width, tail):
                 return a.reshape((B, a.shape[1]) + tail)
             if width == 3 and a.ndim == 2 and a.shape[1] == 0:  # no points in any scene
                 return np.zeros((B, 0, 3))
-    if width is None:
-        def read(item):
-            value = item.get(key)
+
+    def read(item):
+        value = item.get(key)
+        if isinstance(value, np.ndarray):  # decoded, in a group that mixes the two forms
+            return value
+        if isinstance(value, dict):
+            return _encoded_field(value, "'%s'" % key, tail, least)
+        if width is None:
             if not isinstance(value, list) or not value or not all(map(_is_number, value)):
                 raise _Malformed("'%s' must be a non-empty list of numbers" % key)
             return np.array(value, dtype=np.float64)
-    else:
-        def read(item):
-            return _matrices(item, key) if width == 16 else _points(item, key)
-    rows = [_item(i, read, item) for i, item in enumerate(items)]
+        return _matrices(item, key) if width == 16 else _points(item, key)
+
+    rows = [_item(at[i] if at else i, read, item) for i, item in enumerate(items)]
     if any(r.shape != rows[0].shape for r in rows):
         shapes = sorted(set(r.shape for r in rows))
         raise _Malformed("the scenes of one batch differ in the shape of '%s' (%s); a batch "
@@ -320,16 +343,15 @@ def _rows(value, B, field, function):
                          "array with one row per scene, (%d, ...)"
                          % (function, field, a.shape, B, B))
     a = a.astype(np.float64).reshape(B, -1)
-    bad = np.argwhere(~np.isfinite(a))
-    if len(bad):
-        i, j = bad[0]
+    if not np.isfinite(a).all():
+        i, j = np.argwhere(~np.isfinite(a))[0]
         raise _BadResult("'%s' of batch item %d has a non-finite number at index %d: %r"
                          % (field, i, j, a[i, j]))
     return a
 
 
-def _encoded_rows(result, B):
-    """A batched encode's result -> B answers {"actions": [...], "observation": [...]}."""
+def _encoded_arrays(result, B):
+    """A batched encode's result -> (actions (B, a), observation (B, o) or None), float64."""
     if isinstance(result, dict):
         unknown = set(result) - {"actions", "observation"}
         if "actions" not in result or unknown:
@@ -343,15 +365,20 @@ def _encoded_rows(result, B):
     actions = _rows(actions, B, "actions", "encode")
     if actions.shape[1] == 0:
         raise _BadResult("encode returned no actions")
-    if observation is None:
-        return [{"actions": row} for row in actions.tolist()]
-    observation = _rows(observation, B, "observation", "encode")
-    return [{"actions": a, "observation": o}
-            for a, o in zip(actions.tolist(), observation.tolist())]
+    return actions, None if observation is None else _rows(observation, B, "observation", "encode")
 
 
-def _chunks(result, B):
-    """A batched policy's result, (B,K,4,4) or (B,K,16) -> B chunks of K lists of 16 numbers."""
+def _encoded_rows(result, B, encoded=False):
+    """A batched encode's result -> B answers {"actions": [...], "observation": [...]} (encoded:
+    each row an encoded array)."""
+    arrays = [a for a in _encoded_arrays(result, B) if a is not None]
+    rows = [[_encode_array(row) for row in a] if encoded else a.tolist() for a in arrays]
+    return [dict(zip(("actions", "observation"), answer)) for answer in zip(*rows)]
+
+
+def _chunks(result, B, encoded=False):
+    """A batched policy's result, (B,K,4,4) or (B,K,16) -> B chunks of K lists of 16 numbers
+    (encoded: B encoded arrays of shape (K, 4, 4))."""
     a = np.asarray(result)
     shaped = a.ndim == 4 and a.shape[2:] == (4, 4) or a.ndim == 3 and a.shape[2] == 16
     if a.dtype.kind not in "biuf" or not shaped or a.shape[0] != B or a.shape[1] == 0:
@@ -364,13 +391,157 @@ def _chunks(result, B):
         i, k = np.argwhere(off)[0]
         raise _BadResult("the policy's pose %d of batch item %d has last row %s, not "
                          "[0, 0, 0, 1]" % (k, i, a[i, k, 12:].tolist()))
+    if encoded:
+        return [_encode_array(c.reshape(-1, 4, 4)) for c in a]
     return a.tolist()
+
+
+# ----------------------------------------------------------------------------- encoded arrays
+# The "base64" encoding of batched lines (docs/AUDIT.md, "Encoded numbers"): an array is
+# {"dtype": "float64" | "float32" | "uint8", "shape": [...], "data": base64 of its elements,
+# row-major, little-endian}. The audit uses it when our hello offers it ("encodings"), and marks
+# each such line "encoding": "base64"; we answer a line in the encoding it came in, so that an
+# audit that does not know the encoding gets JSON numbers, as before.
+
+ENCODINGS = ("base64",)  # what serve(encoding=...) can offer besides JSON numbers
+# The dtypes an encoded array may have, as NumPy reads their little-endian bytes.
+_DTYPES = {"float64": "<f8", "float32": "<f4", "uint8": "u1"}
+_ARRAY_FORM = ('an encoded array is {"dtype": "float64", "shape": [n, ...], "data": "base64 of '
+               'the elements, row-major, little-endian"}')
+
+
+def _b64decode(text):
+    """Standard, padded base64 -> bytes; anything else raises ValueError (binascii.Error)."""
+    try:
+        return binascii.a2b_base64(text, strict_mode=True)
+    except TypeError:  # Python < 3.11: no strict_mode
+        return base64.b64decode(text, validate=True)
+
+
+def _decode_array(value, what, dtypes=("float64",)):
+    """An encoded array -> a writable NumPy array of its dtype and shape. what: the field, for
+    messages ("batch[2]: 'history'"); dtypes: those the field may have."""
+    if not isinstance(value, dict) or set(value) != {"dtype", "shape", "data"}:
+        raise _Malformed("%s = %.60s is not an encoded array; %s"
+                         % (what, json.dumps(value), _ARRAY_FORM))
+    dtype, shape, data = value["dtype"], value["shape"], value["data"]
+    if not isinstance(dtype, str) or dtype not in _DTYPES:
+        raise _Malformed("%s has dtype %r; an encoded array's dtype is one of %s (little-endian)"
+                         % (what, dtype, ", ".join(_DTYPES)))
+    if dtype not in dtypes:
+        raise _Malformed("%s has dtype %s; it must be %s" % (what, dtype, " or ".join(dtypes)))
+    if not isinstance(shape, list) or len(shape) > 8 or not all(
+            isinstance(d, int) and not isinstance(d, bool) and d >= 0 for d in shape):
+        raise _Malformed("%s has shape %r, not a list of at most 8 sizes (integers >= 0)"
+                         % (what, shape))
+    if not isinstance(data, str):
+        raise _Malformed("%s has \"data\" that is not a string; %s" % (what, _ARRAY_FORM))
+    try:
+        raw = _b64decode(data)
+    except ValueError as error:
+        raise _Malformed("%s has \"data\" that is not standard base64 (%s): A-Z a-z 0-9 + /, "
+                         "padded with = to a multiple of 4 characters" % (what, error))
+    size = np.dtype(_DTYPES[dtype]).itemsize
+    count = math.prod(shape)
+    if len(raw) != count * size:
+        raise _Malformed("%s of shape %s and dtype %s needs %d bytes, but \"data\" holds %d; "
+                         "send every element, row-major, little-endian"
+                         % (what, shape, dtype, count * size, len(raw)))
+    return np.frombuffer(bytearray(raw), dtype=_DTYPES[dtype]).reshape(shape)
+
+
+def _finite(a, what):
+    """a, after checking that every number is finite (the protocol's numbers are)."""
+    if not np.isfinite(a).all():
+        index = tuple(int(i) for i in np.argwhere(~np.isfinite(a))[0])
+        raise _Malformed("%s has a non-finite number at %s: %r; the protocol's numbers are "
+                         "finite" % (what, index if len(index) > 1 else index[0], a[index]))
+    return a
+
+
+def _encoded_field(value, what, tail, least):
+    """A request's encoded array: float64, finite, of shape (n,) + tail with n >= least."""
+    a = _finite(_decode_array(value, what), what)
+    if a.ndim != 1 + len(tail) or a.shape[1:] != tail or a.shape[0] < least:
+        raise _Malformed("%s has shape %s; it must be (%s)%s" % (
+            what, list(a.shape), ", ".join(["n"] + [str(d) for d in tail]),
+            " with n >= %d" % least if least else ""))
+    return a.astype(np.float64, copy=False)
+
+
+def _pose(value, what):
+    """A 4x4 pose in either form (an extra pose)."""
+    if isinstance(value, dict):
+        a = _finite(_decode_array(value, what), what)
+        if a.shape != (4, 4):
+            raise _Malformed("%s has shape %s; a pose is (4, 4)" % (what, list(a.shape)))
+        return a.astype(np.float64, copy=False)
+    return _matrix(value, what)
+
+
+# The array fields of a request: (tail of the shape, the fewest rows).
+_ARRAY_FIELDS = {"history": ((4, 4), 1), "chunk": ((4, 4), 1), "hand_points": ((3,), 0),
+                 "world_points": ((3,), 0), "noise": ((), 1)}
+
+
+def _decoded_column(values, tail, least):
+    """Encoded arrays (one field of every item of a line) -> their arrays, views of one buffer
+    decoded at once (one finiteness check per line, not per item); None unless every one is a
+    plain float64 array of shape (n,) + tail with n >= least (each is then read on its own, so
+    that the message names the item)."""
+    rows = []
+    for v in values:
+        shape = v.get("shape") if type(v) is dict else None
+        if not (type(shape) is list and len(v) == 3 and v.get("dtype") == "float64"
+                and len(shape) == 1 + len(tail) and tuple(shape[1:]) == tail
+                and type(shape[0]) is int and shape[0] >= least):
+            return None
+        rows.append(shape[0])
+    try:
+        data = bytearray().join(_b64decode(v["data"]) for v in values)
+    except (TypeError, ValueError):
+        return None
+    width = math.prod(tail)
+    if len(data) != 8 * width * sum(rows):
+        return None
+    flat = np.frombuffer(data, dtype=_DTYPES["float64"]).astype(np.float64, copy=False)
+    if not np.isfinite(flat).all():
+        return None
+    out, offset = [], 0
+    for n in rows:
+        out.append(flat[offset:offset + n * width].reshape((n,) + tail))
+        offset += n * width
+    return out
+
+
+def _decoded_items(items):
+    """The items of an encoded line with their encoded arrays decoded (NumPy arrays in their
+    place), ready to be grouped by shape and stacked."""
+    items = [dict(item) for item in items]
+    for key, (tail, least) in _ARRAY_FIELDS.items():
+        present = [i for i, item in enumerate(items) if isinstance(item.get(key), dict)]
+        if not present:
+            continue
+        column = _decoded_column([items[i][key] for i in present], tail, least)
+        for j, i in enumerate(present):
+            items[i][key] = column[j] if column is not None else _item(
+                i, lambda item: _encoded_field(item[key], "'%s'" % key, tail, least), items[i])
+    return items
+
+
+def _encode_array(a):
+    """A NumPy array of float64, float32 or uint8 -> its encoded form (little-endian)."""
+    names = {"f8": "float64", "f4": "float32", "u1": "uint8"}
+    name = names[a.dtype.kind + str(a.dtype.itemsize)]
+    return {"dtype": name, "shape": list(a.shape),
+            "data": base64.b64encode(a.astype(_DTYPES[name], copy=False).tobytes())
+            .decode("ascii")}
 
 
 # ----------------------------------------------------------------------------- the loop
 
 def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, batched=False,
-                 batch_size=256, stdin=None, stdout=None):
+                 batch_size=256, encoding="base64", stdin=None, stdout=None):
     """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
 
     policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
@@ -378,14 +549,16 @@ def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, 
         as the policy's only randomness, so that one noise vector gives one chunk.
     batched: policy(history (B,H+1,4,4), hand_points (B,n,3), world_points (B,m,3), noise (B,d))
         -> (B,K,4,4), on up to batch_size observations of one shape per call (needs NumPy).
-    extra_poses, scalars, hello, stdin, stdout: as for serve().
+    extra_poses, scalars, hello, encoding, stdin, stdout: as for serve().
     """
     serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, batched=batched,
-          batch_size=batch_size, stdin=stdin, stdout=stdout, _policy=policy, _noise=noise)
+          batch_size=batch_size, encoding=encoding, stdin=stdin, stdout=stdout, _policy=policy,
+          _noise=noise)
 
 
 def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=None,
-          batched=False, batch_size=256, stdin=None, stdout=None, _policy=None, _noise=None):
+          batched=False, batch_size=256, encoding="base64", stdin=None, stdout=None,
+          _policy=None, _noise=None):
     """Answer the audit's requests until end of input (see the module docstring).
 
     encode(history, chunk, hand_points, world_points) -> actions | (actions, observation) | dict
@@ -398,6 +571,11 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         axis: history (B,H+1,4,4), chunk (B,K,4,4), hand_points (B,n,3), world_points (B,m,3),
         extra_poses={name: (B,4,4)}, scalars={name: (B,)}, and returns actions (B,a), or
         (actions, observation (B,o)), or a dict; decode and flow stay per scene. Needs NumPy.
+    encoding: with batched=True, the hello offers it ("encodings": ["base64"]) and an audit that
+        takes it sends the arrays of its batched lines as base64 of their float64 bytes, answered
+        the same way: the same numbers, bit for bit, for less time in JSON on both sides. None:
+        numbers as JSON text. An audit that does not know the encoding sends JSON numbers, which
+        are answered as such.
     stdin, stdout: text streams (default sys.stdin, sys.stdout).
     """
     if batched:
@@ -411,6 +589,9 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         if hello is False:
             raise ValueError("batched=True needs the hello (it declares the batch size)")
         hello = True
+    if encoding is not None and encoding not in ENCODINGS:
+        raise ValueError("encoding must be one of %s, or None (numbers as JSON text), got %r"
+                         % (", ".join(map(repr, ENCODINGS)), encoding))
     stdin = sys.stdin if stdin is None else stdin
     out = sys.stdout if stdout is None else stdout  # taken now: print() is redirected below
     extra_poses, scalars = tuple(extra_poses), tuple(scalars)
@@ -423,6 +604,8 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         hello_body["noise"] = int(_noise)
     if batched:
         hello_body["batch"] = batch_size
+        if encoding is not None:
+            hello_body["encodings"] = [encoding]
 
     def call(function, request_id, args, named):
         kwargs = {"extra_poses": named[0], "scalars": named[1]} if declared else {}
@@ -509,34 +692,39 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                              % (len(items), batch_size))
         # The items may be of several shapes: the function is called once per shape (its
         # arrays must be stacked), and the answers go back in the request's order.
+        encoded = request.get("encoding") is not None
+        if encoded:
+            items = _decoded_items(items)
         groups = {}
         for i, item in enumerate(items):
-            groups.setdefault(tuple(len(item.get(key) or ()) for key in _SHAPE_FIELDS),
+            groups.setdefault(tuple(_rows_of(item.get(key)) for key in _SHAPE_FIELDS),
                               []).append(i)
         answers = [None] * len(items)
         for indices in groups.values():
-            for i, answer in zip(indices, answer_group(rid, [items[i] for i in indices])):
+            for i, answer in zip(indices, answer_group(rid, [items[i] for i in indices],
+                                                       encoded, indices)):
                 answers[i] = answer
         return {"id": rid, "batch": answers}
 
-    def answer_group(rid, items):
-        """The answers to items of one shape, in order."""
+    def answer_group(rid, items, encoded, at):
+        """The answers to items of one shape, in order (encoded: their arrays encoded); at: the
+        items' indices in the line, for messages."""
         B = len(items)
-        history = _stacked(items, "history", 16, (4, 4))
-        hand_points = _stacked(items, "hand_points", 3, (3,))
-        world_points = _stacked(items, "world_points", 3, (3,))
-        named = _stack_named([_item(i, lambda item: (
-            _named(item, "extra_poses", extra_poses, _matrix),
+        history = _stacked(items, "history", 16, (4, 4), at)
+        hand_points = _stacked(items, "hand_points", 3, (3,), at)
+        world_points = _stacked(items, "world_points", 3, (3,), at)
+        named = _stack_named([_item(at[i], lambda item: (
+            _named(item, "extra_poses", extra_poses, _pose),
             _named(item, "scalars", scalars, _scalar)), items[i]) for i in range(B)])
         if _policy is not None:
-            noise = _stacked(items, "noise", None, ())
+            noise = _stacked(items, "noise", None, (), at)
             result = call(_policy, rid, (history, hand_points, world_points, noise), named)
-            return [{"chunk": c} for c in _chunks(result, B)]
+            return [{"chunk": c} for c in _chunks(result, B, encoded)]
         if any("decode" in item or "eps" in item or "t" in item for item in items):
             raise _Malformed("decode and flow requests are not batched")
-        chunk = _stacked(items, "chunk", 16, (4, 4))
+        chunk = _stacked(items, "chunk", 16, (4, 4), at)
         result = call(encode, rid, (history, chunk, hand_points, world_points), named)
-        return _encoded_rows(result, B)
+        return _encoded_rows(result, B, encoded=True) if encoded else _encoded_rows(result, B)
 
     line_number = 0
     first = True
@@ -551,6 +739,11 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         try:
             request = _parse(line)
             rid = request["id"]
+            if "encoding" in request and request["encoding"] not in hello_body.get("encodings",
+                                                                                   ()):
+                raise _Malformed("a line in encoding %s, which the plug-in did not offer (its "
+                                 "hello offers %s)" % (json.dumps(request["encoding"]),
+                                                       hello_body.get("encodings", [])))
             if first and hello:
                 reply = {"id": rid, "hello": hello_body}
             elif "batch" in request:
@@ -558,6 +751,9 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                     raise _Malformed("a batched request, but the plug-in declared no batch "
                                      "(serve(..., batched=True) does)")
                 reply = answer_batch(request)
+            elif "encoding" in request:
+                raise _Malformed("an encoded line that is not batched; only batched lines are "
+                                 "encoded")
             else:
                 reply = answer(request)
         except _Malformed as error:

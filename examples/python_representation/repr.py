@@ -14,7 +14,9 @@ invariant even in a third-person view (the built-in copies them raw and is not).
 Run:  handcentric audit --exec 'python3 examples/python_representation/repr.py'
       handcentric audit --exec 'python3 examples/python_representation/repr.py --batched'
 With --batched it answers up to 256 scenes per request, of any shapes (encode_batch() on stacked
-arrays; the audit's verdicts and JSON are the same, in a fraction of the time).
+arrays; the audit's verdicts and JSON are the same, in a fraction of the time), their arrays as
+base64 of their float64 bytes when the audit takes that encoding (--batched --text: as JSON
+numbers).
 Copy this file and change encode() (or encode_batch()) to audit your own representation.
 """
 import os
@@ -85,9 +87,13 @@ def encode_batch(history, chunk, hand_points, world_points):
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] == ["--batched"]:
-        hp.serve(encode_batch, batched=True)
+    if sys.argv[1:] in (["--batched"], ["--batched", "--text"]):
+        # The helper offers the base64 encoding of batched lines (the same numbers in fewer
+        # bytes and less parsing); --text keeps them JSON numbers, to compare the two.
+        hp.serve(encode_batch, batched=True,
+                 encoding=None if "--text" in sys.argv else "base64")
     elif sys.argv[1:]:
-        sys.exit("repr.py: unknown arguments %s; the only option is --batched" % sys.argv[1:])
+        sys.exit("repr.py: unknown arguments %s; the options are --batched and --batched --text"
+                 % sys.argv[1:])
     else:
         hp.serve(encode)
