@@ -34,13 +34,7 @@ const PluginCapabilities& PipePolicy::capabilities() const {
   capabilities.scalar_names = merged_names(capabilities.scalar_names, forced_scalars_);
   if (capabilities.noise == 0) capabilities.noise = kPolicyNoise;
   capabilities_ = capabilities;
-  if (reply.hello) {
-    const Eigen::VectorXd asked = fixed_noise(capabilities.noise, 1);
-    const std::string body = policy_request_body(with_extras(probe), asked);
-    reply = capabilities.batch == 0
-                ? connection_.exchange(RequestKind::policy, body, false)
-                : std::move(connection_.exchange_batch(RequestKind::policy, {body}).front());
-  }
+  if (reply.hello) reply = exchange_one(with_extras(probe), fixed_noise(capabilities.noise, 1));
   chunk_length_ = reply.chunk.size();
   return *capabilities_;
 }
@@ -49,16 +43,32 @@ Eigen::Index PipePolicy::noise_dimension() const {
   return capabilities().noise;
 }
 
-std::string PipePolicy::body(const Scene& observation, const Eigen::VectorXd& noise) const {
+std::string PipePolicy::key(const Scene& observation, const Eigen::VectorXd& noise) const {
   observation.validate_observation();
   if (noise.size() != noise_dimension()) {
     throw InvalidArgument(name() + " reads " + std::to_string(noise_dimension()) +
                           " noise numbers, got " + std::to_string(noise.size()));
   }
-  return policy_request_body(observation, noise);
+  std::string out = scene_key(observation);
+  out.append(reinterpret_cast<const char*>(noise.data()),
+             static_cast<std::size_t>(noise.size()) * sizeof(double));
+  return out;
 }
 
-const std::vector<RigidTransform>& PipePolicy::remember(std::string body, PluginReply reply,
+PluginReply PipePolicy::exchange_one(const Scene& observation, const Eigen::VectorXd& noise) const {
+  if (capabilities_->batch == 0) {
+    return connection_.exchange(RequestKind::policy, policy_request_body(observation, noise),
+                                false);
+  }
+  const NumberEncoding encoding = capabilities_->encoding;
+  return std::move(connection_
+                       .exchange_batch(RequestKind::policy,
+                                       {policy_request_body(observation, noise, encoding)},
+                                       encoding)
+                       .front());
+}
+
+const std::vector<RigidTransform>& PipePolicy::remember(std::string key, PluginReply reply,
                                                         const std::string& where) const {
   if (reply.chunk.size() != chunk_length_) {
     connection_.fail(connection_.who() + " answered policy " + where + " with " +
@@ -67,18 +77,15 @@ const std::vector<RigidTransform>& PipePolicy::remember(std::string body, Plugin
                      " for the probe; the chunk length K must not change");
   }
   if (cache_.size() > 200000) cache_.clear();  // bounded memory over long audits
-  return cache_.insert_or_assign(std::move(body), std::move(reply.chunk)).first->second;
+  return cache_.insert_or_assign(std::move(key), std::move(reply.chunk)).first->second;
 }
 
 std::vector<RigidTransform> PipePolicy::act(const Scene& observation,
                                             const Eigen::VectorXd& noise) const {
   capabilities();
-  std::string request = body(observation, noise);
+  std::string request = key(observation, noise);
   if (const auto hit = cache_.find(request); hit != cache_.end()) return hit->second;
-  PluginReply reply =
-      capabilities_->batch == 0
-          ? connection_.exchange(RequestKind::policy, request, false)
-          : std::move(connection_.exchange_batch(RequestKind::policy, {request}).front());
+  PluginReply reply = exchange_one(observation, noise);
   return remember(std::move(request), std::move(reply),
                   "request " + std::to_string(connection_.last_id()));
 }
@@ -101,7 +108,8 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
   // The inputs not cached, each once, in the order they come: a batched line may mix shapes
   // (the plug-in's helper calls its function once per shape).
   struct Missing {
-    std::string body;
+    std::string key;
+    std::size_t first;            // the index of its first occurrence in `observations`
     std::vector<std::size_t> at;  // indices into `observations`
   };
   std::vector<Missing> missing;
@@ -109,7 +117,7 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
   std::vector<std::size_t> order;  // indices into `missing`
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const Scene& observation = *observations[i];
-    std::string request = body(observation, *noises[i]);
+    std::string request = key(observation, *noises[i]);
     if (const auto hit = cache_.find(request); hit != cache_.end()) {
       out[i] = hit->second;
       continue;
@@ -117,20 +125,25 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
     const auto [at, inserted] = missing_index.try_emplace(request, missing.size());
     if (inserted) {
       order.push_back(missing.size());
-      missing.push_back({std::move(request), {}});
+      missing.push_back({std::move(request), i, {}});
     }
     missing[at->second].at.push_back(i);
   }
   for (std::size_t from = 0; from < order.size(); from += static_cast<std::size_t>(batch)) {
     const std::size_t to = std::min(order.size(), from + static_cast<std::size_t>(batch));
     std::vector<std::string> bodies;
-    for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[order[j]].body);
-    std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::policy, bodies);
+    const NumberEncoding encoding = capabilities_->encoding;
+    for (std::size_t j = from; j < to; ++j) {
+      const std::size_t i = missing[order[j]].first;
+      bodies.push_back(policy_request_body(*observations[i], *noises[i], encoding));
+    }
+    std::vector<PluginReply> replies =
+        connection_.exchange_batch(RequestKind::policy, bodies, encoding);
     const std::string id = std::to_string(connection_.last_id());
     for (std::size_t j = from; j < to; ++j) {
       Missing& m = missing[order[j]];
       const std::vector<RigidTransform>& chunk =
-          remember(std::move(m.body), std::move(replies[j - from]),
+          remember(std::move(m.key), std::move(replies[j - from]),
                    "request " + id + " (item " + std::to_string(j - from) + " of " +
                        std::to_string(to - from) + ")");
       for (std::size_t i : m.at) out[i] = chunk;

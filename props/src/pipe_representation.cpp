@@ -59,6 +59,7 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   probe.world_T_hand_history = {RigidTransform::identity()};
   probe.world_T_hand_chunk = {RigidTransform::from_translation(Eigen::Vector3d(0.1, 0.0, 0.0))};
   Scene asked = with_extras(probe);
+  // Before the hello the plug-in's encodings are unknown: the probe is text.
   PluginReply reply =
       connection_.exchange(RequestKind::encode, encode_request_body(asked), /*hello_allowed=*/true);
   PluginCapabilities capabilities;
@@ -68,79 +69,59 @@ const PluginCapabilities& PipeRepresentation::capabilities() const {
   capabilities_ = capabilities;
   if (reply.hello) {
     asked = with_extras(probe);
-    reply = exchange_one(RequestKind::encode, encode_request_body(asked));
+    reply = exchange_one(RequestKind::encode, asked);
   }
   check_lengths(asked, reply, "request " + std::to_string(connection_.last_id()));
   has_observation_ = reply.has_observation;
-  std::string key(1, 'e');
-  key += encode_request_body(asked);
-  cache_.emplace(std::move(key), reply);
+  cache_.emplace(encode_key(asked), reply);
   return *capabilities_;
 }
 
-namespace {
-
-// The scene's numbers and names as raw bytes: a key that costs a copy, where the request body
-// costs formatting every number.
-std::string scene_bytes(const Scene& scene) {
-  std::string out;
-  auto put = [&out](const double* x, std::size_t n) {
-    out.append(reinterpret_cast<const char*>(x), n * sizeof(double));
-  };
-  auto put_pose = [&put](const RigidTransform& T) {
-    const Eigen::Matrix3d& R = T.rotation().matrix();
-    put(R.data(), 9);
-    put(T.translation().data(), 3);
-  };
-  for (const auto& T : scene.world_T_hand_history) put_pose(T);
-  out += '|';
-  for (const auto& T : scene.world_T_hand_chunk) put_pose(T);
-  out += '|';
-  for (const auto& x : scene.hand_points) put(x.data(), 3);
-  out += '|';
-  for (const auto& x : scene.world_points) put(x.data(), 3);
-  for (const auto& [name, T] : scene.extra_poses) {
-    out += '|' + name + '|';
-    put_pose(T);
-  }
-  for (const auto& [name, value] : scene.scalars) {
-    out += '|' + name + '|';
-    put(&value, 1);
-  }
-  return out;
+std::string PipeRepresentation::encode_key(const Scene& scene) {
+  std::string key(1, 'e');
+  key += scene_key(scene);
+  return key;
 }
-
-}  // namespace
 
 const PluginReply& PipeRepresentation::encoded(const Scene& scene) const {
   // A flow evaluates the same scene once per noise vector (n + 3 times in an exact check), each
   // time asking for its actions and observation: remember the last scene's answer.
-  std::string bytes = scene_bytes(scene);
-  if (last_reply_ != nullptr && bytes == last_scene_bytes_) return *last_reply_;
-  const PluginReply& reply = ask(scene, RequestKind::encode, encode_request_body(scene));
-  last_scene_bytes_ = std::move(bytes);
-  last_reply_ = &reply;
-  return reply;
+  std::string key = encode_key(scene);
+  if (last_reply_ != nullptr && key == last_key_) return *last_reply_;
+  capabilities();
+  const PluginReply* reply = nullptr;
+  if (const auto hit = cache_.find(key); hit != cache_.end()) {
+    reply = &hit->second;
+  } else {
+    PluginReply fresh = exchange_one(RequestKind::encode, scene);
+    check_lengths(scene, fresh, "request " + std::to_string(connection_.last_id()));
+    reply = &remember(key, std::move(fresh));
+  }
+  last_key_ = std::move(key);
+  last_reply_ = reply;
+  return *reply;
 }
 
 const PluginReply& PipeRepresentation::ask(const Scene& scene, RequestKind kind,
                                            const std::string& body) const {
-  std::string key(1, kind == RequestKind::encode ? 'e' : kind == RequestKind::flow ? 'f' : 'd');
+  std::string key(1, kind == RequestKind::flow ? 'f' : 'd');
   key += body;
   if (const auto hit = cache_.find(key); hit != cache_.end()) return hit->second;
   capabilities();
-  if (const auto hit = cache_.find(key); hit != cache_.end())
-    return hit->second;  // the probe itself
-  PluginReply reply = exchange_one(kind, body);
+  PluginReply reply = connection_.exchange(kind, body, false);
   if (kind != RequestKind::decode)
     check_lengths(scene, reply, "request " + std::to_string(connection_.last_id()));
   return remember(std::move(key), std::move(reply));
 }
 
-PluginReply PipeRepresentation::exchange_one(RequestKind kind, const std::string& body) const {
-  if (kind != RequestKind::encode || capabilities_->batch == 0)
-    return connection_.exchange(kind, body, false);
-  return std::move(connection_.exchange_batch(kind, {body}).front());
+PluginReply PipeRepresentation::exchange_one(RequestKind kind, const Scene& scene) const {
+  if (capabilities_->batch == 0)
+    return connection_.exchange(kind, encode_request_body(scene), false);
+  const NumberEncoding encoding = capabilities_->encoding;
+  return std::move(
+      connection_
+          .exchange_batch(kind, {encode_request_body(scene, std::nullopt, encoding)}, encoding)
+          .front());
 }
 
 const PluginReply& PipeRepresentation::remember(std::string key, PluginReply reply) const {
@@ -168,7 +149,7 @@ std::vector<Eigen::VectorXd> PipeRepresentation::encode_batch(
   // The scenes not cached, each once, in the order they come: a batched line may mix
   // shapes (the plug-in's helper calls its function once per shape).
   struct Missing {
-    std::string body;
+    std::string key;
     const Scene* scene;
     std::vector<std::size_t> at;  // indices into `scenes`
   };
@@ -178,24 +159,26 @@ std::vector<Eigen::VectorXd> PipeRepresentation::encode_batch(
   for (std::size_t i = 0; i < scenes.size(); ++i) {
     const Scene& scene = *scenes[i];
     scene.validate_observation();
-    std::string body = encode_request_body(scene);
-    std::string key = 'e' + body;
+    std::string key = encode_key(scene);
     if (const auto hit = cache_.find(key); hit != cache_.end()) {
       out[i] = answer(hit->second);
       continue;
     }
-    const auto [at, inserted] = missing_index.try_emplace(std::move(key), missing.size());
+    const auto [at, inserted] = missing_index.try_emplace(key, missing.size());
     if (inserted) {
       order.push_back(missing.size());
-      missing.push_back({std::move(body), &scene, {}});
+      missing.push_back({std::move(key), &scene, {}});
     }
     missing[at->second].at.push_back(i);
   }
+  const NumberEncoding encoding = capabilities_->encoding;
   for (std::size_t from = 0; from < order.size(); from += static_cast<std::size_t>(batch)) {
     const std::size_t to = std::min(order.size(), from + static_cast<std::size_t>(batch));
     std::vector<std::string> bodies;
-    for (std::size_t j = from; j < to; ++j) bodies.push_back(missing[order[j]].body);
-    std::vector<PluginReply> replies = connection_.exchange_batch(RequestKind::encode, bodies);
+    for (std::size_t j = from; j < to; ++j)
+      bodies.push_back(encode_request_body(*missing[order[j]].scene, std::nullopt, encoding));
+    std::vector<PluginReply> replies =
+        connection_.exchange_batch(RequestKind::encode, bodies, encoding);
     const std::string id = std::to_string(connection_.last_id());
     for (std::size_t j = from; j < to; ++j) {
       Missing& m = missing[order[j]];
@@ -204,7 +187,7 @@ std::vector<Eigen::VectorXd> PipeRepresentation::encode_batch(
                     "request " + id + " (item " + std::to_string(j - from) + " of " +
                         std::to_string(to - from) + ")");
       for (std::size_t i : m.at) out[i] = answer(reply);
-      remember('e' + std::move(m.body), std::move(reply));
+      remember(std::move(m.key), std::move(reply));
     }
   }
   return out;

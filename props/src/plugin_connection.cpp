@@ -119,8 +119,10 @@ PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body
 }
 
 std::vector<PluginReply> PluginConnection::exchange_batch(RequestKind kind,
-                                                          const std::vector<std::string>& bodies) {
-  const std::string line = round_trip(batch_request_body(bodies), static_cast<int>(bodies.size()));
+                                                          const std::vector<std::string>& bodies,
+                                                          NumberEncoding encoding) {
+  const std::string line =
+      round_trip(batch_request_body(bodies, encoding), static_cast<int>(bodies.size()));
   std::vector<PluginReply> replies;
   try {
     replies = parse_batch_reply(line, last_id(), kind, who(), bodies.size());

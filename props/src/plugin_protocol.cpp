@@ -3,13 +3,15 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <set>
 #include <cstdio>
+#include <cstring>
+#include <set>
 #include <nlohmann/json.hpp>
 
 #include "handcentric/core/format.hpp"
 #include "handcentric/props/batch.hpp"
 #include "handcentric/props/tolerance.hpp"
+#include "wire_arrays.hpp"
 
 namespace handcentric::props {
 namespace {
@@ -56,6 +58,23 @@ void append_points(std::string& out, const std::vector<Eigen::Vector3d>& points)
   out += ']';
 }
 
+// Poses as one encoded array [n, 4, 4], each matrix row-major (the numbers of append_poses).
+void append_encoded_poses(std::string& out, const std::vector<RigidTransform>& poses) {
+  std::vector<double> values(16 * poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    Eigen::Map<Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(values.data() + 16 * i) =
+        poses[i].matrix();
+  }
+  wire::append_float64_array(out, {poses.size(), 4, 4}, values.data());
+}
+
+void append_encoded_points(std::string& out, const std::vector<Eigen::Vector3d>& points) {
+  std::vector<double> values(3 * points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    Eigen::Map<Eigen::Vector3d>(values.data() + 3 * i) = points[i];
+  wire::append_float64_array(out, {points.size(), 3}, values.data());
+}
+
 void append_vector(std::string& out, const Eigen::VectorXd& v) {
   out += '[';
   for (Eigen::Index i = 0; i < v.size(); ++i) {
@@ -70,21 +89,50 @@ void append_name(std::string& out, const std::string& name) {
   out += nlohmann::json(name).dump();
 }
 
-// History, points and extras: what every request carries.
-void append_observation(std::string& out, const Scene& scene) {
+void append_poses(std::string& out, const std::vector<RigidTransform>& poses,
+                  NumberEncoding encoding) {
+  if (encoding == NumberEncoding::base64)
+    append_encoded_poses(out, poses);
+  else
+    append_poses(out, poses);
+}
+
+void append_points(std::string& out, const std::vector<Eigen::Vector3d>& points,
+                   NumberEncoding encoding) {
+  if (encoding == NumberEncoding::base64)
+    append_encoded_points(out, points);
+  else
+    append_points(out, points);
+}
+
+void append_vector(std::string& out, const Eigen::VectorXd& v, NumberEncoding encoding) {
+  if (encoding == NumberEncoding::base64)
+    wire::append_float64_array(out, {static_cast<std::size_t>(v.size())}, v.data());
+  else
+    append_vector(out, v);
+}
+
+// History, points and extras: what every request carries. Scalars stay JSON numbers in every
+// encoding (one number each).
+void append_observation(std::string& out, const Scene& scene, NumberEncoding encoding) {
   out += "\"history\": ";
-  append_poses(out, scene.world_T_hand_history);
+  append_poses(out, scene.world_T_hand_history, encoding);
   out += ", \"hand_points\": ";
-  append_points(out, scene.hand_points);
+  append_points(out, scene.hand_points, encoding);
   out += ", \"world_points\": ";
-  append_points(out, scene.world_points);
+  append_points(out, scene.world_points, encoding);
   if (!scene.extra_poses.empty()) {
     out += ", \"extra_poses\": {";
     for (std::size_t i = 0; i < scene.extra_poses.size(); ++i) {
       if (i > 0) out += ", ";
       append_name(out, scene.extra_poses[i].first);
       out += ": ";
-      append_matrix(out, scene.extra_poses[i].second);
+      if (encoding == NumberEncoding::base64) {
+        const Eigen::Matrix<double, 4, 4, Eigen::RowMajor> M = scene.extra_poses[i].second.matrix();
+        wire::append_float64_array(out, {4, 4}, M.data());
+      } else {
+        append_matrix(out, scene.extra_poses[i].second);
+      }
     }
     out += '}';
   }
@@ -104,9 +152,45 @@ std::string reply_to(const std::string& who, int id) {
   return who + " answered request " + std::to_string(id);
 }
 
+void require_finite(const double* values, std::size_t count, const std::string& field,
+                    const std::string& answered) {
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!std::isfinite(values[i])) {
+      throw PluginError(answered + " with a non-finite \"" + field + "\"[" + std::to_string(i) +
+                        "] = " + format_number(values[i]) + "; send finite numbers only");
+    }
+  }
+}
+
+// An encoded array of finite float64 numbers, of `rank` dimensions (`form` names the shape
+// expected, for the message).
+wire::Array read_encoded(const nlohmann::json& value, const std::string& field, std::size_t rank,
+                         const std::string& form, const std::string& answered) {
+  const std::string where = answered + " with \"" + field + "\"";
+  wire::Array array = wire::read_array(value, where);
+  if (array.dtype != wire::Dtype::float64) {
+    throw PluginError(where + " of dtype " + wire::dtype_name(array.dtype) +
+                      "; the protocol's numbers are float64 (NumPy: array.astype('<f8'), exact "
+                      "from float32)");
+  }
+  if (array.shape.size() != rank) {
+    std::string shape;
+    for (std::size_t d : array.shape) shape += (shape.empty() ? "" : ", ") + std::to_string(d);
+    throw PluginError(where + " of shape [" + shape + "]; \"" + field + "\" has shape " + form);
+  }
+  require_finite(array.values.data(), array.values.size(), field, answered);
+  return array;
+}
+
 // `answered`: "plug-in 'X' answered request n" (and the item of a batch), for messages.
 Eigen::VectorXd read_numbers(const nlohmann::json& value, const std::string& field,
                              const std::string& answered) {
+  if (wire::is_encoded(value)) {
+    const wire::Array array =
+        read_encoded(value, field, 1, "[n], one row of numbers (reshape(-1))", answered);
+    return Eigen::Map<const Eigen::VectorXd>(array.values.data(),
+                                             static_cast<Eigen::Index>(array.values.size()));
+  }
   if (!value.is_array())
     throw PluginError(answered + " with \"" + field + "\" that is not an array of numbers");
   Eigen::VectorXd v(static_cast<Eigen::Index>(value.size()));
@@ -115,13 +199,9 @@ Eigen::VectorXd read_numbers(const nlohmann::json& value, const std::string& fie
       throw PluginError(answered + " with \"" + field + "\"[" + std::to_string(i) +
                         "] = " + one_line(value[i].dump(), 40) + ", not a number");
     }
-    const double x = value[i].get<double>();
-    if (!std::isfinite(x)) {
-      throw PluginError(answered + " with a non-finite \"" + field + "\"[" + std::to_string(i) +
-                        "] = " + format_number(x) + "; send finite numbers only");
-    }
-    v(static_cast<Eigen::Index>(i)) = x;
+    v(static_cast<Eigen::Index>(i)) = value[i].get<double>();
   }
+  require_finite(v.data(), value.size(), field, answered);
   return v;
 }
 
@@ -153,19 +233,48 @@ bool read_flag(const nlohmann::json& hello, const char* field, int id, const std
 // A world-frame pose: 16 finite numbers, row-major, last row 0 0 0 1 and a rotation block within
 // kOutputPoseTolerance of a rotation. The block is then taken as it is (a float32 plug-in's is
 // orthonormal to ~1e-7 only); distances compare it.
-RigidTransform read_pose(const nlohmann::json& value, std::size_t k, const std::string& answered) {
-  const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", answered);
-  if (v.size() != 16 || v(12) != 0.0 || v(13) != 0.0 || v(14) != 0.0 || v(15) != 1.0) {
+RigidTransform pose_from(const double* v, std::size_t k, const std::string& answered) {
+  if (v[12] != 0.0 || v[13] != 0.0 || v[14] != 0.0 || v[15] != 1.0) {
     throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) +
                       "] that is not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)");
   }
-  const Eigen::Matrix4d M =
-      Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(v.data());
+  const Eigen::Matrix4d M = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(v);
   if (const std::string defect = pose_defect(M); !defect.empty()) {
     throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) + "] " + format_matrix(M) +
                       ": " + defect + "; answer world_T_hand poses [[R, p], [0, 0, 0, 1]]");
   }
   return RigidTransform::unchecked(M.topLeftCorner<3, 3>(), M.topRightCorner<3, 1>());
+}
+
+RigidTransform read_pose(const nlohmann::json& value, std::size_t k, const std::string& answered) {
+  const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", answered);
+  if (v.size() != 16) {
+    throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) +
+                      "] that is not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)");
+  }
+  return pose_from(v.data(), k, answered);
+}
+
+// A decode or policy answer's chunk: a list of poses, or an encoded [K, 4, 4] array; empty when
+// it has no pose (the caller says what was asked).
+std::vector<RigidTransform> read_chunk(const nlohmann::json& value, const std::string& answered) {
+  std::vector<RigidTransform> chunk;
+  if (wire::is_encoded(value)) {
+    const wire::Array array =
+        read_encoded(value, "chunk", 3, "[K, 4, 4], K >= 1 world_T_hand poses", answered);
+    if (array.shape[1] != 4 || array.shape[2] != 4) {
+      throw PluginError(answered + " with \"chunk\" of shape [" + std::to_string(array.shape[0]) +
+                        ", " + std::to_string(array.shape[1]) + ", " +
+                        std::to_string(array.shape[2]) +
+                        "]; \"chunk\" has shape [K, 4, 4], K >= 1 world_T_hand poses");
+    }
+    for (std::size_t k = 0; k < array.shape[0]; ++k)
+      chunk.push_back(pose_from(array.values.data() + 16 * k, k, answered));
+    return chunk;
+  }
+  if (!value.is_array()) return chunk;
+  for (std::size_t k = 0; k < value.size(); ++k) chunk.push_back(read_pose(value[k], k, answered));
+  return chunk;
 }
 
 }  // namespace
@@ -215,11 +324,13 @@ std::string one_line(std::string text, std::size_t limit) {
   return text;
 }
 
-std::string encode_request_body(const Scene& scene, const std::optional<FlowQuery>& flow) {
+std::string encode_request_body(const Scene& scene, const std::optional<FlowQuery>& flow,
+                                NumberEncoding encoding) {
+  if (flow) encoding = NumberEncoding::text;  // flow requests are single lines
   std::string out;
-  append_observation(out, scene);
+  append_observation(out, scene, encoding);
   out += ", \"chunk\": ";
-  append_poses(out, scene.world_T_hand_chunk);
+  append_poses(out, scene.world_T_hand_chunk, encoding);
   if (flow) {
     out += ", \"eps\": ";
     append_vector(out, *flow->eps);
@@ -233,23 +344,25 @@ std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& obs
   std::string out = "\"decode\": ";
   append_vector(out, actions);
   out += ", ";
-  append_observation(out, observation);
+  append_observation(out, observation, NumberEncoding::text);
   return out;
 }
 
-std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise) {
+std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise,
+                                NumberEncoding encoding) {
   std::string out;
-  append_observation(out, observation);
+  append_observation(out, observation, encoding);
   out += ", \"noise\": ";
-  append_vector(out, noise);
+  append_vector(out, noise, encoding);
   return out;
 }
 
-std::string batch_request_body(const std::vector<std::string>& bodies) {
-  std::size_t size = 16;
+std::string batch_request_body(const std::vector<std::string>& bodies, NumberEncoding encoding) {
+  std::size_t size = 48;
   for (const std::string& body : bodies) size += body.size() + 4;
   std::string out;
   out.reserve(size);
+  if (encoding == NumberEncoding::base64) out += "\"encoding\": \"base64\", ";
   out += "\"batch\": [";
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     out += i > 0 ? ", {" : "{";
@@ -257,6 +370,40 @@ std::string batch_request_body(const std::vector<std::string>& bodies) {
     out += '}';
   }
   out += ']';
+  return out;
+}
+
+std::string scene_key(const Scene& scene) {
+  std::string out;
+  auto put = [&out](const void* x, std::size_t bytes) {
+    out.append(static_cast<const char*>(x), bytes);
+  };
+  auto put_count = [&put](std::size_t n) { put(&n, sizeof(n)); };
+  auto put_pose = [&put](const RigidTransform& T) {
+    put(T.rotation().matrix().data(), 9 * sizeof(double));
+    put(T.translation().data(), 3 * sizeof(double));
+  };
+  // Every list with its length first, every name with its length: no two scenes share a key.
+  for (const auto* poses : {&scene.world_T_hand_history, &scene.world_T_hand_chunk}) {
+    put_count(poses->size());
+    for (const auto& T : *poses) put_pose(T);
+  }
+  for (const auto* points : {&scene.hand_points, &scene.world_points}) {
+    put_count(points->size());
+    for (const auto& x : *points) put(x.data(), 3 * sizeof(double));
+  }
+  put_count(scene.extra_poses.size());
+  for (const auto& [name, T] : scene.extra_poses) {
+    put_count(name.size());
+    out += name;
+    put_pose(T);
+  }
+  put_count(scene.scalars.size());
+  for (const auto& [name, value] : scene.scalars) {
+    put_count(name.size());
+    out += name;
+    put(&value, sizeof(value));
+  }
   return out;
 }
 
@@ -318,22 +465,27 @@ nlohmann::json parse_line(const std::string& line, int id, const std::string& wh
 }
 
 // The fields of one answer (a whole reply, or one item of a batched one) for a request of `kind`;
-// `answered` begins each message, which quotes `text` (the line, or the item).
+// `answered` begins each message, which quotes the line (`line`), or else the item, written out
+// only then: a batch's items are not formatted again on the way in.
 PluginReply read_answer(const nlohmann::json& json, RequestKind kind, const std::string& answered,
-                        const std::string& text) {
+                        const std::string* line) {
+  auto quoted = [&] {
+    std::string out(1, '\'');
+    out += one_line(line != nullptr ? *line : json.dump(), 120);
+    out += '\'';
+    return out;
+  };
   PluginReply reply;
   if (kind == RequestKind::decode || kind == RequestKind::policy) {
-    if (!json.contains("chunk") || !json["chunk"].is_array() || json["chunk"].empty()) {
+    if (json.contains("chunk")) reply.chunk = read_chunk(json["chunk"], answered);
+    if (reply.chunk.empty()) {
       throw PluginError(
           answered + (kind == RequestKind::decode ? ", a decode request," : ", a policy request,") +
-          " without a \"chunk\" of poses: '" + one_line(text, 120) + "'");
+          " without a \"chunk\" of poses: " + quoted());
     }
-    for (std::size_t k = 0; k < json["chunk"].size(); ++k)
-      reply.chunk.push_back(read_pose(json["chunk"][k], k, answered));
     return reply;
   }
-  if (!json.contains("actions"))
-    throw PluginError(answered + " without \"actions\": '" + one_line(text, 120) + "'");
+  if (!json.contains("actions")) throw PluginError(answered + " without \"actions\": " + quoted());
   reply.actions = read_numbers(json["actions"], "actions", answered);
   if (reply.actions.size() == 0) throw PluginError(answered + " with no actions");
   reply.has_observation = json.contains("observation") && !json["observation"].is_null();
@@ -399,10 +551,15 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
       }
       capabilities.batch = hello["batch"].get<int>();
     }
+    // The encodings the plug-in reads and writes besides JSON numbers: the audit takes base64
+    // when it is offered and ignores names it does not know (a newer plug-in may offer more).
+    for (const std::string& name : read_names(hello, "encodings", id, who)) {
+      if (name == "base64") capabilities.encoding = NumberEncoding::base64;
+    }
     reply.hello = capabilities;
     return reply;
   }
-  return read_answer(json, kind, reply_to(who, id), line);
+  return read_answer(json, kind, reply_to(who, id), &line);
 }
 
 std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, RequestKind kind,
@@ -432,7 +589,7 @@ std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, Requ
                         ", not an object; each item is what the single request's answer would "
                         "be, without the id, e.g. {\"actions\": [...]}");
     }
-    replies.push_back(read_answer(items[i], kind, item, items[i].dump()));
+    replies.push_back(read_answer(items[i], kind, item, nullptr));
   }
   return replies;
 }

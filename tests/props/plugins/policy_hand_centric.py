@@ -18,7 +18,8 @@ argv[1] picks a planted fault (the audit must find each):
 --batched (after the fault, if any): the same policy served batched, row by row (each row as
 the unbatched call computes it, so the audit's JSON must not change); --batched row_bias adds
 1e-7 times the row's index in its batch to every translation (an answer that depends on its
-batch: the planted fault of the batched-equals-unbatched test).
+batch: the planted fault of the batched-equals-unbatched test); --batched text keeps the
+batched lines' numbers JSON text (the helper offers base64 otherwise).
 """
 import os
 import sys
@@ -31,7 +32,8 @@ import handcentric_plugin as hp  # noqa: E402
 ARGS = sys.argv[1:]
 BATCHED = "--batched" in ARGS
 ROW_BIAS = "row_bias" in ARGS
-FAULT = ([a for a in ARGS if a not in ("--batched", "row_bias")] or [""])[0]
+TEXT = "text" in ARGS
+FAULT = ([a for a in ARGS if a not in ("--batched", "row_bias", "text")] or [""])[0]
 K = 4
 RNG = np.random.default_rng(7)
 W1 = RNG.normal(size=(32, 6 + 3 + 8)) * 0.3
@@ -67,6 +69,7 @@ def policy_batch(history, hand_points, world_points, noise):
 
 if __name__ == "__main__":
     if BATCHED:
-        hp.serve_policy(policy_batch, batched=True, batch_size=64)
+        hp.serve_policy(policy_batch, batched=True, batch_size=64,
+                        encoding=None if TEXT else "base64")
     else:
         hp.serve_policy(policy)

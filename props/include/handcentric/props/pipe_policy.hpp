@@ -9,7 +9,8 @@
 // observations of an act_batch call not yet answered in batched requests of up to B, of any
 // shapes (mixed_shapes(): the plug-in's helper calls its function once per shape), and, after
 // the hello, every request as a batched one (act() sends a batch of one).
-// Without "batch", act_batch asks one observation at a time, as act does.
+// Without "batch", act_batch asks one observation at a time, as act does. A hello that also
+// offers "encodings": ["base64"] gets the batched lines' arrays encoded (plugin_protocol.hpp).
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -50,10 +51,12 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
 
  private:
   Scene with_extras(const Scene& scene) const;
-  /// The request body of (observation, noise), after checking both.
-  std::string body(const Scene& observation, const Eigen::VectorXd& noise) const;
-  /// Checks the chunk length of the answer to `where` and caches it.
-  const std::vector<RigidTransform>& remember(std::string body, PluginReply reply,
+  /// The cache's key of (observation, noise), after checking both.
+  std::string key(const Scene& observation, const Eigen::VectorXd& noise) const;
+  /// One request; a batch of one (in the hello's encoding) when the plug-in batches.
+  PluginReply exchange_one(const Scene& observation, const Eigen::VectorXd& noise) const;
+  /// Checks the chunk length of the answer to `where` and caches it under `key`.
+  const std::vector<RigidTransform>& remember(std::string key, PluginReply reply,
                                               const std::string& where) const;
 
   std::vector<std::string> forced_extra_poses_, forced_scalars_;

@@ -22,9 +22,10 @@ class PluginConnection {
   /// Sends request `body` (the next id) and returns its parsed, validated answer.
   PluginReply exchange(RequestKind kind, const std::string& body, bool hello_allowed);
   /// Sends one batched request (plugin_protocol.hpp, "batch") holding `bodies`, each the body
-  /// of a single request, and returns the answers in their order. The deadline is the timeout
-  /// times the number of scenes.
-  std::vector<PluginReply> exchange_batch(RequestKind kind, const std::vector<std::string>& bodies);
+  /// of a single request written in `encoding`, and returns the answers in their order. The
+  /// deadline is the timeout times the number of scenes.
+  std::vector<PluginReply> exchange_batch(RequestKind kind, const std::vector<std::string>& bodies,
+                                          NumberEncoding encoding);
   /// Throws PluginError(what + the stderr tail) and refuses further requests.
   [[noreturn]] void fail(const std::string& what);
 

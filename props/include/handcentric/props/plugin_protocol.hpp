@@ -16,7 +16,13 @@
 //            asks again.
 //   batch  : after a hello with "batch": B, every encode and policy request (not decode, not
 //            flow) is {"id", "protocol", "batch": [{fields of one request}, ...]} with 1 to B
-//            scenes of one shape -> {"id", "batch": [{fields of one answer}, ...]}, in order.
+//            scenes of any shapes -> {"id", "batch": [{fields of one answer}, ...]}, in order.
+//   base64 : a hello with "batch" and "encodings": [..., "base64", ...] gets its batched lines
+//            as {"id", "protocol", "encoding": "base64", "batch": [...]}, each array of numbers
+//            in them {"dtype": "float64", "shape": [...], "data": base64 of the little-endian
+//            bytes} (history [H+1, 4, 4], points [n, 3], an extra pose [4, 4], noise [d];
+//            scalars stay numbers); an answer's arrays may take the same form (actions [a],
+//            a chunk [K, 4, 4]). Without the offer, lines are as they were, byte for byte.
 // Matrices are 16 numbers, row-major 4x4.
 #include <Eigen/Core>
 #include <optional>
@@ -33,6 +39,10 @@ constexpr int kProtocolVersion = 2;
 /// The deepest JSON nesting a reply may have (a reply needs 3: object, chunk, pose).
 constexpr int kMaxReplyDepth = 32;
 
+/// How the arrays of numbers of a batched line are written: JSON numbers, or encoded arrays
+/// (docs/AUDIT.md, "Encoded numbers"), when the plug-in's hello offers "base64".
+enum class NumberEncoding { text, base64 };
+
 /// What a plug-in said about itself in its hello (or what flags asked for).
 struct PluginCapabilities {
   int protocol = 1;
@@ -42,6 +52,8 @@ struct PluginCapabilities {
   bool flow = false;
   int noise = 0;  ///< a policy's noise length; 0: the default (kPolicyNoise)
   int batch = 0;  ///< the most scenes per batched request; 0: one request per scene
+  /// The encoding of batched lines: base64 when the hello's "encodings" offers it.
+  NumberEncoding encoding = NumberEncoding::text;
 };
 
 /// The noise a policy request carries unless the plug-in's hello asks for another length.
@@ -59,16 +71,23 @@ struct FlowQuery {
   double t = 0.0;
 };
 
-/// The body of an encode request (everything after the id; also the cache key).
+/// The body of an encode request (everything after the id). A flow query is always text.
 std::string encode_request_body(const Scene& scene,
-                                const std::optional<FlowQuery>& flow = std::nullopt);
+                                const std::optional<FlowQuery>& flow = std::nullopt,
+                                NumberEncoding encoding = NumberEncoding::text);
 /// The body of a decode request: the observation (no chunk) and the actions to decode.
 std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& observation);
 /// The body of a policy request: the observation (no chunk) and the noise.
-std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise);
+std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise,
+                                NumberEncoding encoding = NumberEncoding::text);
 /// The body of a batched request: "batch": [{body}, {body}, ...], each body as the single
-/// request's.
-std::string batch_request_body(const std::vector<std::string>& bodies);
+/// request's (written in `encoding`, which the line then names: "encoding": "base64").
+std::string batch_request_body(const std::vector<std::string>& bodies,
+                               NumberEncoding encoding = NumberEncoding::text);
+/// The scene's numbers, counts and names as raw bytes: two scenes have the same key exactly
+/// when their requests would be the same, and it costs a copy where a request formats every
+/// number (the caches' key).
+std::string scene_key(const Scene& scene);
 /// The whole line: {"id": id, "protocol": 2, <body>}\n.
 std::string request_line(int id, const std::string& body);
 
@@ -89,8 +108,11 @@ enum class RequestKind { encode, flow, decode, policy };
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
                         bool hello_allowed);
 /// Parses the reply to batched request `id` of `count` scenes: {"id", "batch": [answers]}, each
-/// answer checked as parse_reply checks one, a message naming the item. Throws PluginError for
-/// a reply without "batch", a count other than `count`, or a bad item.
+/// answer checked as parse_reply checks one, a message naming the item. Each array of an answer
+/// may be JSON numbers or an encoded array (float64 of shape [n]; a chunk [K, 4, 4]). Throws
+/// PluginError for a reply without "batch", a count other than `count`, or a bad item: for an
+/// encoded array, malformed base64, a length that is not the shape's, a dtype other than
+/// float64, a shape other than the field's, or a non-finite number.
 std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, RequestKind kind,
                                            const std::string& who, std::size_t count);
 
