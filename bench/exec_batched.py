@@ -1,8 +1,9 @@
 #!/usr/bin/python3
-"""The default `handcentric audit --exec` of the Python example, one scene per request and
-batched (`repr.py --batched`: up to 256 scenes of one shape per request), in the same run
+"""The default `handcentric audit --exec` of the Python example, one scene per request, batched
+with the numbers as JSON text (`repr.py --batched --text`: up to 256 scenes of any shapes per
+request) and batched with base64 arrays (`repr.py --batched`, the default), in the same run
 (docs/BENCHMARKS.md, "Python"). Prints each run's wall and CPU time (both processes), and
-checks that the two audits printed the same report (the plug-in's command aside).
+checks that the three audits printed the same report (the plug-in's command aside).
 
 Run from the repository after building the CLI:
     /usr/bin/python3 bench/exec_batched.py build/apps/handcentric [runs]
@@ -33,7 +34,8 @@ def audit(command):
 
 
 def main():
-    modes = [("per scene", EXAMPLE), ("batched", EXAMPLE + " --batched")]
+    modes = [("per scene", EXAMPLE), ("batched text", EXAMPLE + " --batched --text"),
+             ("batched base64", EXAMPLE + " --batched")]
     times = {name: [] for name, _ in modes}
     reports = {}
     for _ in range(RUNS):  # alternating, so that a change in the machine's load hits both
@@ -41,12 +43,12 @@ def main():
             wall, cpu, out = audit(command)
             times[name].append((wall, cpu))
             reports[name] = out.replace(command, EXAMPLE)
-    print("handcentric audit --exec '%s [--batched]' (defaults), %d runs each, load average "
-          "%.2f at the end" % (EXAMPLE, RUNS, os.getloadavg()[0]))
+    print("handcentric audit --exec '%s [--batched [--text]]' (defaults), %d runs each, load "
+          "average %.2f at the end" % (EXAMPLE, RUNS, os.getloadavg()[0]))
     for name, _ in modes:
         runs = ", ".join("%.2f s (%.2f s CPU)" % r for r in times[name])
-        print("  %-9s best %.2f s wall: %s" % (name, min(w for w, _ in times[name]), runs))
-    same = reports["per scene"] == reports["batched"]
+        print("  %-14s best %.2f s wall: %s" % (name, min(w for w, _ in times[name]), runs))
+    same = all(report == reports["per scene"] for report in reports.values())
     print("  reports identical (command aside): %s" % ("yes" if same else "NO"))
     return 0 if same else 1
 
