@@ -75,8 +75,11 @@ def encoded_equals_text():
     assert status == 0, err
     coded, status, _ = run_serve([PROBE, encoded_line(1, MIXED)], repr_py.encode_batch,
                                  batched=True)
-    return status == 0 and all(isinstance(v, dict) for a in coded[1]["batch"] for v in a.values()) and \
-        [as_numbers(a) for a in coded[1]["batch"]] == text[1]["batch"]
+    if status != 0:
+        return False
+    answers = coded[1]["batch"]
+    return all(isinstance(v, dict) for a in answers for v in a.values()) and \
+        [as_numbers(a) for a in answers] == text[1]["batch"]
 
 
 def test_the_hello_offers_base64_when_batched_and_only_then():
