@@ -49,7 +49,7 @@ std::string PipePolicy::key(const Scene& observation, const Eigen::VectorXd& noi
     throw InvalidArgument(name() + " reads " + std::to_string(noise_dimension()) +
                           " noise numbers, got " + std::to_string(noise.size()));
   }
-  std::string out = scene_key(observation);
+  std::string out = scene_key(observation, /*with_chunk=*/false);  // a request has no chunk
   out.append(reinterpret_cast<const char*>(noise.data()),
              static_cast<std::size_t>(noise.size()) * sizeof(double));
   return out;

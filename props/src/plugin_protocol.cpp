@@ -373,7 +373,7 @@ std::string batch_request_body(const std::vector<std::string>& bodies, NumberEnc
   return out;
 }
 
-std::string scene_key(const Scene& scene) {
+std::string scene_key(const Scene& scene, bool with_chunk) {
   std::string out;
   auto put = [&out](const void* x, std::size_t bytes) {
     out.append(static_cast<const char*>(x), bytes);
@@ -384,7 +384,9 @@ std::string scene_key(const Scene& scene) {
     put(T.translation().data(), 3 * sizeof(double));
   };
   // Every list with its length first, every name with its length: no two scenes share a key.
-  for (const auto* poses : {&scene.world_T_hand_history, &scene.world_T_hand_chunk}) {
+  const std::vector<RigidTransform> none;
+  for (const auto* poses :
+       {&scene.world_T_hand_history, with_chunk ? &scene.world_T_hand_chunk : &none}) {
     put_count(poses->size());
     for (const auto& T : *poses) put_pose(T);
   }

@@ -86,8 +86,8 @@ std::string batch_request_body(const std::vector<std::string>& bodies,
                                NumberEncoding encoding = NumberEncoding::text);
 /// The scene's numbers, counts and names as raw bytes: two scenes have the same key exactly
 /// when their requests would be the same, and it costs a copy where a request formats every
-/// number (the caches' key).
-std::string scene_key(const Scene& scene);
+/// number (the caches' key). `with_chunk` false: the observation only (a policy request's).
+std::string scene_key(const Scene& scene, bool with_chunk = true);
 /// The whole line: {"id": id, "protocol": 2, <body>}\n.
 std::string request_line(int id, const std::string& body);
 
