@@ -168,7 +168,7 @@ std::vector<Section> audit_sections(const ReportOptions& options,
   top.blocks.push_back(List{{
       {bold("✓ yes"), plain(": f(g·s) = f(s) on every case (in distribution: the laws agree).")},
       {bold("✗ NO"),
-       plain(": a case where it does not; the cell links to that witness, below its grid.")},
+       plain(": a case where it does not; the cell links to that witness (the appendix).")},
       {bold("m/1"), plain(": the largest error seen, in the component's units: metres for "
                           "positions, no unit for rotation-matrix entries (one max-norm over "
                           "both). In distribution: the largest difference of the laws' moments "
