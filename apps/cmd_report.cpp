@@ -220,8 +220,8 @@ Section certificates_section(std::vector<experiments::PageFile>& files, bool& al
   out.blocks.push_back(Paragraph{
       {plain(std::to_string(claims.verified) + "/" + std::to_string(outcomes.size()) +
              " certificates verified. An identity is proved symbolically for generic inputs; a "
-             "counterexample is one exact input where the two sides differ (`handcentric prove`; "
-             "each row links to its entry in "),
+             "counterexample is one exact input where the two sides differ ("),
+       code("handcentric prove"), plain("; each row links to its entry in "),
        plain("docs/CLAIMS.md", "claims.html"), plain(").")}});
   out.blocks.push_back(std::move(claims.table));
   for (experiments::PageFile& f : claims.files) files.push_back(std::move(f));
@@ -435,7 +435,8 @@ void add_report_command(CLI::App& app, int& exit_code) {
                   "with --out: Table 2's demos (3D insertion)")
       ->capture_default_str();
   cmd->add_option("--steps", page->steps,
-                  "with --out: Adam steps per cell (0: the library's budget)")
+                  "with --out: Adam steps per cell and Table 2 policy (0: the library's budget; "
+                  "the quick Table 2: 15000)")
       ->capture_default_str();
   cmd->add_option("--jobs", page->jobs, "with --out: trainings at once (0: one per core)")
       ->capture_default_str();
