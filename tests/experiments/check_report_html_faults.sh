@@ -41,5 +41,6 @@ plant missing_file "link to a missing file: nowhere.md" \
 plant grid_in_pre "a <pre> holds a verdict grid" \
   'html = html.replace("</body>", "<pre>actions | NO   1.0e+01   | yes  5.7e-14</pre></body>")'
 plant no_cell_unlinked "a NO cell links to no witness" \
-  'html = re.sub(r"(<td class=\"no\"[^>]*>)<a href=\"[^\"]*\">(.*?)</a></td>", r"\1\2</td>", html, count=1)'
+  'html = re.sub(r"(<td class=\"no\"[^>]*>)<a href=\"[^\"]*\">(.*?)</a></td>", r"\1\2</td>",
+                html, count=1)'
 echo "all planted faults caught"
