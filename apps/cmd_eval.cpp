@@ -193,9 +193,9 @@ void add_eval_command(CLI::App& app, int& exit_code) {
 
 // Main-report section: the sim's own bar (sim/expert_check.hpp) on seeded scenes.
 int run_sim_section(std::ostream& out, const ReportOptions&) {
-  constexpr int kScenes = 200;
-  constexpr int kRollouts = 50;
-  constexpr std::uint64_t kSeed = 1;
+  constexpr int kScenes = kSimBarScenes;
+  constexpr int kRollouts = kSimBarRollouts;
+  constexpr std::uint64_t kSeed = kSimBarSeed;
   out << "sim: 2D peg-in-hole (Sec. 4.2), expert demos on " << kScenes
       << " scenes and closed-loop expert rollouts on " << kRollouts
       << " scenes per distribution, seed " << kSeed << "\n";

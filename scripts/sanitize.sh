@@ -39,8 +39,9 @@ built=$(date +%s)
 #  - policy_unit_suite_on_{generic,avx2}_kernels, the whole policy unit suite again on the other
 #    kernel sets: test_kernels runs every kernel target and the whole Mlp on each;
 #  - the end-to-end tests that run the `handcentric` command through whole trainings, audits,
-#    tables or reports, or a Python plug-in (which runs in the unsanitized interpreter): half of
-#    this run's time. The library code they drive runs under the sanitizers in the unit tests,
+#    tables or reports (and the report page's check in Chromium), or a Python plug-in (which runs
+#    in the unsanitized interpreter): half of this run's time. The library code they drive runs
+#    under the sanitizers in the unit tests,
 #    and the command's refusals of bad input (the short `*_cli_*` tests) stay in;
 #  - three statistical tests of the audit on random networks (the energy test's fallback, a
 #    decoder that forgets R0, Theorem 1 pointwise and in law): 134 s under ASan; the same code
@@ -54,7 +55,7 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^table1_cli_in_process_plan|^policy_cli_train_defaults_to_the_automatic_budget|'\
 '^table1_c8_cell_from_its_plan_line|^audit_model_finds_a_trained|^protocol_v2_plugin_gets|'\
 '^python_plugin_audit_matches|^main_report_opens_with|^outputs_are_whole_or_absent_after_sigkill|'\
-'^report_page_writes_markdown_and_html|'\
+'^report_page_writes_markdown_and_html|^report_page_check_in_chromium|'\
 '^a_flow_not_affine_in_the_noise_falls_back|^a_policy_whose_decoder_forgets_R0|'\
 '^any_network_inside_the_hand_centric_outer_policy|'\
 '^the_tabulated_detectable_shift_is_the_simulated_one|'\

@@ -1,0 +1,90 @@
+#include "handcentric/experiments/results_page.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "handcentric/experiments/methods.hpp"
+
+namespace handcentric::experiments {
+namespace {
+
+std::string two(double value) {
+  char text[16];
+  std::snprintf(text, sizeof text, "%.2f", value);
+  return text;
+}
+
+// "26/30: 0.87 [0.70, 0.95]"
+std::string counts_text(int successes, int trials) {
+  if (trials < 1) return "-";
+  const Interval interval = wilson_interval(successes, trials);
+  return std::to_string(successes) + "/" + std::to_string(trials) + ": " +
+         rate_text(static_cast<double>(successes) / trials, interval);
+}
+
+}  // namespace
+
+std::string rate_text(const std::optional<double>& rate, const std::optional<Interval>& interval) {
+  if (!rate) return "-";
+  std::string text = two(*rate);
+  if (interval) text += " [" + two(interval->lo) + ", " + two(interval->hi) + "]";
+  return text;
+}
+
+Table table1_table(const std::vector<Row>& rows, const std::string& id,
+                   const std::string& caption) {
+  Table table;
+  table.id = id;
+  table.kind = "results";
+  table.caption = caption;
+  // The paper's numbers are its Table 1's, also beside Fig. 5's grid (whose flow rows they are).
+  table.columns = {"method / head",
+                   "demos",
+                   "trials",
+                   "in distribution",
+                   "paper (Table 1)",
+                   "OOD (independent)",
+                   "paper (Table 1, OOD at 100 demos)",
+                   "OOD (paired)"};
+  for (const Row& row : rows) {
+    const std::optional<PaperRow> paper = paper_row(row.method, row.head);
+    std::string paper_id = "-", paper_ood = "-";
+    if (paper) {
+      const auto at = std::find(kPaperDemoCounts.begin(), kPaperDemoCounts.end(), row.demos);
+      if (at != kPaperDemoCounts.end())
+        paper_id = two(paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())]);
+      if (row.demos == 100) paper_ood = two(paper->ood_at_100);
+      paper_id += " (" + paper->label + ")";
+    }
+    table.rows.push_back(
+        {text_cell(row.method + " / " + row.head), text_cell(std::to_string(row.demos)),
+         text_cell(std::to_string(row.trials)), text_cell(rate_text(row.id_success, row.id_ci)),
+         text_cell(paper_id), text_cell(rate_text(row.ood_success, row.ood_ci)),
+         text_cell(paper_ood), text_cell(rate_text(row.ood_paired_success, {}))});
+  }
+  return table;
+}
+
+Table table2_table(const std::vector<Table2Row>& rows, const std::string& id) {
+  Table table;
+  table.id = id;
+  table.kind = "results";
+  table.caption = "Table 2's analogue: success, counts and [Wilson 95%]";
+  table.columns = {"method", "demos", "steps", "train", "ood (slot on its side)", "random-se3"};
+  for (const Table2Row& row : rows) {
+    table.rows.push_back({text_cell("flow / " + row.method), text_cell(std::to_string(row.demos)),
+                          text_cell(std::to_string(row.steps)),
+                          text_cell(counts_text(row.train.success, row.train.trials)),
+                          text_cell(counts_text(row.ood.success, row.ood.trials)),
+                          text_cell(counts_text(row.random_se3.success, row.random_se3.trials))});
+  }
+  table.rows.push_back(
+      {text_cell("hand-centric (paper, real robot)"), text_cell("-"), text_cell("-"),
+       text_cell(counts_text(kPaperTable2InDistribution[0], kPaperTable2InDistribution[1])),
+       text_cell(counts_text(kPaperTable2OutOfDistribution[0], kPaperTable2OutOfDistribution[1]) +
+                 " (horizontal stacks)"),
+       text_cell("-")});
+  return table;
+}
+
+}  // namespace handcentric::experiments
