@@ -87,6 +87,7 @@ ConvEncoder::ConvEncoder(ImageShape input, const std::vector<ConvLayerSpec>& lay
   patches_.resize(layers_.size());
   sigmoid_.resize(layers_.size());
   activation_.resize(layers_.size());
+  delta_.resize(layers_.size());
 }
 
 void ConvEncoder::initialize(std::mt19937_64& rng) {
@@ -179,13 +180,12 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
                           std::to_string(layers_.empty() ? 0 : output_size()) + "x" +
                           std::to_string(batch_) + " (call forward() first)");
   }
-  int current = 0;
-  delta_[current] = d_features;
+  delta_.back() = d_features;
   for (int l = static_cast<int>(layers_.size()) - 1; l >= 0; --l) {
     const Conv2d& layer = layers_[l];
     const int n = batch_ * layer.output().height * layer.output().width;
     const int k = layer.patch_size(), out = layer.out_channels();
-    Matrix& delta = delta_[current];
+    Matrix& delta = delta_[l];
     // Through SiLU: delta *= SiLU'(z) = s + a (1 - s).
     set.silu_backward(delta.size(), activation_[l].data(), sigmoid_[l].data(), delta.data());
     float* d_weights = gradient_.data() + offsets_[l];
@@ -205,10 +205,9 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
       d_images_.setZero(input_size(), batch_);
       set.col2im(image_patches(layer, batch_, input_size()), d_patches_.data(), d_images_.data());
     } else {
-      Matrix& below = delta_[1 - current];
+      Matrix& below = delta_[l - 1];
       below.setZero(layer.input().size(), batch_);
       set.col2im(map_patches(layer, batch_), d_patches_.data(), below.data());
-      current = 1 - current;
     }
   }
   return d_images_;

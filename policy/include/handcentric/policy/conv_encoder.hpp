@@ -94,7 +94,7 @@ class ConvEncoder {
   std::vector<Vector> patches_;     ///< each layer's patch matrix (K x N) of the last forward()
   std::vector<Matrix> sigmoid_;     ///< sigmoid(z) of each layer (out size x B)
   std::vector<Matrix> activation_;  ///< SiLU(z) of each layer; the last one is the features
-  Matrix delta_[2];
+  std::vector<Matrix> delta_;  ///< d loss / d (each layer's output), kept: no reallocation per step
   Vector d_patches_;
   Vector ones_;
   Matrix d_images_;
