@@ -3,9 +3,11 @@
 
 RGB-D 4 x 48 x 64 -> Conv2d 16, 32, 32 (3x3, stride 2, padding 1), SiLU after each -> flatten
 (1536) -> 256 -> 256 -> 24 (SiLU), MSE to a fixed target, Adam (lr 1e-3), float32; one fixed
-batch of images, as bench_conv.cpp trains on. Prints one JSON line per batch size:
-  {"threads": T, "batch": B, "train_samples_per_s": best over repetitions,
-   "forward_ms": the encoder's forward alone, median}
+batch of images, as bench_conv.cpp trains on. Prints one JSON line per batch size and memory
+format (contiguous NCHW, channels_last NHWC):
+  {"threads": T, "batch": B, "format": F, "train_samples_per_s": best over repetitions,
+   "train_samples_per_cpu_s": the same per second of process CPU time,
+   "forward_ms": the encoder's forward alone, median, "blas": the BLAS library torch loaded}
 """
 import argparse
 import json
@@ -30,15 +32,18 @@ def head():
 
 
 def train_rate(net, optimizer, images, target, seconds):
+    """Samples per second of wall time, and per second of this process's CPU time (on a shared
+    machine the wall time includes the waits for a core)."""
     steps = 0
-    start = time.perf_counter()
+    start, cpu_start = time.perf_counter(), time.process_time()
     while time.perf_counter() - start < seconds:
         loss = torch.nn.functional.mse_loss(net(images), target)
         optimizer.zero_grad(set_to_none=True)
         loss.backward()
         optimizer.step()
         steps += 1
-    return steps * images.shape[0] / (time.perf_counter() - start)
+    samples = steps * images.shape[0]
+    return samples / (time.perf_counter() - start), samples / (time.process_time() - cpu_start)
 
 
 def forward_ms(cnn, images, repeats=20):
@@ -52,6 +57,14 @@ def forward_ms(cnn, images, repeats=20):
     return 1e3 * times[len(times) // 2]
 
 
+def blas_library():
+    """The BLAS this process loaded (torch's Linear layers run on it, its convolutions on
+    oneDNN)."""
+    with open("/proc/self/maps") as maps:
+        paths = {line.split()[-1] for line in maps if "blas" in line and "/" in line}
+    return sorted(paths)[0] if paths else "unknown"
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--threads", type=int, default=1)
@@ -61,18 +74,26 @@ def main():
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     for batch in args.batch:
-        torch.manual_seed(0)
-        cnn = encoder()
-        net = torch.nn.Sequential(cnn, head())
-        optimizer = torch.optim.Adam(net.parameters(), lr=1e-3)
-        images = torch.randn(batch, 4, 48, 64)
-        target = torch.randn(batch, 24)
-        train_rate(net, optimizer, images, target, 1.0)  # warm-up
-        best = max(train_rate(net, optimizer, images, target, args.seconds)
-                   for _ in range(args.repetitions))
-        print(json.dumps({"threads": args.threads, "batch": batch, "train_samples_per_s": best,
-                          "forward_ms": forward_ms(cnn, images)}), flush=True)
-
+        # Both memory formats: oneDNN trains faster on channels_last (NHWC) here, and the
+        # comparison is against PyTorch's best.
+        for layout in ("contiguous", "channels_last"):
+            torch.manual_seed(0)
+            cnn = encoder()
+            net = torch.nn.Sequential(cnn, head())
+            images = torch.randn(batch, 4, 48, 64)
+            if layout == "channels_last":
+                net = net.to(memory_format=torch.channels_last)
+                images = images.contiguous(memory_format=torch.channels_last)
+            optimizer = torch.optim.Adam(net.parameters(), lr=1e-3)
+            target = torch.randn(batch, 24)
+            train_rate(net, optimizer, images, target, 1.0)  # warm-up
+            rates = [train_rate(net, optimizer, images, target, args.seconds)
+                     for _ in range(args.repetitions)]
+            print(json.dumps({"threads": args.threads, "batch": batch, "format": layout,
+                              "train_samples_per_s": max(wall for wall, _ in rates),
+                              "train_samples_per_cpu_s": max(cpu for _, cpu in rates),
+                              "forward_ms": forward_ms(cnn, images), "blas": blas_library()}),
+                  flush=True)
 
 if __name__ == "__main__":
     main()

@@ -14,14 +14,15 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 /// body(patch_offset, pixel) for every in-image run of one output pixel's patch: `count`
 /// consecutive patch entries that read `count` consecutive floats of the image (a row of the
-/// window when the channels and columns are dense, channel_stride 1 and column_stride
-/// channels), or one entry each when they are not (then pixel is the address of that one
-/// float). Entries whose pixel is in the padding are passed to `padding(patch_offset, count)`.
+/// window when the channels and columns are dense, channel_stride 1 or a single channel, and
+/// column_stride channels), or one entry each when they are not (then pixel is the address of that
+/// one float). Entries whose pixel is in the padding are passed to `padding(patch_offset, count)`.
 template <class Run, class Pad>
 HWY_INLINE void ForEachPatchRun(const ConvPatches& g, long sample, int oy, int ox, Run&& run,
                                 Pad&& padding) {
   const int c = g.channels;
-  const bool dense = g.channel_stride == 1 && g.column_stride == c;
+  // One channel needs no channel stride: a depth image (channels, height, width) is dense too.
+  const bool dense = (c == 1 || g.channel_stride == 1) && g.column_stride == c;
   const int x0 = ox * g.stride - g.padding, y0 = oy * g.stride - g.padding;
   // The window's columns inside the image: kx in [kx_begin, kx_end).
   const int kx_begin = std::max(0, -x0), kx_end = std::min(g.kernel, g.width - x0);
