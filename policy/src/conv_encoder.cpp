@@ -1,5 +1,6 @@
 #include "handcentric/policy/conv_encoder.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -73,6 +74,16 @@ kernels::ConvPatches map_patches(const Conv2d& layer, int batch) {
                     in.channels);
 }
 
+// Samples per chunk of the batch whose patch matrix (K x pixels each) fills about half of a
+// 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and the product reads it back from
+// there, and backward's col2im reads its gradient from there; at least one sample.
+int samples_per_chunk(const Conv2d& layer) {
+  constexpr Eigen::Index kChunkFloats = Eigen::Index{1} << 17;  // 512 KB
+  const Eigen::Index per_sample =
+      static_cast<Eigen::Index>(layer.patch_size()) * layer.output().height * layer.output().width;
+  return static_cast<int>(std::max<Eigen::Index>(1, kChunkFloats / per_sample));
+}
+
 }  // namespace
 
 ConvEncoder::ConvEncoder(ImageShape input, const std::vector<ConvLayerSpec>& layers)
@@ -137,34 +148,43 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
   input_sample_stride_ = images.outerStride();
   for (std::size_t l = 0; l < layers_.size(); ++l) {
     const Conv2d& layer = layers_[l];
-    const int n = batch_ * layer.output().height * layer.output().width;
+    const int pixels = layer.output().height * layer.output().width;
     const int k = layer.patch_size(), out = layer.out_channels();
-    patches_[l].resize(static_cast<Eigen::Index>(k) * n);
-    if (l == 0) {
-      set.im2col(image_patches(layer, batch_, input_sample_stride_), images.data(),
-                 patches_[l].data());
-    } else {
-      set.im2col(map_patches(layer, batch_), activation_[l - 1].data(), patches_[l].data());
-    }
+    const Eigen::Index per_sample = static_cast<Eigen::Index>(k) * pixels;
+    patches_[l].resize(per_sample * batch_);
     activation_[l].resize(layer.output().size(), batch);
     sigmoid_[l].resize(layer.output().size(), batch);
-    // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward().
-    kernels::Gemm product{Op::none,
-                          Op::none,
-                          out,
-                          n,
-                          k,
-                          parameters_.data() + offsets_[l],
-                          out,
-                          patches_[l].data(),
-                          k,
-                          parameters_.data() + offsets_[l] + static_cast<Eigen::Index>(out) * k,
-                          activation_[l].data(),
-                          out};
-    product.epilogue = kernels::Epilogue::silu;
-    product.sigmoid = sigmoid_[l].data();
-    product.lds = out;
-    set.gemm(product);
+    const int chunk = samples_per_chunk(layer);
+    for (int b0 = 0; b0 < batch_; b0 += chunk) {
+      const int count = std::min(chunk, batch_ - b0);
+      float* patches = patches_[l].data() + b0 * per_sample;
+      if (l == 0) {
+        set.im2col(image_patches(layer, count, input_sample_stride_),
+                   images.data() + b0 * input_sample_stride_, patches);
+      } else {
+        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
+                   patches);
+      }
+      // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), while the
+      // chunk's patches are still in L2.
+      const Eigen::Index first = b0 * layer.output().size();
+      kernels::Gemm product{Op::none,
+                            Op::none,
+                            out,
+                            count * pixels,
+                            k,
+                            parameters_.data() + offsets_[l],
+                            out,
+                            patches,
+                            k,
+                            parameters_.data() + offsets_[l] + static_cast<Eigen::Index>(out) * k,
+                            activation_[l].data() + first,
+                            out};
+      product.epilogue = kernels::Epilogue::silu;
+      product.sigmoid = sigmoid_[l].data() + first;
+      product.lds = out;
+      set.gemm(product);
+    }
   }
   return activation_.back();
 }
@@ -197,17 +217,30 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     set.gemm(
         {Op::none, Op::none, out, 1, n, delta.data(), out, ones_.data(), n, nullptr, d_bias, out});
     if (l == 0 && !input_gradient) break;
-    // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from.
-    d_patches_.resize(static_cast<Eigen::Index>(k) * n);
-    set.gemm({Op::transpose, Op::none, k, n, out, parameters_.data() + offsets_[l], out,
-              delta.data(), out, nullptr, d_patches_.data(), k});
+    // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from: a
+    // chunk of samples at a time, so that col2im reads the patches from L2.
+    float* target = nullptr;
     if (l == 0) {
       d_images_.setZero(input_size(), batch_);
-      set.col2im(image_patches(layer, batch_, input_size()), d_patches_.data(), d_images_.data());
+      target = d_images_.data();
     } else {
-      Matrix& below = delta_[l - 1];
-      below.setZero(layer.input().size(), batch_);
-      set.col2im(map_patches(layer, batch_), d_patches_.data(), below.data());
+      delta_[l - 1].setZero(layer.input().size(), batch_);
+      target = delta_[l - 1].data();
+    }
+    const int pixels = layer.output().height * layer.output().width;
+    const int chunk = samples_per_chunk(layer);
+    d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
+    for (int b0 = 0; b0 < batch_; b0 += chunk) {
+      const int count = std::min(chunk, batch_ - b0);
+      set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
+                out, delta.data() + b0 * layer.output().size(), out, nullptr, d_patches_.data(),
+                k});
+      float* samples = target + b0 * layer.input().size();
+      if (l == 0) {
+        set.col2im(image_patches(layer, count, input_size()), d_patches_.data(), samples);
+      } else {
+        set.col2im(map_patches(layer, count), d_patches_.data(), samples);
+      }
     }
   }
   return d_images_;

@@ -189,6 +189,8 @@ const std::vector<Case> kCases = {
     {"one output pixel", {1, 5, 5}, {{9, 5, 1, 0}}, 4},
     {"depth 24 x 32", {1, 24, 32}, {{8, 3, 2, 1}, {16, 3, 2, 1}, {16, 3, 2, 1}}, 5},
     {"rgb-d 48 x 64", {4, 48, 64}, {{16, 3, 2, 1}, {32, 3, 2, 1}, {32, 3, 2, 1}}, 2},
+    // Patches of more than half a megabyte per image: the encoder works one image at a time.
+    {"chunks of one image", {4, 64, 64}, {{8, 3, 1, 1}, {8, 3, 2, 1}}, 3},
 };
 
 // The results of one encoder run: features, parameter gradient, image gradient.
