@@ -73,6 +73,8 @@ class ConvEncoder {
 
   /// The same on one given kernel set rather than the one in use (kernels::active()): the
   /// tests run every Highway target this CPU has, and sets with planted faults, through it.
+  /// With input_gradient false, backward() is backward_parameters(): d loss / d images is not
+  /// computed and the matrix returned holds an earlier one.
   const Matrix& forward(const Eigen::Ref<const Matrix>& images, const kernels::KernelSet& set);
   const Matrix& backward(const Eigen::Ref<const Matrix>& d_features, const kernels::KernelSet& set,
                          bool input_gradient = true);
