@@ -84,6 +84,21 @@ struct ExpPolynomial {
                                   4.1665795894e-2f, 1.6666665459e-1f, 5.0000001201e-1f};
 };
 
+/// The patches of a 2D convolution over a batch of images (conv_layer.hpp). Pixel (c, y, x) of
+/// sample b is image[b sample_stride + c channel_stride + y row_stride + x column_stride], so one
+/// function reads both the encoder's input (channels, height, width) and its hidden maps (height,
+/// width, channels; channel_stride 1). Output pixel (oy, ox) sees input rows
+/// oy stride - padding + ky and columns ox stride - padding + kx, ky, kx < kernel; rows and
+/// columns outside the image are zeros (the padding).
+/// The patch matrix is K x N, column-major: K = kernel^2 channels in the order (ky, kx, c), c
+/// fastest; N = batch out_height out_width in the order (b, oy, ox), ox fastest.
+struct ConvPatches {
+  int batch = 0, channels = 0, height = 0, width = 0;
+  int kernel = 0, stride = 1, padding = 0;
+  int out_height = 0, out_width = 0;
+  long sample_stride = 0, channel_stride = 0, row_stride = 0, column_stride = 0;
+};
+
 /// One target's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
 struct KernelSet {
   void (*gemm)(const Gemm& problem);
@@ -97,6 +112,11 @@ struct KernelSet {
   /// sum of g_i^2, in double.
   double (*squared_norm)(std::ptrdiff_t n, const float* g);
   void (*adam)(const AdamUpdate& update);
+  /// im2col: the K x N patch matrix (ConvPatches) of `image` into `patches` (ld K).
+  void (*im2col)(const ConvPatches& shape, const float* image, float* patches);
+  /// col2im, im2col's adjoint: adds each entry of the K x N `patches` to the pixel it was read
+  /// from (entries of the padding are dropped). `image` is accumulated into, not cleared.
+  void (*col2im)(const ConvPatches& shape, const float* patches, float* image);
   /// The Highway target (HWY_AVX3, HWY_AVX2, ...) the functions are compiled for.
   std::int64_t target;
 };

@@ -17,6 +17,7 @@
 #include "kernels/silu-inl.h"
 #include "kernels/adam-inl.h"
 #include "kernels/gemm-inl.h"
+#include "kernels/conv-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace handcentric::policy::kernels::HWY_NAMESPACE {
@@ -28,6 +29,8 @@ const KernelSet* TargetKernels() {
                                   SiluInPlace,
                                   SquaredNorm,
                                   Adam,
+                                  Im2col,
+                                  Col2im,
                                   HWY_TARGET};
   return &kSet;
 }

@@ -1,7 +1,7 @@
 #pragma once
-// The analogue of Table 2 of "Hand-centric action representations make behavior cloning
-// SE(3)-equivariant" (blade insertion, real robot: hand-centric 26/30 in distribution, 5/5 out
-// of distribution) on the simulated 3D blade insertion (sim/insert3d): flow policies with the
+// The analogue of Table 2 of "Guaranteed SE(3)-Equivariant Control via Hand-Centric Behavior
+// Cloning" (blade insertion, real robot: hand-centric 26/30 in distribution, 5/5 out of
+// distribution) on the simulated 3D blade insertion (sim/insert3d): flow policies with the
 // hand-centric, relative and absolute action representations, trained on demos of train scenes
 // and evaluated in closed loop on train, ood (the slot on its side) and random-se3 scenes.
 //

@@ -1,6 +1,6 @@
 #pragma once
-// The expert of the 3D blade insertion: demonstrations for "Hand-centric action representations
-// make behavior cloning SE(3)-equivariant", planned in the slot's frame and kept only when the
+// The expert of the 3D blade insertion: demonstrations for "Guaranteed SE(3)-Equivariant
+// Control via Hand-Centric Behavior Cloning", planned in the slot's frame and kept only when the
 // exact continuous collision check and the success test accept them.
 //
 // Everything is computed in the slot frame from slot_T_hand_start = world_T_slot^-1

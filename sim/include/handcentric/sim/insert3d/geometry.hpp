@@ -1,6 +1,6 @@
 #pragma once
 // The blade and the slot of the 3D insertion task, in cm: the simulated analogue of the blade
-// insertion of "Hand-centric action representations make behavior cloning SE(3)-equivariant"
+// insertion of "Guaranteed SE(3)-Equivariant Control via Hand-Centric Behavior Cloning"
 // (Table 2), placed anywhere in SE(3).
 //
 //   Blade: a box kBladeThickness (x) by kBladeWidth (y) by kBladeLength (z), held rigidly. The

@@ -1,8 +1,8 @@
 #pragma once
 // Closed-loop chunked rollouts of any ChunkPolicy on the 3D blade insertion, and the observation
 // a policy sees: the hand's poses T_0, ..., T_-H (the start repeated before it) and the slot
-// opening's four corners in the hand frame (eye-in-hand, "Hand-centric action representations
-// make behavior cloning SE(3)-equivariant", Sec. 3.2).
+// opening's four corners in the hand frame (eye-in-hand, "Guaranteed SE(3)-Equivariant Control
+// via Hand-Centric Behavior Cloning", Sec. 3.2).
 //
 // Each replan: observe, act (noise seed splitmix64(seed, replan)), execute the first `execute`
 // poses of the chunk. A command beyond kMaxStepCm or kMaxStepDeg from the current pose is clipped

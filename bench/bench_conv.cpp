@@ -1,0 +1,74 @@
+// Image-encoder speed: the training step of a small CNN feeding the flow MLP, the network of
+// bench/vs_pytorch_conv.py, in float32 on the run-time dispatched kernels:
+//   RGB-D 4 x 48 x 64 -> conv 16 (3x3, stride 2, pad 1) -> conv 32 (same) -> conv 32 (same),
+//   SiLU after each -> flatten (32 x 6 x 8 = 1536) -> 256 -> 256 -> 24 (SiLU), MSE to a target,
+//   Adam (lr 1e-3) on the encoder's and the MLP's parameters;
+// at batch 64 and 256 (items/s = training samples/s), and the encoder's forward alone.
+// Numbers and commands: docs/BENCHMARKS.md, "Image encoder".
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+#include "handcentric/core/sampling.hpp"
+#include "handcentric/policy/adam.hpp"
+#include "handcentric/policy/conv_encoder.hpp"
+#include "handcentric/policy/mlp.hpp"
+
+using namespace handcentric;
+using namespace handcentric::policy;
+
+namespace {
+
+const ImageShape kImage{4, 48, 64};
+const std::vector<ConvLayerSpec> kLayers = {{16, 3, 2, 1}, {32, 3, 2, 1}, {32, 3, 2, 1}};
+
+Eigen::MatrixXf random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937_64& rng) {
+  Eigen::MatrixXf m(rows, cols);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m(i) = static_cast<float>(standard_normal(rng));
+  return m;
+}
+
+void BM_conv_train_step(benchmark::State& state) {
+  const int batch = static_cast<int>(state.range(0));
+  std::mt19937_64 rng(1);
+  ConvEncoder encoder(kImage, kLayers);
+  encoder.initialize(rng);
+  Mlp mlp({static_cast<int>(encoder.output_size()), 256, 256, 24}, Activation::silu);
+  mlp.initialize(rng);
+  Adam encoder_adam(encoder.parameter_count(), {}), mlp_adam(mlp.parameter_count(), {});
+  const Eigen::MatrixXf images = random_matrix(kImage.size(), batch, rng);
+  const Eigen::MatrixXf target = random_matrix(24, batch, rng);
+  Eigen::MatrixXf d_output(24, batch);
+  for (auto _ : state) {
+    const Eigen::MatrixXf& output = mlp.forward(encoder.forward(images));
+    d_output = (output - target) * (2.0f / static_cast<float>(output.size()));  // MSE
+    encoder.backward_parameters(mlp.backward(d_output));
+    mlp_adam.step(mlp.parameters(), mlp.gradient());
+    encoder_adam.step(encoder.parameters(), encoder.gradient());
+    benchmark::DoNotOptimize(encoder.parameters().data());
+  }
+  state.SetItemsProcessed(state.iterations() * batch);
+}
+// Wall time (UseRealTime), as PyTorch's side measures: on a shared machine the CPU time would
+// leave out the waits for a core that PyTorch's rate includes.
+BENCHMARK(BM_conv_train_step)
+    ->Arg(64)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+
+void BM_conv_encoder_forward(benchmark::State& state) {
+  const int batch = static_cast<int>(state.range(0));
+  std::mt19937_64 rng(2);
+  ConvEncoder encoder(kImage, kLayers);
+  encoder.initialize(rng);
+  const Eigen::MatrixXf images = random_matrix(kImage.size(), batch, rng);
+  for (auto _ : state) benchmark::DoNotOptimize(encoder.forward(images).data());
+  state.SetItemsProcessed(state.iterations() * batch);
+}
+BENCHMARK(BM_conv_encoder_forward)->Arg(256)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Our image encoder + MLP training step (bench_conv) against PyTorch (Debian's python3-torch,
+# CPU, its convolutions on oneDNN) on the same network, in one run on this machine. Prints both
+# throughputs per batch size and last one line per batch, `ratio at batch B: X (wall), Y (CPU
+# time, 1 thread)`: X = our training samples/s / PyTorch's best samples/s (1 or 2 threads, either
+# memory format), Y = the same per second of CPU time, each on one thread (on a shared machine
+# the wall times include waits for a core, which differ between the two runs).
+#
+#   bench/vs_pytorch_conv.sh [BUILD_DIR]        (default: build)
+#
+# As bench/vs_pytorch.sh: /usr/bin/python3 (Debian's torch imports only there), both sides
+# pinned with taskset when it exists, ours on core 0, PyTorch on core 0 (1 thread) and cores 0
+# and 1 (2 threads), in both memory formats (its best is taken). PyTorch's Linear layers run on
+# the BLAS it loads (printed): with only the reference BLAS they are slow, which would flatter
+# us. bench/vs_pytorch.sh installs OpenBLAS system-wide; without root, or to leave the
+# machine's BLAS alone, unpack it anywhere (apt-get download libopenblas0-pthread; dpkg -x) and
+# give its folder:  PYTORCH_BLAS_DIR=.../usr/lib/x86_64-linux-gnu/openblas-pthread
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+build="${1:-$here/../build}"
+bench="$build/bench/bench_conv"
+python=/usr/bin/python3
+
+if [[ ! -x "$bench" ]]; then
+  echo "vs_pytorch_conv.sh: $bench not found: build first (cmake --build $build --target" \
+    "bench_conv)" >&2
+  exit 1
+fi
+if ! "$python" -c "import torch" 2>/dev/null; then
+  echo "vs_pytorch_conv.sh: PyTorch is missing: bench/vs_pytorch.sh installs it" >&2
+  exit 1
+fi
+echo "handcentric's kernels: ${HANDCENTRIC_KERNELS:-best for this CPU}"
+pin() { if command -v taskset >/dev/null; then taskset -c "$1" "${@:2}"; else "${@:2}"; fi; }
+
+ours_json="$(pin 0 "$bench" --benchmark_filter='BM_conv_train_step' \
+  --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"
+if [[ -n "${PYTORCH_BLAS_DIR:-}" ]]; then
+  export LD_LIBRARY_PATH="$PYTORCH_BLAS_DIR${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
+fi
+torch_lines="$(pin 0 "$python" "$here/vs_pytorch_conv.py" --threads 1
+               pin 0,1 "$python" "$here/vs_pytorch_conv.py" --threads 2)"
+echo "$torch_lines" | sed 's/^/pytorch: /'
+"$python" -c '
+import json, sys
+ours, ours_cpu = {}, {}
+for b in json.loads(sys.argv[1])["benchmarks"]:
+    if b.get("run_type") != "iteration":
+        continue
+    batch = int(b["name"].split("/")[1])
+    ours[batch] = max(ours.get(batch, 0.0), b["items_per_second"])
+    cpu_seconds = b["cpu_time"] * {"ms": 1e-3, "us": 1e-6, "ns": 1e-9, "s": 1.0}[b["time_unit"]]
+    ours_cpu[batch] = max(ours_cpu.get(batch, 0.0), batch / cpu_seconds)
+torch, best_of, torch_cpu = {}, {}, {}
+for line in sys.argv[2].splitlines():
+    run = json.loads(line)
+    batch = run["batch"]
+    if run["train_samples_per_s"] > torch.get(batch, 0.0):
+        torch[batch] = run["train_samples_per_s"]
+        best_of[batch] = "%d thread(s), %s" % (run["threads"], run["format"])
+    if run["threads"] == 1:
+        torch_cpu[batch] = max(torch_cpu.get(batch, 0.0), run["train_samples_per_cpu_s"])
+    blas = run["blas"]
+print("pytorch BLAS: %s%s" % (blas, " (the reference BLAS: its Linear layers are slow)"
+                              if "/blas/" in blas else ""))
+for batch in sorted(ours):
+    print("handcentric: batch %d train %.0f samples/s (%.0f per CPU second); pytorch best %.0f "
+          "samples/s (%s; 1 thread: %.0f per CPU second)" %
+          (batch, ours[batch], ours_cpu[batch], torch[batch], best_of[batch], torch_cpu[batch]))
+# The CPU-time ratio (1 thread each) is the one to read on a shared machine.
+for batch in sorted(ours):
+    print("ratio at batch %d: %.3f (wall), %.3f (CPU time, 1 thread)" %
+          (batch, ours[batch] / torch[batch], ours_cpu[batch] / torch_cpu[batch]))' \
+  "$ours_json" "$torch_lines"

@@ -1,0 +1,106 @@
+#pragma once
+// ConvEncoder: a small CNN that turns a minibatch of images into features for the MLP (the
+// image policies of the paper's Sec. 4.3, where a ResNet-18 plays this part): a few Conv2d
+// layers (conv2d.hpp), each followed by SiLU, usually with stride 2, then flattened.
+//
+// Images come one per column, (channels x height x width) each, width fastest, as PyTorch
+// stores an image: an input is (channels height width x B). The hidden maps, and so the
+// features, are stored (height, width, channels) with the channels fastest: the output is
+// (out_height out_width out_channels x B), feature (y, x, c) of the last layer at
+// (y out_width + x) out_channels + c.
+// All parameters live in one flat vector (W_1, b_1, W_2, b_2, ...), as the MLP keeps them
+// (conv2d.hpp gives a layer's layout), so that Adam, clipping and model files see one array.
+// float32 on the run-time dispatched kernels (kernels.hpp): im2col, then one product per layer
+// with the bias and SiLU in its epilogue; backward the two products of the gradients and col2im.
+#include <Eigen/Core>
+#include <random>
+#include <vector>
+
+#include "handcentric/policy/conv2d.hpp"
+
+namespace handcentric::policy {
+
+class ByteReader;
+class ByteWriter;
+namespace kernels {
+struct KernelSet;
+}
+
+/// One layer of a ConvEncoder (the input channels come from the layer before).
+struct ConvLayerSpec {
+  int out_channels = 16;
+  int kernel = 3;
+  int stride = 2;
+  int padding = 1;
+};
+
+class ConvEncoder {
+ public:
+  using Matrix = Eigen::MatrixXf;
+  using Vector = Eigen::VectorXf;
+
+  ConvEncoder() = default;
+  /// Throws InvalidArgument for no layer, or a layer Conv2d refuses (the message names the
+  /// layer). Parameters start at zero: call initialize().
+  ConvEncoder(ImageShape input, const std::vector<ConvLayerSpec>& layers);
+
+  /// PyTorch's default for Conv2d: W, b uniform in +-1/sqrt(K), from `rng` (same seed, same bits).
+  void initialize(std::mt19937_64& rng);
+
+  const ImageShape& input_shape() const { return layers_.front().input(); }
+  /// The last layer's output; the features are its (height, width, channels).
+  const ImageShape& output_shape() const { return layers_.back().output(); }
+  Eigen::Index input_size() const { return input_shape().size(); }
+  Eigen::Index output_size() const { return output_shape().size(); }
+  const std::vector<Conv2d>& layers() const { return layers_; }
+  /// Start of layer l's W in parameters(); its b follows W.
+  Eigen::Index parameter_offset(int layer) const { return offsets_[layer]; }
+  Eigen::Index parameter_count() const { return parameters_.size(); }
+
+  Vector& parameters() { return parameters_; }
+  const Vector& parameters() const { return parameters_; }
+  /// d loss / d parameters, written by backward().
+  const Vector& gradient() const { return gradient_; }
+
+  /// Training forward pass (keeps what backward() needs): images (input_size x B) to
+  /// features (output_size x B). Throws InvalidArgument for another number of rows.
+  const Matrix& forward(const Eigen::Ref<const Matrix>& images);
+  /// Backward pass from d loss / d features (output_size x B) of the last forward(): sets
+  /// gradient() and returns d loss / d images (input_size x B).
+  const Matrix& backward(const Eigen::Ref<const Matrix>& d_features);
+  /// backward() without d loss / d images (one product and one col2im less).
+  void backward_parameters(const Eigen::Ref<const Matrix>& d_features);
+
+  /// The same on one given kernel set rather than the one in use (kernels::active()): the
+  /// tests run every Highway target this CPU has, and sets with planted faults, through it.
+  /// With input_gradient false, backward() is backward_parameters(): d loss / d images is not
+  /// computed and the matrix returned holds an earlier one.
+  const Matrix& forward(const Eigen::Ref<const Matrix>& images, const kernels::KernelSet& set);
+  const Matrix& backward(const Eigen::Ref<const Matrix>& d_features, const kernels::KernelSet& set,
+                         bool input_gradient = true);
+
+  /// The architecture (input shape, each layer's out_channels, kernel, stride, padding) and
+  /// the parameters, little-endian, for a model file.
+  void write(ByteWriter& out) const;
+  /// Reads what write() wrote. Throws InvalidModelFile naming the source for a truncated
+  /// record, an architecture Conv2d refuses or larger than the bytes that follow, or a
+  /// parameter vector of the wrong length or with a non-finite entry.
+  static ConvEncoder read(ByteReader& in);
+
+ private:
+  std::vector<Conv2d> layers_;
+  std::vector<Eigen::Index> offsets_;
+  Vector parameters_;
+  Vector gradient_;
+  int batch_ = 0;                   ///< of the last forward()
+  std::vector<Vector> patches_;     ///< each layer's patch matrix (K x N) of the last forward()
+  std::vector<Matrix> sigmoid_;     ///< sigmoid(z) of each layer (out size x B)
+  std::vector<Matrix> activation_;  ///< SiLU(z) of each layer; the last one is the features
+  std::vector<Matrix> delta_;  ///< d loss / d (each layer's output), kept: no reallocation per step
+  Vector d_patches_;
+  Vector ones_;
+  Matrix d_images_;
+  long input_sample_stride_ = 0;  ///< of the images of the last forward()
+};
+
+}  // namespace handcentric::policy

@@ -1,0 +1,314 @@
+#include "handcentric/policy/conv_encoder.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <string>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/sampling.hpp"
+#include "handcentric/policy/binary_io.hpp"
+#include "handcentric/policy/errors.hpp"
+#include "kernels/kernel_set.hpp"
+
+namespace handcentric::policy {
+
+using kernels::Op;
+
+namespace {
+
+std::vector<Conv2d> stack(ImageShape input, const std::vector<ConvLayerSpec>& specs) {
+  if (specs.empty()) throw InvalidArgument("ConvEncoder needs at least one layer");
+  std::vector<Conv2d> layers;
+  for (std::size_t l = 0; l < specs.size(); ++l) {
+    const ConvLayerSpec& spec = specs[l];
+    try {
+      layers.emplace_back(layers.empty() ? input : layers.back().output(), spec.out_channels,
+                          spec.kernel, spec.stride, spec.padding);
+    } catch (const InvalidArgument& error) {
+      throw InvalidArgument("ConvEncoder layer " + std::to_string(l) + ": " + error.what());
+    }
+  }
+  return layers;
+}
+
+Eigen::Index total_parameters(const std::vector<Conv2d>& layers) {
+  Eigen::Index count = 0;
+  for (const Conv2d& layer : layers) count += layer.parameter_count();
+  return count;
+}
+
+// The patches of `layer` over `batch` images whose pixel (c, y, x) of sample b is at
+// b sample_stride + c channel_stride + y row_stride + x column_stride.
+kernels::ConvPatches patches_of(const Conv2d& layer, int batch, long sample_stride,
+                                long channel_stride, long row_stride, long column_stride) {
+  kernels::ConvPatches g;
+  g.batch = batch;
+  g.channels = layer.input().channels;
+  g.height = layer.input().height;
+  g.width = layer.input().width;
+  g.kernel = layer.kernel();
+  g.stride = layer.stride();
+  g.padding = layer.padding();
+  g.out_height = layer.output().height;
+  g.out_width = layer.output().width;
+  g.sample_stride = sample_stride;
+  g.channel_stride = channel_stride;
+  g.row_stride = row_stride;
+  g.column_stride = column_stride;
+  return g;
+}
+
+// The encoder's input, (channels, height, width) per sample, width fastest.
+kernels::ConvPatches image_patches(const Conv2d& layer, int batch, long sample_stride) {
+  const ImageShape& in = layer.input();
+  return patches_of(layer, batch, sample_stride, static_cast<long>(in.height) * in.width, in.width,
+                    1);
+}
+
+// A hidden map, (height, width, channels) per sample, channels fastest: as the layer before
+// wrote it (out_channels x N, column-major).
+kernels::ConvPatches map_patches(const Conv2d& layer, int batch) {
+  const ImageShape& in = layer.input();
+  return patches_of(layer, batch, in.size(), 1, static_cast<long>(in.width) * in.channels,
+                    in.channels);
+}
+
+// Samples per chunk of the batch whose patch matrix (K x pixels each) fills about half of a
+// 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and the product reads it back from
+// there, and backward's col2im reads its gradient from there; at least one sample.
+int samples_per_chunk(const Conv2d& layer) {
+  constexpr Eigen::Index kChunkFloats = Eigen::Index{1} << 17;  // 512 KB
+  const Eigen::Index per_sample =
+      static_cast<Eigen::Index>(layer.patch_size()) * layer.output().height * layer.output().width;
+  return static_cast<int>(std::max<Eigen::Index>(1, kChunkFloats / per_sample));
+}
+
+}  // namespace
+
+ConvEncoder::ConvEncoder(ImageShape input, const std::vector<ConvLayerSpec>& layers)
+    : layers_(stack(input, layers)) {
+  Eigen::Index count = 0;
+  for (const Conv2d& layer : layers_) {
+    offsets_.push_back(count);
+    count += layer.parameter_count();
+  }
+  parameters_ = Vector::Zero(count);
+  gradient_ = Vector::Zero(count);
+  patches_.resize(layers_.size());
+  sigmoid_.resize(layers_.size());
+  activation_.resize(layers_.size());
+  delta_.resize(layers_.size());
+}
+
+void ConvEncoder::initialize(std::mt19937_64& rng) {
+  for (std::size_t l = 0; l < layers_.size(); ++l) {
+    const double bound = 1.0 / std::sqrt(static_cast<double>(layers_[l].patch_size()));
+    for (Eigen::Index i = 0; i < layers_[l].parameter_count(); ++i) {
+      parameters_[offsets_[l] + i] = static_cast<float>(bound * (2.0 * uniform01(rng) - 1.0));
+    }
+  }
+}
+
+const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& images) {
+  return forward(images, kernels::active());
+}
+
+const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>& d_features) {
+  return backward(d_features, kernels::active(), true);
+}
+
+void ConvEncoder::backward_parameters(const Eigen::Ref<const Matrix>& d_features) {
+  backward(d_features, kernels::active(), false);
+}
+
+const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& images,
+                                                const kernels::KernelSet& set) {
+  if (layers_.empty()) throw InvalidArgument("ConvEncoder::forward on an encoder without layers");
+  if (images.rows() != input_size()) {
+    throw InvalidArgument("ConvEncoder input has " + std::to_string(images.rows()) +
+                          " rows, expected " + std::to_string(input_size()) + " (" +
+                          std::to_string(input_shape().channels) + " x " +
+                          std::to_string(input_shape().height) + " x " +
+                          std::to_string(input_shape().width) + " per column)");
+  }
+  const Eigen::Index batch = images.cols();
+  for (const Conv2d& layer : layers_) {
+    const Eigen::Index columns = batch * layer.output().height * layer.output().width;
+    if (columns * layer.patch_size() >= (Eigen::Index{1} << 31)) {
+      throw InvalidArgument(
+          "ConvEncoder batch of " + std::to_string(batch) +
+          " images makes a patch matrix of more than 2^31 entries: "
+          "use a batch of at most " +
+          std::to_string(((Eigen::Index{1} << 31) - 1) /
+                         (columns / std::max<Eigen::Index>(batch, 1) * layer.patch_size())));
+    }
+  }
+  batch_ = static_cast<int>(batch);
+  input_sample_stride_ = images.outerStride();
+  for (std::size_t l = 0; l < layers_.size(); ++l) {
+    const Conv2d& layer = layers_[l];
+    const int pixels = layer.output().height * layer.output().width;
+    const int k = layer.patch_size(), out = layer.out_channels();
+    const Eigen::Index per_sample = static_cast<Eigen::Index>(k) * pixels;
+    patches_[l].resize(per_sample * batch_);
+    activation_[l].resize(layer.output().size(), batch);
+    sigmoid_[l].resize(layer.output().size(), batch);
+    const int chunk = samples_per_chunk(layer);
+    for (int b0 = 0; b0 < batch_; b0 += chunk) {
+      const int count = std::min(chunk, batch_ - b0);
+      float* patches = patches_[l].data() + b0 * per_sample;
+      if (l == 0) {
+        set.im2col(image_patches(layer, count, input_sample_stride_),
+                   images.data() + b0 * input_sample_stride_, patches);
+      } else {
+        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
+                   patches);
+      }
+      // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), while the
+      // chunk's patches are still in L2.
+      const Eigen::Index first = b0 * layer.output().size();
+      kernels::Gemm product{Op::none,
+                            Op::none,
+                            out,
+                            count * pixels,
+                            k,
+                            parameters_.data() + offsets_[l],
+                            out,
+                            patches,
+                            k,
+                            parameters_.data() + offsets_[l] + static_cast<Eigen::Index>(out) * k,
+                            activation_[l].data() + first,
+                            out};
+      product.epilogue = kernels::Epilogue::silu;
+      product.sigmoid = sigmoid_[l].data() + first;
+      product.lds = out;
+      set.gemm(product);
+    }
+  }
+  return activation_.back();
+}
+
+const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>& d_features,
+                                                 const kernels::KernelSet& set,
+                                                 bool input_gradient) {
+  if (layers_.empty() || d_features.rows() != output_size() || d_features.cols() != batch_ ||
+      batch_ == 0) {
+    throw InvalidArgument("ConvEncoder::backward: d_features is " +
+                          std::to_string(d_features.rows()) + "x" +
+                          std::to_string(d_features.cols()) + ", expected " +
+                          std::to_string(layers_.empty() ? 0 : output_size()) + "x" +
+                          std::to_string(batch_) + " (call forward() first)");
+  }
+  delta_.back() = d_features;
+  for (int l = static_cast<int>(layers_.size()) - 1; l >= 0; --l) {
+    const Conv2d& layer = layers_[l];
+    const int n = batch_ * layer.output().height * layer.output().width;
+    const int k = layer.patch_size(), out = layer.out_channels();
+    Matrix& delta = delta_[l];
+    // Through SiLU: delta *= SiLU'(z) = s + a (1 - s).
+    set.silu_backward(delta.size(), activation_[l].data(), sigmoid_[l].data(), delta.data());
+    float* d_weights = gradient_.data() + offsets_[l];
+    float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
+    // dW (out x K) = delta patches^T; db = delta 1.
+    set.gemm({Op::none, Op::transpose, out, k, n, delta.data(), out, patches_[l].data(), k, nullptr,
+              d_weights, out});
+    if (ones_.size() < n) ones_ = Vector::Ones(n);
+    set.gemm(
+        {Op::none, Op::none, out, 1, n, delta.data(), out, ones_.data(), n, nullptr, d_bias, out});
+    if (l == 0 && !input_gradient) break;
+    // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from: a
+    // chunk of samples at a time, so that col2im reads the patches from L2.
+    float* target = nullptr;
+    if (l == 0) {
+      d_images_.setZero(input_size(), batch_);
+      target = d_images_.data();
+    } else {
+      delta_[l - 1].setZero(layer.input().size(), batch_);
+      target = delta_[l - 1].data();
+    }
+    const int pixels = layer.output().height * layer.output().width;
+    const int chunk = samples_per_chunk(layer);
+    d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
+    for (int b0 = 0; b0 < batch_; b0 += chunk) {
+      const int count = std::min(chunk, batch_ - b0);
+      set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
+                out, delta.data() + b0 * layer.output().size(), out, nullptr, d_patches_.data(),
+                k});
+      float* samples = target + b0 * layer.input().size();
+      if (l == 0) {
+        set.col2im(image_patches(layer, count, input_size()), d_patches_.data(), samples);
+      } else {
+        set.col2im(map_patches(layer, count), d_patches_.data(), samples);
+      }
+    }
+  }
+  return d_images_;
+}
+
+void ConvEncoder::write(ByteWriter& out) const {
+  out.u32(static_cast<std::uint32_t>(input_shape().channels));
+  out.u32(static_cast<std::uint32_t>(input_shape().height));
+  out.u32(static_cast<std::uint32_t>(input_shape().width));
+  out.u32(static_cast<std::uint32_t>(layers_.size()));
+  for (const Conv2d& layer : layers_) {
+    out.u32(static_cast<std::uint32_t>(layer.out_channels()));
+    out.u32(static_cast<std::uint32_t>(layer.kernel()));
+    out.u32(static_cast<std::uint32_t>(layer.stride()));
+    out.u32(static_cast<std::uint32_t>(layer.padding()));
+  }
+  out.floats(parameters_);
+}
+
+namespace {
+
+// A u32 of the architecture as an int; values past INT32_MAX are refused here and small
+// negative ones never occur, so Conv2d's checks see every value that could be meant.
+int read_dimension(ByteReader& in, const std::string& what) {
+  const std::uint32_t value = in.u32();
+  if (value > 1u << 20) {
+    in.fail("the image encoder's " + what + " is " + std::to_string(value) +
+            ", more than the 2^20 a model file may give");
+  }
+  return static_cast<int>(value);
+}
+
+}  // namespace
+
+ConvEncoder ConvEncoder::read(ByteReader& in) {
+  constexpr std::uint32_t kMaxLayers = 64;
+  ImageShape input;
+  input.channels = read_dimension(in, "input channels");
+  input.height = read_dimension(in, "input height");
+  input.width = read_dimension(in, "input width");
+  const std::uint32_t count = in.u32();
+  if (count == 0 || count > kMaxLayers) {
+    in.fail("the image encoder has " + std::to_string(count) + " layers, expected 1 to " +
+            std::to_string(kMaxLayers));
+  }
+  std::vector<ConvLayerSpec> specs(count);
+  for (std::uint32_t l = 0; l < count; ++l) {
+    const std::string name = "layer " + std::to_string(l) + " ";
+    specs[l].out_channels = read_dimension(in, name + "out_channels");
+    specs[l].kernel = read_dimension(in, name + "kernel");
+    specs[l].stride = read_dimension(in, name + "stride");
+    specs[l].padding = read_dimension(in, name + "padding");
+  }
+  std::vector<Conv2d> layers;
+  try {
+    layers = stack(input, specs);
+  } catch (const InvalidArgument& error) {
+    in.fail(std::string("the image encoder's architecture is refused: ") + error.what());
+  }
+  // Before allocating: the parameters the architecture describes must be in the bytes that follow.
+  const Eigen::Index parameters = total_parameters(layers);
+  if (static_cast<std::uint64_t>(parameters) > in.remaining() / sizeof(float)) {
+    in.fail("the image encoder's architecture has " + std::to_string(parameters) +
+            " parameters but only " + std::to_string(in.remaining()) + " bytes follow");
+  }
+  ConvEncoder encoder(input, specs);
+  encoder.parameters_ = in.floats(parameters);
+  return encoder;
+}
+
+}  // namespace handcentric::policy

@@ -1,0 +1,555 @@
+// The image encoder (ConvEncoder, conv2d.hpp) on the float32 kernels of every Highway target
+// this build compiled and this CPU runs, against a naive double-precision convolution written
+// here from the definition (direct sums, its own (c, y, x) storage): forward, the gradients of
+// the weights, biases and input, with odd sizes, stride 1 and 2, no padding, a kernel of 2 and
+// images with a column stride. The reference's backward is checked by central differences of
+// its forward, and the float encoder's by directional differences of its own. Each check is seen
+// failing on kernel sets with a planted fault (a mutant im2col, col2im, product or SiLU'), on
+// every target. Then the model-file record of the encoder and the typed errors of bad shapes.
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/sampling.hpp"
+#include "handcentric/policy/binary_io.hpp"
+#include "handcentric/policy/conv2d.hpp"
+#include "handcentric/policy/conv_encoder.hpp"
+#include "handcentric/policy/errors.hpp"
+#include "handcentric/policy/kernels.hpp"
+#include "kernels/kernel_set.hpp"
+#include "throws.hpp"
+
+using namespace handcentric;
+using namespace handcentric::policy;
+using Catch::Matchers::Contains;
+
+namespace {
+
+std::vector<std::pair<std::string, const kernels::KernelSet*>> conv_targets() {
+  std::vector<std::pair<std::string, const kernels::KernelSet*>> sets;
+  for (std::int64_t target : kernels::available_targets()) {
+    sets.emplace_back(kernels::target_name(target), &kernels::kernels_of_target(target));
+  }
+  return sets;
+}
+
+Eigen::MatrixXd random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937_64& rng) {
+  Eigen::MatrixXd m(rows, cols);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m(i) = 2.0 * uniform01(rng) - 1.0;
+  return m;
+}
+
+// The naive convolution stack in double. Maps are stored [b][c][y][x]; a layer's parameters are
+// read from the encoder's flat vector by conv2d.hpp's layout (W(o, (ky, kx, c)) column-major,
+// then b), the one thing shared with the code under test.
+struct Reference {
+  std::vector<Conv2d> layers;
+  std::vector<Eigen::Index> offsets;
+  Eigen::VectorXd parameters;
+  int batch = 0;
+  std::vector<std::vector<double>> input_of, z_of;  // per layer: its input map, its z
+
+  explicit Reference(const ConvEncoder& encoder)
+      : layers(encoder.layers()), parameters(encoder.parameters().cast<double>()) {
+    for (std::size_t l = 0; l < layers.size(); ++l) offsets.push_back(encoder.parameter_offset(l));
+  }
+  static long at(const ImageShape& s, int b, int c, int y, int x) {
+    return ((static_cast<long>(b) * s.channels + c) * s.height + y) * s.width + x;
+  }
+  double weight(int l, int o, int ky, int kx, int c) const {
+    const Conv2d& layer = layers[l];
+    const int k = (ky * layer.kernel() + kx) * layer.input().channels + c;
+    return parameters[offsets[l] + o + static_cast<Eigen::Index>(k) * layer.out_channels()];
+  }
+  double bias(int l, int o) const {
+    return parameters[offsets[l] +
+                      static_cast<Eigen::Index>(layers[l].out_channels()) * layers[l].patch_size() +
+                      o];
+  }
+  static double silu(double z) { return z / (1.0 + std::exp(-z)); }
+  static double silu_derivative(double z) {
+    const double s = 1.0 / (1.0 + std::exp(-z));
+    return s * (1.0 + z * (1.0 - s));
+  }
+
+  // images (C H W x B), (c, y, x) per column; returns the features in the encoder's order,
+  // (y, x, c) of the last layer per column.
+  Eigen::MatrixXd forward(const Eigen::MatrixXd& images) {
+    batch = static_cast<int>(images.cols());
+    std::vector<double> map(images.data(), images.data() + images.size());
+    input_of.assign(layers.size(), {});
+    z_of.assign(layers.size(), {});
+    for (std::size_t l = 0; l < layers.size(); ++l) {
+      const Conv2d& layer = layers[l];
+      const ImageShape &in = layer.input(), &out = layer.output();
+      std::vector<double> z(static_cast<std::size_t>(batch * out.size()));
+      for (int b = 0; b < batch; ++b)
+        for (int o = 0; o < out.channels; ++o)
+          for (int oy = 0; oy < out.height; ++oy)
+            for (int ox = 0; ox < out.width; ++ox) {
+              double sum = bias(static_cast<int>(l), o);
+              for (int ky = 0; ky < layer.kernel(); ++ky)
+                for (int kx = 0; kx < layer.kernel(); ++kx) {
+                  const int iy = oy * layer.stride() - layer.padding() + ky;
+                  const int ix = ox * layer.stride() - layer.padding() + kx;
+                  if (iy < 0 || iy >= in.height || ix < 0 || ix >= in.width) continue;
+                  for (int c = 0; c < in.channels; ++c)
+                    sum += weight(static_cast<int>(l), o, ky, kx, c) * map[at(in, b, c, iy, ix)];
+                }
+              z[at(out, b, o, oy, ox)] = sum;
+            }
+      input_of[l] = std::move(map);
+      map.resize(z.size());
+      for (std::size_t i = 0; i < z.size(); ++i) map[i] = silu(z[i]);
+      z_of[l] = std::move(z);
+    }
+    const ImageShape& out = layers.back().output();
+    Eigen::MatrixXd features(out.size(), batch);
+    for (int b = 0; b < batch; ++b)
+      for (int c = 0; c < out.channels; ++c)
+        for (int y = 0; y < out.height; ++y)
+          for (int x = 0; x < out.width; ++x)
+            features((static_cast<long>(y) * out.width + x) * out.channels + c, b) =
+                map[at(out, b, c, y, x)];
+    return features;
+  }
+
+  // From d loss / d features (encoder order) of the last forward: the parameter gradient (the
+  // encoder's layout) and d loss / d images (C H W x B). `fault` plants a wrong backward:
+  // 1 reads the weights with ky and kx swapped.
+  std::pair<Eigen::VectorXd, Eigen::MatrixXd> backward(const Eigen::MatrixXd& d_features,
+                                                       int fault = 0) const {
+    Eigen::VectorXd gradient = Eigen::VectorXd::Zero(parameters.size());
+    const ImageShape& last = layers.back().output();
+    std::vector<double> delta(static_cast<std::size_t>(batch * last.size()));
+    for (int b = 0; b < batch; ++b)
+      for (int c = 0; c < last.channels; ++c)
+        for (int y = 0; y < last.height; ++y)
+          for (int x = 0; x < last.width; ++x)
+            delta[at(last, b, c, y, x)] =
+                d_features((static_cast<long>(y) * last.width + x) * last.channels + c, b);
+    for (int l = static_cast<int>(layers.size()) - 1; l >= 0; --l) {
+      const Conv2d& layer = layers[l];
+      const ImageShape &in = layer.input(), &out = layer.output();
+      for (std::size_t i = 0; i < delta.size(); ++i) delta[i] *= silu_derivative(z_of[l][i]);
+      std::vector<double> below(static_cast<std::size_t>(batch * in.size()), 0.0);
+      const Eigen::Index w0 = offsets[l];
+      const Eigen::Index b0 = w0 + static_cast<Eigen::Index>(out.channels) * layer.patch_size();
+      for (int b = 0; b < batch; ++b)
+        for (int o = 0; o < out.channels; ++o)
+          for (int oy = 0; oy < out.height; ++oy)
+            for (int ox = 0; ox < out.width; ++ox) {
+              const double d = delta[at(out, b, o, oy, ox)];
+              gradient[b0 + o] += d;
+              for (int ky = 0; ky < layer.kernel(); ++ky)
+                for (int kx = 0; kx < layer.kernel(); ++kx) {
+                  const int iy = oy * layer.stride() - layer.padding() + ky;
+                  const int ix = ox * layer.stride() - layer.padding() + kx;
+                  if (iy < 0 || iy >= in.height || ix < 0 || ix >= in.width) continue;
+                  for (int c = 0; c < in.channels; ++c) {
+                    const int k = (ky * layer.kernel() + kx) * in.channels + c;
+                    gradient[w0 + o + static_cast<Eigen::Index>(k) * out.channels] +=
+                        d * input_of[l][at(in, b, c, iy, ix)];
+                    below[at(in, b, c, iy, ix)] +=
+                        d * (fault == 1 ? weight(l, o, kx, ky, c) : weight(l, o, ky, kx, c));
+                  }
+                }
+            }
+      delta = std::move(below);
+    }
+    const ImageShape& in = layers.front().input();
+    return {gradient, Eigen::Map<const Eigen::MatrixXd>(delta.data(), in.size(), batch)};
+  }
+};
+
+double relative_error(const Eigen::MatrixXd& x, const Eigen::MatrixXd& reference) {
+  return (x - reference).cwiseAbs().maxCoeff() / (1.0 + reference.cwiseAbs().maxCoeff());
+}
+
+struct Case {
+  std::string name;
+  ImageShape input;
+  std::vector<ConvLayerSpec> layers;
+  int batch;
+};
+
+// Odd sizes and channel counts that fill no vector, stride 1 and 2, no padding, kernels 1, 2,
+// 3 and 5, a 1 x 1 output; the image policies' depth and RGB-D encoders.
+const std::vector<Case> kCases = {
+    {"odd sizes", {3, 13, 11}, {{5, 3, 1, 1}, {7, 2, 2, 0}, {6, 3, 2, 1}}, 3},
+    {"kernel 1 and 5", {2, 9, 7}, {{17, 1, 1, 0}, {4, 5, 1, 2}, {3, 3, 2, 0}}, 2},
+    {"one output pixel", {1, 5, 5}, {{9, 5, 1, 0}}, 4},
+    {"depth 24 x 32", {1, 24, 32}, {{8, 3, 2, 1}, {16, 3, 2, 1}, {16, 3, 2, 1}}, 5},
+    {"rgb-d 48 x 64", {4, 48, 64}, {{16, 3, 2, 1}, {32, 3, 2, 1}, {32, 3, 2, 1}}, 2},
+    // Patches of more than half a megabyte per image: the encoder works one image at a time.
+    {"chunks of one image", {4, 64, 64}, {{8, 3, 1, 1}, {8, 3, 2, 1}}, 3},
+};
+
+// The results of one encoder run: features, parameter gradient, image gradient.
+struct Run {
+  Eigen::MatrixXd features, d_images;
+  Eigen::VectorXd gradient;
+};
+
+// Forward and backward on `set`, with the images in a wider matrix (a column stride > rows).
+Run run_on(ConvEncoder& encoder, const kernels::KernelSet& set, const Eigen::MatrixXd& images,
+           const Eigen::MatrixXd& d_features) {
+  Eigen::MatrixXf wide = Eigen::MatrixXf::Constant(images.rows() + 5, images.cols(), 1e30f);
+  wide.topRows(images.rows()) = images.cast<float>();
+  const Eigen::Ref<const Eigen::MatrixXf> view = wide.topRows(images.rows());
+  Run run;
+  run.features = encoder.forward(view, set).cast<double>();
+  run.d_images = encoder.backward(d_features.cast<float>(), set).cast<double>();
+  run.gradient = encoder.gradient().cast<double>();
+  return run;
+}
+
+struct Errors {
+  double features, gradient, d_images;
+  double worst() const { return std::max({features, gradient, d_images}); }
+};
+
+Errors errors_of(const Run& run, const Eigen::MatrixXd& features, const Eigen::VectorXd& gradient,
+                 const Eigen::MatrixXd& d_images) {
+  return {relative_error(run.features, features), relative_error(run.gradient, gradient),
+          relative_error(run.d_images, d_images)};
+}
+
+constexpr double kTolerance = 1e-5;  // float against double, as for the Mlp (test_kernels.cpp)
+
+// Planted faults: a kernel set that is `base` but for one function. The wrappers reach the base
+// through this pointer (function pointers carry no state); the tests run on one thread.
+const kernels::KernelSet* g_base = nullptr;
+
+void im2col_stride_off_by_one(const kernels::ConvPatches& shape, const float* image, float* out) {
+  kernels::ConvPatches wrong = shape;
+  wrong.stride += 1;  // same output size: the windows walk one pixel too far per step
+  g_base->im2col(wrong, image, out);
+}
+void col2im_window_shifted(const kernels::ConvPatches& shape, const float* patches, float* image) {
+  kernels::ConvPatches wrong = shape;
+  wrong.padding -= 1;  // every window one pixel down and right of where im2col read it
+  g_base->col2im(wrong, patches, image);
+}
+void gemm_short_k(const kernels::Gemm& problem) {
+  kernels::Gemm wrong = problem;
+  if (wrong.k > 1) wrong.k -= 1;  // the k loop stops one term short
+  g_base->gemm(wrong);
+}
+void gemm_untransposed_weights(const kernels::Gemm& problem) {
+  kernels::Gemm wrong = problem;
+  // The input-gradient product W^T delta read as W delta. It stays inside W's storage only
+  // when K >= out_channels, which every case's layers have.
+  if (wrong.op_a == kernels::Op::transpose && wrong.op_b == kernels::Op::none &&
+      wrong.m >= wrong.k) {
+    wrong.op_a = kernels::Op::none;
+  }
+  g_base->gemm(wrong);
+}
+void silu_backward_left_out(std::ptrdiff_t, const float*, const float*, float*) {}
+
+struct Mutant {
+  std::string name;
+  kernels::KernelSet set;
+  bool forward_wrong;  // whether the features are wrong too, or only the gradients
+};
+
+std::vector<Mutant> mutants_of(const kernels::KernelSet& base) {
+  std::vector<Mutant> mutants(5, {"", base, false});
+  mutants[0].name = "im2col stride off by one";
+  mutants[0].set.im2col = im2col_stride_off_by_one;
+  mutants[0].forward_wrong = true;
+  mutants[1].name = "col2im window shifted";
+  mutants[1].set.col2im = col2im_window_shifted;
+  mutants[2].name = "product one k term short";
+  mutants[2].set.gemm = gemm_short_k;
+  mutants[2].forward_wrong = true;
+  mutants[3].name = "input gradient through W, not W^T";
+  mutants[3].set.gemm = gemm_untransposed_weights;
+  mutants[4].name = "SiLU' left out";
+  mutants[4].set.silu_backward = silu_backward_left_out;
+  return mutants;
+}
+
+ConvEncoder encoder_of(const Case& c, std::uint64_t seed) {
+  ConvEncoder encoder(c.input, c.layers);
+  std::mt19937_64 rng(seed);
+  encoder.initialize(rng);
+  return encoder;
+}
+
+// One case's encoder, random images and d loss / d features, and the reference's answers.
+struct Expected {
+  ConvEncoder encoder;
+  Eigen::MatrixXd images, d_features, features, d_images;
+  Eigen::VectorXd gradient;
+
+  Expected(const Case& c, std::uint64_t seed, std::mt19937_64& rng, double image_scale = 1.0)
+      : encoder(encoder_of(c, seed)) {
+    images = image_scale * random_matrix(c.input.size(), c.batch, rng);
+    d_features = random_matrix(encoder.output_size(), c.batch, rng);
+    Reference reference(encoder);
+    features = reference.forward(images);
+    std::tie(gradient, d_images) = reference.backward(d_features);
+  }
+  Errors errors(const kernels::KernelSet& set) {
+    return errors_of(run_on(encoder, set, images, d_features), features, gradient, d_images);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("conv_encoder_on_every_target_matches_the_double_reference", "[unit]") {
+  std::mt19937_64 rng(41);
+  for (const Case& c : kCases) {
+    // Inputs of a few units: z spans both sides of SiLU's bend.
+    Expected expected(c, 42, rng, 2.0);
+    for (const auto& [name, set] : conv_targets()) {
+      INFO(c.name << ", target " << name);
+      const Errors e = expected.errors(*set);
+      CHECK(e.features < kTolerance);
+      CHECK(e.gradient < kTolerance);
+      CHECK(e.d_images < kTolerance);
+    }
+  }
+}
+
+TEST_CASE("mutant_conv_kernel_sets_are_caught_on_every_target", "[unit]") {
+  std::mt19937_64 rng(43);
+  for (const Case& c : kCases) {
+    if (c.name == "one output pixel") continue;  // no stride or col2im overlap to get wrong
+    Expected expected(c, 44, rng, 2.0);
+    for (const auto& [name, set] : conv_targets()) {
+      g_base = set;
+      for (const Mutant& mutant : mutants_of(*set)) {
+        INFO(c.name << ", target " << name << ", mutant: " << mutant.name);
+        const Errors e = expected.errors(mutant.set);
+        CHECK(e.worst() > 100 * kTolerance);
+        if (mutant.forward_wrong) CHECK(e.features > 100 * kTolerance);
+        if (!mutant.forward_wrong) CHECK(e.features < kTolerance);
+      }
+    }
+    g_base = nullptr;
+  }
+}
+
+TEST_CASE("conv_encoder_on_every_named_kernel_set_matches_the_reference", "[unit]") {
+  // The public calls (kernels::active()) on each set the process can be switched to.
+  const KernelIsa saved = kernel_isa();
+  std::mt19937_64 rng(45);
+  Expected expected(kCases[0], 46, rng);
+  ConvEncoder& encoder = expected.encoder;
+  const Eigen::MatrixXd &images = expected.images, &d_features = expected.d_features;
+  const Eigen::MatrixXd &features = expected.features, &d_images = expected.d_images;
+  const Eigen::VectorXd& gradient = expected.gradient;
+  for (KernelIsa isa : {KernelIsa::generic, KernelIsa::avx2, KernelIsa::avx512}) {
+    if (!kernel_isa_supported(isa)) continue;
+    INFO("kernel set " << to_string(isa));
+    set_kernel_isa(isa);
+    const Eigen::MatrixXf out = encoder.forward(images.cast<float>());
+    CHECK(relative_error(out.cast<double>(), features) < kTolerance);
+    encoder.backward_parameters(d_features.cast<float>());
+    CHECK(relative_error(encoder.gradient().cast<double>(), gradient) < kTolerance);
+    const Eigen::MatrixXf din = encoder.backward(d_features.cast<float>());
+    CHECK(relative_error(din.cast<double>(), d_images) < kTolerance);
+  }
+  set_kernel_isa(saved);
+}
+
+TEST_CASE("the_reference_backward_matches_central_differences", "[unit]") {
+  // L = <d_features, features>: its exact gradient is the reference's backward(d_features).
+  std::mt19937_64 rng(47);
+  const Case& c = kCases[0];
+  ConvEncoder encoder = encoder_of(c, 48);
+  const Eigen::MatrixXd images = random_matrix(c.input.size(), c.batch, rng);
+  const Eigen::MatrixXd d_features = random_matrix(encoder.output_size(), c.batch, rng);
+  Reference reference(encoder);
+  reference.forward(images);
+  const auto [gradient, d_images] = reference.backward(d_features);
+  const auto [wrong_gradient, wrong_d_images] = reference.backward(d_features, /*fault=*/1);
+  const double h = 1e-6;
+  const auto loss = [&](Reference& r, const Eigen::MatrixXd& x) {
+    return (r.forward(x).array() * d_features.array()).sum();
+  };
+  double worst_p = 0, worst_x = 0, wrong_x = 0;
+  for (Eigen::Index i = 0; i < gradient.size(); i += 7) {
+    Reference r = reference;
+    r.parameters[i] += h;
+    const double plus = loss(r, images);
+    r.parameters[i] -= 2 * h;
+    const double minus = loss(r, images);
+    worst_p = std::max(worst_p, std::abs((plus - minus) / (2 * h) - gradient[i]));
+  }
+  for (Eigen::Index i = 0; i < images.size(); i += 5) {
+    Reference r = reference;
+    Eigen::MatrixXd x = images;
+    x(i) += h;
+    const double plus = loss(r, x);
+    x(i) -= 2 * h;
+    const double minus = loss(r, x);
+    const double numeric = (plus - minus) / (2 * h);
+    worst_x = std::max(worst_x, std::abs(numeric - d_images(i)));
+    wrong_x = std::max(wrong_x, std::abs(numeric - wrong_d_images(i)));
+  }
+  CHECK(worst_p < 1e-6);
+  CHECK(worst_x < 1e-6);
+  CHECK(wrong_x > 1e-3);  // planted fault: the input gradient through W with ky, kx swapped
+}
+
+TEST_CASE("the_float_encoder_gradient_matches_directional_differences", "[unit]") {
+  // d/dh L(theta + h v) = <gradient, v> for a random direction v, L = <g, features>, by central
+  // differences of the float encoder itself (h = 1e-2: float rounding of L stays far below).
+  std::mt19937_64 rng(49);
+  const Case& c = kCases[3];
+  ConvEncoder encoder = encoder_of(c, 50);
+  const Eigen::MatrixXf images = random_matrix(c.input.size(), c.batch, rng).cast<float>();
+  const Eigen::MatrixXf g = random_matrix(encoder.output_size(), c.batch, rng).cast<float>();
+  encoder.forward(images);
+  const Eigen::MatrixXd d_images = encoder.backward(g).cast<double>();
+  const Eigen::VectorXd gradient = encoder.gradient().cast<double>();
+  const Eigen::VectorXf theta = encoder.parameters();
+  const Eigen::VectorXf v = random_matrix(theta.size(), 1, rng).cast<float>();
+  const Eigen::MatrixXf u = random_matrix(images.rows(), images.cols(), rng).cast<float>();
+  const auto loss = [&](const Eigen::MatrixXf& x) {
+    return (encoder.forward(x).cast<double>().array() * g.cast<double>().array()).sum();
+  };
+  const float h = 1e-2f;
+  encoder.parameters() = theta + h * v;
+  const double plus = loss(images);
+  encoder.parameters() = theta - h * v;
+  const double minus = loss(images);
+  encoder.parameters() = theta;
+  const double along_v = gradient.dot(v.cast<double>());
+  CHECK(std::abs((plus - minus) / (2 * h) - along_v) < 1e-2 * (1 + std::abs(along_v)));
+  const Eigen::MatrixXf image_plus = images + h * u, image_minus = images - h * u;
+  const double numeric_u = (loss(image_plus) - loss(image_minus)) / (2 * h);
+  const double along_u = (d_images.array() * u.cast<double>().array()).sum();
+  CHECK(std::abs(numeric_u - along_u) < 1e-2 * (1 + std::abs(along_u)));
+  // Planted fault: the same check against the gradient of the mutant without SiLU'.
+  g_base = &kernels::active();
+  const kernels::KernelSet no_derivative = mutants_of(kernels::active()).back().set;
+  encoder.forward(images, no_derivative);
+  encoder.backward(g, no_derivative);
+  const double wrong = encoder.gradient().cast<double>().dot(v.cast<double>());
+  g_base = nullptr;
+  CHECK(std::abs((plus - minus) / (2 * h) - wrong) > 1e-2 * (1 + std::abs(wrong)));
+}
+
+TEST_CASE("conv_encoder_is_deterministic_for_a_seed", "[unit]") {
+  const Case& c = kCases[4];
+  ConvEncoder a = encoder_of(c, 7), b = encoder_of(c, 7), other = encoder_of(c, 8);
+  CHECK(a.parameters() == b.parameters());
+  CHECK(a.parameters() != other.parameters());
+  std::mt19937_64 rng(9);
+  const Eigen::MatrixXf images = random_matrix(c.input.size(), 3, rng).cast<float>();
+  const Eigen::MatrixXf first = a.forward(images);
+  const Eigen::MatrixXf d_first = a.backward(first);
+  const Eigen::VectorXf g_first = a.gradient();
+  CHECK(b.forward(images) == first);
+  CHECK(b.backward(first) == d_first);
+  CHECK(b.gradient() == g_first);
+}
+
+TEST_CASE("conv_shapes_are_refused_with_the_value_and_the_fix", "[unit]") {
+  HC_CHECK_THROWS(Conv2d({0, 8, 8}, 4, 3, 1, 1), InvalidArgument,
+                  Contains("input channels is 0") && Contains("at least one channel"));
+  HC_CHECK_THROWS(Conv2d({1, 8, 8}, 0, 3, 1, 1), InvalidArgument, Contains("out_channels is 0"));
+  HC_CHECK_THROWS(Conv2d({1, 8, 8}, 4, 0, 1, 0), InvalidArgument, Contains("kernel is 0"));
+  HC_CHECK_THROWS(Conv2d({1, 8, 8}, 4, 3, 0, 1), InvalidArgument,
+                  Contains("stride is 0") && Contains("use 1, or 2"));
+  HC_CHECK_THROWS(Conv2d({1, 8, 8}, 4, 3, 1, -1), InvalidArgument, Contains("padding is -1"));
+  HC_CHECK_THROWS(Conv2d({1, 8, 8}, 4, 3, 1, 3), InvalidArgument,
+                  Contains("padding is 3 with a kernel of 3") && Contains("padding < kernel"));
+  HC_CHECK_THROWS(
+      Conv2d({1, 4, 8}, 4, 7, 1, 1), InvalidArgument,
+      Contains("kernel is 7 but the padded input is 6 x 10") && Contains("smaller kernel"));
+  const Conv2d layer({4, 48, 64}, 16, 3, 2, 1);
+  CHECK(layer.output() == ImageShape{16, 24, 32});
+  CHECK(layer.patch_size() == 36);
+  CHECK(layer.parameter_count() == 16 * 37);
+  HC_CHECK_THROWS(ConvEncoder({1, 8, 8}, {}), InvalidArgument, Contains("at least one layer"));
+  // The third stride-2 layer of an 8 x 8 image sees a 2 x 2 map: a kernel of 5 does not fit.
+  HC_CHECK_THROWS(ConvEncoder({1, 8, 8}, {{4, 3, 2, 1}, {4, 3, 2, 1}, {4, 5, 2, 1}}),
+                  InvalidArgument, Contains("layer 2: Conv2d kernel is 5"));
+  ConvEncoder encoder({1, 8, 8}, {{4, 3, 2, 1}});
+  HC_CHECK_THROWS(encoder.forward(Eigen::MatrixXf::Zero(63, 2)), InvalidArgument,
+                  Contains("63 rows, expected 64") && Contains("1 x 8 x 8"));
+  HC_CHECK_THROWS(encoder.backward(Eigen::MatrixXf::Zero(64, 2)), InvalidArgument,
+                  Contains("call forward() first"));
+}
+
+namespace {
+
+std::string record_of(const ConvEncoder& encoder) {
+  ByteWriter out;
+  encoder.write(out);
+  return out.bytes();
+}
+
+ConvEncoder read_record(const std::string& bytes) {
+  ByteReader in(bytes, "encoder.bin");
+  ConvEncoder encoder = ConvEncoder::read(in);
+  if (!in.at_end()) in.fail("bytes after the encoder");
+  return encoder;
+}
+
+// A record with the u32 at byte `offset` replaced.
+std::string with_u32(std::string bytes, std::size_t offset, std::uint32_t value) {
+  for (int i = 0; i < 4; ++i) bytes[offset + i] = static_cast<char>((value >> (8 * i)) & 0xff);
+  return bytes;
+}
+
+}  // namespace
+
+TEST_CASE("conv_encoder_record_round_trips_bit_for_bit", "[unit]") {
+  const Case& c = kCases[0];
+  const ConvEncoder encoder = encoder_of(c, 51);
+  ConvEncoder read = read_record(record_of(encoder));
+  CHECK(read.parameters() == encoder.parameters());
+  CHECK(read.input_shape() == encoder.input_shape());
+  REQUIRE(read.layers().size() == encoder.layers().size());
+  for (std::size_t l = 0; l < read.layers().size(); ++l) {
+    CHECK(read.layers()[l].output() == encoder.layers()[l].output());
+    CHECK(read.layers()[l].kernel() == encoder.layers()[l].kernel());
+    CHECK(read.layers()[l].stride() == encoder.layers()[l].stride());
+    CHECK(read.layers()[l].padding() == encoder.layers()[l].padding());
+  }
+  std::mt19937_64 rng(52);
+  const Eigen::MatrixXf images = random_matrix(c.input.size(), 2, rng).cast<float>();
+  ConvEncoder copy = encoder;
+  CHECK(read.forward(images) == copy.forward(images));
+}
+
+TEST_CASE("bad_conv_encoder_records_are_invalid_model_files", "[unit]") {
+  const ConvEncoder encoder = encoder_of(kCases[0], 53);
+  const std::string good = record_of(encoder);
+  // Truncated anywhere: in the architecture, the length of the weights, or the weights.
+  for (std::size_t size : {std::size_t{0}, std::size_t{2}, std::size_t{13}, std::size_t{40},
+                           std::size_t{65}, good.size() - 1}) {
+    INFO("truncated to " << size << " bytes");
+    CHECK_THROWS_AS(read_record(good.substr(0, size)), InvalidModelFile);
+  }
+  // Layout: 3 u32 of the input, the layer count at 12, then 4 u32 per layer from 16.
+  HC_CHECK_THROWS(read_record(with_u32(good, 12, 0)), InvalidModelFile,
+                  Contains("encoder.bin") && Contains("0 layers, expected 1 to 64"));
+  HC_CHECK_THROWS(read_record(with_u32(good, 16 + 4, 20)), InvalidModelFile,
+                  Contains("layer 0: Conv2d kernel is 20"));
+  HC_CHECK_THROWS(read_record(with_u32(good, 0, 0)), InvalidModelFile,
+                  Contains("input channels is 0"));
+  HC_CHECK_THROWS(read_record(with_u32(good, 4, 3000000000u)), InvalidModelFile,
+                  Contains("input height is 3000000000"));
+  // A wider layer than the weights stored: refused before anything of its size is allocated.
+  HC_CHECK_THROWS(read_record(with_u32(good, 16, 1u << 20)), InvalidModelFile,
+                  Contains("parameters but only"));
+  // Another input shape (more channels) with the same weights: a wrong weight count.
+  HC_CHECK_THROWS(read_record(with_u32(good, 16 + 16, 6)), InvalidModelFile,
+                  Contains("encoder.bin"));
+}
