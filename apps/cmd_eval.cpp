@@ -4,9 +4,9 @@
 // one-line warning on stderr naming the first such scene, so one diverging scene does not throw
 // away a long evaluation; --strict stops at it with an error instead.
 // Policies: --policy expert|straight|hold (no file needed), or --model FILE: a trained model
-// (policy/model_file.hpp), when this build has the policy module. With --task insert3d: the 3D
-// blade insertion (sim/insert3d/rollout.hpp), with --policy expert or a model trained with
-// `handcentric train --task insert3d` (a model of the other task is a TaskMismatch error).
+// (policy/model_file.hpp), when this build has the policy module. The 3D blade insertion
+// (sim/insert3d/rollout.hpp) with an insert3d model (its file names the task) or with --task
+// insert3d --policy expert; a --task that contradicts the model file is an error naming both.
 #include <cmath>
 #include <cstdio>
 #include <limits>

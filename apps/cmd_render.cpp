@@ -1,7 +1,7 @@
 // `handcentric render`: PNG drawings of the 2D insertion task (sim/draw.hpp): one scene, a demo
-// file, or one closed-loop rollout; with --task insert3d, a 3D scene or a rollout of the expert or
-// a 3D model from a fixed viewpoint, the hand camera's depth images beside it
-// (experiments/insert3d_drawing.hpp).
+// file, or one closed-loop rollout; for the 3D task (an insert3d model, or --task insert3d), a 3D
+// scene or a rollout of the expert or a 3D model from a fixed viewpoint, the hand camera's depth
+// images beside it (experiments/insert3d_drawing.hpp).
 #include <iostream>
 #include <memory>
 #include <string>
