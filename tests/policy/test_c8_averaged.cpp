@@ -156,6 +156,18 @@ TEST_CASE("the_audit_catches_chunks_averaged_after_sampling_with_a_noise_per_ele
   CHECK(verdicts[0].witness->error > 1e-6);
 }
 
+TEST_CASE("c8ddpm_avg_trains_the_weights_and_budget_of_c8ddpm", "[unit]") {
+  // The two Table 1 rows differ by the sampler alone: averaged over the augmented head's
+  // weights, the sampler gives the averaged head's chunk bit for bit.
+  CHECK(training_budget(HeadKind::c8ddpm_avg, 500) == training_budget(HeadKind::c8ddpm, 500));
+  const LearnedPolicy averaged = trained(HeadKind::c8ddpm_avg, 1.0);
+  const LearnedPolicy augmented = trained(HeadKind::c8ddpm, 1.0);
+  const Eigen::MatrixXd o =
+      averaged.representation().encode_observation(planar_training_scenes(1, 8)[0]);
+  std::mt19937_64 rng_a(3), rng_b(3);
+  CHECK(c8::averaged_sample(augmented.head(), o, rng_a) == averaged.head().sample_double(o, rng_b));
+}
+
 TEST_CASE("the_averaged_sampler_refuses_other_heads_and_bad_elements", "[unit]") {
   const LearnedPolicy model = trained(HeadKind::c8ddpm_avg, 0.0);
   const Eigen::MatrixXd o =
