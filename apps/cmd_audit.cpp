@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
+#include "handcentric/experiments/model_audit.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
@@ -37,6 +38,7 @@ struct AuditCommandOptions {
   double tolerance = 0.0;
   std::string precision = "float64";
   bool json = false;
+  bool pointwise = false;
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
 };
@@ -133,28 +135,6 @@ int gate(const std::vector<props::Classification>& results,
   return failed == 0 ? 0 : 1;
 }
 
-// A model's scenes must have its H and point counts; it sees world points only if trained on them.
-props::ClassifierOptions model_options(const policy::PolicyConfig& config,
-                                       props::ClassifierOptions classifier) {
-  props::SceneShape& shape = classifier.check.shape;
-  shape.min_history = shape.max_history = config.history_length;
-  shape.min_hand_points = shape.max_hand_points = config.hand_points;
-  const props::View only =
-      config.world_points > 0 ? props::View::third_person : props::View::eye_in_hand;
-  std::vector<props::View> views;
-  for (props::View v : classifier.views) {
-    if (v == only) views.push_back(v);
-  }
-  if (views.empty()) {
-    throw InvalidArgument("this model was trained with " + std::to_string(config.world_points) +
-                          " world points, so it can only be audited in the " +
-                          props::to_string(only) + " view; use --view " + props::to_string(only) +
-                          " or all");
-  }
-  classifier.views = views;
-  return classifier;
-}
-
 int run_audit(const AuditCommandOptions& options) {
   props::AuditOptions audit;
   audit.groups = parse_groups(options.group);
@@ -167,7 +147,7 @@ int run_audit(const AuditCommandOptions& options) {
   const std::vector<Expectation> expectations = parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
   std::vector<props::Classification> results;
-  bool policies = false;
+  bool policies = false, planar_model = false;
   if (!options.exec.empty()) {
     auto plugin = std::make_shared<props::PipeRepresentation>(options.exec, options.timeout,
                                                               options.extra_poses, options.scalars);
@@ -204,8 +184,12 @@ int run_audit(const AuditCommandOptions& options) {
     if (plugin_names)
       throw InvalidArgument("--extra-poses and --scalars are for plug-ins; a model reads neither");
     auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(options.model));
-    const props::ClassifierOptions classifier =
-        model_options(model->config(), props::classifier_options(audit));
+    planar_model = model->config().task == policy::kTaskPeg2d;
+    audit.groups =
+        experiments::model_groups(model->config(), audit.groups, options.group, options.model);
+    props::ClassifierOptions classifier =
+        experiments::model_classifier_options(model->config(), props::classifier_options(audit));
+    classifier.in_distribution = !options.pointwise;
     audit.views = classifier.views;
     results.push_back(
         props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier));
@@ -242,6 +226,11 @@ int run_audit(const AuditCommandOptions& options) {
       << " per cell) the energy distance of the tested coordinates (a statistic, not a length). "
          "Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
+  if (planar_model && options.group == "all") {
+    std::cout << "\nA model of the 2D task (peg2d) is audited on planar scenes (poses rotating "
+                 "about z, everything at z = 0) under the groups that keep them planar; rotation "
+                 "and se3 tilt the plane and are not checked.\n";
+  }
   return gate(results, expectations);
 }
 
@@ -292,6 +281,9 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       ->delimiter(',');
   cmd->add_flag("--json", options->json,
                 "print the JSON document of docs/AUDIT.md instead of tables");
+  auto* pointwise = cmd->add_flag(
+      "--pointwise", options->pointwise,
+      "--model only: the pointwise cells alone, no in-distribution ones (Table 1's audit)");
   auto* exec =
       cmd->add_option("--exec", options->exec,
                       "audit a representation written in any language: COMMAND speaks JSON Lines "
@@ -305,6 +297,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   exec->excludes(repr)->excludes(policy_exec)->excludes(model);
   policy_exec->excludes(repr)->excludes(model);
   model->excludes(repr);
+  pointwise->needs(model);
   cmd->callback([options, &exit_code] { exit_code = run_audit(*options); });
 }
 

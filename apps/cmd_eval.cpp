@@ -4,9 +4,9 @@
 // one-line warning on stderr naming the first such scene, so one diverging scene does not throw
 // away a long evaluation; --strict stops at it with an error instead.
 // Policies: --policy expert|straight|hold (no file needed), or --model FILE: a trained model
-// (policy/model_file.hpp), when this build has the policy module. With --task insert3d: the 3D
-// blade insertion (sim/insert3d/rollout.hpp), with --policy expert or a model trained with
-// `handcentric train --task insert3d` (a model of the other task is a TaskMismatch error).
+// (policy/model_file.hpp), when this build has the policy module. The 3D blade insertion
+// (sim/insert3d/rollout.hpp) with an insert3d model (its file names the task) or with --task
+// insert3d --policy expert; a --task that contradicts the model file is an error naming both.
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -16,6 +16,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "task_of_files.hpp"
 #include "insert3d_options.hpp"
 #include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
@@ -32,7 +33,7 @@ namespace handcentric::apps {
 namespace {
 
 struct EvalOptions {
-  std::string task = "peg2d";
+  std::string task;  ///< --task as given; empty: the model file's, else peg2d
   std::string model;
   std::string policy;
   std::string dist;
@@ -93,7 +94,9 @@ int run_insert3d_eval(const EvalOptions& options) {
 int run_eval(const EvalOptions& options) {
   if (options.trials < 1)
     throw InvalidArgument("--trials must be at least 1, got " + std::to_string(options.trials));
-  if (options.task == "insert3d") return run_insert3d_eval(options);
+  const std::string task = resolve_task(options.task, model_task(options.model),
+                                        "--model '" + options.model + "', a model");
+  if (task == policy::kTaskInsert3d) return run_insert3d_eval(options);
   refuse_3d_options(options.dist, options.rotate_deg);
   const sim::SceneDistribution distribution =
       sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist);
@@ -140,9 +143,8 @@ void add_eval_command(CLI::App& app, int& exit_code) {
       "closed-loop rollouts of a policy on the 2D peg-in-hole task or the 3D blade insertion");
   cmd->add_option("--task", options->task,
                   "peg2d (the 2D task) or insert3d (the 3D blade insertion: --policy expert or an "
-                  "insert3d --model)")
-      ->check(CLI::IsMember({"peg2d", "insert3d"}))
-      ->capture_default_str();
+                  "insert3d --model); default: the task the --model file records, else peg2d")
+      ->check(CLI::IsMember({"peg2d", "insert3d"}));
   auto* model =
       cmd->add_option("--model", options->model, "a trained model file (from `handcentric train`)");
   auto* policy = cmd->add_option("--policy", options->policy,

@@ -1,12 +1,13 @@
 // `handcentric render`: PNG drawings of the 2D insertion task (sim/draw.hpp): one scene, a demo
-// file, or one closed-loop rollout; with --task insert3d, a 3D scene or a rollout of the expert or
-// a 3D model from a fixed viewpoint, the hand camera's depth images beside it
-// (experiments/insert3d_drawing.hpp).
+// file, or one closed-loop rollout; for the 3D task (an insert3d model, or --task insert3d), a 3D
+// scene or a rollout of the expert or a 3D model from a fixed viewpoint, the hand camera's depth
+// images beside it (experiments/insert3d_drawing.hpp).
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "commands.hpp"
+#include "task_of_files.hpp"
 #include "insert3d_options.hpp"
 #include "policy_source.hpp"
 #include "handcentric/experiments/insert3d_drawing.hpp"
@@ -23,7 +24,7 @@ namespace handcentric::apps {
 namespace {
 
 struct RenderOptions {
-  std::string task = "peg2d";
+  std::string task;  ///< --task as given; empty: the --demos or --model file's, else peg2d
   std::string rotate_deg;
   bool scene = false;
   std::string demos;
@@ -41,8 +42,9 @@ struct RenderOptions {
 // The 3D task: scene --index of --dist or --rotate-deg, alone (--scene) or with a rollout.
 int run_insert3d_render(const RenderOptions& options) {
   if (!options.demos.empty()) {
-    throw InvalidArgument(
-        "--demos draws 2D demo files only; with --task insert3d use --scene or --rollout");
+    throw InvalidArgument("--demos draws 2D demo files only, and '" + options.demos +
+                          "' is one of task insert3d: draw its scenes with --scene or --rollout "
+                          "(and --task insert3d)");
   }
   if (options.policy != "expert") {
     throw InvalidArgument("--policy " + options.policy +
@@ -76,7 +78,13 @@ int run_insert3d_render(const RenderOptions& options) {
 }
 
 int run_render(const RenderOptions& options) {
-  if (options.task == "insert3d") return run_insert3d_render(options);
+  const std::string task =
+      !options.demos.empty()
+          ? resolve_task(options.task, demo_task(options.demos),
+                         "--demos '" + options.demos + "', a demo file")
+          : resolve_task(options.task, options.rollout ? model_task(options.model) : "",
+                         "--model '" + options.model + "', a model");
+  if (task == policy::kTaskInsert3d) return run_insert3d_render(options);
   refuse_3d_options(options.dist, options.rotate_deg);
   const sim::CollisionChecker checker;
   sim::Image image;
@@ -117,9 +125,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   CLI::App* cmd = app.add_subcommand(
       "render", "PNG of a scene, a demo file or a rollout (2D, or 3D with --task insert3d)");
   cmd->add_option("--task", options->task,
-                  "peg2d (the 2D task) or insert3d (the 3D blade insertion)")
-      ->check(CLI::IsMember({"peg2d", "insert3d"}))
-      ->capture_default_str();
+                  "peg2d (the 2D task) or insert3d (the 3D blade insertion); default: the task "
+                  "the --demos or --model file records, else peg2d")
+      ->check(CLI::IsMember({"peg2d", "insert3d"}));
   cmd->add_option(
       "--rotate-deg", options->rotate_deg,
       "insert3d: a train scene under the global rotation RX,RY,RZ (XYZ Euler, degrees)");

@@ -19,7 +19,7 @@ namespace {
 
 struct Table1CommandOptions {
   std::string demos = "5,10,20,40,60,80,100";
-  std::string methods = "hand_centric,relative,absolute,c8_centre,c8_base";
+  std::string methods = "hand_centric,relative,absolute,c8_centre,c8_base,c8_averaged";
   std::string heads = "flow";
   std::string train_seeds = "1";
   experiments::Table1Options table;
@@ -69,10 +69,15 @@ void add_table1_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--trials", t.eval.trials, "rollouts per cell and scene set")
       ->capture_default_str();
-  cmd->add_option("--methods", options->methods,
-                  "hand_centric, relative, absolute, c8_centre, c8_base")
+  cmd->add_option("--audit-cases", t.eval.audit_cases,
+                  "cases per group of each model's pointwise audit (the audited symmetry column; "
+                  "0: no audit)")
       ->capture_default_str();
-  cmd->add_option("--heads", options->heads, "flow, ddpm, cvae (c8_centre and c8_base use c8ddpm)")
+  cmd->add_option("--methods", options->methods,
+                  "hand_centric, relative, absolute, c8_centre, c8_base, c8_averaged")
+      ->capture_default_str();
+  cmd->add_option("--heads", options->heads,
+                  "flow, ddpm, cvae (c8_centre and c8_base use c8ddpm, c8_averaged c8ddpm_avg)")
       ->capture_default_str();
   cmd->add_option("--seed", t.demo_seed, "seed of the demos")->capture_default_str();
   cmd->add_option("--train-seeds", options->train_seeds, "training seeds, one row each")

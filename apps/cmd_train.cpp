@@ -2,10 +2,11 @@
 // (sim/demos.hpp), written to a model file (policy/model_file.hpp).
 //
 //   handcentric train --demos demos.jsonl --out m.model   # the library defaults (PolicyConfig)
-//   handcentric train --task insert3d --demos d3.jsonl --out m3.hcm   # the 3D blade insertion
+//   handcentric train --demos d3.jsonl --out m3.hcm   # a 3D demo file: the 3D blade insertion
 //
-// The model records its task (PolicyConfig::task); demos of the other task are refused by their
-// loader, naming both tasks. The 3D task has no mirror images (--no-mirror is implied).
+// The task is the one the demo file records (--task may repeat it; naming another is an error
+// naming both), and the model records it (PolicyConfig::task). The 3D task has no mirror images
+// (--no-mirror is implied).
 //
 // Progress on stderr (step, loss, samples/s, ETA): one line rewritten in place on a terminal, a
 // line every 10% otherwise; the final summary line on stdout.
@@ -19,6 +20,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "task_of_files.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/cell.hpp"
@@ -34,7 +36,7 @@ namespace {
 
 // The library's PolicyConfig holds every default; the command line only overrides it.
 struct TrainOptions {
-  std::string task = policy::kTaskPeg2d;
+  std::string task;  ///< --task as given; empty: the demo file's
   std::string demos, out;
   policy::PolicyConfig config;
   std::string head = policy::to_string(config.head);
@@ -78,8 +80,9 @@ int run_train(const TrainOptions& options) {
                           " does not exist: create it first");
   }
 
-  config.task = options.task;
-  const bool planar = options.task == policy::kTaskPeg2d;
+  config.task = resolve_task(options.task, demo_task(options.demos),
+                             "--demos '" + options.demos + "', a demo file");
+  const bool planar = config.task == policy::kTaskPeg2d;
   // The 2D task's recipe (mirror images, perturbed copies); the 3D task trains on its demos.
   sim::TrainingData data = options.data;
   data.mirror = planar && options.data.mirror;
@@ -148,24 +151,24 @@ void add_train_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<TrainOptions>();
   CLI::App* cmd =
       app.add_subcommand("train", "train a policy on demonstrations and write a model file");
-  cmd->add_option(
-         "--task", options->task,
-         "peg2d (the 2D peg-in-hole) or insert3d (the 3D blade insertion); the demos' task")
-      ->check(CLI::IsMember({policy::kTaskPeg2d, policy::kTaskInsert3d}))
-      ->capture_default_str();
+  cmd->add_option("--task", options->task,
+                  "peg2d (the 2D peg-in-hole) or insert3d (the 3D blade insertion); default: the "
+                  "task the demo file records")
+      ->check(CLI::IsMember({policy::kTaskPeg2d, policy::kTaskInsert3d}));
   cmd->add_option("--demos", options->demos, "demo file (handcentric demos --out)")->required();
   cmd->add_option("--out", options->out, "model file to write (atomically)")->required();
   policy::PolicyConfig& config = options->config;
   cmd->add_option("--repr", config.representation, "absolute|relative|relative_diff|hand_centric")
       ->capture_default_str();
   cmd->add_option("--head", options->head,
-                  "flow|ddpm|cvae|c8flow|c8ddpm|c8flow_planar (the c8 heads need --repr absolute)")
+                  "flow|ddpm|cvae|c8flow|c8ddpm|c8flow_planar|c8ddpm_avg (the c8 heads need --repr "
+                  "absolute)")
       ->capture_default_str();
   cmd->add_option("--c8-centre-x", config.c8_centre_x,
-                  "c8ddpm, c8flow_planar: x of the C8 centre (cm)")
+                  "c8ddpm, c8flow_planar, c8ddpm_avg: x of the C8 centre (cm)")
       ->capture_default_str();
   cmd->add_option("--c8-centre-y", config.c8_centre_y,
-                  "c8ddpm, c8flow_planar: y of the C8 centre (cm)")
+                  "c8ddpm, c8flow_planar, c8ddpm_avg: y of the C8 centre (cm)")
       ->capture_default_str();
   cmd->add_option("--steps", config.steps,
                   "Adam steps (0: the automatic budget for the number of training samples)")

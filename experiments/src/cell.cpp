@@ -36,6 +36,10 @@ std::string Cell::result_path(SceneSet set, const EvalSettings& eval) const {
          std::to_string(eval.trials) + "-r" + std::to_string(sim::kRolloutRulesVersion) + ".json";
 }
 
+std::string Cell::audit_path(const EvalSettings& eval) const {
+  return "results/" + hash + ".audit-pointwise-n" + std::to_string(eval.audit_cases) + ".json";
+}
+
 std::string digest(const std::string& bytes) {
   std::uint64_t h = 1469598103934665603ull;
   for (const unsigned char c : bytes) {

@@ -8,7 +8,8 @@
 namespace handcentric::experiments {
 namespace {
 
-constexpr const char* kMethodNames = "hand_centric, relative, absolute, c8_centre, c8_base";
+constexpr const char* kMethodNames =
+    "hand_centric, relative, absolute, c8_centre, c8_base, c8_averaged";
 
 std::vector<std::string> split(const std::string& list) {
   std::vector<std::string> items;
@@ -30,6 +31,10 @@ const std::vector<Method>& table1_methods() {
        kWorkspaceCentre},
       {"c8_base", "absolute", "c8ddpm",
        "C8 DDPM about a robot base at (0, -60) (stand-in for Equivariant-DiffPo [7])", kRobotBase},
+      {"c8_averaged", "absolute", "c8ddpm_avg",
+       "C8 DDPM about the workspace centre (0, 0), each denoising step averaged over C8: "
+       "equivariant by construction (stand-in for Equivariant-DiffPo [7])",
+       kWorkspaceCentre},
   };
   return methods;
 }
@@ -81,7 +86,7 @@ std::optional<PaperRow> paper_row(const std::string& method, const std::string& 
   if (method == "absolute" && head == "flow") {
     return PaperRow{"Absolute-Action-Flow", {0.00, 0.00, 0.01, 0.06, 0.08, 0.12, 0.14}, 0.02};
   }
-  if (method == "c8_centre" || method == "c8_base") {
+  if (method == "c8_centre" || method == "c8_base" || method == "c8_averaged") {
     return PaperRow{"Equivariant-DiffPo [7]", {0.00, 0.01, 0.03, 0.07, 0.12, 0.18, 0.27}, 0.12};
   }
   return std::nullopt;

@@ -3,8 +3,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 
 #include "handcentric/core/errors.hpp"
 
@@ -59,6 +61,27 @@ sim::RolloutSummary parse_eval_json(const std::string& text, const std::string& 
   }
 }
 
+std::vector<SymmetryVerdict> parse_audit_json(const std::string& text, const std::string& source) {
+  try {
+    std::vector<SymmetryVerdict> out;
+    const nlohmann::json j = nlohmann::json::parse(text);
+    for (const auto& check : j.at("policies").at(0).at("checks")) {
+      if (check.at("mode") != "pointwise" || check.at("view") != "eye_in_hand") continue;
+      const auto& error = check.at("max_error");
+      // An infinite error (a chunk that could not be compared) is written as a string.
+      out.push_back(
+          {check.at("group").get<std::string>(), check.at("equivariant").get<bool>(),
+           error.is_number() ? error.get<double>() : std::numeric_limits<double>::infinity()});
+    }
+    if (out.empty()) throw std::runtime_error("no eye-in-hand pointwise check");
+    return out;
+  } catch (const std::exception& e) {
+    throw InvalidArgument("audit file '" + source +
+                          "' is not `handcentric audit --model --json` output (" + e.what() +
+                          "): delete it and run its job again");
+  }
+}
+
 Row collect_row(const Cell& cell, const EvalSettings& eval, const std::string& dir) {
   Row row;
   row.method = cell.method;
@@ -90,12 +113,25 @@ Row collect_row(const Cell& cell, const EvalSettings& eval, const std::string& d
         break;
     }
   }
+  const std::filesystem::path audit = std::filesystem::path(dir) / cell.audit_path(eval);
+  if (eval.audit_cases > 0 && std::filesystem::exists(audit)) {
+    std::ifstream in(audit);
+    std::stringstream text;
+    text << in.rdbuf();
+    row.symmetry = parse_audit_json(text.str(), audit.string());
+  }
   return row;
 }
 
 std::string rows_json(const std::vector<Row>& rows) {
   nlohmann::json list = nlohmann::json::array();
   for (const Row& r : rows) {
+    nlohmann::json symmetry = nullptr;
+    for (const SymmetryVerdict& v : r.symmetry) {
+      symmetry[v.group] = {{"equivariant", v.equivariant},
+                           {"max_error", std::isfinite(v.max_error) ? nlohmann::json(v.max_error)
+                                                                    : nlohmann::json("inf")}};
+    }
     list.push_back({{"method", r.method},
                     {"head", r.head},
                     {"demos", r.demos},
@@ -107,7 +143,8 @@ std::string rows_json(const std::vector<Row>& rows) {
                     {"ood_success", optional_number(r.ood_success)},
                     {"ood_paired_success", optional_number(r.ood_paired_success)},
                     {"id_ci", optional_interval(r.id_ci)},
-                    {"ood_ci", optional_interval(r.ood_ci)}});
+                    {"ood_ci", optional_interval(r.ood_ci)},
+                    {"symmetry", symmetry}});
   }
   return nlohmann::json{{"rows", list}}.dump(2) + "\n";
 }

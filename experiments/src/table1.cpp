@@ -16,10 +16,12 @@
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
+#include "handcentric/experiments/model_audit.hpp"
 #include "handcentric/experiments/plot.hpp"
 #include "handcentric/experiments/progress.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
+#include "handcentric/props/run.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
 #include "handcentric/sim/expert.hpp"
@@ -62,7 +64,7 @@ bool cell_done(const Cell& cell, const EvalSettings& eval, const fs::path& dir) 
   for (const SceneSet set : kSceneSets) {
     if (!fs::exists(dir / cell.result_path(set, eval))) return false;
   }
-  return true;
+  return eval.audit_cases == 0 || fs::exists(dir / cell.audit_path(eval));
 }
 
 // Trains (or loads) the cell's model and writes each missing result file.
@@ -90,6 +92,12 @@ void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir,
         sim::evaluate(trained, scenes, checker, seed, rollout_options);
     write_file_atomically(result.string(),
                           eval_json(summary, trained.name(), distribution.name, seed) + "\n");
+  }
+  // Each row's symmetry beside its success: the model file's pointwise audit.
+  const fs::path audit = dir / cell.audit_path(eval);
+  if (eval.audit_cases > 0 && !fs::exists(audit)) {
+    write_file_atomically(
+        audit.string(), table1_model_audit_json(dir.string(), cell.model_path(), eval.audit_cases));
   }
 }
 
@@ -129,7 +137,10 @@ nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval,
           {"demo_file", grid.demo_file},
           {"demo_seed", demo_seed},
           {"eval",
-           {{"trials", eval.trials}, {"eval_seed", eval.eval_seed}, {"ood_seed", eval.ood_seed}}},
+           {{"trials", eval.trials},
+            {"eval_seed", eval.eval_seed},
+            {"ood_seed", eval.ood_seed},
+            {"audit_cases", eval.audit_cases}}},
           {"cells", cells}};
 }
 
@@ -168,6 +179,11 @@ void Table1Options::validate() const {
   if (train_seeds.empty()) throw InvalidArgument("--train-seeds is empty: give at least one seed");
   if (eval.trials < 1)
     throw InvalidArgument("--trials must be at least 1, got " + std::to_string(eval.trials));
+  if (eval.audit_cases < 0 || eval.audit_cases > props::kMaxCases) {
+    throw InvalidArgument("--audit-cases must be 0 (no audit) to " +
+                          std::to_string(props::kMaxCases) + ", got " +
+                          std::to_string(eval.audit_cases));
+  }
   if (jobs < 0)
     throw InvalidArgument("--jobs must be >= 0 (0: one per hardware thread), got " +
                           std::to_string(jobs));
@@ -350,6 +366,13 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
               std::to_string(eval.seed(set)) + " --json > " + result + ".tmp && mv " + result +
               ".tmp " + result + "; }; }";
     }
+    if (eval.audit_cases > 0) {
+      const std::string audit = cell.audit_path(eval);
+      line += " && { test -f " + audit + " || { " + shell_quote(cli) + " audit --model " +
+              cell.model_path() + " --view eye_in_hand --pointwise --cases " +
+              std::to_string(eval.audit_cases) + " --json > " + audit + ".tmp && mv " + audit +
+              ".tmp " + audit + "; }; }";
+    }
     lines += line + "\n";
     ++count;
   }
@@ -373,6 +396,8 @@ std::string collect_table1(const std::string& dir_text) {
     eval.trials = j.at("eval").at("trials").get<int>();
     eval.eval_seed = j.at("eval").at("eval_seed").get<std::uint64_t>();
     eval.ood_seed = j.at("eval").at("ood_seed").get<std::uint64_t>();
+    // Runs written before the audit column have no audits.
+    eval.audit_cases = j.at("eval").value("audit_cases", 0);
     demo_seed = j.at("demo_seed").get<std::uint64_t>();
     for (const auto& c : j.at("cells")) {
       Cell cell;
@@ -435,6 +460,46 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
     header += cell_text(std::to_string(n));
     rule += "---|";
   }
+  const bool audited =
+      std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.symmetry.empty(); });
+  if (audited) {
+    header += " audited symmetry |";
+    rule += "---|";
+  }
+  // The audit column of (m, h): per group, yes when every audited model of the row is
+  // equivariant, with the largest error over them.
+  const auto symmetry = [&](const std::string& m, const std::string& h) {
+    std::vector<SymmetryVerdict> merged;
+    int models = 0, with_audit = 0;
+    for (const Row& r : rows) {
+      if (r.method != m || r.head != h) continue;
+      ++models;
+      if (r.symmetry.empty()) continue;
+      ++with_audit;
+      for (const SymmetryVerdict& v : r.symmetry) {
+        auto it = std::find_if(merged.begin(), merged.end(),
+                               [&](const SymmetryVerdict& u) { return u.group == v.group; });
+        if (it == merged.end()) {
+          merged.push_back(v);
+        } else {
+          it->equivariant = it->equivariant && v.equivariant;
+          it->max_error = std::max(it->max_error, v.max_error);
+        }
+      }
+    }
+    std::string text;
+    for (const SymmetryVerdict& v : merged) {
+      char number[32];
+      std::snprintf(number, sizeof number, "%.1e", v.max_error);
+      text += (text.empty() ? "" : ", ") + v.group + (v.equivariant ? " yes" : " no") + " (" +
+              number + ")";
+    }
+    if (with_audit < models) {
+      text += (text.empty() ? "" : "; ") + std::to_string(with_audit) + " of " +
+              std::to_string(models) + " models audited";
+    }
+    return text;
+  };
   std::string text = "# Table 1 on this library\n\n";
   char line[512];
   std::snprintf(
@@ -448,11 +513,21 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
       static_cast<unsigned long long>(eval.eval_seed),
       static_cast<unsigned long long>(eval.ood_seed), static_cast<unsigned long long>(demo_seed));
   text += line;
+  if (audited) {
+    std::snprintf(line, sizeof line,
+                  "`audited symmetry`: each model's pointwise audit, eq. (4) with the same noise "
+                  "on both sides (`handcentric audit --model M --view eye_in_hand --pointwise`, "
+                  "%d cases per group, planar scenes for the 2D task): per group yes when every "
+                  "model of the row is equivariant, and the largest error over them (the task's "
+                  "units).\n\n",
+                  eval.audit_cases);
+    text += line;
+  }
   text += header + "\n" + rule + "\n";
   for (std::size_t i = 0; i < series.size(); ++i) {
     const auto& [m, h] = series[i];
     const auto paper = paper_row(m, h);
-    // Two rows standing in for one paper row (c8_centre, c8_base): its line once, after both.
+    // Rows standing in for one paper row (the C8 rows): its line once, after the last of them.
     const auto next =
         i + 1 < series.size() ? paper_row(series[i + 1].first, series[i + 1].second) : std::nullopt;
     const bool paper_follows = paper && next && next->label == paper->label;
@@ -470,11 +545,18 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
               ? rate(paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())])
               : std::string("-"));
     }
+    if (audited) {
+      id += cell_text(symmetry(m, h));
+      ood += cell_text("");
+      paired += cell_text("");
+      paper_line += cell_text("");
+    }
     text += id + "\n" + ood + "\n" + paired + "\n";
     if (paper && !paper_follows) {
       std::string paper_ood = "| " + paper->label + " (paper) | ood |";
       for (const int n : counts)
         paper_ood += cell_text(n == 100 ? rate(paper->ood_at_100) : std::string("-"));
+      if (audited) paper_ood += cell_text("");
       text += paper_line + "\n" + paper_ood + "\n";
     }
   }

@@ -1,5 +1,6 @@
 // Heads c8ddpm (the C8 baseline of Table 1, a stand-in for the 2D variant of Equivariant
-// Diffusion Policy [7]) and c8flow_planar; c8_planar.hpp has the encoding and the group action.
+// Diffusion Policy [7]), c8flow_planar and c8ddpm_avg; c8_planar.hpp has the encoding and the
+// group action, c8_averaged.hpp the averaged sampler of c8ddpm_avg.
 //
 //   encoding : absolute actions and observations -> planar ones (x, y, z, cos, sin per pose;
 //              eye-in-hand points as they are), decoded back with theta = atan2(sin, cos);
@@ -17,11 +18,18 @@
 // loss asks a plain MLP for the function class an equivariant network has by construction.
 // Averaging the 8 sampled chunks g_k s(g_k^-1 o) would make the sampler exactly equivariant,
 // but an average of two different modes is a chunk no demo has, and the hole allows 0.05 cm.
-// So the trained model is equivariant only as far as the network learned it; [7]'s layers
-// are equivariant exactly (docs/EXPERIMENTS.md, "The C8 baseline": not [7] itself).
+// So the trained c8ddpm model is equivariant only as far as the network learned it; [7]'s
+// layers are equivariant exactly (docs/EXPERIMENTS.md, "The C8 baseline": not [7] itself).
+// c8ddpm_avg trains the same network the same way and averages each DDIM step over the group
+// instead (c8_averaged.hpp): exactly equivariant, with the modes of the unaveraged sampler.
+#include <cmath>
 #include <memory>
+#include <numbers>
+#include <string>
 
+#include "ddpm_head.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/policy/c8_averaged.hpp"
 #include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/head.hpp"
 
@@ -64,12 +72,20 @@ class C8PlanarHead final : public Head {
     return inner_->train_step(a_, o_, rng);
   }
 
+  Eigen::MatrixXd sample_double(const Eigen::MatrixXd& observations,
+                                std::mt19937_64& rng) const override {
+    if (kind_ == HeadKind::c8ddpm_avg) return c8::averaged_sample(*this, observations, rng);
+    return sample(observations.cast<float>(), rng).cast<double>();
+  }
+
   void set_learning_rate(double learning_rate) override {
     inner_->set_learning_rate(learning_rate);
   }
   void finish_training() override { inner_->finish_training(); }
 
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
+    if (kind_ == HeadKind::c8ddpm_avg)
+      return c8::averaged_sample(*this, observations.cast<double>(), rng).cast<float>();
     Eigen::MatrixXf o(observations_.planar_size(), observations.cols());
     for (Eigen::Index j = 0; j < observations.cols(); ++j)
       o.col(j) = moved(0, observations.col(j), observations_);
@@ -84,6 +100,12 @@ class C8PlanarHead final : public Head {
   // The centre is in the config, which the model file stores; the weights are the inner DDPM's.
   void write(ByteWriter& out) const override { inner_->write(out); }
   void read(ByteReader& in) override { inner_->read(in); }
+
+  /// The inner DDPM (c8ddpm, c8ddpm_avg), else null.
+  const DdpmHead* ddpm() const { return dynamic_cast<const DdpmHead*>(inner_.get()); }
+  const c8::Layout& action_layout() const { return actions_; }
+  const c8::Layout& observation_layout() const { return observations_; }
+  const Eigen::Vector2d& centre() const { return centre_; }
 
  private:
   // g_k encode(v) as float32, for a raw absolute column.
@@ -101,6 +123,98 @@ class C8PlanarHead final : public Head {
 };
 
 }  // namespace
+
+namespace c8 {
+
+const std::vector<int>& all_elements() {
+  static const std::vector<int> elements = {0, 1, 2, 3, 4, 5, 6, 7};
+  return elements;
+}
+
+int heading_sector(const Eigen::VectorXd& planar_observation) {
+  if (planar_observation.size() < kPlanarPoseSize) {
+    throw InvalidArgument("heading_sector: a planar observation of length " +
+                          std::to_string(planar_observation.size()) +
+                          " has no pose block; give an encode_planar observation");
+  }
+  const double theta = std::atan2(planar_observation[4], planar_observation[3]);
+  const int k = static_cast<int>(std::lround(theta / (std::numbers::pi / 4.0)));
+  return ((k % 8) + 8) % 8;
+}
+
+Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observations,
+                                std::mt19937_64& rng, const std::vector<int>& elements) {
+  const auto* planar = dynamic_cast<const C8PlanarHead*>(&head);
+  const DdpmHead* ddpm = planar != nullptr ? planar->ddpm() : nullptr;
+  if (ddpm == nullptr) {
+    throw InvalidArgument("the C8-averaged sampler needs a c8ddpm or c8ddpm_avg head, got " +
+                          to_string(head.kind()) + ": train with --head c8ddpm_avg");
+  }
+  if (elements.empty()) {
+    throw InvalidArgument("the C8-averaged sampler needs at least one group element, got none");
+  }
+  for (int k : elements) {
+    if (k < 0 || k > 7)
+      throw InvalidArgument("C8 element " + std::to_string(k) + " is not one of 0..7");
+  }
+  const Layout& A = planar->action_layout();
+  const Layout& O = planar->observation_layout();
+  const Eigen::Vector2d& c = planar->centre();
+  const Normalizer& action_normalizer = ddpm->action_normalizer();
+  const auto n = static_cast<Eigen::Index>(elements.size());
+  const Eigen::Index batch = observations.cols();
+
+  // The start: the prior's mode moved onto C8's fixed points (the centre, heading vector 0; the
+  // orbit mean is there up to rounding), plus the noise in raw units, turned by the element
+  // nearest to the hand's heading so that the start moves with g (c8_averaged.hpp).
+  Eigen::VectorXd mode = action_normalizer.mean();
+  for (int i = 0; i < A.poses; ++i) {
+    mode.segment<2>(kPlanarPoseSize * i) = c;
+    mode.segment<2>(kPlanarPoseSize * i + 3).setZero();
+  }
+  const Eigen::MatrixXf noise = ddpm->initial_noise(batch, rng);  // normalized, drawn once
+  std::vector<Eigen::VectorXd> x(static_cast<std::size_t>(batch));
+  Eigen::MatrixXf o_images(O.planar_size(), batch * n);
+  for (Eigen::Index j = 0; j < batch; ++j) {
+    const Eigen::VectorXd o = encode_planar(observations.col(j), O);
+    const Eigen::VectorXd start =
+        mode + action_normalizer.scale().cwiseProduct(noise.col(j).cast<double>());
+    x[static_cast<std::size_t>(j)] = act_planar(heading_sector(o), c, start, A);
+    for (Eigen::Index e = 0; e < n; ++e)
+      o_images.col(j * n + e) =
+          act_planar(elements[static_cast<std::size_t>(e)], c, o, O).cast<float>();
+  }
+  ddpm->observation_normalizer().normalize(o_images);
+
+  // Every DDIM step on all images at once (one network call), each image's result moved back
+  // by its element's inverse and averaged: Phi(x, o) = 1/8 sum_k g_k^-1 phi(g_k x, g_k o).
+  Eigen::MatrixXf x_images(A.planar_size(), batch * n);
+  for (int step = 0; step < ddpm->ddim_steps(); ++step) {
+    for (Eigen::Index j = 0; j < batch; ++j) {
+      for (Eigen::Index e = 0; e < n; ++e) {
+        x_images.col(j * n + e) =
+            act_planar(elements[static_cast<std::size_t>(e)], c, x[static_cast<std::size_t>(j)], A)
+                .cast<float>();
+      }
+    }
+    action_normalizer.normalize(x_images);
+    ddpm->ddim_step(x_images, o_images, step);
+    action_normalizer.denormalize(x_images);
+    for (Eigen::Index j = 0; j < batch; ++j) {
+      Eigen::VectorXd sum = Eigen::VectorXd::Zero(A.planar_size());
+      for (Eigen::Index e = 0; e < n; ++e)
+        sum += act_planar(-elements[static_cast<std::size_t>(e)], c,
+                          x_images.col(j * n + e).cast<double>(), A);
+      x[static_cast<std::size_t>(j)] = sum / static_cast<double>(n);
+    }
+  }
+  Eigen::MatrixXd out(A.absolute_size(), batch);
+  for (Eigen::Index j = 0; j < batch; ++j)
+    out.col(j) = decode_planar(x[static_cast<std::size_t>(j)], A);
+  return out;
+}
+
+}  // namespace c8
 
 std::unique_ptr<Head> make_c8_planar_head(const PolicyConfig& config) {
   if (config.representation != "absolute") {

@@ -25,21 +25,25 @@ std::string to_string(HeadKind kind) {
       return "c8ddpm";
     case HeadKind::c8flow_planar:
       return "c8flow_planar";
+    case HeadKind::c8ddpm_avg:
+      return "c8ddpm_avg";
   }
   return "?";
 }
 
 HeadKind parse_head(const std::string& name) {
   for (HeadKind kind : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow,
-                        HeadKind::c8ddpm, HeadKind::c8flow_planar}) {
+                        HeadKind::c8ddpm, HeadKind::c8flow_planar, HeadKind::c8ddpm_avg}) {
     if (to_string(kind) == name) return kind;
   }
-  throw InvalidArgument("unknown head '" + name +
-                        "': use one of flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar");
+  throw InvalidArgument(
+      "unknown head '" + name +
+      "': use one of flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar, c8ddpm_avg");
 }
 
 bool is_c8_planar(HeadKind kind) {
-  return kind == HeadKind::c8ddpm || kind == HeadKind::c8flow_planar;
+  return kind == HeadKind::c8ddpm || kind == HeadKind::c8flow_planar ||
+         kind == HeadKind::c8ddpm_avg;
 }
 
 std::string to_string(Activation activation) {

@@ -29,7 +29,7 @@
 
 #include "handcentric/policy/gaussian.hpp"
 #include "handcentric/policy/time_embedding.hpp"
-#include "network_head.hpp"
+#include "ddpm_head.hpp"
 
 namespace handcentric::policy {
 namespace {
@@ -49,100 +49,95 @@ std::vector<double> cosine_alpha_bar(int T) {
   return alpha_bar;
 }
 
-class DdpmHead final : public NetworkHead {
- public:
-  explicit DdpmHead(const PolicyConfig& config)
-      : NetworkHead(config),
-        alpha_bar_(cosine_alpha_bar(config.ddpm_train_steps)),
-        initial_noise_(static_cast<float>(config.noise_scale)) {}
-  HeadKind kind() const override { return HeadKind::ddpm; }
-
-  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
-               std::mt19937_64& rng) override {
-    NetworkHead::prepare(actions, observations, rng);
-    Eigen::MatrixXf normalized = actions.cast<float>();
-    action_normalizer_.normalize(normalized);
-    clip_ = std::max(1.0f, normalized.cwiseAbs().maxCoeff());
-  }
-
-  void write(ByteWriter& out) const override {
-    NetworkHead::write(out);
-    out.f64(clip_);
-  }
-
-  void read(ByteReader& in) override {
-    NetworkHead::read(in);
-    const double clip = in.f64();
-    if (!(clip >= 1.0 && clip < 1e6)) in.fail("a DDPM clip range of " + std::to_string(clip));
-    clip_ = static_cast<float>(clip);
-  }
-
-  double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
-                    std::mt19937_64& rng) override {
-    a_ = actions;
-    o_ = observations;
-    action_normalizer_.normalize(a_);
-    observation_normalizer_.normalize(o_);
-    const Eigen::Index batch = a_.cols();
-    const int T = config_.ddpm_train_steps;
-    noise_.resize(a_.rows(), batch);
-    fill_standard_normal(rng, noise_);
-    noise_.array().colwise() *=
-        action_normalizer_.active_float().array();  // constant dims: no noise
-    t_.resize(batch);
-    x_.resize(a_.rows(), batch);
-    for (Eigen::Index j = 0; j < batch; ++j) {
-      const int k = static_cast<int>(rng() % static_cast<std::uint64_t>(T));
-      t_[j] = static_cast<double>(k + 1) / T;
-      x_.col(j) = static_cast<float>(std::sqrt(alpha_bar_[k])) * a_.col(j) +
-                  static_cast<float>(std::sqrt(1.0 - alpha_bar_[k])) * noise_.col(j);
-    }
-    assemble(x_, t_, o_, input_);
-    return regress(network_.forward(input_),
-                   config_.ddpm_prediction == DdpmPrediction::sample ? a_ : noise_);
-  }
-
-  Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
-    Eigen::MatrixXf o = observations;
-    observation_normalizer_.normalize(o);
-    const Eigen::Index batch = o.cols();
-    const int T = config_.ddpm_train_steps, S = config_.ddim_steps;
-    Eigen::MatrixXf x(config_.action_dimension, batch);
-    fill_standard_normal(rng, x);
-    const Eigen::VectorXf& active = action_normalizer_.active_float();
-    x.array().colwise() *= active.array() * initial_noise_;
-    const bool predicts_sample = config_.ddpm_prediction == DdpmPrediction::sample;
-    Eigen::MatrixXf input, output, x0, eps_hat, scratch[2];
-    for (int i = 0; i < S; ++i) {
-      const int k = T - 1 - i * (T / S);
-      const int k_prev = i + 1 < S ? T - 1 - (i + 1) * (T / S) : -1;
-      const double abar = alpha_bar_[k], abar_prev = k_prev >= 0 ? alpha_bar_[k_prev] : 1.0;
-      const float signal = static_cast<float>(std::sqrt(abar));
-      const float noise = static_cast<float>(std::sqrt(1.0 - abar));
-      assemble(x, Eigen::VectorXd::Constant(batch, static_cast<double>(k + 1) / T), o, input);
-      network_.infer(input, output, scratch);
-      output.array().colwise() *= active.array();
-      if (predicts_sample) {
-        x0 = output.cwiseMax(-clip_).cwiseMin(clip_);
-        eps_hat = (x - signal * x0) / noise;
-      } else {
-        eps_hat = output;
-        x0 = ((x - noise * eps_hat) / signal).cwiseMax(-clip_).cwiseMin(clip_);
-      }
-      x = static_cast<float>(std::sqrt(abar_prev)) * x0 +
-          static_cast<float>(std::sqrt(1.0 - abar_prev)) * eps_hat;
-    }
-    action_normalizer_.denormalize(x);
-    return x;
-  }
-
- private:
-  std::vector<double> alpha_bar_;
-  float clip_ = 1.0f;           ///< max |normalized training action|, at least 1
-  float initial_noise_ = 1.0f;  ///< scale of x_T; 0 starts DDIM at the prior's mode
-};
-
 }  // namespace
+
+DdpmHead::DdpmHead(const PolicyConfig& config)
+    : NetworkHead(config),
+      alpha_bar_(cosine_alpha_bar(config.ddpm_train_steps)),
+      initial_noise_(static_cast<float>(config.noise_scale)) {}
+
+void DdpmHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+                       std::mt19937_64& rng) {
+  NetworkHead::prepare(actions, observations, rng);
+  Eigen::MatrixXf normalized = actions.cast<float>();
+  action_normalizer_.normalize(normalized);
+  clip_ = std::max(1.0f, normalized.cwiseAbs().maxCoeff());
+}
+
+void DdpmHead::write(ByteWriter& out) const {
+  NetworkHead::write(out);
+  out.f64(clip_);
+}
+
+void DdpmHead::read(ByteReader& in) {
+  NetworkHead::read(in);
+  const double clip = in.f64();
+  if (!(clip >= 1.0 && clip < 1e6)) in.fail("a DDPM clip range of " + std::to_string(clip));
+  clip_ = static_cast<float>(clip);
+}
+
+double DdpmHead::train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
+                            std::mt19937_64& rng) {
+  a_ = actions;
+  o_ = observations;
+  action_normalizer_.normalize(a_);
+  observation_normalizer_.normalize(o_);
+  const Eigen::Index batch = a_.cols();
+  const int T = config_.ddpm_train_steps;
+  noise_.resize(a_.rows(), batch);
+  fill_standard_normal(rng, noise_);
+  noise_.array().colwise() *= action_normalizer_.active_float().array();  // constant dims: no noise
+  t_.resize(batch);
+  x_.resize(a_.rows(), batch);
+  for (Eigen::Index j = 0; j < batch; ++j) {
+    const int k = static_cast<int>(rng() % static_cast<std::uint64_t>(T));
+    t_[j] = static_cast<double>(k + 1) / T;
+    x_.col(j) = static_cast<float>(std::sqrt(alpha_bar_[k])) * a_.col(j) +
+                static_cast<float>(std::sqrt(1.0 - alpha_bar_[k])) * noise_.col(j);
+  }
+  assemble(x_, t_, o_, input_);
+  return regress(network_.forward(input_),
+                 config_.ddpm_prediction == DdpmPrediction::sample ? a_ : noise_);
+}
+
+Eigen::MatrixXf DdpmHead::initial_noise(Eigen::Index batch, std::mt19937_64& rng) const {
+  Eigen::MatrixXf x(config_.action_dimension, batch);
+  fill_standard_normal(rng, x);
+  x.array().colwise() *= action_normalizer_.active_float().array() * initial_noise_;
+  return x;
+}
+
+void DdpmHead::ddim_step(Eigen::MatrixXf& x, const Eigen::MatrixXf& o, int i) const {
+  const Eigen::Index batch = x.cols();
+  const int T = config_.ddpm_train_steps, S = config_.ddim_steps;
+  const int k = T - 1 - i * (T / S);
+  const int k_prev = i + 1 < S ? T - 1 - (i + 1) * (T / S) : -1;
+  const double abar = alpha_bar_[k], abar_prev = k_prev >= 0 ? alpha_bar_[k_prev] : 1.0;
+  const float signal = static_cast<float>(std::sqrt(abar));
+  const float noise = static_cast<float>(std::sqrt(1.0 - abar));
+  Eigen::MatrixXf input, output, x0, eps_hat, scratch[2];
+  assemble(x, Eigen::VectorXd::Constant(batch, static_cast<double>(k + 1) / T), o, input);
+  network_.infer(input, output, scratch);
+  output.array().colwise() *= action_normalizer_.active_float().array();
+  if (config_.ddpm_prediction == DdpmPrediction::sample) {
+    x0 = output.cwiseMax(-clip_).cwiseMin(clip_);
+    eps_hat = (x - signal * x0) / noise;
+  } else {
+    eps_hat = output;
+    x0 = ((x - noise * eps_hat) / signal).cwiseMax(-clip_).cwiseMin(clip_);
+  }
+  x = static_cast<float>(std::sqrt(abar_prev)) * x0 +
+      static_cast<float>(std::sqrt(1.0 - abar_prev)) * eps_hat;
+}
+
+Eigen::MatrixXf DdpmHead::sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const {
+  Eigen::MatrixXf o = observations;
+  observation_normalizer_.normalize(o);
+  Eigen::MatrixXf x = initial_noise(o.cols(), rng);
+  for (int i = 0; i < config_.ddim_steps; ++i) ddim_step(x, o, i);
+  action_normalizer_.denormalize(x);
+  return x;
+}
 
 // DDIM starts at config.noise_scale times the prior's noise, as the flow heads' Euler
 // integration does: 0 (the default) samples the most likely chunk (eq. 6), which the 0.1 cm

@@ -34,6 +34,7 @@ std::unique_ptr<Head> make_head(const PolicyConfig& config) {
       return make_c8_flow_head(config);
     case HeadKind::c8ddpm:
     case HeadKind::c8flow_planar:
+    case HeadKind::c8ddpm_avg:
       return make_c8_planar_head(config);
   }
   throw InvalidArgument("make_head: unknown head");

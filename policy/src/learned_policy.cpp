@@ -40,10 +40,10 @@ Eigen::VectorXd LearnedPolicy::action_vector(const Scene& observation,
                        ": give observations shaped like the training data");
   }
   // Step 1: the observation in the representation's frame (hand-centric: eq. (3)).
-  const Eigen::MatrixXf o = representation_->encode_observation(observation).cast<float>();
+  const Eigen::MatrixXd o = representation_->encode_observation(observation);
   // Step 2: the head, with noise from the caller's seed.
   std::mt19937_64 rng(noise_seed);
-  const Eigen::VectorXd a = head_->sample(o, rng).col(0).cast<double>();
+  const Eigen::VectorXd a = head_->sample_double(o, rng).col(0);
   if (!a.allFinite()) {
     throw NonFiniteAction(
         name() +

@@ -123,7 +123,7 @@ PrefetchedCases run_prefetch_passes(const CaseFunction& run_case, Group group,
           // nothing has nothing to shrink): generating them all would only cost time.
           if (out.cases.size() >= kept) RC_FAIL("the cases to prefetch are kept");
           const Scene scene = *props::scene(shape);
-          const RigidTransform g = *group_element(group);
+          const RigidTransform g = *group_element(group, shape.planar);
           out.cases.emplace_back(scene, g);
           run(out.cases.size() - 1);
         },
@@ -230,7 +230,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
     if (!searching && ++shrink_evaluations > (options.shrink ? shrink_budget : 0))
       return;  // budget spent: keep the witness
     const Scene scene = *props::scene(shape);
-    const RigidTransform g = *group_element(group);
+    const RigidTransform g = *group_element(group, shape.planar);
     CaseOutcome outcome;
     const bool holds = search_case(scene, g, outcome);
     // Failing the property ends RapidCheck's search at once (its shrinking then sees every
@@ -270,6 +270,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
 CaseOutcome decide_pointwise(const PointwiseSides& sides, const Scene& scene,
                              const RigidTransform& g, const CheckOptions& options) {
   constexpr int kRoundingDraws = 2;
+  const bool planar = options.shape.planar;  // perturbations stay in the 2D task's plane
   CaseOutcome outcome;
   auto measure = [&](const Scene& s, Witness& witness) {
     const Scene moved = g * s;
@@ -295,8 +296,10 @@ CaseOutcome decide_pointwise(const PointwiseSides& sides, const Scene& scene,
   std::mt19937_64 rng(options.seed ^ 0x6a09e667f3bcc909ULL);
   std::vector<std::pair<const Scene*, Scene>> perturbed;  // (side, perturbed side), in draw order
   for (int d = 0; d < kRoundingDraws; ++d) {
-    perturbed.emplace_back(&scene, rounding_perturbation(scene, options.unit_roundoff, rng));
-    perturbed.emplace_back(&moved, rounding_perturbation(moved, options.unit_roundoff, rng));
+    perturbed.emplace_back(&scene,
+                           rounding_perturbation(scene, options.unit_roundoff, rng, planar));
+    perturbed.emplace_back(&moved,
+                           rounding_perturbation(moved, options.unit_roundoff, rng, planar));
   }
   if (prefetching()) {
     std::vector<Scene> asked;
@@ -316,7 +319,8 @@ CaseOutcome decide_pointwise(const PointwiseSides& sides, const Scene& scene,
   }
   const double eta = off_case_scale(options.unit_roundoff);
   std::vector<Scene> nearby;
-  for (int d = 0; d < options.off_case_draws; ++d) nearby.push_back(nearby_scene(scene, eta, rng));
+  for (int d = 0; d < options.off_case_draws; ++d)
+    nearby.push_back(nearby_scene(scene, eta, rng, planar));
   if (prefetching()) {
     std::vector<Scene> asked;
     for (const Scene& s : nearby) {

@@ -106,11 +106,34 @@ rc::Gen<Twist> step_twist(double step, double turn) {
   });
 }
 
+// A step twist in the plane: translation in x, y and rotation about z only.
+rc::Gen<Twist> planar_step_twist(double step, double turn) {
+  return rc::gen::map(rc::gen::tuple(translation(step), symmetric(turn)), [](const auto& vw) {
+    Twist twist;
+    const Eigen::Vector3d& v = std::get<0>(vw);
+    twist << v.x(), v.y(), 0.0, 0.0, 0.0, std::get<1>(vw);
+    return twist;
+  });
+}
+
 // A step twist, or, one time in eight, none: a hand at rest, T_k = T_0 exactly, where a map
 // that bins relative poses sits on the bin edge at 0 (a robot pausing in a demo does this).
-rc::Gen<Twist> step_or_rest(double step, double turn) {
+rc::Gen<Twist> step_or_rest(double step, double turn, bool planar) {
   return rc::gen::weightedOneOf<Twist>(
-      {{7, step_twist(step, turn)}, {1, rc::gen::just<Twist>(Twist::Zero())}});
+      {{7, planar ? planar_step_twist(step, turn) : step_twist(step, turn)},
+       {1, rc::gen::just<Twist>(Twist::Zero())}});
+}
+
+// A rotation about z: uniform angles mixed with the edge cases (identity, 1e-12, pi - 1e-9, pi).
+rc::Gen<Rotation> planar_rotation() {
+  return rc::gen::weightedOneOf<Rotation>({{4, rotation_about_z()}, {1, z_rotation_edge_cases()}});
+}
+
+// A uniform direction in the plane z = 0.
+rc::Gen<Eigen::Vector3d> planar_axis() {
+  return rc::gen::map(unit_interval(), [](double u) {
+    return Eigen::Vector3d(std::cos(2.0 * kPi * u), std::sin(2.0 * kPi * u), 0.0);
+  });
 }
 
 }  // namespace
@@ -148,16 +171,14 @@ rc::Gen<Eigen::Vector3d> translation(double max_abs) {
                       });
 }
 
-rc::Gen<RigidTransform> group_element(Group group) {
+rc::Gen<RigidTransform> group_element(Group group, bool planar) {
   switch (group) {
     case Group::translation:
-      return combine(rc::gen::just(Rotation::identity()), translation_with_edges(false));
+      return combine(rc::gen::just(Rotation::identity()), translation_with_edges(planar));
     case Group::rotation:
       return combine(rotation(), rc::gen::just<Eigen::Vector3d>(Eigen::Vector3d::Zero()));
     case Group::se2:
-      return combine(
-          rc::gen::weightedOneOf<Rotation>({{4, rotation_about_z()}, {1, z_rotation_edge_cases()}}),
-          translation_with_edges(true));
+      return combine(planar_rotation(), translation_with_edges(true));
     case Group::se3:
       return combine(rotation(), translation_with_edges(false));
     case Group::c8:
@@ -168,16 +189,26 @@ rc::Gen<RigidTransform> group_element(Group group) {
 
 namespace {
 
+// A point with coordinates in [-max_abs, max_abs], in the plane z = 0 when planar.
+rc::Gen<Eigen::Vector3d> point(double max_abs, bool planar) {
+  if (!planar) return translation(max_abs);
+  return rc::gen::map(translation(max_abs), [](Eigen::Vector3d p) {
+    p.z() = 0.0;
+    return p;
+  });
+}
+
 // Between min_count and max_count points; with min_count = 0, RapidCheck's sized container.
-rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, double max_abs) {
+rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, double max_abs,
+                                             bool planar) {
   if (min_count <= 0) {
-    return rc::gen::resize(max_count,
-                           rc::gen::container<std::vector<Eigen::Vector3d>>(translation(max_abs)));
+    return rc::gen::resize(
+        max_count, rc::gen::container<std::vector<Eigen::Vector3d>>(point(max_abs, planar)));
   }
   return rc::gen::mapcat(rc::gen::inRange(min_count, std::max(min_count, max_count) + 1),
-                         [max_abs](int count) {
+                         [max_abs, planar](int count) {
                            return rc::gen::container<std::vector<Eigen::Vector3d>>(
-                               static_cast<std::size_t>(count), translation(max_abs));
+                               static_cast<std::size_t>(count), point(max_abs, planar));
                          });
 }
 
@@ -211,11 +242,13 @@ rc::Gen<Scene> scene(SceneShape shape) {
           s.world_points = world_points;
           return s;
         },
-        rotation(), unit_axis(), rc::gen::just(scale), step_or_rest(0.01 * scale, 0.3),
-        step_or_rest(0.01 * scale, 0.3), rc::gen::inRange(shape.min_history, shape.max_history + 1),
+        shape.planar ? planar_rotation() : rotation(), shape.planar ? planar_axis() : unit_axis(),
+        rc::gen::just(scale), step_or_rest(0.01 * scale, 0.3, shape.planar),
+        step_or_rest(0.01 * scale, 0.3, shape.planar),
+        rc::gen::inRange(shape.min_history, shape.max_history + 1),
         rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
-        points(shape.min_hand_points, shape.max_hand_points, 0.1 * scale),
-        points(shape.min_world_points, shape.max_world_points, scale));
+        points(shape.min_hand_points, shape.max_hand_points, 0.1 * scale, shape.planar),
+        points(shape.min_world_points, shape.max_world_points, scale, shape.planar));
   });
   if (shape.extra_pose_names.empty() && shape.scalar_names.empty()) return geometry;
   // Named extras: one random pose per name (anywhere, any orientation), one number per scalar.

@@ -50,6 +50,21 @@ Eigen::Vector3d random_direction(std::mt19937_64& rng) {
   return v.normalized();
 }
 
+// A random unit direction, in the plane z = 0 when planar.
+Eigen::Vector3d random_direction(std::mt19937_64& rng, bool planar) {
+  if (!planar) return random_direction(rng);
+  Eigen::Vector3d v;
+  do {
+    v = Eigen::Vector3d(standard_normal(rng), standard_normal(rng), 0.0);
+  } while (!(v.norm() > 1e-12));
+  return v.normalized();
+}
+
+// A random rotation axis: any, or +-z when planar (the plane's rotations).
+Eigen::Vector3d random_axis(std::mt19937_64& rng, bool planar) {
+  return planar ? Eigen::Vector3d(0.0, 0.0, random_sign(rng)) : random_direction(rng);
+}
+
 // Every pose, point and scalar of `scene` mapped through the given functions.
 template <typename Pose, typename Point, typename Scalar>
 Scene moved_each(const Scene& scene, Pose&& pose, Point&& point, Scalar&& scalar) {
@@ -65,7 +80,8 @@ Scene moved_each(const Scene& scene, Pose&& pose, Point&& point, Scalar&& scalar
 
 }  // namespace
 
-Scene rounding_perturbation(const Scene& scene, double unit_roundoff, std::mt19937_64& rng) {
+Scene rounding_perturbation(const Scene& scene, double unit_roundoff, std::mt19937_64& rng,
+                            bool planar) {
   const double step = kRoundingPerturbationUlps * unit_roundoff;
   auto coordinates = [&](Eigen::Vector3d x) {
     for (int i = 0; i < 3; ++i) x(i) *= 1.0 + step * random_sign(rng);
@@ -73,21 +89,21 @@ Scene rounding_perturbation(const Scene& scene, double unit_roundoff, std::mt199
   };
   auto pose = [&](const RigidTransform& T) {
     return RigidTransform::unchecked(
-        T.rotation().matrix() * Rotation::exp(step * random_direction(rng)).matrix(),
+        T.rotation().matrix() * Rotation::exp(step * random_axis(rng, planar)).matrix(),
         coordinates(T.translation()));
   };
   return moved_each(scene, pose, coordinates,
                     [&](double x) { return x * (1.0 + step * random_sign(rng)); });
 }
 
-Scene nearby_scene(const Scene& scene, double eta, std::mt19937_64& rng) {
+Scene nearby_scene(const Scene& scene, double eta, std::mt19937_64& rng, bool planar) {
   const double reach = eta * (1.0 + length_scale(scene));
   auto point = [&](const Eigen::Vector3d& x) -> Eigen::Vector3d {
-    return x + reach * random_direction(rng);
+    return x + reach * random_direction(rng, planar);
   };
   auto pose = [&](const RigidTransform& T) {
     Twist twist;
-    twist << reach * random_direction(rng), eta * random_direction(rng);
+    twist << reach * random_direction(rng, planar), eta * random_axis(rng, planar);
     return T * RigidTransform::exp(twist);
   };
   return moved_each(scene, pose, point, [&](double x) {

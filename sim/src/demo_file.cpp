@@ -158,9 +158,8 @@ void save_demo_records(const std::string& path, const DemoFileTask& task, double
 
 namespace {
 
-// The one reader of demo files, from a file or from memory; `path` names the source in errors.
-std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& path,
-                                          const DemoFileTask& task, const DemoFileLimits& limits) {
+// The header line, its format and version checked; `path` names the source in errors.
+json read_header(std::istream& in, const std::string& path, const DemoFileLimits& limits) {
   std::string line;
   bool newline = false;
   if (!read_line(in, line, newline, limits, path, "line 1 (header)")) {
@@ -183,10 +182,23 @@ std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& p
              (header.contains("version") ? header["version"].dump() : "(none)") +
              "; this build reads version " + std::to_string(kVersion));
   }
-  // A header without a task is the 2D task's: files written before the 3D task existed.
-  const std::string file_task = !header.contains("task")     ? "peg2d"
-                                : header["task"].is_string() ? header["task"].get<std::string>()
-                                                             : header["task"].dump();
+  return header;
+}
+
+// A header without a task is the 2D task's: files written before the 3D task existed.
+std::string task_of(const json& header) {
+  return !header.contains("task")     ? "peg2d"
+         : header["task"].is_string() ? header["task"].get<std::string>()
+                                      : header["task"].dump();
+}
+
+// The one reader of demo files, from a file or from memory; `path` names the source in errors.
+std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& path,
+                                          const DemoFileTask& task, const DemoFileLimits& limits) {
+  json header = read_header(in, path, limits);
+  std::string line;
+  bool newline = false;
+  const std::string file_task = task_of(header);
   if (file_task != task.name) {
     fail(path, "line 1 (header)",
          "a demo file of task '" + file_task + "', not '" + task.name + "': use a " + task.name +
@@ -257,14 +269,34 @@ std::vector<DemoRecord> read_demo_records(std::istream& in, const std::string& p
 
 }  // namespace
 
-std::vector<DemoRecord> load_demo_records(const std::string& path, const DemoFileTask& task,
-                                          const DemoFileLimits& limits) {
+namespace {
+std::ifstream open_demo_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in)
     throw InvalidDemoFile("cannot open demo file '" + path +
                           "'; check the path (make one with `handcentric demos`)");
+  return in;
+}
+}  // namespace
+
+std::vector<DemoRecord> load_demo_records(const std::string& path, const DemoFileTask& task,
+                                          const DemoFileLimits& limits) {
+  std::ifstream in = open_demo_file(path);
   return read_demo_records(in, path, task, limits);
 }
+
+}  // namespace handcentric::sim::detail
+
+namespace handcentric::sim {
+
+std::string demo_file_task(const std::string& path, const DemoFileLimits& limits) {
+  std::ifstream in = detail::open_demo_file(path);
+  return detail::task_of(detail::read_header(in, path, limits));
+}
+
+}  // namespace handcentric::sim
+
+namespace handcentric::sim::detail {
 
 std::vector<DemoRecord> parse_demo_records(const std::string& bytes, const std::string& source,
                                            const DemoFileTask& task, const DemoFileLimits& limits) {

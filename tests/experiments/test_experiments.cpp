@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <unistd.h>
 
 #include "handcentric/core/errors.hpp"
@@ -257,5 +258,45 @@ TEST_CASE("collect_builds_the_table_from_whatever_results_exist", "[unit]") {
   CHECK_THAT(text, Contains("\"id_success\": 0.4"));
   CHECK_THAT(text, Contains("\"ood_success\": null"));
   CHECK(std::filesystem::exists(dir / "table1.png"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("table1_audits_every_model_and_shows_its_symmetry_beside_its_success", "[unit]") {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("handcentric_test_table1_audit_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  Table1Options options;
+  options.demo_counts = {2};
+  options.methods = parse_methods("hand_centric,absolute,c8_averaged");
+  options.steps = 20;
+  options.eval.trials = 1;
+  options.eval.audit_cases = 30;
+  options.jobs = 1;
+  options.quiet = true;
+  options.out = dir.string();
+  run_table1(options, prepare_table1(options));
+  const std::string md = collect_table1(dir.string());
+  std::ifstream json(dir / "table1.json");
+  const nlohmann::json rows = nlohmann::json::parse(json).at("rows");
+  REQUIRE(rows.size() == 3);
+  const auto verdict = [&](const std::string& method, const std::string& group) {
+    for (const auto& r : rows) {
+      if (r.at("method") == method) return r.at("symmetry").at(group).at("equivariant").get<bool>();
+    }
+    FAIL("no row " << method);
+    return false;
+  };
+  // The 2D task's groups: translation in the plane, se2, c8 (rotation and se3 tilt the plane).
+  for (const char* group : {"translation", "se2", "c8"}) CHECK(verdict("hand_centric", group));
+  for (const char* group : {"translation", "se2", "c8"}) CHECK_FALSE(verdict("absolute", group));
+  CHECK(verdict("c8_averaged", "c8"));
+  CHECK_FALSE(verdict("c8_averaged", "se2"));
+  CHECK_FALSE(verdict("c8_averaged", "translation"));
+  CHECK_FALSE(rows[0].at("symmetry").contains("se3"));
+  CHECK_THAT(md, Contains("| audited symmetry |"));
+  CHECK_THAT(md, Contains("| c8_averaged/c8ddpm_avg | id | ") && Contains(", c8 yes ("));
+  // A damaged audit file is named, not read as a verdict.
+  HC_CHECK_THROWS(parse_audit_json("{\"policies\": []}", "a.json"), InvalidArgument,
+                  Contains("'a.json'"));
   std::filesystem::remove_all(dir);
 }

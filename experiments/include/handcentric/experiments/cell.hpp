@@ -29,6 +29,9 @@ struct EvalSettings {
   std::uint64_t ood_seed = 101;   ///< the independent OOD scenes
   /// The scene seed of `set` ("train" or "ood" distribution is implied by the set).
   std::uint64_t seed(SceneSet set) const { return set == SceneSet::ood ? ood_seed : eval_seed; }
+  /// Cases per group of each model's pointwise audit (model_audit.hpp); 0: no audit (a run
+  /// written before the audit column).
+  int audit_cases = 200;
 };
 
 struct Cell {
@@ -46,6 +49,9 @@ struct Cell {
   std::string model_path() const;  ///< "models/<hash>.hcm"
   /// "results/<hash>.<set>-s<seed>-n<trials>-r<sim::kRolloutRulesVersion>.json"
   std::string result_path(SceneSet set, const EvalSettings& eval) const;
+  /// "results/<hash>.audit-pointwise-n<eval.audit_cases>.json": `handcentric audit --model
+  /// --view eye_in_hand --pointwise --json` of the model.
+  std::string audit_path(const EvalSettings& eval) const;
 };
 
 /// FNV-1a 64 of `bytes`, as 16 hex digits.

@@ -21,6 +21,14 @@ std::string eval_json(const sim::RolloutSummary& summary, const std::string& pol
 /// such an object (a cut or foreign file).
 sim::RolloutSummary parse_eval_json(const std::string& text, const std::string& source);
 
+/// One group's verdict of a model's pointwise audit (model_audit.hpp): equivariant or not, and
+/// the largest error seen (m and rad, the chunk distance of props/policy_audit.hpp).
+struct SymmetryVerdict {
+  std::string group;
+  bool equivariant = false;
+  double max_error = 0.0;
+};
+
 /// One row of table1.json.
 struct Row {
   std::string method, head;
@@ -29,13 +37,20 @@ struct Row {
   std::string model;  ///< the cell hash
   std::optional<double> id_success, ood_success, ood_paired_success;
   std::optional<Interval> id_ci, ood_ci;
+  /// The model's audit, one verdict per group in the audit's order; empty when not audited.
+  std::vector<SymmetryVerdict> symmetry;
 };
 
 /// The row of `cell` from whichever of its result files exist under `dir` (missing ones stay
 /// empty). Throws InvalidArgument for a damaged result file.
 Row collect_row(const Cell& cell, const EvalSettings& eval, const std::string& dir);
 
-/// {"rows": [...]} with the field names (null for a missing value).
+/// The eye-in-hand pointwise verdicts of a `handcentric audit --model --json` document. Throws
+/// InvalidArgument naming `source` when it is not one.
+std::vector<SymmetryVerdict> parse_audit_json(const std::string& text, const std::string& source);
+
+/// {"rows": [...]} with the field names (null for a missing value); "symmetry": the
+/// audit's verdicts as {group: {"equivariant", "max_error"}}, null when not audited.
 std::string rows_json(const std::vector<Row>& rows);
 
 }  // namespace handcentric::experiments

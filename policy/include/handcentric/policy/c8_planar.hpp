@@ -61,14 +61,14 @@ Eigen::MatrixXd orbit(const Eigen::MatrixXd& planar, const Eigen::Vector2d& cent
 /// The symmetry centre a c8ddpm config names (c8_centre_x, c8_centre_y).
 Eigen::Vector2d centre_of(const PolicyConfig& config);
 
-/// How many training samples each demo step stands for: 8 for c8ddpm and c8flow_planar, which
+/// How many training samples each demo step stands for: 8 for the planar C8 heads, which
 /// train on every sample's C8 orbit (the 8x augmented data), 1 for every other head. The automatic
 /// budget counts the augmented data (training_budget(HeadKind, samples), trainer.hpp).
 int augmentation_copies(HeadKind head);
 
-/// The config of the network inside a c8ddpm (c8flow_planar) head: a DDPM (flow) head on the
-/// planar dimensions, with every other setting of config (network, training, noise_scale); the
-/// DDPM predicts epsilon whatever config.ddpm_prediction says.
+/// The config of the network inside a c8ddpm or c8ddpm_avg (c8flow_planar) head: a DDPM (flow)
+/// head on the planar dimensions, with every other setting of config (network, training,
+/// noise_scale); the DDPM predicts epsilon whatever config.ddpm_prediction says.
 /// Throws InvalidArgument if config's action or observation dimension does not fit its layout
 /// (an observation with extra poses or scalars, which the C8 baseline does not transform).
 PolicyConfig inner_config(const PolicyConfig& config);

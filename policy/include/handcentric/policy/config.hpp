@@ -9,8 +9,10 @@ namespace handcentric::policy {
 /// The generative head (Sec. 2.3 and App. B): rectified flow, DDPM, CVAE, the C8-symmetrized
 /// flow on absolute rotation vectors, or the C8 baseline of Table 1 (c8_planar.hpp): DDPM on
 /// planar poses, trained on the C8 orbit of its data (stand-ins for Equivariant-DiffPo [7]),
-/// or the same with the rectified flow (c8flow_planar, a control for the DDPM).
-enum class HeadKind { flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar };
+/// or the same with the rectified flow (c8flow_planar, a control for the DDPM), or c8ddpm with
+/// its denoising step averaged over C8 at every DDIM step, C8-equivariant by construction
+/// (c8ddpm_avg, c8_averaged.hpp).
+enum class HeadKind { flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar, c8ddpm_avg };
 
 enum class Activation { silu, relu };
 
@@ -24,11 +26,12 @@ enum class LearningRateSchedule { constant, cosine };
 /// as `prediction_type`). Either gives the other through x_k = sqrt(abar) x0 + sqrt(1 - abar) eps.
 enum class DdpmPrediction { epsilon, sample };
 
-/// "flow", "ddpm", "cvae", "c8flow", "c8ddpm", "c8flow_planar".
+/// "flow", "ddpm", "cvae", "c8flow", "c8ddpm", "c8flow_planar", "c8ddpm_avg".
 std::string to_string(HeadKind kind);
 /// Throws InvalidArgument naming the value and the valid names.
 HeadKind parse_head(const std::string& name);
-/// c8ddpm or c8flow_planar: the heads on the planar C8 encoding, which read c8_centre_*.
+/// c8ddpm, c8flow_planar or c8ddpm_avg: the heads on the planar C8 encoding, which read
+/// c8_centre_*.
 bool is_c8_planar(HeadKind kind);
 std::string to_string(Activation activation);
 Activation parse_activation(const std::string& name);
@@ -112,8 +115,8 @@ struct PolicyConfig {
   /// decoder was trained on. On the tuning seeds hand-centric CVAE at 40 demos inserts 0.75 of
   /// the time with 10, 0.69 with 1, 0.67 with 100 and 0.03 with 0.01 (docs/EXPERIMENTS.md).
   double cvae_kl_weight = 10.0;
-  /// The point C8 rotates about (world x, y; the task's cm) for heads c8ddpm and c8flow_planar
-  /// (c8_planar.hpp).
+  /// The point C8 rotates about (world x, y; the task's cm) for heads c8ddpm, c8flow_planar and
+  /// c8ddpm_avg (c8_planar.hpp).
   /// Stored only for that head, so other heads' configs (and Table 1 hashes) are unchanged.
   double c8_centre_x = 0.0;
   double c8_centre_y = 0.0;

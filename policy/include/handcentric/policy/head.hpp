@@ -11,6 +11,8 @@
 //            analogue of Equivariant Diffusion Policy [7] (not [7] itself; see c8_action.hpp)
 //   c8ddpm : DDPM on planar poses (x, y, z, cos, sin) trained on the C8 orbit of its data about
 //            config.c8_centre_*: Table 1's stand-in for [7] (c8_planar.hpp)
+//   c8ddpm_avg : c8ddpm's network, trained the same way, whose DDIM step is averaged over C8
+//            at every step: exactly C8-equivariant whatever the weights (c8_averaged.hpp)
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
@@ -45,6 +47,16 @@ class Head {
   /// One raw action vector per raw observation column; all noise from `rng`.
   virtual Eigen::MatrixXf sample(const Eigen::MatrixXf& observations,
                                  std::mt19937_64& rng) const = 0;
+
+  /// sample() in double, from observations as the representation encoded them (what
+  /// LearnedPolicy calls). By default the observations are rounded to float32 and the actions
+  /// are sample()'s. c8ddpm_avg moves the observations by C8 before rounding and returns its
+  /// average in double: o and g o rounded first, or g a and a(g o) rounded after, would differ
+  /// by float32 rounding of world coordinates, an equivariance error far above double rounding.
+  virtual Eigen::MatrixXd sample_double(const Eigen::MatrixXd& observations,
+                                        std::mt19937_64& rng) const {
+    return sample(observations.cast<float>(), rng).cast<double>();
+  }
 
   /// Normalization statistics and weights (the config is stored by the model file).
   virtual void write(ByteWriter& out) const = 0;

@@ -35,7 +35,9 @@ rc::Gen<Eigen::Vector3d> translation(double max_abs);
 /// An element of `group`, including that group's edge cases (identity, tiny angles, angles near
 /// pi where the group has them, zero and 1e3 m translations where it has translations).
 /// Translations are otherwise of log-uniform length in [0.01, 10] m, in a uniform direction.
-rc::Gen<RigidTransform> group_element(Group group);
+/// `planar`: translations in the plane z = 0 (the 2D task's); rotation and se3 have no planar
+/// form (they tilt the plane) and are generated as without it.
+rc::Gen<RigidTransform> group_element(Group group, bool planar = false);
 
 /// Scene sizes.
 struct SceneShape {
@@ -50,6 +52,9 @@ struct SceneShape {
   std::vector<std::string> extra_pose_names;
   /// Named scalars to generate (e.g. "gripper"): numbers in [-1, 1] that g leaves alone.
   std::vector<std::string> scalar_names;
+  /// The 2D task's scenes: every pose a rotation about z at z = 0, every step in the plane,
+  /// every point at z = 0; the checks then draw planar translations and perturb in the plane.
+  bool planar = false;
 };
 
 /// A scene at a length scale lambda drawn log-uniformly in [0.01, 10] m: a random start pose
@@ -57,7 +62,7 @@ struct SceneShape {
 /// 0.01 lambda and 0.3 rad per axis; one time in eight none, a hand at rest with T_k = T_0), a
 /// history the same way backwards, eye-in-hand points
 /// within 0.1 lambda and world points within lambda per coordinate, and the extra poses (within
-/// 10 m) and scalars the shape names.
+/// 10 m) and scalars the shape names; all of it in the plane z = 0 when shape.planar.
 rc::Gen<Scene> scene(SceneShape shape = {});
 
 }  // namespace handcentric::props

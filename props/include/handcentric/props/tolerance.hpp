@@ -74,12 +74,15 @@ double off_case_scale(double unit_roundoff);
 /// `scene` with every input moved by a few units of rounding: each translation and point
 /// coordinate x -> x (1 + 4 u xi) and each rotation R -> R exp(4 u omega) (xi = +-1, |omega| =
 /// 1, random), each scalar likewise. What the map does to it is its own rounding response.
-Scene rounding_perturbation(const Scene& scene, double unit_roundoff, std::mt19937_64& rng);
+/// `planar` (the 2D task's scenes): omega along z, so that the scene stays in the plane.
+Scene rounding_perturbation(const Scene& scene, double unit_roundoff, std::mt19937_64& rng,
+                            bool planar = false);
 
 /// `scene` moved slightly off: each pose T -> T exp(rho, omega) with |rho| = eta (1 + L(s)) and
 /// |omega| = eta, each point by eta (1 + L) and each scalar by eta max(1, |x|), in random
-/// directions. Applied before g, so g * nearby_scene(s) is the moved case.
-Scene nearby_scene(const Scene& scene, double eta, std::mt19937_64& rng);
+/// directions (in the plane, omega along z, when `planar`). Applied before g, so
+/// g * nearby_scene(s) is the moved case.
+Scene nearby_scene(const Scene& scene, double eta, std::mt19937_64& rng, bool planar = false);
 
 /// angle(R~) + |p~| / (1 + L(s)): how far g is from the identity, relative to the scene.
 double distance_from_identity(const RigidTransform& g, const Scene& scene);

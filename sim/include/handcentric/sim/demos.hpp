@@ -61,6 +61,12 @@ struct Demo {
 std::vector<Demo> load_demos(const std::string& path,
                              const DemoFileLimits& limits = DemoFileLimits());
 
+/// The task a demo file records in its header ("peg2d" for a header without one, written before
+/// the 3D task), reading the header line only. Throws InvalidDemoFile as load_demos does for a
+/// missing file or a bad header.
+std::string demo_file_task(const std::string& path,
+                           const DemoFileLimits& limits = DemoFileLimits());
+
 /// load_demos on a file's bytes already in memory (received, embedded, or a fuzzer's input);
 /// `source` names them in errors as the path would. Same checks, limits and errors.
 std::vector<Demo> parse_demos(const std::string& bytes, const std::string& source,
