@@ -181,16 +181,17 @@ PYBIND11_MODULE(_core, m) {
 #define HANDCENTRIC_SETUP_PARAMETERS                                                         \
   py::handle batch_size, const std::string &array, py::handle device, bool quiet,            \
       py::handle history, py::handle hand_points, py::handle world_points, py::handle chunk, \
-      py::handle cameras, py::handle image_size, const std::string &channels, bool floor
-#define HANDCENTRIC_SETUP_VALUE                                          \
-  Setup{batch_size,   array, device,  quiet,      history,  hand_points, \
-        world_points, chunk, cameras, image_size, channels, floor}
+      py::handle cameras, py::handle image_size, const std::string &channels, bool floor,    \
+      py::handle workspace
+#define HANDCENTRIC_SETUP_VALUE                                                        \
+  Setup{batch_size, array,   device,     quiet,    history, hand_points, world_points, \
+        chunk,      cameras, image_size, channels, floor,   workspace}
 #define HANDCENTRIC_SETUP_ARGUMENTS                                                               \
   py::arg("batch_size") = py::none(), py::arg("array") = "numpy", py::arg("device") = py::none(), \
   py::arg("quiet") = false, py::arg("history") = py::none(), py::arg("hand_points") = py::none(), \
   py::arg("world_points") = py::none(), py::arg("chunk") = py::none(),                            \
   py::arg("cameras") = py::none(), py::arg("image_size") = py::none(),                            \
-  py::arg("channels") = "rgbd", py::arg("floor") = false
+  py::arg("channels") = "rgbd", py::arg("floor") = false, py::arg("workspace") = py::none()
 
   m.def(
       "audit",

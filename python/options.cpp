@@ -118,6 +118,20 @@ namespace {
 constexpr long long kMaxImageSide = 1024;
 constexpr long long kMaxImageNumbers = 1LL << 26;
 
+/// workspace=: None, ((x0, y0, z0), (x1, y1, z1)) or six numbers, validated.
+std::optional<props::Workspace> workspace_of(py::handle value) {
+  if (value.is_none()) return std::nullopt;
+  const auto a = real_array(value, "workspace");
+  if (a.size() != 6) {
+    throw ShapeError("workspace has shape " + shape_of(a) +
+                     "; give ((x0, y0, z0), (x1, y1, z1)) in m, e.g. ((-1, -1, 0), (1, 1, 1))");
+  }
+  props::Workspace box{Eigen::Vector3d(a.data()[0], a.data()[1], a.data()[2]),
+                       Eigen::Vector3d(a.data()[3], a.data()[4], a.data()[5])};
+  box.validate();
+  return box;
+}
+
 }  // namespace
 
 std::shared_ptr<const props::CameraRig> camera_rig_of(const Setup& setup,
@@ -196,6 +210,7 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
   o.world_points = optional_integer(setup.world_points, "world_points", 1, kMaxSceneSize, "64");
   o.chunk = optional_integer(setup.chunk, "chunk", 1, kMaxSceneSize, "64");
   o.call.cameras = camera_rig_of(setup, o.batch_size);
+  o.audit.workspace = workspace_of(setup.workspace);
   return o;
 }
 

@@ -34,6 +34,7 @@ struct Setup {
   py::handle cameras = py::none(), image_size = py::none();
   std::string channels = "rgbd";
   bool floor = false;
+  py::handle workspace = py::none();
 };
 
 /// The docstring part about Setup's keywords.
@@ -56,6 +57,8 @@ green, blue in [0, 1], then depth in m), "rgb" or "depth"; floor=True adds the f
 lamp straight down, which do not move with g. Each point is drawn as a sphere of radius 5 cm
 (eye-in-hand points orange, world points green), each extra pose as a blue box;
 handcentric.render_cameras shows what the audit rendered for a scene.
+workspace=((x0, y0, z0), (x1, y1, z1)) (m): every scene is drawn inside this box and every g so
+that g o stays inside too (a policy meant for its cell); each verdict's note says so.
 A progress line with the time left goes to stderr after 3 s (quiet=True: none). Needs NumPy
 (ImportError at once without it); Ctrl-C stops it with KeyboardInterrupt.)doc";
 
