@@ -37,6 +37,7 @@ struct AuditCommandOptions {
   double timeout = 10.0;
   double tolerance = 0.0;
   std::string precision = "float64";
+  std::string workspace;
   bool json = false;
   bool pointwise = false;
   std::string exec, policy_exec, model;
@@ -143,6 +144,7 @@ int run_audit(const AuditCommandOptions& options) {
   audit.seed = options.seed;
   audit.precision = props::parse_precision(options.precision);
   audit.relative_tolerance = options.tolerance;
+  if (!options.workspace.empty()) audit.workspace = props::Workspace::parse(options.workspace);
   const double relative = props::audit_relative_tolerance(audit);  // validates --tolerance
   const std::vector<Expectation> expectations = parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
@@ -213,6 +215,9 @@ int run_audit(const AuditCommandOptions& options) {
       << (options.tolerance > 0.0                        ? " (--tolerance)"
           : audit.precision == props::Precision::float32 ? " (float32 rounding)"
                                                          : "")
+      << (audit.workspace ? "; every case inside the workspace " + audit.workspace->describe() +
+                                ", g * scene too (--workspace)"
+                          : std::string())
       << "\n"
       << (policies ? "'yes' = equivariant, a(g o, n) = g a(o, n) (eq. 4); pointwise with the same "
                      "noise n, in distribution with n ~ N(0, I). "
@@ -262,6 +267,9 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--precision", options->precision,
                   "float64, or float32 for a representation computed in float32 (REL = 1e-4)")
       ->capture_default_str();
+  cmd->add_option("--workspace", options->workspace,
+                  "x0,y0,z0,x1,y1,z1 (m): draw every scene inside this box and every g so that "
+                  "g * scene stays in it (a policy meant for its cell); default: anywhere");
   cmd->add_option("--timeout", options->timeout, "seconds to wait for each answer of a plug-in")
       ->capture_default_str();
   cmd->add_option(

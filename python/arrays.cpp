@@ -288,12 +288,25 @@ ArrayKind array_kind_of(const std::string& array, py::handle device) {
   return kind;
 }
 
-py::object for_callable(py::array_t<double> a, const ArrayKind& kind) {
-  if (!kind.torch) return a;
+namespace {
+
+py::object as_tensor(py::array a, const ArrayKind& kind) {
   static py::object from_numpy = py::module_::import("torch").attr("from_numpy");
   py::object tensor = from_numpy(std::move(a));
   if (!kind.device.is_none()) tensor = tensor.attr("to")(kind.device);
   return tensor;
+}
+
+}  // namespace
+
+py::object for_callable(py::array_t<double> a, const ArrayKind& kind) {
+  if (!kind.torch) return a;
+  return as_tensor(std::move(a), kind);
+}
+
+py::object for_callable(py::array_t<float> a, const ArrayKind& kind) {
+  if (!kind.torch) return a;
+  return as_tensor(std::move(a), kind);
 }
 
 }  // namespace handcentric::python

@@ -91,6 +91,8 @@ ArrayKind array_kind_of(const std::string& array, py::handle device);
 
 /// `a` as the callable wants it: itself, or torch.from_numpy(a) on the device (float64).
 py::object for_callable(py::array_t<double> a, const ArrayKind& kind);
+/// The same for float32 images (torch.float32 tensors).
+py::object for_callable(py::array_t<float> a, const ArrayKind& kind);
 
 /// Stacked arguments of scenes of one shape: (B, H+1, 4, 4), (B, K, 4, 4), (B, n, 3), (B, m, 3),
 /// (B, d), a pose per scene (B, 4, 4), a number per scene (B,).

@@ -1,5 +1,6 @@
 #include "callables.hpp"
 
+#include <algorithm>
 #include <pybind11/stl.h>
 #include <utility>
 
@@ -17,9 +18,11 @@ py::object call(const py::object& fn, Args&&... args) {
   }
 }
 
-/// extra_poses={name: (4, 4) or (B, 4, 4)} and scalars={name: float or (B,)}, when wanted.
+/// extra_poses={name: (4, 4) or (B, 4, 4)} and scalars={name: float or (B,)}, when wanted, and
+/// images= when the audit has cameras.
 py::kwargs extras_kwargs(const std::vector<const Scene*>& scenes, const CallOptions& options) {
   py::kwargs kw;
+  if (options.cameras && !scenes.empty()) kw["images"] = images_of(scenes, options);
   if (!options.extras || scenes.empty()) return kw;
   py::dict poses, scalars;
   const Scene& first = *scenes.front();
@@ -56,6 +59,30 @@ std::vector<Eigen::VectorXd> rows_of(py::handle result, std::size_t rows, const 
 }
 
 }  // namespace
+
+py::dict images_of(const std::vector<const Scene*>& scenes, const CallOptions& options) {
+  const props::CameraRig& rig = *options.cameras;
+  const int c = props::channel_count(rig.channels);
+  const py::ssize_t h = rig.camera.height, w = rig.camera.width;
+  std::vector<py::array_t<float>> arrays;
+  for (std::size_t v = 0; v < rig.views.size(); ++v) {
+    arrays.push_back(options.stacked ? py::array_t<float>({static_cast<py::ssize_t>(scenes.size()),
+                                                           static_cast<py::ssize_t>(c), h, w})
+                                     : py::array_t<float>({static_cast<py::ssize_t>(c), h, w}));
+  }
+  const std::size_t per_image = static_cast<std::size_t>(c) * static_cast<std::size_t>(h * w);
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const std::vector<CameraImage> images = props::render_views(*scenes[i], rig);
+    for (std::size_t v = 0; v < images.size(); ++v) {
+      const std::vector<float> pixels = props::network_image(images[v], rig.channels);
+      std::copy(pixels.begin(), pixels.end(), arrays[v].mutable_data() + i * per_image);
+    }
+  }
+  py::dict out;
+  for (std::size_t v = 0; v < rig.views.size(); ++v)
+    out[py::str(props::to_string(rig.views[v]))] = for_callable(arrays[v], options.arrays);
+  return out;
+}
 
 std::string callable_name(const py::object& fn) {
   if (py::hasattr(fn, "__qualname__")) return py::str(fn.attr("__qualname__"));

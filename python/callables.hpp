@@ -15,6 +15,7 @@
 
 #include "arrays.hpp"
 #include "handcentric/props/batch.hpp"
+#include "handcentric/props/observation/camera_rig.hpp"
 
 namespace handcentric::python {
 
@@ -23,7 +24,13 @@ struct CallOptions {
   bool stacked = false;  ///< stacked arrays (B, ...) instead of one scene's
   ArrayKind arrays;      ///< NumPy arrays or torch tensors
   bool extras = false;   ///< pass extra_poses= and scalars= keywords (the audit asked for some)
+  /// When set: pass images={view: (C, h, w) or (B, C, h, w) float32} rendered by this rig.
+  std::shared_ptr<const props::CameraRig> cameras;
 };
+
+/// images={view: array} as a callable receives them for `scenes` (one: (C, h, w); stacked:
+/// (B, C, h, w) float32), rendered by options.cameras.
+py::dict images_of(const std::vector<const Scene*>& scenes, const CallOptions& options);
 
 /// The name a report shows for a callable: a function's qualified name, else its class's (an
 /// object with __call__, e.g. a torch module), so that the name does not change between runs.

@@ -59,6 +59,21 @@ py::object json_loads(const std::string& text) {
   return py::module_::import("json").attr("loads")(text);
 }
 
+/// What the audited callable was shown besides poses: the report says how its images were made.
+py::dict cameras_dict(const props::CameraRig& rig) {
+  py::list views;
+  for (const props::CameraView view : rig.views) views.append(props::to_string(view));
+  py::dict d;
+  d["views"] = views;
+  d["image_size"] = py::make_tuple(rig.camera.width, rig.camera.height);
+  d["channels"] = props::to_string(rig.channels);
+  d["horizontal_fov_deg"] = rig.camera.horizontal_fov_deg;
+  d["max_range_m"] = rig.camera.max_range;
+  d["point_radius_m"] = rig.point_radius;
+  d["floor"] = rig.floor;
+  return d;
+}
+
 py::dict audit(py::object actions, py::object observation, py::handle groups, py::handle views,
                py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
                const std::string& precision, py::object decode, py::handle extra_poses,
@@ -80,7 +95,9 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
   ProgressLine progress("audit", o.quiet);
   c.progress = std::ref(progress);
   const props::Classification result = props::classify_representation(representation, c);
-  return json_loads(props::audit_json({result}))["representations"][py::int_(0)];
+  py::dict report = json_loads(props::audit_json({result}))["representations"][py::int_(0)];
+  if (o.call.cameras) report["cameras"] = cameras_dict(*o.call.cameras);
+  return report;
 }
 
 py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py::handle cases,
@@ -97,7 +114,9 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   ProgressLine progress("audit_policy", o.quiet);
   c.progress = std::ref(progress);
   const props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
-  return json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
+  py::dict report = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
+  if (o.call.cameras) report["cameras"] = cameras_dict(*o.call.cameras);
+  return report;
 }
 
 // Built-ins on NumPy
@@ -159,15 +178,20 @@ PYBIND11_MODULE(_core, m) {
   m.attr("MAX_BATCH_SIZE") = props::kMaxBatchSize;  // batch_size= above it: ValueError
 
   // The keywords of Setup, the same on every audit.
-#define HANDCENTRIC_SETUP_PARAMETERS                                              \
-  py::handle batch_size, const std::string &array, py::handle device, bool quiet, \
-      py::handle history, py::handle hand_points, py::handle world_points, py::handle chunk
-#define HANDCENTRIC_SETUP_VALUE \
-  Setup{batch_size, array, device, quiet, history, hand_points, world_points, chunk}
+#define HANDCENTRIC_SETUP_PARAMETERS                                                         \
+  py::handle batch_size, const std::string &array, py::handle device, bool quiet,            \
+      py::handle history, py::handle hand_points, py::handle world_points, py::handle chunk, \
+      py::handle cameras, py::handle image_size, const std::string &channels, bool floor,    \
+      py::handle workspace
+#define HANDCENTRIC_SETUP_VALUE                                                        \
+  Setup{batch_size, array,   device,     quiet,    history, hand_points, world_points, \
+        chunk,      cameras, image_size, channels, floor,   workspace}
 #define HANDCENTRIC_SETUP_ARGUMENTS                                                               \
   py::arg("batch_size") = py::none(), py::arg("array") = "numpy", py::arg("device") = py::none(), \
   py::arg("quiet") = false, py::arg("history") = py::none(), py::arg("hand_points") = py::none(), \
-  py::arg("world_points") = py::none(), py::arg("chunk") = py::none()
+  py::arg("world_points") = py::none(), py::arg("chunk") = py::none(),                            \
+  py::arg("cameras") = py::none(), py::arg("image_size") = py::none(),                            \
+  py::arg("channels") = "rgbd", py::arg("floor") = false, py::arg("workspace") = py::none()
 
   m.def(
       "audit",
@@ -294,6 +318,33 @@ Every view in `views` must hold.
       },
       py::arg("representation"), py::arg("history"), py::arg("hand_points") = py::none(),
       py::arg("world_points") = py::none(), "A built-in representation's observation vector.");
+  m.def(
+      "render_cameras",
+      [](py::handle history, py::handle hand_points, py::handle world_points, py::handle cameras,
+         py::handle image_size, const std::string& channels, bool floor, py::dict extra_poses) {
+        Setup setup;
+        setup.cameras = cameras;
+        setup.image_size = image_size;
+        setup.channels = channels;
+        setup.floor = floor;
+        CallOptions call;
+        call.cameras = camera_rig_of(setup, std::nullopt);
+        Scene scene = scene_from(history, py::none(), hand_points, world_points);
+        for (const auto& [name, pose] : extra_poses) {
+          const std::string key = py::str(name);
+          scene.extra_poses.emplace_back(
+              key, RigidTransform::from_matrix(matrix4_from(pose, "extra_poses['" + key + "']")));
+        }
+        return images_of({&scene}, call);
+      },
+      py::arg("history"), py::arg("hand_points") = py::none(), py::arg("world_points") = py::none(),
+      py::kw_only(), py::arg("cameras") = py::make_tuple("eye_in_hand"),
+      py::arg("image_size") = py::none(), py::arg("channels") = "rgbd", py::arg("floor") = false,
+      py::arg("extra_poses") = py::dict(),
+      R"doc(The images an audit with these cameras hands a policy for one scene.
+
+Returns {camera: (C, h, w) float32}, as audit_policy(..., cameras=...) passes images=: what the
+policy saw, e.g. for a witness's scene and g * scene.)doc");
   m.def(
       "decode",
       [](const std::string& name, py::handle actions, py::handle world_T_hand0) {

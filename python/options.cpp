@@ -111,6 +111,74 @@ int noise_of(py::handle noise) {
   return bounded_integer(noise, "noise", 1, props::kMaxPolicyNoise, "handcentric.MAX_NOISE");
 }
 
+/// The largest image side, in pixels, and the most float32 numbers one batch's images may hold
+/// (256 MiB): bounds fixed before anything is allocated.
+namespace {
+
+constexpr long long kMaxImageSide = 1024;
+constexpr long long kMaxImageNumbers = 1LL << 26;
+
+/// workspace=: None, ((x0, y0, z0), (x1, y1, z1)) or six numbers, validated.
+std::optional<props::Workspace> workspace_of(py::handle value) {
+  if (value.is_none()) return std::nullopt;
+  const auto a = real_array(value, "workspace");
+  if (a.size() != 6) {
+    throw ShapeError("workspace has shape " + shape_of(a) +
+                     "; give ((x0, y0, z0), (x1, y1, z1)) in m, e.g. ((-1, -1, 0), (1, 1, 1))");
+  }
+  props::Workspace box{Eigen::Vector3d(a.data()[0], a.data()[1], a.data()[2]),
+                       Eigen::Vector3d(a.data()[3], a.data()[4], a.data()[5])};
+  box.validate();
+  return box;
+}
+
+}  // namespace
+
+std::shared_ptr<const props::CameraRig> camera_rig_of(const Setup& setup,
+                                                      std::optional<int> batch_size) {
+  if (setup.cameras.is_none()) {
+    if (!setup.image_size.is_none() || setup.channels != "rgbd" || setup.floor) {
+      throw InvalidArgument(
+          "image_size=, channels= and floor= describe the cameras' images, but cameras=None: "
+          "pass cameras=(\"eye_in_hand\",) (or \"third_person\") too");
+    }
+    return nullptr;
+  }
+  auto rig = std::make_shared<props::CameraRig>();
+  rig->views.clear();
+  for (const std::string& name : names_of(setup.cameras, "cameras"))
+    rig->views.push_back(props::parse_camera_view(name));
+  if (!setup.image_size.is_none()) {
+    std::vector<py::object> size;
+    try {
+      size = setup.image_size.cast<std::vector<py::object>>();
+    } catch (const py::cast_error&) {
+      throw DtypeError("image_size must be (width, height), got a " + type_name(setup.image_size));
+    }
+    if (size.size() != 2) {
+      throw InvalidArgument("image_size must be two numbers (width, height), got " +
+                            std::to_string(size.size()) + "; e.g. (64, 48)");
+    }
+    rig->camera.width = bounded_integer(size[0], "image width", 1, kMaxImageSide, "1024");
+    rig->camera.height = bounded_integer(size[1], "image height", 1, kMaxImageSide, "1024");
+  }
+  rig->channels = props::parse_image_channels(setup.channels);
+  rig->floor = setup.floor;
+  rig->validate();
+  const long long numbers =
+      static_cast<long long>(batch_size.value_or(1)) * static_cast<long long>(rig->views.size()) *
+      props::channel_count(rig->channels) * rig->camera.width * rig->camera.height;
+  if (numbers > kMaxImageNumbers) {
+    throw InvalidArgument("batch_size=" + std::to_string(batch_size.value_or(1)) + " with " +
+                          std::to_string(rig->views.size()) + " camera(s) of " +
+                          std::to_string(rig->camera.width) + " x " +
+                          std::to_string(rig->camera.height) + " makes " + std::to_string(numbers) +
+                          " numbers of images per batch, above 2**26; use a smaller batch_size "
+                          "or image_size");
+  }
+  return rig;
+}
+
 CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
                              std::uint64_t seed, std::optional<double> tolerance,
                              const std::string& precision, py::handle extra_poses,
@@ -141,6 +209,8 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
   o.hand_points = optional_integer(setup.hand_points, "hand_points", 0, kMaxSceneSize, "64");
   o.world_points = optional_integer(setup.world_points, "world_points", 1, kMaxSceneSize, "64");
   o.chunk = optional_integer(setup.chunk, "chunk", 1, kMaxSceneSize, "64");
+  o.call.cameras = camera_rig_of(setup, o.batch_size);
+  o.audit.workspace = workspace_of(setup.workspace);
   return o;
 }
 

@@ -31,6 +31,10 @@ struct Setup {
   bool quiet = false;
   py::handle history = py::none(), hand_points = py::none(), world_points = py::none(),
              chunk = py::none();
+  py::handle cameras = py::none(), image_size = py::none();
+  std::string channels = "rgbd";
+  bool floor = false;
+  py::handle workspace = py::none();
 };
 
 /// The docstring part about Setup's keywords.
@@ -46,6 +50,15 @@ call) bit for bit. Scenes of one shape share a batch: history=, hand_points=, wo
 (third-person view) and chunk= fix the sizes (None: the audit draws them per case).
 array="torch" passes float64 torch tensors (on device=, e.g. "cuda"), array="numpy" (default)
 NumPy arrays; results may be either, on any device, with or without grad.
+cameras=("eye_in_hand",) (or "third_person", or both) renders, for each scene, the images a
+policy would see and passes images={name: array} as a keyword: (C, h, w) float32 per scene,
+(B, C, h, w) batched; image_size=(w, h) (default (64, 48)); channels "rgbd" (default: red,
+green, blue in [0, 1], then depth in m), "rgb" or "depth"; floor=True adds the floor z <= 0 and a
+lamp straight down, which do not move with g. Each point is drawn as a sphere of radius 5 cm
+(eye-in-hand points orange, world points green), each extra pose as a blue box;
+handcentric.render_cameras shows what the audit rendered for a scene.
+workspace=((x0, y0, z0), (x1, y1, z1)) (m): every scene is drawn inside this box and every g so
+that g o stays inside too (a policy meant for its cell); each verdict's note says so.
 A progress line with the time left goes to stderr after 3 s (quiet=True: none). Needs NumPy
 (ImportError at once without it); Ctrl-C stops it with KeyboardInterrupt.)doc";
 
@@ -65,6 +78,11 @@ void require_numpy(const char* function);
 
 /// `noise` in [1, MAX_NOISE].
 int noise_of(py::handle noise);
+
+/// The camera rig of cameras=, image_size=, channels= and floor= (None when cameras=None), its
+/// images per batch bounded (2**26 float32 numbers) before anything is allocated.
+std::shared_ptr<const props::CameraRig> camera_rig_of(const Setup& setup,
+                                                      std::optional<int> batch_size);
 
 CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
                              std::uint64_t seed, std::optional<double> tolerance,

@@ -62,11 +62,11 @@ void draw_box(cv::Mat& canvas, const ViewCamera& view, const RigidTransform& wor
 }
 
 // The depth image, enlarged, near bright: depth d maps to 255 (1 - d / max_range).
-cv::Mat depth_panel(const insert3d::DepthImage& image, double max_range) {
+cv::Mat depth_panel(const CameraImage& image, double max_range) {
   cv::Mat panel(image.height * kDepthScale, image.width * kDepthScale, CV_8UC3);
   for (int row = 0; row < image.height; ++row) {
     for (int col = 0; col < image.width; ++col) {
-      const double shade = 255.0 * std::clamp(1.0 - image.at(row, col) / max_range, 0.0, 1.0);
+      const double shade = 255.0 * std::clamp(1.0 - image.depth_at(row, col) / max_range, 0.0, 1.0);
       const cv::Scalar grey(shade, shade, shade);
       cv::rectangle(panel, cv::Rect(col * kDepthScale, row * kDepthScale, kDepthScale, kDepthScale),
                     grey, cv::FILLED);

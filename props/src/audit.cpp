@@ -98,6 +98,8 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
       options.precision == Precision::float32 ? kFloat32UnitRoundoff : kFloat64UnitRoundoff;
   classifier.distribution.cases = std::max(10, (options.cases + 99) / 100);
   classifier.injectivity_cases = std::max(100, options.cases / 5);
+  if (options.workspace) options.workspace->validate();
+  classifier.check.shape.workspace = options.workspace;
   return classifier;
 }
 
@@ -149,8 +151,15 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
         }
       }
     }
-    for (const Verdict* verdict : noted)
-      out << "  note: " << cell_name(*verdict) << ": " << verdict->note << "\n";
+    for (const Verdict* verdict : noted) {
+      // The workspace is said once, in the header: its note is left out of each cell's here.
+      std::string note = verdict->note;
+      if (options.workspace) {
+        const std::string shared = options.workspace->verdict_note();
+        if (note.rfind(shared, 0) == 0) note.erase(0, std::min(note.size(), shared.size() + 2));
+      }
+      if (!note.empty()) out << "  note: " << cell_name(*verdict) << ": " << note << "\n";
+    }
     // One line for the "yes" cells decided (partly) by tests (marked ~): what they could miss.
     int tested_yes = 0;
     bool policy = false;

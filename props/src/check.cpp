@@ -62,6 +62,14 @@ double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<Ri
   return worst;
 }
 
+std::pair<Scene, RigidTransform> draw_case(const SceneShape& shape, Group group) {
+  if (shape.workspace) return *case_in_workspace(shape, group, *shape.workspace);
+  // Two draws, in this order, as every verdict and witness without a workspace was found.
+  Scene scene = *props::scene(shape);
+  const RigidTransform g = *group_element(group, shape.planar);
+  return {std::move(scene), g};
+}
+
 void run_silently(const std::function<void()>& property, const std::string& description,
                   std::uint64_t seed, int cases) {
   load_rapidcheck_configuration_quietly();
@@ -122,9 +130,7 @@ PrefetchedCases run_prefetch_passes(const CaseFunction& run_case, Group group,
           // Beyond the kept cases, failing ends RapidCheck's run at once (a case that generated
           // nothing has nothing to shrink): generating them all would only cost time.
           if (out.cases.size() >= kept) RC_FAIL("the cases to prefetch are kept");
-          const Scene scene = *props::scene(shape);
-          const RigidTransform g = *group_element(group, shape.planar);
-          out.cases.emplace_back(scene, g);
+          out.cases.push_back(draw_case(shape, group));
           run(out.cases.size() - 1);
         },
         description, seed, cases);
@@ -175,6 +181,8 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   bool searching = true;  // false once the first failure is seen: then RapidCheck shrinks
   std::exception_ptr error;
   const SceneShape shape = options.shape;
+  // A workspace that leaves the group no room is an error of the call, said before any case.
+  if (shape.workspace) (void)shape.workspace->room_for(group);
   int shrink_evaluations = 0;
   // One case of the search: false when it failed (or raised: `error`).
   auto search_case = [&](const Scene& scene, const RigidTransform& g, CaseOutcome& outcome,
@@ -229,8 +237,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
     if (error) return;  // a broken function under test: let RapidCheck finish at once
     if (!searching && ++shrink_evaluations > (options.shrink ? shrink_budget : 0))
       return;  // budget spent: keep the witness
-    const Scene scene = *props::scene(shape);
-    const RigidTransform g = *group_element(group, shape.planar);
+    const auto [scene, g] = draw_case(shape, group);
     CaseOutcome outcome;
     const bool holds = search_case(scene, g, outcome);
     // Failing the property ends RapidCheck's search at once (its shrinking then sees every
@@ -255,14 +262,16 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
                 "; run more cases (seed " + std::to_string(options.seed) + ")");
   }
   verdict.invariant = !verdict.witness.has_value();
+  if (shape.workspace) verdict.note = shape.workspace->verdict_note();
   if (verdict.discontinuities > 0) {
-    verdict.note = std::to_string(verdict.discontinuities) + " of " +
-                   std::to_string(verdict.cases) +
-                   " far cases sat on a discontinuity of the map (a bin edge, where inputs that "
-                   "differ by rounding fall into neighbouring bins): the outputs differed there "
-                   "but agreed with both scenes moved " +
-                   format_number(off_case_scale(options.unit_roundoff)) +
-                   " (1 + L) off the case; not counted as symmetry breaking";
+    verdict.note += std::string(verdict.note.empty() ? "" : "; ") +
+                    std::to_string(verdict.discontinuities) + " of " +
+                    std::to_string(verdict.cases) +
+                    " far cases sat on a discontinuity of the map (a bin edge, where inputs that "
+                    "differ by rounding fall into neighbouring bins): the outputs differed there "
+                    "but agreed with both scenes moved " +
+                    format_number(off_case_scale(options.unit_roundoff)) +
+                    " (1 + L) off the case; not counted as symmetry breaking";
   }
   return verdict;
 }

@@ -20,10 +20,11 @@ Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
   loose.unit_roundoff = kFloat32UnitRoundoff;
   loose.shrink = false;
   if (recheck(loose).invariant) {
-    verdict.note = "fails at tolerance " + format_number(options.check.relative_tolerance) +
-                   " (1 + L) but holds at float32 rounding, " +
-                   format_number(kFloat32RelativeTolerance) +
-                   " (1 + L): the errors look like float32 rounding; " + options.float32_advice;
+    verdict.note += std::string(verdict.note.empty() ? "" : "; ") + "fails at tolerance " +
+                    format_number(options.check.relative_tolerance) +
+                    " (1 + L) but holds at float32 rounding, " +
+                    format_number(kFloat32RelativeTolerance) +
+                    " (1 + L): the errors look like float32 rounding; " + options.float32_advice;
   }
   return verdict;
 }

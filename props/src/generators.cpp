@@ -1,7 +1,11 @@
 #include "handcentric/props/generators.hpp"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <type_traits>
+
+#include "handcentric/core/errors.hpp"
 
 #include "handcentric/core/sampling.hpp"
 
@@ -267,6 +271,122 @@ rc::Gen<Scene> scene(SceneShape shape) {
         return s;
       },
       geometry, poses, numbers);
+}
+
+}  // namespace handcentric::props
+
+namespace handcentric::props {
+namespace {
+
+// Every world-frame position of a scene (Workspace::contains reads the same ones).
+template <class Visit>
+void for_each_world_position(Scene& scene, Visit visit) {
+  for (RigidTransform& T : scene.world_T_hand_history) visit(T);
+  for (RigidTransform& T : scene.world_T_hand_chunk) visit(T);
+  for (Eigen::Vector3d& p : scene.world_points) visit(p);
+  for (auto& [name, T] : scene.extra_poses) visit(T);
+}
+
+Eigen::Vector3d position_of(const RigidTransform& T) {
+  return T.translation();
+}
+Eigen::Vector3d position_of(const Eigen::Vector3d& p) {
+  return p;
+}
+
+// The scene scaled by k about `centre` and moved so that centre lands at `target`: a valid scene
+// of the same shape and rotations (eye-in-hand points scaled too, so that it looks the same).
+Scene scaled_and_placed(Scene scene, const Eigen::Vector3d& centre, double k,
+                        const Eigen::Vector3d& target) {
+  const auto place = [&](const Eigen::Vector3d& p) -> Eigen::Vector3d {
+    return target + k * (p - centre);
+  };
+  for_each_world_position(scene, [&](auto& x) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(x)>, RigidTransform>) {
+      x = RigidTransform(x.rotation(), place(x.translation()));
+    } else {
+      x = place(x);
+    }
+  });
+  for (Eigen::Vector3d& p : scene.hand_points) p *= k;
+  return scene;
+}
+
+// The translations t with R x + t inside the box for every world position x of `scene`, per
+// axis [low, high] (non-empty by the placement's construction, up to rounding).
+std::pair<Eigen::Vector3d, Eigen::Vector3d> feasible_translations(Scene scene,
+                                                                  const Eigen::Matrix3d& R,
+                                                                  const Workspace& box) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  for_each_world_position(scene, [&](auto& x) {
+    const Eigen::Vector3d turned = R * position_of(x);
+    low = low.cwiseMax(box.min - turned);
+    high = high.cwiseMin(box.max - turned);
+  });
+  return {low, high};
+}
+
+}  // namespace
+
+rc::Gen<std::pair<Scene, RigidTransform>> case_in_workspace(const SceneShape& shape, Group group,
+                                                            const Workspace& box) {
+  SceneShape free_shape = shape;
+  free_shape.workspace.reset();
+  const Eigen::Vector3d half = 0.5 * (box.max - box.min);
+  const Eigen::Vector3d middle = 0.5 * (box.max + box.min);
+  // The room each group's rotations leave: a ball about the origin (rotation), a cylinder about
+  // world z (c8), the box itself (groups with translations, which move the scene back in).
+  const double room = box.room_for(group);
+  const bool planar = shape.planar;
+  if (planar && !(box.min.z() <= 0.0 && box.max.z() >= 0.0)) {
+    throw InvalidArgument("the workspace " + box.describe() +
+                          " does not contain the plane z = 0 of the 2D task's scenes: give a box "
+                          "with z0 <= 0 <= z1");
+  }
+  return rc::gen::apply(
+      [box, group, room, half, middle, planar](Scene scene, double size_u, const Eigen::Vector3d& spot,
+                                       const RigidTransform& g_drawn, const Eigen::Vector3d& t_u) {
+        // The scene's centre and radius (over its world positions).
+        Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+        Eigen::Vector3d hi = -lo;
+        for_each_world_position(scene, [&](auto& x) {
+          lo = lo.cwiseMin(position_of(x));
+          hi = hi.cwiseMax(position_of(x));
+        });
+        const Eigen::Vector3d centre = 0.5 * (lo + hi);
+        double radius = 0.0;
+        for_each_world_position(
+            scene, [&](auto& x) { radius = std::max(radius, (position_of(x) - centre).norm()); });
+        // Scaled to a radius between room / 20 and room / 2 (never up), leaving room to move.
+        const double target_radius = room * (0.05 + 0.45 * size_u);
+        const double k = radius > target_radius ? target_radius / radius : 1.0;
+        const double r = k * radius;
+        Eigen::Vector3d target;  // spot in [-1, 1]^3 picks where the centre goes
+        if (group == Group::rotation) {
+          target = (room - r) * spot / std::max(1.0, spot.norm());
+        } else if (group == Group::c8) {
+          Eigen::Vector2d xy = spot.head<2>() / std::max(1.0, spot.head<2>().norm());
+          target << (room - r) * xy, middle.z() + (half.z() - r) * spot.z();
+        } else {
+          target = middle + (half - Eigen::Vector3d::Constant(r)).cwiseProduct(spot);
+        }
+        if (planar) target.z() = 0.0;  // the scene stays in its plane
+        Scene placed = scaled_and_placed(std::move(scene), centre, k, target);
+        const Eigen::Matrix3d R = g_drawn.rotation().matrix();
+        Eigen::Vector3d t = Eigen::Vector3d::Zero();
+        if (group == Group::translation || group == Group::se2 || group == Group::se3) {
+          const auto [low, high] = feasible_translations(placed, R, box);
+          const int axes = group == Group::se2 || planar ? 2 : 3;  // se2 moves in the plane
+          for (int axis = 0; axis < axes; ++axis)
+            t(axis) = low(axis) + t_u(axis) * std::max(0.0, high(axis) - low(axis));
+        }
+        return std::make_pair(std::move(placed), RigidTransform(g_drawn.rotation(), t));
+      },
+      scene(free_shape), unit_interval(), translation(1.0), group_element(group, planar),
+      rc::gen::map(translation(1.0), [](const Eigen::Vector3d& u) {
+        return Eigen::Vector3d(0.5 * (u.array() + 1.0));
+      }));
 }
 
 }  // namespace handcentric::props

@@ -5,10 +5,12 @@
 // injectivity and failing cells' witnesses below) or the JSON document of docs/AUDIT.md.
 #include <memory>
 #include <ostream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "handcentric/props/classifier.hpp"
+#include "handcentric/props/workspace.hpp"
 
 namespace handcentric::props {
 
@@ -27,6 +29,8 @@ struct AuditOptions {
   /// REL of the tolerance REL * (1 + L); 0 = from `precision` (kRelativeTolerance for float64,
   /// kFloat32RelativeTolerance for float32).
   double relative_tolerance = 0.0;
+  /// Draw every case inside this box, g * scene included (workspace.hpp); none: anywhere.
+  std::optional<Workspace> workspace;
 };
 
 /// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value

@@ -6,6 +6,8 @@
 // and exactly pi. Every generator shrinks toward simpler values (smaller numbers, fewer poses).
 #include <rapidcheck.h>
 
+#include <optional>
+
 #include <string>
 #include <vector>
 
@@ -13,6 +15,7 @@
 #include "handcentric/core/rotation.hpp"
 #include "handcentric/core/scene.hpp"
 #include "handcentric/props/group.hpp"
+#include "handcentric/props/workspace.hpp"
 
 namespace handcentric::props {
 
@@ -55,6 +58,9 @@ struct SceneShape {
   /// The 2D task's scenes: every pose a rotation about z at z = 0, every step in the plane,
   /// every point at z = 0; the checks then draw planar translations and perturb in the plane.
   bool planar = false;
+  /// When set, the checks draw their cases by case_in_workspace() instead of scene() and
+  /// group_element().
+  std::optional<Workspace> workspace;
 };
 
 /// A scene at a length scale lambda drawn log-uniformly in [0.01, 10] m: a random start pose
@@ -64,5 +70,16 @@ struct SceneShape {
 /// within 0.1 lambda and world points within lambda per coordinate, and the extra poses (within
 /// 10 m) and scalars the shape names; all of it in the plane z = 0 when shape.planar.
 rc::Gen<Scene> scene(SceneShape shape = {});
+
+/// A scene inside `workspace` and a g in `group` that keeps it there (every world-frame position
+/// of g * scene inside too, Workspace::contains). The scene is one of scene(shape), scaled about
+/// its centre so that it has room to move, and placed: anywhere in the box for the groups with
+/// translations, whose g then gets a translation drawn from those that keep g * scene inside;
+/// within the largest ball about the origin inside the box for rotation, and within the largest
+/// cylinder about world z for c8 (g has no translation there). Throws InvalidArgument when the
+/// box leaves a rotation group no room (rotation: the origin not inside the box; c8: the z axis
+/// not inside it).
+rc::Gen<std::pair<Scene, RigidTransform>> case_in_workspace(const SceneShape& shape, Group group,
+                                                            const Workspace& workspace);
 
 }  // namespace handcentric::props

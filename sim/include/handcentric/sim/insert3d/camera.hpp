@@ -1,28 +1,25 @@
 #pragma once
-// The hand camera of the 3D task: a small depth image rendered by ray casting from a camera
-// fixed to the hand (eye-in-hand, as in "Hand-centric action representations make behavior
-// cloning SE(3)-equivariant", Sec. 3.2). The image depends only on where the slot is relative
-// to the hand, hand_T_slot, so the image of g * scene is the image of the scene for every g in
-// SE(3) (tests/sim checks it to 1e-9, and that a camera fixed in the world fails).
+// The hand camera of the 3D task: a small depth image rendered by ray casting (core/camera.hpp,
+// the camera model the audit renders with too) from a camera fixed to the hand (eye-in-hand, as
+// in "Guaranteed SE(3)-Equivariant Control via Hand-Centric Behavior Cloning", Sec. 3.2). The
+// image depends only on where the slot is relative to the hand, hand_T_slot, so the image of
+// g * scene is the image of the scene for every g in SE(3) (tests/sim checks it to 1e-9, and that
+// a camera fixed in the world fails).
 //
-// Camera frame (OpenCV's): +z along the optical axis, +x to the right of the image, +y down.
-// Pixel (row, col) looks along ((col + 0.5 - W/2) / f, (row + 0.5 - H/2) / f, 1) with
-// f = (W/2) / tan(horizontal_fov / 2), so the ray parameter of a hit is its depth (its camera z).
 // The rendered objects are the block's five boxes and the blade (which the camera sees at the
-// same place in every image); a ray that hits nothing within max_range reads max_range.
-#include <vector>
+// same place in every image); a ray that hits nothing within max_range (cm) reads max_range.
+#include <array>
 
+#include "handcentric/core/camera.hpp"
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/sim/insert3d/geometry.hpp"
 
 namespace handcentric::sim::insert3d {
 
-struct DepthCamera {
-  int width = 32;
-  int height = 24;
-  double horizontal_fov_deg = 70.0;
-  /// Depth (cm) read where a ray hits nothing.
-  double max_range = 60.0;
+/// The task's hand camera: 32 x 24 pixels, 70 deg across, 60 cm of range, on default_mount().
+struct DepthCamera : PinholeCamera {
+  DepthCamera() : PinholeCamera{32, 24, 70.0, 60.0} {}
+
   /// Where the camera sits on the hand.
   RigidTransform hand_T_camera = default_mount();
 
@@ -31,36 +28,23 @@ struct DepthCamera {
   /// slot's opening from the approach to full insertion.
   static RigidTransform default_mount();
 
-  /// Throws InvalidArgument naming the value and the fix: sizes outside [1, 4096], a field of
-  /// view outside (0, 170) deg, a non-positive or non-finite range.
-  void validate() const;
-
-  /// f, the focal length in pixels.
-  double focal_length() const;
+  /// Throws InvalidArgument naming the value and the fix (PinholeCamera::validate).
+  void validate() const { PinholeCamera::validate("depth camera"); }
 };
 
-/// A depth image, row-major: depth(row, col) = values[row * width + col].
-struct DepthImage {
-  int width = 0;
-  int height = 0;
-  std::vector<double> values;
+/// The block's walls (in the slot frame) and the blade (in the hand frame) as solids in the hand
+/// frame, for the hand at hand_T_slot relative to the slot.
+std::vector<Solid> task_solids_in_hand(const BladeSlotGeometry& geometry,
+                                       const RigidTransform& hand_T_slot);
 
-  double at(int row, int col) const { return values[static_cast<std::size_t>(row * width + col)]; }
-};
-
-/// The nearest hit of the ray origin + t direction (t >= 0) with the axis-aligned box, or a
-/// negative number when it misses (slab method; a ray starting inside the box hits at t = 0).
-double ray_box_hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
-                   const Box3& box);
-
-/// The depth image seen by `camera` on the hand at hand_T_slot relative to the slot. Throws
-/// InvalidArgument for a bad camera or geometry.
-DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera,
-                        const RigidTransform& hand_T_slot);
+/// The image seen by `camera` on the hand at hand_T_slot relative to the slot (its depth is what
+/// the task's policies and figures read). Throws InvalidArgument for a bad camera or geometry.
+CameraImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera,
+                         const RigidTransform& hand_T_slot);
 
 /// The same for a scene in the world: renders hand_T_slot = world_T_hand^-1 world_T_slot.
-DepthImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera,
-                        const RigidTransform& world_T_hand, const RigidTransform& world_T_slot);
+CameraImage render_depth(const BladeSlotGeometry& geometry, const DepthCamera& camera,
+                         const RigidTransform& world_T_hand, const RigidTransform& world_T_slot);
 
 /// The eye-in-hand key points: the slot opening's four corners (BladeSlotGeometry's order) in the
 /// hand frame, as the 2D task's two corners.
