@@ -8,6 +8,9 @@
 //   handcentric audit --exec 'python3 examples/python_representation/repr.py' --json
 //   handcentric audit --policy-exec 'python3 my_policy.py' --expect se3
 //   handcentric audit --model hc.model
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -24,6 +27,7 @@
 #include "handcentric/props/pipe_policy.hpp"
 #include "handcentric/props/pipe_representation.hpp"
 #include "handcentric/props/policy_audit.hpp"
+#include "handcentric/sim/draw.hpp"
 
 namespace handcentric::apps {
 namespace {
@@ -37,12 +41,66 @@ struct AuditCommandOptions {
   double timeout = 10.0;
   double tolerance = 0.0;
   std::string precision = "float64";
-  std::string workspace;
+  std::string workspace, witness_dir;
   bool json = false;
   bool pointwise = false;
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
 };
+
+// One camera image as a PNG: the colour image beside its depth (near bright, black at the
+// camera's range), each pixel 4 x 4, so that a 64 x 48 image reads at a glance.
+sim::Image witness_panel(const CameraImage& image, double max_range) {
+  constexpr int kScale = 4;
+  sim::Image out;
+  out.width = 2 * image.width * kScale + kScale;
+  out.height = image.height * kScale;
+  out.rgb.assign(static_cast<std::size_t>(out.width) * out.height * 3, 255);
+  for (int y = 0; y < out.height; ++y) {
+    for (int x = 0; x < out.width; ++x) {
+      const int col = x / kScale, row = y / kScale;
+      const std::size_t pixel = static_cast<std::size_t>(row) * image.width;
+      std::uint8_t* to = &out.rgb[3 * (static_cast<std::size_t>(y) * out.width + x)];
+      if (col < image.width) {
+        for (int c = 0; c < 3; ++c)
+          to[c] = static_cast<std::uint8_t>(
+              std::lround(255.0 * std::clamp(image.rgb[3 * (pixel + col) + c], 0.0, 1.0)));
+      } else if (col > image.width) {
+        const double depth = image.depth[pixel + static_cast<std::size_t>(col - image.width - 1)];
+        const auto shade = static_cast<std::uint8_t>(
+            std::lround(255.0 * std::clamp(1.0 - depth / max_range, 0.0, 1.0)));
+        to[0] = to[1] = to[2] = shade;
+      }
+    }
+  }
+  return out;
+}
+
+// --witness-dir: for each failing check of a policy that sees cameras, the images it was shown
+// of the witness's o and of g o (what the policy saw differ), one PNG per camera and side.
+void write_witness_images(const std::string& dir, const props::Classification& result,
+                          const props::CameraRig& rig) {
+  std::filesystem::create_directories(dir);
+  int written = 0;
+  for (const props::Verdict& verdict : result.verdicts) {
+    if (!verdict.witness) continue;
+    const std::string stem =
+        dir + "/" + props::to_string(verdict.component) + "_" + props::to_string(verdict.group) +
+        "_" + props::to_string(verdict.mode) + "_" + props::to_string(verdict.view) + "_";
+    const Scene& o = verdict.witness->scene;
+    const Scene moved = verdict.witness->g * o;
+    const std::vector<CameraImage> before = props::render_views(o, rig);
+    const std::vector<CameraImage> after = props::render_views(moved, rig);
+    for (std::size_t v = 0; v < rig.views.size(); ++v) {
+      const std::string camera = props::to_string(rig.views[v]);
+      sim::write_png(stem + camera + "_o.png", witness_panel(before[v], rig.camera.max_range));
+      sim::write_png(stem + camera + "_g_o.png", witness_panel(after[v], rig.camera.max_range));
+      written += 2;
+    }
+  }
+  std::cerr << "handcentric audit: " << written << " witness images in " << dir
+            << " (colour beside depth, of o and of g o)\n";
+}
 
 std::vector<props::Group> parse_groups(const std::string& name) {
   if (name == "all") return props::all_groups();
@@ -182,6 +240,15 @@ int run_audit(const AuditCommandOptions& options) {
     }
     results.push_back(props::classify_policy(audited, classifier));
     policies = true;
+    if (!options.witness_dir.empty()) {
+      if (!capabilities.cameras) {
+        throw InvalidArgument(
+            "--witness-dir saves the images of a failing check, but the plug-in's "
+            "hello declares no \"cameras\"; declare them, or leave --witness-dir "
+            "out");
+      }
+      write_witness_images(options.witness_dir, results.back(), *capabilities.cameras);
+    }
   } else if (!options.model.empty()) {
     if (plugin_names)
       throw InvalidArgument("--extra-poses and --scalars are for plug-ins; a model reads neither");
@@ -267,6 +334,9 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--precision", options->precision,
                   "float64, or float32 for a representation computed in float32 (REL = 1e-4)")
       ->capture_default_str();
+  cmd->add_option("--witness-dir", options->witness_dir,
+                  "with --policy-exec and a plug-in that sees cameras: save the images of each "
+                  "failing check's o and g o as PNGs in this folder");
   cmd->add_option("--workspace", options->workspace,
                   "x0,y0,z0,x1,y1,z1 (m): draw every scene inside this box and every g so that "
                   "g * scene stays in it (a policy meant for its cell); default: anywhere");

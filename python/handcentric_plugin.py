@@ -546,7 +546,7 @@ def _encode_array(a):
 # ----------------------------------------------------------------------------- the loop
 
 def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, batched=False,
-                 batch_size=256, encoding="base64", stdin=None, stdout=None):
+                 batch_size=256, encoding="base64", cameras=None, stdin=None, stdout=None):
     """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
 
     policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
@@ -554,16 +554,31 @@ def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, 
         as the policy's only randomness, so that one noise vector gives one chunk.
     batched: policy(history (B,H+1,4,4), hand_points (B,n,3), world_points (B,m,3), noise (B,d))
         -> (B,K,4,4), on up to batch_size observations of one shape per call (needs NumPy).
+    cameras: what the policy sees, e.g. ("eye_in_hand",) or {"views": ["eye_in_hand"],
+        "image_size": [64, 48], "channels": "rgbd", "floor": False} (the defaults but views):
+        the audit renders each observation's images and the policy gets images={view: (C,h,w)}
+        float32 as a keyword ((B,C,h,w) batched), as audit_policy(..., cameras=...) passes them
+        (docs/AUDIT_YOUR_POLICY.md). Needs NumPy.
     extra_poses, scalars, hello, encoding, stdin, stdout: as for serve().
     """
+    if cameras is not None:
+        if np is None:
+            _die(1, "handcentric_plugin: serve_policy(..., cameras=...) needs NumPy, which does "
+                    "not import in %s (Debian: python3-numpy)" % sys.executable)
+        cameras = dict(cameras) if isinstance(cameras, dict) else {
+            "views": [cameras] if isinstance(cameras, str) else list(cameras)}
+        if not cameras.get("views") or not all(isinstance(v, str) for v in cameras["views"]):
+            raise ValueError("cameras needs at least one view name, e.g. ('eye_in_hand',), "
+                             "got %r" % (cameras,))
+        hello = True
     serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, batched=batched,
           batch_size=batch_size, encoding=encoding, stdin=stdin, stdout=stdout, _policy=policy,
-          _noise=noise)
+          _noise=noise, _cameras=cameras)
 
 
 def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=None,
           batched=False, batch_size=256, encoding="base64", stdin=None, stdout=None,
-          _policy=None, _noise=None):
+          _policy=None, _noise=None, _cameras=None):
     """Answer the audit's requests until end of input (see the module docstring).
 
     encode(history, chunk, hand_points, world_points) -> actions | (actions, observation) | dict
@@ -607,13 +622,27 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                   "scalars": list(scalars), "decode": decode is not None, "flow": flow is not None}
     if _noise is not None:
         hello_body["noise"] = int(_noise)
+    if _cameras is not None:
+        hello_body["cameras"] = _cameras
     if batched:
         hello_body["batch"] = batch_size
         if encoding is not None:
             hello_body["encodings"] = [encoding]
 
-    def call(function, request_id, args, named):
+    def images_of(item, what):
+        """The request's images, {view: float32 (C, h, w)}, checked against the hello's views."""
+        value = item.get("images")
+        if not isinstance(value, dict) or set(value) != set(_cameras["views"]):
+            raise _Malformed("%s: 'images' must hold one encoded image per camera of the hello, "
+                             "%s" % (what, list(_cameras["views"])))
+        return {view: _finite(_decode_array(image, "%s: images[%r]" % (what, view),
+                                            ("float32",)), "images[%r]" % view)
+                for view, image in value.items()}
+
+    def call(function, request_id, args, named, images=None):
         kwargs = {"extra_poses": named[0], "scalars": named[1]} if declared else {}
+        if images is not None:
+            kwargs["images"] = images
         try:
             # A stray print() in user code would be read as an answer: send it to stderr.
             with contextlib.redirect_stdout(sys.stderr):
@@ -641,13 +670,17 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                 raise _Malformed("'noise' must be a non-empty list of numbers")
             noise = (np.array(value, dtype=np.float64) if np is not None
                      else [float(x) for x in value])
+            images = images_of(request, "request") if _cameras is not None else None
             if batched:  # a batch of one
                 stacked = (history[None], hand_points[None], world_points[None], noise[None])
+                if images is not None:
+                    images = {view: image[None] for view, image in images.items()}
                 return {"id": rid, "chunk": _chunks(call(_policy, rid, stacked,
-                                                         _stack_named([named])), 1)[0]}
+                                                         _stack_named([named]), images), 1)[0]}
             return {"id": rid,
                     "chunk": _chunk(call(_policy, rid,
-                                         (history, hand_points, world_points, noise), named))}
+                                         (history, hand_points, world_points, noise), named,
+                                         images))}
         if "decode" in request:
             if decode is None:
                 raise _Malformed("a decode request, but the plug-in declared no decode")
@@ -723,7 +756,12 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             _named(item, "scalars", scalars, _scalar)), items[i]) for i in range(B)])
         if _policy is not None:
             noise = _stacked(items, "noise", None, (), at)
-            result = call(_policy, rid, (history, hand_points, world_points, noise), named)
+            images = None
+            if _cameras is not None:
+                each = [images_of(item, "batch[%d]" % i) for i, item in zip(at, items)]
+                images = {view: np.stack([e[view] for e in each]) for view in _cameras["views"]}
+            result = call(_policy, rid, (history, hand_points, world_points, noise), named,
+                          images)
             return [{"chunk": c} for c in _chunks(result, B, encoded)]
         if any("decode" in item or "eps" in item or "t" in item for item in items):
             raise _Malformed("decode and flow requests are not batched")

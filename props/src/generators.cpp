@@ -345,8 +345,9 @@ rc::Gen<std::pair<Scene, RigidTransform>> case_in_workspace(const SceneShape& sh
                           "with z0 <= 0 <= z1");
   }
   return rc::gen::apply(
-      [box, group, room, half, middle, planar](Scene scene, double size_u, const Eigen::Vector3d& spot,
-                                       const RigidTransform& g_drawn, const Eigen::Vector3d& t_u) {
+      [box, group, room, half, middle, planar](
+          Scene scene, double size_u, const Eigen::Vector3d& spot, const RigidTransform& g_drawn,
+          const Eigen::Vector3d& t_u) {
         // The scene's centre and radius (over its world positions).
         Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
         Eigen::Vector3d hi = -lo;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "wire_arrays.hpp"
+
 namespace handcentric::props {
 
 PipePolicy::PipePolicy(std::string command, double timeout_seconds,
@@ -55,16 +57,36 @@ std::string PipePolicy::key(const Scene& observation, const Eigen::VectorXd& noi
   return out;
 }
 
+std::string PipePolicy::request_body(const Scene& observation, const Eigen::VectorXd& noise,
+                                     NumberEncoding encoding) const {
+  std::string body = policy_request_body(observation, noise, encoding);
+  if (!capabilities_ || !capabilities_->cameras) return body;
+  // Images always travel as base64 float32 arrays: a 64 x 48 RGB-D image is 49 KB so, ~150 KB
+  // as JSON numbers.
+  const CameraRig& rig = *capabilities_->cameras;
+  const std::vector<CameraImage> images = render_views(observation, rig);
+  body += ", \"images\": {";
+  for (std::size_t v = 0; v < images.size(); ++v) {
+    const std::vector<float> pixels = network_image(images[v], rig.channels);
+    body += (v > 0 ? ", \"" : "\"") + to_string(rig.views[v]) + "\": ";
+    wire::append_float32_array(
+        body,
+        {static_cast<std::size_t>(channel_count(rig.channels)),
+         static_cast<std::size_t>(rig.camera.height), static_cast<std::size_t>(rig.camera.width)},
+        pixels.data());
+  }
+  body += '}';
+  return body;
+}
+
 PluginReply PipePolicy::exchange_one(const Scene& observation, const Eigen::VectorXd& noise) const {
   if (capabilities_->batch == 0) {
-    return connection_.exchange(RequestKind::policy, policy_request_body(observation, noise),
-                                false);
+    return connection_.exchange(RequestKind::policy, request_body(observation, noise), false);
   }
   const NumberEncoding encoding = capabilities_->encoding;
   return std::move(connection_
                        .exchange_batch(RequestKind::policy,
-                                       {policy_request_body(observation, noise, encoding)},
-                                       encoding)
+                                       {request_body(observation, noise, encoding)}, encoding)
                        .front());
 }
 
@@ -135,7 +157,7 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
     const NumberEncoding encoding = capabilities_->encoding;
     for (std::size_t j = from; j < to; ++j) {
       const std::size_t i = missing[order[j]].first;
-      bodies.push_back(policy_request_body(*observations[i], *noises[i], encoding));
+      bodies.push_back(request_body(*observations[i], *noises[i], encoding));
     }
     std::vector<PluginReply> replies =
         connection_.exchange_batch(RequestKind::policy, bodies, encoding);

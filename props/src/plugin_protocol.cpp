@@ -506,6 +506,49 @@ PluginReply read_answer(const nlohmann::json& json, RequestKind kind, const std:
   return reply;
 }
 
+// The hello's "cameras": what the policy sees, each field checked with the fix in the message.
+CameraRig read_cameras(const nlohmann::json& cameras, const std::string& answered) {
+  const std::string form =
+      "; declare {\"views\": [\"eye_in_hand\"], \"image_size\": [64, 48], \"channels\": "
+      "\"rgbd\", \"floor\": false} (only views is needed)";
+  if (!cameras.is_object() || !cameras.contains("views") || !cameras["views"].is_array())
+    throw PluginError(answered + " with a hello whose \"cameras\" is " +
+                      one_line(cameras.dump(), 60) + form);
+  CameraRig rig;
+  rig.views.clear();
+  try {
+    for (const nlohmann::json& view : cameras["views"]) {
+      if (!view.is_string()) throw InvalidArgument("a camera's name must be a string");
+      rig.views.push_back(parse_camera_view(view.get<std::string>()));
+    }
+    if (cameras.contains("image_size")) {
+      const nlohmann::json& size = cameras["image_size"];
+      if (!size.is_array() || size.size() != 2 || !size[0].is_number_integer() ||
+          !size[1].is_number_integer() || size[0].get<long long>() < 1 ||
+          size[1].get<long long>() < 1 || size[0].get<long long>() > 1024 ||
+          size[1].get<long long>() > 1024) {
+        throw InvalidArgument("\"image_size\" " + one_line(size.dump(), 40) +
+                              " is not [width, height], each 1 to 1024");
+      }
+      rig.camera.width = size[0].get<int>();
+      rig.camera.height = size[1].get<int>();
+    }
+    if (cameras.contains("channels")) {
+      if (!cameras["channels"].is_string())
+        throw InvalidArgument("\"channels\" must be \"depth\", \"rgb\" or \"rgbd\"");
+      rig.channels = parse_image_channels(cameras["channels"].get<std::string>());
+    }
+    if (cameras.contains("floor")) {
+      if (!cameras["floor"].is_boolean()) throw InvalidArgument("\"floor\" must be true or false");
+      rig.floor = cameras["floor"].get<bool>();
+    }
+    rig.validate();
+  } catch (const InvalidArgument& e) {
+    throw PluginError(answered + " with a hello whose \"cameras\" is wrong: " + e.what() + form);
+  }
+  return rig;
+}
+
 }  // namespace
 
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
@@ -558,6 +601,8 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     for (const std::string& name : read_names(hello, "encodings", id, who)) {
       if (name == "base64") capabilities.encoding = NumberEncoding::base64;
     }
+    if (hello.contains("cameras") && !hello["cameras"].is_null())
+      capabilities.cameras = read_cameras(hello["cameras"], reply_to(who, id));
     reply.hello = capabilities;
     return reply;
   }

@@ -127,22 +127,42 @@ const char* dtype_name(Dtype dtype) {
   return "?";
 }
 
-void append_float64_array(std::string& out, const std::vector<std::size_t>& shape,
-                          const double* values) {
+namespace {
+
+// {"dtype": name, "shape": [...], "data": base64 of the elements' little-endian bytes}, for an
+// element type T whose bits travel as the unsigned integer Bits of the same size.
+template <class T, class Bits>
+void append_array(std::string& out, const char* name, const std::vector<std::size_t>& shape,
+                  const T* values) {
+  static_assert(sizeof(T) == sizeof(Bits));
   std::size_t count = 1;
   for (std::size_t d : shape) count *= d;
   // Little-endian whatever the host's order: the shifts compile to plain stores on x86 and ARM.
-  std::vector<unsigned char> bytes(count * 8);
+  std::vector<unsigned char> bytes(count * sizeof(T));
   for (std::size_t i = 0; i < count; ++i) {
-    std::uint64_t u;
-    std::memcpy(&u, &values[i], 8);
-    for (int b = 0; b < 8; ++b) bytes[8 * i + static_cast<std::size_t>(b)] = u >> (8 * b) & 0xff;
+    Bits u;
+    std::memcpy(&u, &values[i], sizeof(T));
+    for (std::size_t b = 0; b < sizeof(T); ++b) bytes[sizeof(T) * i + b] = u >> (8 * b) & 0xff;
   }
-  out += "{\"dtype\": \"float64\", \"shape\": ";
+  out += "{\"dtype\": \"";
+  out += name;
+  out += "\", \"shape\": ";
   out += shape_text(shape);
   out += ", \"data\": \"";
   append_base64(out, bytes.data(), bytes.size());
   out += "\"}";
+}
+
+}  // namespace
+
+void append_float64_array(std::string& out, const std::vector<std::size_t>& shape,
+                          const double* values) {
+  append_array<double, std::uint64_t>(out, "float64", shape, values);
+}
+
+void append_float32_array(std::string& out, const std::vector<std::size_t>& shape,
+                          const float* values) {
+  append_array<float, std::uint32_t>(out, "float32", shape, values);
 }
 
 Array read_array(const nlohmann::json& value, const std::string& where) {

@@ -22,6 +22,10 @@ const char* dtype_name(Dtype dtype);
 void append_float64_array(std::string& out, const std::vector<std::size_t>& shape,
                           const double* values);
 
+/// The same for float32 elements ({"dtype": "float32", ...}): images, which need no more.
+void append_float32_array(std::string& out, const std::vector<std::size_t>& shape,
+                          const float* values);
+
 /// A decoded array: its dtype, shape and elements (every dtype widens to double exactly).
 struct Array {
   Dtype dtype = Dtype::float64;

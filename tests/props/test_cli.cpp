@@ -1,6 +1,7 @@
 // `handcentric audit` and `handcentric report` end to end: exit codes, the JSON document, the
 // --exec audit of the Python example, one-line errors.
 #include <catch2/catch.hpp>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -309,6 +310,49 @@ TEST_CASE("policy_exec_audits_a_whole_policy_and_finds_each_planted_fault", "[un
   const auto velocity = policy("world_velocity");
   CHECK(velocity.at("summary").at("eye_in_hand").at("pointwise").at("translation") == true);
   CHECK(velocity.at("summary").at("eye_in_hand").at("distribution").at("rotation") == false);
+}
+
+TEST_CASE("policy_exec_hands_a_plugin_the_images_of_its_hellos_cameras", "[unit]") {
+  // The plug-in declares its camera in its hello; each request then carries the rendered image.
+  // A network on the eye-in-hand image is equivariant (with the floor, under se2 and c8 only);
+  // on the third-person image (the planted fault) it is not.
+  auto audit = [](const std::string& args, const std::string& groups) {
+    const auto result = test::run_command(
+        test::cli() + " audit --policy-exec '" + test::test_plugin("policy_camera.py", args) +
+        "' --cases 40 --view eye_in_hand --group " + groups + " --json");
+    INFO(result.err);
+    REQUIRE(result.exit_code == 0);
+    return nlohmann::json::parse(result.out)
+        .at("policies")
+        .at(0)
+        .at("summary")
+        .at("eye_in_hand")
+        .at("pointwise");
+  };
+  const auto eye = audit("eye_in_hand", "se3");
+  CHECK(eye.at("se3") == true);
+  const auto fixed = audit("third_person", "se2");
+  CHECK(fixed.at("se2") == false);
+  CHECK(audit("eye_in_hand floor", "se2").at("se2") == true);
+  CHECK(audit("eye_in_hand floor", "se3").at("se3") == false);
+  // --witness-dir: the two images the policy saw of the witness, as PNGs.
+  const std::string dir = (std::filesystem::temp_directory_path() / "handcentric_witness_images");
+  std::filesystem::remove_all(dir);
+  const auto saved =
+      test::run_command(test::cli() + " audit --policy-exec '" +
+                        test::test_plugin("policy_camera.py", "third_person") +
+                        "' --cases 40 --view eye_in_hand --group se2 --witness-dir " + dir);
+  INFO(saved.err);
+  CHECK(saved.exit_code == 0);
+  CHECK(std::filesystem::file_size(dir + "/policy_se2_pointwise_eye_in_hand_third_person_o.png") >
+        100);
+  CHECK(std::filesystem::exists(dir + "/policy_se2_pointwise_eye_in_hand_third_person_g_o.png"));
+  const auto blind = test::run_command(
+      test::cli() + " audit --policy-exec '" + test::test_plugin("policy_hand_centric.py", "") +
+      "' --cases 5 --view eye_in_hand --group se2 --witness-dir " + dir);
+  CHECK(blind.exit_code != 0);
+  CHECK_THAT(blind.err, Contains("declares no \"cameras\""));
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[unit]") {

@@ -157,12 +157,14 @@ TEST_CASE("a_wrong_batched_answer_is_a_plugin_error_naming_request_item_and_fix"
 }
 
 TEST_CASE("a_batch_has_as_many_timeouts_as_scenes", "[unit]") {
-  // 0.06 s per scene, 0.2 s per answer: a batch of 4 scenes (0.24 s) is within 0.8 s; a single
-  // timeout for the whole batch (the planted fault) would have fired.
+  // 0.5 s per scene, 1 s per answer: a batch of 4 scenes (2 s) is within 4 s; a single timeout
+  // for the whole batch (the planted fault) would have fired. At 0.4 s per answer the batch is
+  // late (1.6 s); the plug-in's start, within the first answer's 0.4 s, leaves a loaded machine
+  // room (0.04 s did not).
   const auto start = std::chrono::steady_clock::now();
-  CHECK(batch_error("slow", 0.2, 4).empty());
-  CHECK_THAT(batch_error("slow", 0.04, 4), Contains("no answer to request 2 within 0.16 s") &&
-                                               Contains("0.04 s per scene, 4 scenes"));
+  CHECK(batch_error("slow", 1.0, 4).empty());
+  CHECK_THAT(batch_error("slow", 0.4, 4), Contains("no answer to request 2 within 1.6 s") &&
+                                              Contains("0.4 s per scene, 4 scenes"));
   CHECK(std::chrono::steady_clock::now() - start < std::chrono::seconds(10));
 }
 

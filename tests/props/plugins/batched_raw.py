@@ -7,7 +7,7 @@ misbehaving in the way argv[1] names.
   short         one answer too few in each batch of more than one scene
   item_shape    the second item of each batch has no "actions" (a policy: no "chunk")
   unbatched     answers a batched line as a single request ({"id", "actions"}), no "batch"
-  slow          as right, after sleeping 0.06 s per scene of a batch of more than one
+  slow          as right, after sleeping 0.5 s per scene of a batch of more than one
 The b64_* modes also offer "encodings": ["base64"], check that each batched line comes encoded,
 and answer with encoded arrays; the second item of a batch of more than one is spoiled:
   b64_right     no spoiling: float64 zeros of shape [6] (a policy: T_0 as [1, 4, 4])
@@ -95,7 +95,7 @@ for line in sys.stdin:
         if mode == "item_shape" and len(answers) > 1:
             answers[1] = {"nothing": 1}
         if mode == "slow" and len(scenes) > 1:
-            time.sleep(0.06 * len(scenes))
+            time.sleep(0.5 * len(scenes))
         reply = {"id": request["id"], "batch": answers}
         if mode == "unbatched":
             reply = dict(answers[0], id=request["id"])

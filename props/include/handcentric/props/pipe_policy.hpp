@@ -55,6 +55,9 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   std::string key(const Scene& observation, const Eigen::VectorXd& noise) const;
   /// One request; a batch of one (in the hello's encoding) when the plug-in batches.
   PluginReply exchange_one(const Scene& observation, const Eigen::VectorXd& noise) const;
+  /// A policy request, with the images of the hello's cameras when it declared some.
+  std::string request_body(const Scene& observation, const Eigen::VectorXd& noise,
+                           NumberEncoding encoding = NumberEncoding::text) const;
   /// Checks the chunk length of the answer to `where` and caches it under `key`.
   const std::vector<RigidTransform>& remember(std::string key, PluginReply reply,
                                               const std::string& where) const;

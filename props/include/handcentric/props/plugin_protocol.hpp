@@ -31,6 +31,7 @@
 
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/core/scene.hpp"
+#include "handcentric/props/observation/camera_rig.hpp"
 #include "handcentric/props/subprocess.hpp"
 
 namespace handcentric::props {
@@ -54,6 +55,10 @@ struct PluginCapabilities {
   int batch = 0;  ///< the most scenes per batched request; 0: one request per scene
   /// The encoding of batched lines: base64 when the hello's "encodings" offers it.
   NumberEncoding encoding = NumberEncoding::text;
+  /// A policy that sees cameras (hello "cameras": {"views": [...], "image_size": [w, h],
+  /// "channels": "rgbd", "floor": false}): each policy request then carries "images": {view:
+  /// float32 array (C, h, w) in the base64 form}, rendered by this rig.
+  std::optional<CameraRig> cameras;
 };
 
 /// The noise a policy request carries unless the plug-in's hello asks for another length.
