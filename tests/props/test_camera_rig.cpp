@@ -22,7 +22,7 @@ using props::Group;
 
 namespace {
 
-constexpr int kChunk = 2;
+constexpr int kImageChunk = 2;
 
 CameraRig small_rig(CameraView view, bool floor = false) {
   CameraRig rig;
@@ -65,9 +65,9 @@ class RandomImagePolicy final : public props::ImagePolicy {
   explicit RandomImagePolicy(const CameraRig& rig)
       : channels_(rig.channels),
         inputs_(props::channel_count(rig.channels) * rig.camera.width * rig.camera.height),
-        network_(inputs_ + 6 + 6 * kChunk, {16}, 6 * kChunk, 7) {}
+        network_(inputs_ + 6 + 6 * kImageChunk, {16}, 6 * kImageChunk, 7) {}
   std::string name() const override { return "random_image_policy"; }
-  Eigen::Index noise_dimension() const override { return 6 * kChunk; }
+  Eigen::Index noise_dimension() const override { return 6 * kImageChunk; }
   std::vector<RigidTransform> act(const Scene& o, const std::vector<CameraImage>& images,
                                   const Eigen::VectorXd& noise) const override {
     Eigen::VectorXd input(network_.inputs());
@@ -76,7 +76,7 @@ class RandomImagePolicy final : public props::ImagePolicy {
     Scene now = o;
     now.world_T_hand_history.resize(1);
     input.segment(inputs_, 6) = hand_centric_.encode_observation(now).head(6);
-    input.tail(6 * kChunk) = noise;
+    input.tail(6 * kImageChunk) = noise;
     return hand_centric_.decode_actions(0.1 * network_(input), o.world_T_hand0());
   }
 
