@@ -6,7 +6,6 @@
 #include <type_traits>
 
 #include "handcentric/core/errors.hpp"
-
 #include "handcentric/core/sampling.hpp"
 
 namespace handcentric::props {
@@ -255,9 +254,11 @@ rc::Gen<Scene> scene(SceneShape shape) {
         points(shape.min_world_points, shape.max_world_points, scale, shape.planar));
   });
   if (shape.extra_pose_names.empty() && shape.scalar_names.empty()) return geometry;
-  // Named extras: one random pose per name (anywhere, any orientation), one number per scalar.
+  // Named extras: one random pose per name (anywhere within 10 m, any orientation; in the plane
+  // and turned about z only when planar), one number per scalar.
   const auto poses = rc::gen::container<std::vector<RigidTransform>>(
-      shape.extra_pose_names.size(), combine(rotation(), translation(10.0)));
+      shape.extra_pose_names.size(), shape.planar ? combine(planar_rotation(), point(10.0, true))
+                                                  : combine(rotation(), translation(10.0)));
   const auto numbers =
       rc::gen::container<std::vector<double>>(shape.scalar_names.size(), symmetric(1.0));
   return rc::gen::apply(
@@ -273,9 +274,6 @@ rc::Gen<Scene> scene(SceneShape shape) {
       geometry, poses, numbers);
 }
 
-}  // namespace handcentric::props
-
-namespace handcentric::props {
 namespace {
 
 // Every world-frame position of a scene (Workspace::contains reads the same ones).
@@ -372,7 +370,7 @@ rc::Gen<std::pair<Scene, RigidTransform>> case_in_workspace(const SceneShape& sh
         } else {
           target = middle + (half - Eigen::Vector3d::Constant(r)).cwiseProduct(spot);
         }
-        if (planar) target.z() = 0.0;  // the scene stays in its plane
+        if (planar) target.z() = centre.z();  // the scene stays in its plane (z = 0)
         Scene placed = scaled_and_placed(std::move(scene), centre, k, target);
         const Eigen::Matrix3d R = g_drawn.rotation().matrix();
         Eigen::Vector3d t = Eigen::Vector3d::Zero();

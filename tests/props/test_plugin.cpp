@@ -120,6 +120,37 @@ TEST_CASE("subprocess_reads_with_a_deadline_and_sees_a_closed_stdout", "[unit]")
   CHECK(quiet.read_line(line, 5.0) == props::Subprocess::Outcome::closed);
 }
 
+TEST_CASE("a_hellos_cameras_are_read_and_each_bad_field_named", "[unit]") {
+  using props::RequestKind;
+  const auto hello_with = [](const std::string& cameras) {
+    return props::parse_reply(R"({"id": 0, "hello": {"protocol": 2, "cameras": )" + cameras + "}}",
+                              0, RequestKind::policy, "plug-in 'x'", true);
+  };
+  const auto good = hello_with(
+      R"({"views": ["third_person", "eye_in_hand"], "image_size": [32, 24], "channels": "depth",)"
+      R"( "floor": true})");
+  REQUIRE(good.hello->cameras);
+  CHECK(good.hello->cameras->views ==
+        std::vector<props::CameraView>{props::CameraView::third_person,
+                                       props::CameraView::eye_in_hand});
+  CHECK(good.hello->cameras->camera.width == 32);
+  CHECK(good.hello->cameras->channels == props::ImageChannels::depth);
+  CHECK(good.hello->cameras->floor);
+  CHECK_FALSE(hello_with("null").hello->cameras);
+  for (const auto& [cameras, named] : std::vector<std::pair<std::string, std::string>>{
+           {R"(["eye_in_hand"])", "declare {\"views\""},
+           {R"({"views": ["wrist"]})", "unknown camera 'wrist'"},
+           {R"({"views": []})", "at least one camera"},
+           {R"({"views": ["eye_in_hand"], "image_size": [0, 48]})", "[0,48]"},
+           {R"({"views": ["eye_in_hand"], "image_size": [64]})", "[width, height]"},
+           {R"({"views": ["eye_in_hand"], "channels": "bgr"})", "unknown image channels"},
+           {R"({"views": ["eye_in_hand"], "floor": 1})", "true or false"}}) {
+    INFO(cameras);
+    CHECK_THROWS_AS(hello_with(cameras), props::PluginError);
+    CHECK_THROWS_WITH(hello_with(cameras), Contains(named) && Contains("plug-in 'x'"));
+  }
+}
+
 TEST_CASE("protocol_replies_are_validated_field_by_field", "[unit]") {
   using props::RequestKind;
   const std::string who = "plug-in 'x'";

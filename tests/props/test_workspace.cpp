@@ -75,6 +75,28 @@ TEST_CASE("every_case_drawn_in_a_workspace_stays_in_it_under_its_g", "[property]
   }
 }
 
+TEST_CASE("the_2d_tasks_planar_scenes_stay_in_their_plane_inside_a_workspace", "[property]") {
+  props::SceneShape planar = shape_in(kCell);
+  planar.planar = true;
+  for (const Group group : {Group::translation, Group::se2, Group::c8}) {
+    INFO(props::to_string(group));
+    props::require_property("planar and inside", [planar, group] {
+      const auto [scene, g] = *props::case_in_workspace(planar, group, kCell);
+      const Scene moved = g * scene;
+      RC_ASSERT(with_margin(kCell).contains(scene));
+      RC_ASSERT(with_margin(kCell).contains(moved));
+      for (const Scene* s : {&scene, &moved}) {
+        for (const RigidTransform& T : s->world_T_hand_history)
+          RC_ASSERT(T.translation().z() == 0.0);
+        for (const Eigen::Vector3d& p : s->world_points) RC_ASSERT(p.z() == 0.0);
+      }
+    });
+  }
+  const Workspace above{Eigen::Vector3d(-1.0, -1.0, 0.5), Eigen::Vector3d(1.0, 1.0, 1.0)};
+  CHECK_THROWS_WITH(props::case_in_workspace(planar, Group::se2, above),
+                    Catch::Matchers::Contains("plane z = 0"));
+}
+
 TEST_CASE("a_policy_clipping_to_its_box_is_equivariant_within_it_and_not_beyond", "[property]") {
   for (const Group group : {Group::translation, Group::se2, Group::se3}) {
     INFO(props::to_string(group));

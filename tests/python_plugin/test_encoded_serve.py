@@ -233,3 +233,53 @@ def test_an_encoded_line_to_a_helper_that_did_not_offer_it_exits_2():
 def test_an_unknown_encoding_is_a_value_error_naming_the_choices():
     with pytest.raises(ValueError, match="encoding must be one of 'base64', or None"):
         hp.serve(repr_py.encode_batch, batched=True, encoding="zstd")
+
+
+def camera_policy_answers(images_of_item):
+    """serve_policy(..., cameras=...) on one batched line of 2 scenes whose items carry
+    images_of_item(i): (answers, status, stderr). The policy returns T_0 moved by the image's
+    mean along x, so an image that arrived is seen in the answer."""
+    def policy(history, hand_points, world_points, noise, images):
+        out = history[:, :1].copy()
+        out[:, 0, 0, 3] += images["eye_in_hand"].reshape(len(out), -1).mean(axis=1)
+        return out
+
+    batch = scenes(2, H=0, K=1)
+    items = [dict(encoded_item(s), noise=encode_array(np.zeros(1))) for s in batch]
+    for i, it in enumerate(items):
+        del it["chunk"]
+        it.update(images_of_item(i))
+    line = {"id": 1, "protocol": 2, "encoding": "base64", "batch": items}
+    out, err = io.StringIO(), io.StringIO()
+    status = 0
+    lines = [dict(PROBE, noise=[0.0]), line]
+    with contextlib.redirect_stderr(err):
+        try:
+            hp.serve_policy(policy, noise=1, batched=True, cameras=("eye_in_hand",),
+                            stdin=io.StringIO("".join(json.dumps(r) + "\n" for r in lines)),
+                            stdout=out)
+        except SystemExit as exit_:
+            status = exit_.code
+    return [json.loads(x) for x in out.getvalue().splitlines()], status, err.getvalue()
+
+
+def test_a_policy_with_cameras_declares_them_and_gets_each_items_image():
+    image = [np.full((4, 3, 2), float(i + 1), np.float32) for i in range(2)]
+    answers, status, err = camera_policy_answers(
+        lambda i: {"images": {"eye_in_hand": encode_array(image[i], "float32")}})
+    assert status == 0, err
+    assert answers[0]["hello"]["cameras"] == {"views": ["eye_in_hand"]}
+    moved = [decode_array(a["chunk"])[0, 0, 3] for a in answers[1]["batch"]]
+    shift = [m - s["history"][0][0, 3] for m, s in zip(moved, scenes(2, H=0, K=1))]
+    assert shift == pytest.approx([1.0, 2.0])  # each item its own image
+
+
+@pytest.mark.parametrize("images, message", [
+    ({}, "'images' must hold one encoded image per camera"),
+    ({"images": {"third_person": None}}, "'images' must hold one encoded image per camera"),
+    ({"images": {"eye_in_hand": encode_array(np.zeros((1, 2, 2)))}}, "must be float32"),
+])
+def test_a_request_without_the_declared_images_exits_2_naming_the_item(images, message):
+    answers, status, err = camera_policy_answers(lambda i: images)
+    assert status == 2
+    assert message in err and "batch[0]" in err
