@@ -24,8 +24,8 @@
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
 #include "handcentric/props/batch.hpp"
-#include "handcentric/props/pipe_policy.hpp"
-#include "handcentric/props/pipe_representation.hpp"
+#include "handcentric/props/transport/pipe_policy.hpp"
+#include "handcentric/props/transport/pipe_representation.hpp"
 #include "handcentric/props/policy_audit.hpp"
 #include "handcentric/sim/draw.hpp"
 

@@ -43,7 +43,7 @@
 #include "handcentric/props/audit.hpp"
 #include "handcentric/props/check.hpp"
 #include "handcentric/props/classifier.hpp"
-#include "handcentric/props/plugin_protocol.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
 #include "handcentric/props/policy_audit.hpp"
 #include "handcentric/props/verdict.hpp"
 #include "handcentric/sim/demos.hpp"

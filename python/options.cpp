@@ -7,7 +7,7 @@
 
 #include "arrays.hpp"
 #include "handcentric/core/errors.hpp"
-#include "handcentric/props/plugin_protocol.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
 
 namespace handcentric::python {
 namespace {

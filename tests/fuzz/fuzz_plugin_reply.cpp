@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "handcentric/props/plugin_protocol.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return 0;

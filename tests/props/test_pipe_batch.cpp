@@ -12,8 +12,8 @@
 #include <random>
 
 #include "handcentric/core/sampling.hpp"
-#include "handcentric/props/pipe_policy.hpp"
-#include "handcentric/props/pipe_representation.hpp"
+#include "handcentric/props/transport/pipe_policy.hpp"
+#include "handcentric/props/transport/pipe_representation.hpp"
 #include "run_command.hpp"
 
 using namespace handcentric;

@@ -8,7 +8,7 @@
 
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/sampling.hpp"
-#include "handcentric/props/pipe_representation.hpp"
+#include "handcentric/props/transport/pipe_representation.hpp"
 #include "run_command.hpp"
 
 using namespace handcentric;

@@ -1,4 +1,4 @@
-#include "handcentric/props/pipe_representation.hpp"
+#include "handcentric/props/transport/pipe_representation.hpp"
 
 #include <algorithm>
 

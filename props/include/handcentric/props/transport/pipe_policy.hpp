@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "handcentric/props/batch.hpp"
-#include "handcentric/props/plugin_connection.hpp"
+#include "handcentric/props/transport/plugin_connection.hpp"
 #include "handcentric/props/policy_audit.hpp"
 
 namespace handcentric::props {

@@ -6,8 +6,8 @@
 #include <cstring>
 #include <limits>
 
-#include "handcentric/props/plugin_protocol.hpp"
-#include "handcentric/props/subprocess.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
+#include "handcentric/props/transport/subprocess.hpp"
 
 namespace handcentric::props::wire {
 namespace {

@@ -37,8 +37,8 @@
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representation.hpp"
 #include "handcentric/props/batch.hpp"
-#include "handcentric/props/plugin_connection.hpp"
-#include "handcentric/props/plugin_protocol.hpp"
+#include "handcentric/props/transport/plugin_connection.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
 
 namespace handcentric::props {
 

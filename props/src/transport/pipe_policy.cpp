@@ -1,4 +1,4 @@
-#include "handcentric/props/pipe_policy.hpp"
+#include "handcentric/props/transport/pipe_policy.hpp"
 
 #include <algorithm>
 

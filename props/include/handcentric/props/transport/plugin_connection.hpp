@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "handcentric/props/plugin_protocol.hpp"
-#include "handcentric/props/subprocess.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
+#include "handcentric/props/transport/subprocess.hpp"
 
 namespace handcentric::props {
 

@@ -1,4 +1,4 @@
-#include "handcentric/props/plugin_protocol.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -1,4 +1,4 @@
-#include "handcentric/props/subprocess.hpp"
+#include "handcentric/props/transport/subprocess.hpp"
 
 #include <fcntl.h>
 #include <poll.h>

@@ -32,7 +32,7 @@
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/core/scene.hpp"
 #include "handcentric/props/observation/camera_rig.hpp"
-#include "handcentric/props/subprocess.hpp"
+#include "handcentric/props/transport/subprocess.hpp"
 
 namespace handcentric::props {
 

@@ -1,4 +1,4 @@
-#include "handcentric/props/plugin_connection.hpp"
+#include "handcentric/props/transport/plugin_connection.hpp"
 
 #include <chrono>
 #include <cmath>
