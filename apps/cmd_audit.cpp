@@ -41,7 +41,7 @@ struct AuditCommandOptions {
   double timeout = 10.0;
   double tolerance = 0.0;
   std::string precision = "float64";
-  std::string workspace, witness_dir;
+  std::string workspace, witness_dir, observations;
   bool json = false;
   bool pointwise = false;
   std::string exec, policy_exec, model;
@@ -194,6 +194,29 @@ int gate(const std::vector<props::Classification>& results,
   return failed == 0 ? 0 : 1;
 }
 
+// A plug-in's declared extra poses and scalars must be in recorded observations: the pipe would
+// otherwise fill the missing ones with placeholders the data never had.
+void require_recorded_names(const props::AuditOptions& audit,
+                            const props::PluginCapabilities& capabilities) {
+  if (!audit.observations) return;
+  const Scene& first = audit.observations->scenes.front();
+  auto has = [](const auto& named, const std::string& name) {
+    return std::any_of(named.begin(), named.end(), [&](const auto& n) { return n.first == name; });
+  };
+  for (const std::string& name : capabilities.extra_pose_names) {
+    if (!has(first.extra_poses, name))
+      throw InvalidArgument("the plug-in asks for extra pose '" + name +
+                            "', which the observations of " + audit.observations->source +
+                            " do not record: add it under \"extra_poses\"");
+  }
+  for (const std::string& name : capabilities.scalar_names) {
+    if (!has(first.scalars, name))
+      throw InvalidArgument("the plug-in asks for scalar '" + name +
+                            "', which the observations of " + audit.observations->source +
+                            " do not record: add it under \"scalars\"");
+  }
+}
+
 int run_audit(const AuditCommandOptions& options) {
   props::AuditOptions audit;
   audit.groups = parse_groups(options.group);
@@ -203,6 +226,13 @@ int run_audit(const AuditCommandOptions& options) {
   audit.precision = props::parse_precision(options.precision);
   audit.relative_tolerance = options.tolerance;
   if (!options.workspace.empty()) audit.workspace = props::Workspace::parse(options.workspace);
+  if (!options.observations.empty()) {
+    audit.observations = std::make_shared<props::RecordedObservations>(
+        props::read_observations(options.observations));
+    // Data without world points show the third-person view nothing to move: one view only.
+    if (options.view == "all" && !audit.observations->has_world_points())
+      audit.views = {props::View::eye_in_hand};
+  }
   const double relative = props::audit_relative_tolerance(audit);  // validates --tolerance
   const std::vector<Expectation> expectations = parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
@@ -211,7 +241,9 @@ int run_audit(const AuditCommandOptions& options) {
   if (!options.exec.empty()) {
     auto plugin = std::make_shared<props::PipeRepresentation>(options.exec, options.timeout,
                                                               options.extra_poses, options.scalars);
+    if (audit.observations) plugin->use_probe(audit.observations->scenes.front());
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
+    require_recorded_names(audit, capabilities);
     props::ClassifierOptions classifier = props::classifier_options(audit);
     classifier.observation = plugin->provides_observation();
     classifier.check.shape.extra_pose_names = capabilities.extra_pose_names;
@@ -229,7 +261,9 @@ int run_audit(const AuditCommandOptions& options) {
   } else if (!options.policy_exec.empty()) {
     auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout,
                                                       options.extra_poses, options.scalars);
+    if (audit.observations) plugin->use_probe(audit.observations->scenes.front());
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
+    require_recorded_names(audit, capabilities);
     props::ClassifierOptions classifier = props::classifier_options(audit);
     classifier.check.shape.extra_pose_names = capabilities.extra_pose_names;
     classifier.check.shape.scalar_names = capabilities.scalar_names;
@@ -285,6 +319,8 @@ int run_audit(const AuditCommandOptions& options) {
       << (audit.workspace ? "; every case inside the workspace " + audit.workspace->describe() +
                                 ", g * scene too (--workspace)"
                           : std::string())
+      << (audit.observations ? "; " + audit.observations->verdict_note() + " (--observations)"
+                             : std::string())
       << "\n"
       << (policies ? "'yes' = equivariant, a(g o, n) = g a(o, n) (eq. 4); pointwise with the same "
                      "noise n, in distribution with n ~ N(0, I). "
@@ -337,6 +373,10 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--witness-dir", options->witness_dir,
                   "with --policy-exec and a plug-in that sees cameras: save the images of each "
                   "failing check's o and g o as PNGs in this folder");
+  cmd->add_option("--observations", options->observations,
+                  "FILE.jsonl or FILE.npz: draw every scene from your own recorded observations "
+                  "(world-frame poses and points that move with g; hand points, scalars and "
+                  "held arrays such as images that do not; docs/AUDIT.md)");
   cmd->add_option("--workspace", options->workspace,
                   "x0,y0,z0,x1,y1,z1 (m): draw every scene inside this box and every g so that "
                   "g * scene stays in it (a policy meant for its cell); default: anywhere");

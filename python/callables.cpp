@@ -18,11 +18,14 @@ py::object call(const py::object& fn, Args&&... args) {
   }
 }
 
+py::dict held_of(const std::vector<const Scene*>& scenes, const CallOptions& options);
+
 /// extra_poses={name: (4, 4) or (B, 4, 4)} and scalars={name: float or (B,)}, when wanted, and
 /// images= when the audit has cameras.
 py::kwargs extras_kwargs(const std::vector<const Scene*>& scenes, const CallOptions& options) {
   py::kwargs kw;
   if (options.cameras && !scenes.empty()) kw["images"] = images_of(scenes, options);
+  if (!scenes.empty() && !scenes.front()->held.empty()) kw["held"] = held_of(scenes, options);
   if (!options.extras || scenes.empty()) return kw;
   py::dict poses, scalars;
   const Scene& first = *scenes.front();
@@ -40,6 +43,36 @@ py::kwargs extras_kwargs(const std::vector<const Scene*>& scenes, const CallOpti
   kw["extra_poses"] = poses;
   kw["scalars"] = scalars;
   return kw;
+}
+
+/// held={name: array} of recorded observations: one scene's in its own shape, or (B, ...)
+/// stacked (a batch's scenes share their held shapes: props/batch.hpp's shape key), float32 kept.
+py::dict held_of(const std::vector<const Scene*>& scenes, const CallOptions& options) {
+  py::dict out;
+  const Scene& first = *scenes.front();
+  for (std::size_t i = 0; i < first.held.size(); ++i) {
+    const HeldArray& a = *first.held[i].second;
+    std::vector<py::ssize_t> shape;
+    if (options.stacked) shape.push_back(static_cast<py::ssize_t>(scenes.size()));
+    for (const std::int64_t size : a.shape) shape.push_back(static_cast<py::ssize_t>(size));
+    auto fill = [&](auto* data) {
+      for (std::size_t s = 0; s < (options.stacked ? scenes.size() : 1); ++s) {
+        const std::vector<double>& values = scenes[s]->held[i].second->values;
+        std::copy(values.begin(), values.end(), data + s * a.values.size());
+      }
+    };
+    py::str name(first.held[i].first);
+    if (a.float32) {
+      py::array_t<float> f(shape);
+      fill(f.mutable_data());
+      out[name] = for_callable(f, options.arrays);
+    } else {
+      py::array_t<double> d(shape);
+      fill(d.mutable_data());
+      out[name] = for_callable(d, options.arrays);
+    }
+  }
+  return out;
 }
 
 /// The rows of a stacked result (B, a), B = `rows`.

@@ -55,6 +55,11 @@ sends its batched lines with "encoding": "base64" and each array as {"dtype": "f
 same way: the same doubles, bit for bit, in fewer bytes and less JSON work on both sides. A line
 without "encoding" (an older audit) is answered with JSON numbers, as before.
 
+Held arrays: an audit on recorded observations (--observations FILE) whose data carry "held"
+arrays (a wrist camera's images, token ids: parts that move with the hand, so g leaves them
+alone) sends each request "held": {name: encoded array} in the array's own dtype, and the
+functions then get the keyword held={name: array} ((B, ...) stacked when batched).
+
 The functions get NumPy float64 arrays when NumPy imports (empty point lists have shape (0,3)),
 nested Python lists otherwise ((H+1) x 4 x 4, K x 4 x 4, n x 3). They may return NumPy arrays of
 any real dtype (float32 too), lists or tuples, nested or flat: everything is flattened to Python
@@ -275,6 +280,16 @@ def _rows_of(value):
     if isinstance(shape, list) and shape and isinstance(shape[0], int):
         return shape[0]
     return -1
+
+
+def _held_shapes(value):
+    """The names and shapes of a request's held arrays, to group the items of a batch (arrays
+    of one name stack only when their shapes agree)."""
+    if not isinstance(value, dict):
+        return ()
+    return tuple(sorted((name, tuple(a["shape"]) if isinstance(a, dict)
+                         and isinstance(a.get("shape"), list) else None)
+                        for name, a in value.items()))
 
 
 def _item(i, read, item):
@@ -639,10 +654,24 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                                             ("float32",)), "images[%r]" % view)
                 for view, image in value.items()}
 
-    def call(function, request_id, args, named, images=None):
+    def held_of(item, what):
+        """The request's held arrays (a user's recorded images, ...), {name: array}, or None
+        when it has none (then the functions get no held= keyword)."""
+        value = item.get("held")
+        if value is None:
+            return None
+        if not isinstance(value, dict) or not value:
+            raise _Malformed("%s: 'held' must be an object {name: encoded array}" % what)
+        return {name: _finite(_decode_array(array, "%s: held[%r]" % (what, name),
+                                            ("float64", "float32", "uint8")), "held[%r]" % name)
+                for name, array in value.items()}
+
+    def call(function, request_id, args, named, images=None, held=None):
         kwargs = {"extra_poses": named[0], "scalars": named[1]} if declared else {}
         if images is not None:
             kwargs["images"] = images
+        if held is not None:
+            kwargs["held"] = held
         try:
             # A stray print() in user code would be read as an answer: send it to stderr.
             with contextlib.redirect_stdout(sys.stderr):
@@ -661,6 +690,7 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         world_points = _points(request, "world_points")
         named = (_named(request, "extra_poses", extra_poses, _matrix),
                  _named(request, "scalars", scalars, _scalar))
+        held = held_of(request, "request")
         if _policy is not None:
             if "noise" not in request:
                 raise _Malformed("a policy plug-in needs 'noise' in every request (run it with "
@@ -675,12 +705,15 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                 stacked = (history[None], hand_points[None], world_points[None], noise[None])
                 if images is not None:
                     images = {view: image[None] for view, image in images.items()}
+                if held is not None:
+                    held = {name: array[None] for name, array in held.items()}
                 return {"id": rid, "chunk": _chunks(call(_policy, rid, stacked,
-                                                         _stack_named([named]), images), 1)[0]}
+                                                         _stack_named([named]), images, held),
+                                                    1)[0]}
             return {"id": rid,
                     "chunk": _chunk(call(_policy, rid,
                                          (history, hand_points, world_points, noise), named,
-                                         images))}
+                                         images, held))}
         if "decode" in request:
             if decode is None:
                 raise _Malformed("a decode request, but the plug-in declared no decode")
@@ -691,14 +724,17 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             if np is not None:
                 actions = np.array(actions)
             return {"id": rid, "chunk": _chunk(call(decode, rid, (actions, history, hand_points,
-                                                     world_points), named))}
+                                                     world_points), named, None, held))}
         chunk = _matrices(request, "chunk")
         if batched:  # a batch of one
             stacked = (history[None], chunk[None], hand_points[None], world_points[None])
             reply = {"id": rid}
-            reply.update(_encoded_rows(call(encode, rid, stacked, _stack_named([named])), 1)[0])
+            one = None if held is None else {name: a[None] for name, a in held.items()}
+            reply.update(_encoded_rows(call(encode, rid, stacked, _stack_named([named]), None,
+                                            one), 1)[0])
         else:
-            encoded = call(encode, rid, (history, chunk, hand_points, world_points), named)
+            encoded = call(encode, rid, (history, chunk, hand_points, world_points), named,
+                           None, held)
             actions, observation = _split_encoded(encoded)
             reply = {"id": rid, "actions": _flatten(actions, "actions")}
             if not reply["actions"]:
@@ -713,7 +749,8 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             t = _scalar(request.get("t"), "'t'")
             if np is not None:
                 eps = np.array(eps)
-            pair = call(flow, rid, (history, chunk, hand_points, world_points, eps, t), named)
+            pair = call(flow, rid, (history, chunk, hand_points, world_points, eps, t), named,
+                        None, held)
             if not isinstance(pair, (tuple, list)) or len(pair) != 2:
                 raise _BadResult("flow must return the pair (flow_input, flow_target)")
             reply["flow_input"] = _flatten(pair[0], "flow_input")
@@ -735,8 +772,8 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
             items = _decoded_items(items)
         groups = {}
         for i, item in enumerate(items):
-            groups.setdefault(tuple(_rows_of(item.get(key)) for key in _SHAPE_FIELDS),
-                              []).append(i)
+            groups.setdefault((tuple(_rows_of(item.get(key)) for key in _SHAPE_FIELDS),
+                               _held_shapes(item.get("held"))), []).append(i)
         answers = [None] * len(items)
         for indices in groups.values():
             for i, answer in zip(indices, answer_group(rid, [items[i] for i in indices],
@@ -754,6 +791,10 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
         named = _stack_named([_item(at[i], lambda item: (
             _named(item, "extra_poses", extra_poses, _pose),
             _named(item, "scalars", scalars, _scalar)), items[i]) for i in range(B)])
+        held = None
+        if "held" in items[0]:
+            each = [held_of(item, "batch[%d]" % i) for i, item in zip(at, items)]
+            held = {name: np.stack([e[name] for e in each]) for name in each[0]}
         if _policy is not None:
             noise = _stacked(items, "noise", None, (), at)
             images = None
@@ -761,12 +802,13 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
                 each = [images_of(item, "batch[%d]" % i) for i, item in zip(at, items)]
                 images = {view: np.stack([e[view] for e in each]) for view in _cameras["views"]}
             result = call(_policy, rid, (history, hand_points, world_points, noise), named,
-                          images)
+                          images, held)
             return [{"chunk": c} for c in _chunks(result, B, encoded)]
         if any("decode" in item or "eps" in item or "t" in item for item in items):
             raise _Malformed("decode and flow requests are not batched")
         chunk = _stacked(items, "chunk", 16, (4, 4), at)
-        result = call(encode, rid, (history, chunk, hand_points, world_points), named)
+        result = call(encode, rid, (history, chunk, hand_points, world_points), named, None,
+                      held)
         return _encoded_rows(result, B, encoded=True) if encoded else _encoded_rows(result, B)
 
     line_number = 0

@@ -74,6 +74,15 @@ py::dict cameras_dict(const props::CameraRig& rig) {
   return d;
 }
 
+// What the audit showed the callables besides random scenes: the cameras and the user's data.
+void add_inputs(py::dict& report, const CommonOptions& o) {
+  if (o.call.cameras) report["cameras"] = cameras_dict(*o.call.cameras);
+  if (o.audit.observations) {
+    report["observations"] = py::dict(py::arg("source") = o.audit.observations->source,
+                                      py::arg("count") = o.audit.observations->scenes.size());
+  }
+}
+
 py::dict audit(py::object actions, py::object observation, py::handle groups, py::handle views,
                py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
                const std::string& precision, py::object decode, py::handle extra_poses,
@@ -96,7 +105,7 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
   c.progress = std::ref(progress);
   const props::Classification result = props::classify_representation(representation, c);
   py::dict report = json_loads(props::audit_json({result}))["representations"][py::int_(0)];
-  if (o.call.cameras) report["cameras"] = cameras_dict(*o.call.cameras);
+  add_inputs(report, o);
   return report;
 }
 
@@ -115,7 +124,7 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   c.progress = std::ref(progress);
   const props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
   py::dict report = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
-  if (o.call.cameras) report["cameras"] = cameras_dict(*o.call.cameras);
+  add_inputs(report, o);
   return report;
 }
 
@@ -182,16 +191,17 @@ PYBIND11_MODULE(_core, m) {
   py::handle batch_size, const std::string &array, py::handle device, bool quiet,            \
       py::handle history, py::handle hand_points, py::handle world_points, py::handle chunk, \
       py::handle cameras, py::handle image_size, const std::string &channels, bool floor,    \
-      py::handle workspace
+      py::handle workspace, py::handle observations
 #define HANDCENTRIC_SETUP_VALUE                                                        \
   Setup{batch_size, array,   device,     quiet,    history, hand_points, world_points, \
-        chunk,      cameras, image_size, channels, floor,   workspace}
+        chunk,      cameras, image_size, channels, floor,   workspace,   observations}
 #define HANDCENTRIC_SETUP_ARGUMENTS                                                               \
   py::arg("batch_size") = py::none(), py::arg("array") = "numpy", py::arg("device") = py::none(), \
   py::arg("quiet") = false, py::arg("history") = py::none(), py::arg("hand_points") = py::none(), \
   py::arg("world_points") = py::none(), py::arg("chunk") = py::none(),                            \
   py::arg("cameras") = py::none(), py::arg("image_size") = py::none(),                            \
-  py::arg("channels") = "rgbd", py::arg("floor") = false, py::arg("workspace") = py::none()
+  py::arg("channels") = "rgbd", py::arg("floor") = false, py::arg("workspace") = py::none(),      \
+  py::arg("observations") = py::none()
 
   m.def(
       "audit",

@@ -1,6 +1,7 @@
 #include "options.hpp"
 
 #include <pybind11/stl.h>
+#include <algorithm>
 #include <cstdlib>
 #include <iomanip>
 #include <sstream>
@@ -8,6 +9,7 @@
 #include "arrays.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/props/transport/plugin_protocol.hpp"
+#include "observations.hpp"
 
 namespace handcentric::python {
 namespace {
@@ -179,6 +181,39 @@ std::shared_ptr<const props::CameraRig> camera_rig_of(const Setup& setup,
   return rig;
 }
 
+namespace {
+
+// observations=: the data fix the scenes' sizes and names; the callables get the recorded
+// extras; a view the data cannot tell apart from the other is audited once.
+void with_recorded(CommonOptions& o) {
+  const props::RecordedObservations& data = *o.audit.observations;
+  if (o.history || o.hand_points || o.world_points || o.chunk) {
+    throw InvalidArgument(
+        "history=, hand_points=, world_points= and chunk= fix the sizes of "
+        "random scenes; with observations= the data's sizes are used: leave "
+        "them out");
+  }
+  const Scene& first = data.scenes.front();
+  auto has = [](const auto& named, const std::string& name) {
+    return std::any_of(named.begin(), named.end(), [&](const auto& n) { return n.first == name; });
+  };
+  for (const std::string& name : o.extra_poses) {
+    if (!has(first.extra_poses, name))
+      throw InvalidArgument("extra_poses names '" + name + "', which the observations of " +
+                            data.source + " do not record: add it under \"extra_poses\"");
+  }
+  for (const std::string& name : o.scalars) {
+    if (!has(first.scalars, name))
+      throw InvalidArgument("scalars names '" + name + "', which the observations of " +
+                            data.source + " do not record: add it under \"scalars\"");
+  }
+  o.call.extras = o.call.extras || !first.extra_poses.empty() || !first.scalars.empty();
+  if (!data.has_world_points() && o.audit.views.size() > 1)
+    o.audit.views = {props::View::eye_in_hand};
+}
+
+}  // namespace
+
 CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
                              std::uint64_t seed, std::optional<double> tolerance,
                              const std::string& precision, py::handle extra_poses,
@@ -211,6 +246,8 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
   o.chunk = optional_integer(setup.chunk, "chunk", 1, kMaxSceneSize, "64");
   o.call.cameras = camera_rig_of(setup, o.batch_size);
   o.audit.workspace = workspace_of(setup.workspace);
+  o.audit.observations = observations_of(setup.observations);
+  if (o.audit.observations) with_recorded(o);
   return o;
 }
 

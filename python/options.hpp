@@ -35,6 +35,7 @@ struct Setup {
   std::string channels = "rgbd";
   bool floor = false;
   py::handle workspace = py::none();
+  py::handle observations = py::none();
 };
 
 /// The docstring part about Setup's keywords.
@@ -59,6 +60,13 @@ lamp straight down, which do not move with g. Each point is drawn as a sphere of
 handcentric.render_cameras shows what the audit rendered for a scene.
 workspace=((x0, y0, z0), (x1, y1, z1)) (m): every scene is drawn inside this box and every g so
 that g o stays inside too (a policy meant for its cell); each verdict's note says so.
+observations=[{...}, ...] or a path to a .jsonl / .npz file: draw every scene from your own
+recorded observations instead of random ones, each a dict of world-frame "history" (H+1, 4, 4)
+(and "chunk" (K, 4, 4), needed by audit()), "world_points" (m, 3) and "extra_poses" {name:
+(4, 4)}, which move with g, and "hand_points" (n, 3), "scalars" {name: number} and "held"
+{name: array} (a wrist camera's image, token ids), which g leaves alone; the callables then get
+the recorded extra_poses= and scalars= and held={name: array} (float32 kept) as keywords. Without
+world points in the data only the eye-in-hand view is audited.
 A progress line with the time left goes to stderr after 3 s (quiet=True: none). Needs NumPy
 (ImportError at once without it); Ctrl-C stops it with KeyboardInterrupt.)doc";
 

@@ -7,12 +7,16 @@ set -euo pipefail
 packages=(
   ca-certificates cmake g++ make pkg-config python3
   libeigen3-dev catch2 librapidcheck-dev libbox2d-dev libfcl-dev libopencv-dev libginac-dev
-  libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev
+  libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev zlib1g-dev
   python3-numpy python3-pytest time
   # tests/python_package: `pip install --no-build-isolation .` into a venv of Debian's Python
   python3-venv python3-pip python3-setuptools python3-wheel
   parallel
   python3-dev pybind11-dev python3-torch
+  # libtorch's first Recommends, which --no-install-recommends would drop: torch then runs its
+  # linear layers on OpenBLAS, as an `apt install python3-torch` user's does, not on the
+  # reference BLAS (docs/BENCHMARKS.md, "Python: batched audits")
+  libopenblas0
   # scripts/fuzz.sh: clang, libFuzzer, and the sanitizer and fuzzer runtimes clang links (only
   # recommended by clang, so not installed under --no-install-recommends without this name)
   clang libfuzzer-14-dev libclang-rt-14-dev

@@ -31,6 +31,9 @@ void Scene::validate_observation() const {
       throw InvalidScene("scalar '" + name + "' is not finite: " + format_number(value));
     }
   }
+  for (const auto& [name, array] : held) {
+    if (!array) throw InvalidScene("held array '" + name + "' is null");
+  }
 }
 
 void Scene::validate() const {
@@ -59,6 +62,7 @@ Scene operator*(const RigidTransform& g, const Scene& scene) {
   for (const auto& [name, world_T_other] : scene.extra_poses)
     moved.extra_poses.emplace_back(name, g * world_T_other);
   moved.scalars = scene.scalars;
+  moved.held = scene.held;
   return moved;
 }
 

@@ -21,7 +21,12 @@ std::string row_label(Component component, Mode mode) {
   return to_string(component) + (mode == Mode::distribution ? " (in distribution)" : "");
 }
 
-std::string view_heading(View view) {
+std::string view_heading(View view, bool recorded) {
+  if (recorded) {
+    return view == View::eye_in_hand
+               ? "eye-in-hand view (the recorded observations without their world points)"
+               : "third-person view (the recorded observations, world points moving with g)";
+  }
   return view == View::eye_in_hand ? "eye-in-hand view (no world points: Theorem 1's setting)"
                                    : "third-person view (1-8 world points that move with g)";
 }
@@ -100,6 +105,11 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
   classifier.injectivity_cases = std::max(100, options.cases / 5);
   if (options.workspace) options.workspace->validate();
   classifier.check.shape.workspace = options.workspace;
+  if (options.observations) {
+    options.observations->validate();
+    if (options.workspace) options.observations->require_inside(*options.workspace);
+    classifier.check.shape.recorded = options.observations;
+  }
   return classifier;
 }
 
@@ -130,7 +140,8 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
     out << classification.name << "\n";
     std::vector<const Verdict*> failing, noted;
     for (View view : options.views) {
-      out << "  " << view_heading(view) << "\n  " << pad("component", kLabel);
+      out << "  " << view_heading(view, options.observations != nullptr) << "\n  "
+          << pad("component", kLabel);
       for (Group group : options.groups) out << " | " << pad(to_string(group), kCell);
       out << "\n";
       for (Mode mode : {Mode::pointwise, Mode::distribution}) {
@@ -153,10 +164,13 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
     }
     for (const Verdict* verdict : noted) {
       // The workspace is said once, in the header: its note is left out of each cell's here.
+      // So are the recorded observations'.
       std::string note = verdict->note;
-      if (options.workspace) {
-        const std::string shared = options.workspace->verdict_note();
-        if (note.rfind(shared, 0) == 0) note.erase(0, std::min(note.size(), shared.size() + 2));
+      for (const std::string& shared :
+           {options.workspace ? options.workspace->verdict_note() : std::string(),
+            options.observations ? options.observations->verdict_note() : std::string()}) {
+        if (!shared.empty() && note.rfind(shared, 0) == 0)
+          note.erase(0, std::min(note.size(), shared.size() + 2));
       }
       if (!note.empty()) out << "  note: " << cell_name(*verdict) << ": " << note << "\n";
     }

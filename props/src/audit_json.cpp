@@ -60,6 +60,11 @@ nlohmann::json scene_json(const Scene& scene) {
     for (const auto& [name, value] : scene.scalars) scalars[name] = value;
     out["scalars"] = scalars;
   }
+  if (!scene.held.empty()) {  // described, not copied: an image would swamp the report
+    nlohmann::json held = nlohmann::json::object();
+    for (const auto& [name, array] : scene.held) held[name] = array->describe();
+    out["held"] = held;
+  }
   return out;
 }
 

@@ -114,6 +114,11 @@ std::string scene_key(const Scene& scene, bool with_chunk) {
   for (const auto& [name, T] : scene.extra_poses) append(key, T);
   for (const auto& [name, x] : scene.scalars)
     key.append(reinterpret_cast<const char*>(&x), sizeof(x));
+  // Held arrays are shared and never changed: the same array is the same object.
+  for (const auto& [name, array] : scene.held) {
+    const HeldArray* address = array.get();
+    key.append(reinterpret_cast<const char*>(&address), sizeof(address));
+  }
   return key;
 }
 
@@ -123,6 +128,12 @@ std::string shape_key(const Scene& scene, bool with_chunk) {
   append_count(key, with_chunk ? scene.world_T_hand_chunk.size() : 0);
   append_count(key, scene.hand_points.size());
   append_count(key, scene.world_points.size());
+  // Held arrays stack into one array per name: their shapes must agree within a batch.
+  for (const auto& [name, array] : scene.held) {
+    append_count(key, array->shape.size());
+    for (const std::int64_t size : array->shape) append_count(key, static_cast<std::size_t>(size));
+    key += array->float32 ? 'f' : 'd';
+  }
   return key;
 }
 

@@ -13,6 +13,7 @@
 #include "handcentric/core/format.hpp"
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/props/batch.hpp"
+#include "handcentric/props/observation/recorded.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 #include "rapidcheck/detail/TestListenerAdapter.h"
@@ -63,6 +64,7 @@ double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<Ri
 }
 
 std::pair<Scene, RigidTransform> draw_case(const SceneShape& shape, Group group) {
+  if (shape.recorded) return *recorded_case(shape, group);
   if (shape.workspace) return *case_in_workspace(shape, group, *shape.workspace);
   // Two draws, in this order, as every verdict and witness without a workspace was found.
   Scene scene = *props::scene(shape);
@@ -182,7 +184,9 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   std::exception_ptr error;
   const SceneShape shape = options.shape;
   // A workspace that leaves the group no room is an error of the call, said before any case.
-  if (shape.workspace) (void)shape.workspace->room_for(group);
+  // Recorded observations must lie inside it (recorded_case then finds a g for every group).
+  if (shape.workspace && !shape.recorded) (void)shape.workspace->room_for(group);
+  if (shape.workspace && shape.recorded) shape.recorded->require_inside(*shape.workspace);
   int shrink_evaluations = 0;
   // One case of the search: false when it failed (or raised: `error`).
   auto search_case = [&](const Scene& scene, const RigidTransform& g, CaseOutcome& outcome,
@@ -263,6 +267,9 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   }
   verdict.invariant = !verdict.witness.has_value();
   if (shape.workspace) verdict.note = shape.workspace->verdict_note();
+  if (shape.recorded) {
+    verdict.note += (verdict.note.empty() ? "" : "; ") + shape.recorded->verdict_note();
+  }
   if (verdict.discontinuities > 0) {
     verdict.note += std::string(verdict.note.empty() ? "" : "; ") +
                     std::to_string(verdict.discontinuities) + " of " +

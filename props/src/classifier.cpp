@@ -4,6 +4,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
+#include "handcentric/props/observation/recorded.hpp"
 #include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
@@ -67,6 +68,21 @@ const std::vector<Group> kRotations = {Group::rotation, Group::c8};
 
 }  // namespace
 
+namespace {
+
+// A representation encodes the chunk: recorded observations must carry theirs.
+void require_recorded_chunks(const ClassifierOptions& options, const std::string& name) {
+  const auto& recorded = options.check.shape.recorded;
+  if (recorded && !recorded->has_chunks) {
+    throw InvalidArgument("the observations of " + recorded->source +
+                          " record no action chunk, which " + name +
+                          " encodes: give each a 'chunk' (K, 4, 4) of world_T_hand poses, or "
+                          "audit a whole policy on them");
+  }
+}
+
+}  // namespace
+
 CheckOptions with_view(CheckOptions check, View view) {
   // A fixed count of world points the caller chose (a network with fixed inputs) is kept for
   // the third-person view.
@@ -84,6 +100,7 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
                                        std::shared_ptr<const FlowTarget> flow) {
   if (!representation)
     throw InvalidArgument("classify_representation needs a representation, got null");
+  require_recorded_chunks(options, representation->name());
   Classification out;
   out.name = representation->name();
   if (!flow) flow = std::make_shared<RectifiedFlow>(representation);
@@ -127,6 +144,7 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
 Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
                                     const ClassifierOptions& options) {
   if (!target) throw InvalidArgument("classify_flow_target needs a flow target, got null");
+  require_recorded_chunks(options, target->name());
   Classification out;
   out.name = target->name();
   const int total = static_cast<int>(options.views.size() * options.groups.size()) * 2 *

@@ -7,6 +7,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "handcentric/props/observation/recorded.hpp"
 
 namespace handcentric::props {
 namespace {
@@ -386,6 +387,84 @@ rc::Gen<std::pair<Scene, RigidTransform>> case_in_workspace(const SceneShape& sh
       rc::gen::map(translation(1.0), [](const Eigen::Vector3d& u) {
         return Eigen::Vector3d(0.5 * (u.array() + 1.0));
       }));
+}
+
+namespace {
+
+// g_drawn turned back toward the identity until a translation of `group` keeps g * scene inside
+// the box (recorded_case); t_u in [0, 1]^3 picks that translation among the feasible ones.
+RigidTransform kept_inside(const Scene& scene, const RigidTransform& g_drawn, Group group,
+                           const Workspace& box, const Eigen::Vector3d& t_u, bool planar) {
+  const bool translates = group == Group::translation || group == Group::se2 || group == Group::se3;
+  const int axes = group == Group::se2 || planar ? 2 : 3;  // se2 moves in the plane
+  // The rotations to try, the drawn one first: c8 one step of 45 degrees at a time toward the
+  // identity, the others with their angle halved (30 halvings reach below 1e-9 rad).
+  std::vector<Rotation> tries;
+  if (group == Group::c8) {
+    const Eigen::Matrix3d R = g_drawn.rotation().matrix();
+    int k = static_cast<int>(std::lround(std::atan2(R(1, 0), R(0, 0)) / (kPi / 4)));
+    for (; k != 0; k -= k > 0 ? 1 : -1)
+      tries.push_back(Rotation::exp(Eigen::Vector3d(0.0, 0.0, k * kPi / 4)));
+  } else {
+    const Eigen::Vector3d w = g_drawn.rotation().log();
+    for (int j = 0; j <= 30 && w.norm() > 0.0; ++j)
+      tries.push_back(Rotation::exp(std::ldexp(1.0, -j) * w));
+  }
+  tries.push_back(Rotation());
+  for (const Rotation& R : tries) {
+    const auto [low, high] = feasible_translations(scene, R.matrix(), box);
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    bool fits = true;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (translates && axis < axes) {
+        fits = fits && low(axis) <= high(axis);
+        t(axis) = low(axis) + t_u(axis) * std::max(0.0, high(axis) - low(axis));
+      } else {
+        fits = fits && low(axis) <= 0.0 && 0.0 <= high(axis);
+      }
+    }
+    if (fits) return RigidTransform(R, t);
+  }
+  return RigidTransform::identity();  // the observation itself is inside (require_inside)
+}
+
+}  // namespace
+
+rc::Gen<std::pair<Scene, RigidTransform>> recorded_case(const SceneShape& shape, Group group) {
+  if (!shape.recorded) throw InvalidArgument("recorded_case needs recorded observations");
+  std::shared_ptr<const RecordedObservations> data = shape.recorded;
+  const bool eye_in_hand = shape.max_world_points == 0;
+  const auto index = rc::gen::inRange<std::size_t>(0, data->scenes.size());
+  const auto observation = rc::gen::map(index, [data, eye_in_hand](std::size_t i) {
+    Scene s = data->scenes[i];
+    if (eye_in_hand) s.world_points.clear();
+    return s;
+  });
+  if (!shape.workspace) {
+    return rc::gen::apply(
+        [](Scene s, const RigidTransform& g) { return std::make_pair(std::move(s), g); },
+        observation, group_element(group, shape.planar));
+  }
+  const Workspace box = *shape.workspace;
+  const bool planar = shape.planar;
+  return rc::gen::apply(
+      [box, group, planar](Scene s, const RigidTransform& g_drawn, const Eigen::Vector3d& t_u) {
+        const RigidTransform g = kept_inside(s, g_drawn, group, box, t_u, planar);
+        return std::make_pair(std::move(s), g);
+      },
+      observation, group_element(group, planar),
+      rc::gen::map(translation(1.0), [](const Eigen::Vector3d& u) {
+        return Eigen::Vector3d(0.5 * (u.array() + 1.0));
+      }));
+}
+
+rc::Gen<Scene> shaped_scene(const SceneShape& shape) {
+  // Translation leaves every scene shape room in any box, so the workspace's scenes are drawn so.
+  const auto first = [](const std::pair<Scene, RigidTransform>& c) { return c.first; };
+  if (shape.recorded) return rc::gen::map(recorded_case(shape, Group::translation), first);
+  if (shape.workspace)
+    return rc::gen::map(case_in_workspace(shape, Group::translation, *shape.workspace), first);
+  return scene(shape);
 }
 
 }  // namespace handcentric::props

@@ -211,7 +211,7 @@ Scan scan_resolution(const Representation& representation, const CheckOptions& o
   };
   auto property = [&] {
     if (error) return;
-    const Scene first = *scene(options.shape);
+    const Scene first = *shaped_scene(options.shape);
     // Every pair's draws first, in the order of the loop below, so that a prefetch pass can ask
     // for all the pairs' scenes at once.
     std::vector<Pair> pairs;
@@ -308,7 +308,7 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
   auto property = [&] {
     if (error) return;
     if (!searching && ++shrink_evaluations > (options.shrink ? 1000 : 0)) return;
-    const Scene first = *scene(shape);
+    const Scene first = *shaped_scene(shape);
     const auto change = static_cast<Change>(*rc::gen::inRange(0, 4));
     const int index = *rc::gen::inRange(0, 64);
     const Eigen::Vector3d v = *translation(1.0), w = *translation(1.0);

@@ -82,6 +82,8 @@ std::string format_witness(const Witness& witness) {
     out << "  extra pose '" << name << "': " << pose_text(T) << "\n";
   for (const auto& [name, value] : s.scalars)
     out << "  scalar '" << name << "': " << format_number(value) << "\n";
+  for (const auto& [name, array] : s.held)
+    out << "  held array '" << name << "': " << array->describe() << " (unchanged by g)\n";
   const bool law = !witness.detail.empty();
   out << (law ? "mean before: " : "before: ") << vector_text(witness.before) << "\n"
       << (law ? "mean after:  " : "after:  ") << vector_text(witness.after) << "\n";

@@ -312,6 +312,72 @@ TEST_CASE("policy_exec_audits_a_whole_policy_and_finds_each_planted_fault", "[un
   CHECK(velocity.at("summary").at("eye_in_hand").at("distribution").at("rotation") == false);
 }
 
+TEST_CASE("policy_exec_audits_a_plugin_on_recorded_observations_with_their_held_arrays", "[unit]") {
+  // A log of 16 observations (a goal pose, a gripper width and a float32 wrist image) written by
+  // NumPy as JSON Lines; the plug-in reads the goal as an extra pose (equivariant) or from the
+  // held arrays where the log also files it (the planted fault: it stays put under g).
+  const std::string dir = std::filesystem::temp_directory_path() / "handcentric_recorded_cli";
+  std::filesystem::create_directories(dir);
+  const std::string log = dir + "/log.jsonl";
+  const auto written = test::run_command(
+      std::string(HANDCENTRIC_PYTHON) + " -c '" +
+      "import json, numpy as np, base64\n"
+      "rng = np.random.default_rng(2)\n"
+      "def enc(a): return {\"dtype\": str(a.dtype), \"shape\": list(a.shape), "
+      "\"data\": base64.b64encode(a.tobytes()).decode()}\n"
+      "def pose(a, t):\n"
+      "    c, s = np.cos(a), np.sin(a); T = np.eye(4); T[:2, :2] = [[c, -s], [s, c]]; "
+      "T[:3, 3] = t; return T\n"
+      "with open(\"" +
+      log +
+      "\", \"w\") as f:\n"
+      "    for i in range(16):\n"
+      "        T0 = pose(rng.uniform(-3, 3), rng.uniform(-0.5, 0.5, 3)); "
+      "goal = pose(rng.uniform(-3, 3), rng.uniform(-0.5, 0.5, 3))\n"
+      "        f.write(json.dumps({\"history\": [T0.tolist()], \"extra_poses\": "
+      "{\"goal\": goal.tolist()}, \"scalars\": {\"gripper\": 0.5}, \"held\": "
+      "{\"wrist\": enc(rng.random((2, 3, 4)).astype(np.float32)), \"goal\": enc(goal)}}) "
+      "+ \"\\n\")\n'");
+  INFO(written.err);
+  REQUIRE(written.exit_code == 0);
+  auto audit = [&](const std::string& args) {
+    const auto result = test::run_command(test::cli() + " audit --policy-exec '" +
+                                          test::test_plugin("policy_recorded.py", args) +
+                                          "' --cases 60 --observations " + log + " --json");
+    INFO(result.err);
+    REQUIRE(result.exit_code == 0);
+    return nlohmann::json::parse(result.out).at("policies").at(0);
+  };
+  const std::vector<std::string> served = {"plain", "--batched"};
+  for (const std::string& args : served) {
+    const auto right = audit(args);
+    CHECK_FALSE(right.at("summary").contains("third_person"));  // no world points in the log
+    for (const auto& [group, yes] : right.at("summary").at("eye_in_hand").at("pointwise").items())
+      CHECK(yes == true);
+    const auto wrong = audit("held_goal " + args);  // "plain" is no argument the plug-in reads
+    for (const auto& [group, yes] : wrong.at("summary").at("eye_in_hand").at("pointwise").items())
+      CHECK(yes == false);
+  }
+  const auto text = test::run_command(test::cli() + " audit --policy-exec '" +
+                                      test::test_plugin("policy_recorded.py", "") +
+                                      "' --cases 30 --group se3 --observations " + log);
+  CHECK_THAT(text.out, Contains("cases drawn from 16 recorded observations (" + log + ")"));
+  // The plug-in asks for an extra pose the log does not record: refused, not filled in.
+  std::ofstream(dir + "/bare.jsonl")
+      << "{\"history\": [[[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]], \"scalars\": "
+         "{\"gripper\": 1}, \"held\": {\"wrist\": [1, 2]}}\n";
+  const auto bare = test::run_command(test::cli() + " audit --policy-exec '" +
+                                      test::test_plugin("policy_recorded.py", "") +
+                                      "' --observations " + dir + "/bare.jsonl");
+  CHECK(bare.exit_code == 1);
+  CHECK_THAT(bare.err, Contains("asks for extra pose 'goal'"));
+  const auto missing =
+      test::run_command(test::cli() + " audit --observations " + dir + "/none.npz");
+  CHECK(missing.exit_code == 1);
+  CHECK_THAT(missing.err, Contains("cannot open observations file"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("policy_exec_hands_a_plugin_the_images_of_its_hellos_cameras", "[unit]") {
   // The plug-in declares its camera in its hello; each request then carries the rendered image.
   // A network on the eye-in-hand image is equivariant (with the floor, under se2 and c8 only);

@@ -24,9 +24,10 @@ Scene PipePolicy::with_extras(const Scene& scene) const {
 
 const PluginCapabilities& PipePolicy::capabilities() const {
   if (capabilities_) return *capabilities_;
-  // The probe: the hand at the origin, the default noise.
+  // The probe: the hand at the origin (or use_probe()'s scene), the default noise.
   Scene probe;
   probe.world_T_hand_history = {RigidTransform::identity()};
+  if (probe_) probe = *probe_;
   const Eigen::VectorXd noise = fixed_noise(kPolicyNoise, 1);
   PluginReply reply = connection_.exchange(RequestKind::policy,
                                            policy_request_body(with_extras(probe), noise), true);

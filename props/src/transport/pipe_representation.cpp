@@ -54,10 +54,11 @@ Scene PipeRepresentation::with_extras(const Scene& scene) const {
 
 const PluginCapabilities& PipeRepresentation::capabilities() const {
   if (capabilities_) return *capabilities_;
-  // The probe: the hand at the origin, one pose 10 cm ahead.
+  // The probe: the hand at the origin, one pose 10 cm ahead (or use_probe()'s scene).
   Scene probe;
   probe.world_T_hand_history = {RigidTransform::identity()};
   probe.world_T_hand_chunk = {RigidTransform::from_translation(Eigen::Vector3d(0.1, 0.0, 0.0))};
+  if (probe_) probe = *probe_;
   Scene asked = with_extras(probe);
   // Before the hello the plug-in's encodings are unknown: the probe is text.
   PluginReply reply =

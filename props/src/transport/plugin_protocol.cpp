@@ -146,6 +146,25 @@ void append_observation(std::string& out, const Scene& scene, NumberEncoding enc
     }
     out += '}';
   }
+  // Held arrays (a dataset's images) always travel encoded, in their own dtype: as JSON numbers
+  // an image would be several times its size.
+  if (!scene.held.empty()) {
+    out += ", \"held\": {";
+    for (std::size_t i = 0; i < scene.held.size(); ++i) {
+      if (i > 0) out += ", ";
+      append_name(out, scene.held[i].first);
+      out += ": ";
+      const HeldArray& array = *scene.held[i].second;
+      const std::vector<std::size_t> shape(array.shape.begin(), array.shape.end());
+      if (array.float32) {
+        const std::vector<float> narrow(array.values.begin(), array.values.end());
+        wire::append_float32_array(out, shape, narrow.data());
+      } else {
+        wire::append_float64_array(out, shape, array.values.data());
+      }
+    }
+    out += '}';
+  }
 }
 
 std::string reply_to(const std::string& who, int id) {

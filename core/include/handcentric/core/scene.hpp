@@ -8,15 +8,19 @@
 //   extra_poses             other named world-frame poses (the episode's start pose, a second
 //                           arm's hand): they move with the scene
 //   scalars                 named numbers no transform changes (a gripper's width)
+//   held                    named arrays no transform changes (a dataset's eye-in-hand image)
 //
 // A global rigid transform g acts as in Sec. 2.2: g * scene moves every pose (T -> g T) and
-// every world point (x -> g x), and leaves the eye-in-hand points and the scalars alone, because
+// every world point (x -> g x), and leaves the eye-in-hand points, the scalars and the held
+// arrays alone, because
 // the camera, the hand and the objects move together (the proposition behind Lemma 2).
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "handcentric/core/held_array.hpp"
 #include "handcentric/core/rigid_transform.hpp"
 
 namespace handcentric {
@@ -30,6 +34,8 @@ struct Scene {
   std::vector<std::pair<std::string, RigidTransform>> extra_poses;
   /// Named numbers that a global transform leaves alone, in a fixed order.
   std::vector<std::pair<std::string, double>> scalars;
+  /// Named arrays that a global transform leaves alone, in a fixed order (shared, read-only).
+  std::vector<std::pair<std::string, std::shared_ptr<const HeldArray>>> held;
 
   /// T_0, the hand now. Precondition: the history is not empty (see validate()).
   const RigidTransform& world_T_hand0() const { return world_T_hand_history.front(); }
@@ -49,7 +55,7 @@ struct Scene {
 };
 
 /// g * scene (Sec. 2.2's "T~ o"): poses (extra ones too) and world points move, eye-in-hand
-/// points and scalars do not.
+/// points, scalars and held arrays do not.
 Scene operator*(const RigidTransform& g, const Scene& scene);
 
 }  // namespace handcentric

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "handcentric/props/classifier.hpp"
+#include "handcentric/props/observation/recorded.hpp"
 #include "handcentric/props/workspace.hpp"
 
 namespace handcentric::props {
@@ -31,6 +32,8 @@ struct AuditOptions {
   double relative_tolerance = 0.0;
   /// Draw every case inside this box, g * scene included (workspace.hpp); none: anywhere.
   std::optional<Workspace> workspace;
+  /// Draw every scene from these (observation/recorded.hpp); none: random scenes.
+  std::shared_ptr<const RecordedObservations> observations;
 };
 
 /// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value

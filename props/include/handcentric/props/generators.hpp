@@ -6,6 +6,7 @@
 // and exactly pi. Every generator shrinks toward simpler values (smaller numbers, fewer poses).
 #include <rapidcheck.h>
 
+#include <memory>
 #include <optional>
 
 #include <string>
@@ -18,6 +19,8 @@
 #include "handcentric/props/workspace.hpp"
 
 namespace handcentric::props {
+
+struct RecordedObservations;  // observation/recorded.hpp
 
 /// A Haar-uniform rotation (no edge cases).
 rc::Gen<Rotation> haar_rotation();
@@ -61,6 +64,10 @@ struct SceneShape {
   /// When set, the checks draw their cases by case_in_workspace() instead of scene() and
   /// group_element().
   std::optional<Workspace> workspace;
+  /// When set, the checks draw their scenes from these instead (recorded_case()); the sizes
+  /// above are then the data's, except that a shape with no world points (the eye-in-hand
+  /// view) drops the recorded world points.
+  std::shared_ptr<const RecordedObservations> recorded;
 };
 
 /// A scene at a length scale lambda drawn log-uniformly in [0.01, 10] m: a random start pose
@@ -81,5 +88,17 @@ rc::Gen<Scene> scene(SceneShape shape = {});
 /// not inside it).
 rc::Gen<std::pair<Scene, RigidTransform>> case_in_workspace(const SceneShape& shape, Group group,
                                                             const Workspace& workspace);
+
+/// A recorded observation (shape.recorded, drawn uniformly; shrinking goes to the first) and a g
+/// in `group`. With shape.workspace, g is drawn as without one and then turned back toward the
+/// identity (its angle halved, or for c8 one step of 45 degrees at a time) until a translation
+/// of its group keeps every world position of g * o inside the box; that translation is then
+/// drawn uniformly among those. The observations must lie inside the box
+/// (RecordedObservations::require_inside), so the identity always does.
+rc::Gen<std::pair<Scene, RigidTransform>> recorded_case(const SceneShape& shape, Group group);
+
+/// The scene a check starts from, without g: a recorded observation (shape.recorded), else one
+/// inside shape.workspace, else scene(shape). Injectivity draws its scenes so.
+rc::Gen<Scene> shaped_scene(const SceneShape& shape);
 
 }  // namespace handcentric::props

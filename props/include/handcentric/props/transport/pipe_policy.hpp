@@ -45,6 +45,12 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   /// The hello's "batch" (the most observations per request), 0 when the plug-in does not batch.
   int batch_size() const { return capabilities().batch; }
 
+  /// The scene of the handshake's first request instead of the built-in probe (the hand at the
+  /// origin): an audit on recorded observations sends their first, so that the plug-in meets
+  /// the parts it will be sent (held arrays, extra poses) from its first request on. Call it
+  /// before the handshake runs.
+  void use_probe(Scene probe) { probe_ = std::move(probe); }
+
   /// The handshake's result (runs it if it has not run).
   const PluginCapabilities& capabilities() const;
   int requests_sent() const { return connection_.requests_sent(); }
@@ -65,6 +71,7 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   std::vector<std::string> forced_extra_poses_, forced_scalars_;
   mutable PluginConnection connection_;
   mutable std::optional<PluginCapabilities> capabilities_;
+  std::optional<Scene> probe_;  ///< use_probe()'s scene
   mutable std::unordered_map<std::string, std::vector<RigidTransform>> cache_;
   mutable std::size_t chunk_length_ = 0;
 };

@@ -80,6 +80,12 @@ class PipeRepresentation final : public Representation, public BatchRepresentati
   std::vector<RigidTransform> decode_in_scene(const Eigen::VectorXd& actions,
                                               const Scene& observation) const override;
 
+  /// The scene of the handshake's first request instead of the built-in probe (the hand at the
+  /// origin): an audit on recorded observations sends their first, so that the plug-in meets
+  /// the parts it will be sent (held arrays, extra poses) from its first request on. Call it
+  /// before the handshake runs.
+  void use_probe(Scene probe) { probe_ = std::move(probe); }
+
   /// The handshake's result (runs it if it has not run): protocol, names, decode, flow.
   const PluginCapabilities& capabilities() const;
   /// Whether the plug-in sent an "observation" (runs the handshake if it has not run).
@@ -115,6 +121,7 @@ class PipeRepresentation final : public Representation, public BatchRepresentati
   std::vector<std::string> forced_extra_poses_, forced_scalars_;
   mutable PluginConnection connection_;
   mutable std::optional<PluginCapabilities> capabilities_;
+  std::optional<Scene> probe_;  ///< use_probe()'s scene
   mutable bool has_observation_ = false;
   mutable std::unordered_map<std::string, PluginReply> cache_;
   mutable std::string last_key_;                     ///< the last scene encoded, its key
