@@ -119,9 +119,9 @@ def test_files_written_by_numpy_and_json_lines_give_the_dicts_verdicts(tmp_path)
 def handcentric_encoded(array):
     """The pipe's encoded array form, which JSON Lines files may use for images."""
     import base64
+    little = np.ascontiguousarray(array).astype(array.dtype.newbyteorder("<"))
     return {"dtype": str(array.dtype), "shape": list(array.shape),
-            "data": base64.b64encode(np.ascontiguousarray(array).astype(array.dtype.newbyteorder("<"))
-                                     .tobytes()).decode()}
+            "data": base64.b64encode(little.tobytes()).decode()}
 
 
 def test_representation_audits_read_the_recorded_chunks():
@@ -173,7 +173,8 @@ def test_a_corrupt_npz_is_refused(tmp_path):
     raw = (tmp_path / "log.npz").read_bytes()
     (tmp_path / "cut.npz").write_bytes(raw[: len(raw) // 2])
     middle = len(raw) // 3  # inside the deflated data: the CRC check must see it
-    (tmp_path / "flipped.npz").write_bytes(raw[:middle] + bytes([raw[middle] ^ 0xFF]) + raw[middle + 1:])
+    flipped = raw[:middle] + bytes([raw[middle] ^ 0xFF]) + raw[middle + 1:]
+    (tmp_path / "flipped.npz").write_bytes(flipped)
     for name in ("cut.npz", "flipped.npz"):
         with pytest.raises((ValueError, OSError, RuntimeError), match="observations file"):
             audit(str(tmp_path / name))

@@ -25,7 +25,8 @@ def act(T0, goal, gripper, wrist, noise):
     hand_goal = hp.relative_pose(T0, goal)
     gain = 0.1 * gripper * float(np.mean(wrist))
     step = np.eye(4)
-    step[:3, :3] = hp.rotation_matrix(0.1 * hp.rotation_vector(hand_goal[:3, :3]) + [0.0, 0.0, 0.01 * noise[0]])
+    turn = 0.1 * hp.rotation_vector(hand_goal[:3, :3]) + [0.0, 0.0, 0.01 * noise[0]]
+    step[:3, :3] = hp.rotation_matrix(turn)
     step[:3, 3] = gain * hand_goal[:3, 3]
     return np.stack([T0 @ step, T0 @ step @ step])
 
