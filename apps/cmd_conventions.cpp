@@ -51,8 +51,7 @@ int run_conventions(ConventionsCommandOptions options) {
                 << "' is out of date: the audit of conventions/ gives another table (first "
                    "difference at line "
                 << d.line << ")\n  file:  " << d.first << "\n  audit: " << d.second
-                << "\nregenerate it with: handcentric conventions --out " << options.check
-                << "\n";
+                << "\nregenerate it with: handcentric conventions --out " << options.check << "\n";
       return 1;
     }
     std::cout << options.check << " is up to date (" << conventions.size() << " conventions)\n";

@@ -274,9 +274,9 @@ std::vector<Section> conventions_page_sections(const PageOptions& page) {
   options.python = page.python;
   if (!std::filesystem::is_directory(options.folder)) {
     Section note = section("conventions", "Public pose conventions, audited");
-    note.blocks.push_back(Paragraph{
-        {plain("Not run: no folder of convention plug-ins at " + options.folder + " ("),
-         code("--conventions DIR"), plain(": the source tree's conventions/).")}});
+    note.blocks.push_back(
+        Paragraph{{plain("Not run: no folder of convention plug-ins at " + options.folder + " ("),
+                   code("--conventions DIR"), plain(": the source tree's conventions/).")}});
     return {std::move(note)};
   }
   options.progress = [](const std::string& name, int index, int count) {

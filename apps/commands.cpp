@@ -9,8 +9,9 @@ namespace {
 constexpr Command kCommands[] = {
     {"audit", add_audit_command},   {"conventions", add_conventions_command},
     {"demos", add_demos_command},   {"eval", add_eval_command},
-    {"figure", add_figure_command}, {"prove", add_prove_command},   {"render", add_render_command},
-    {"report", add_report_command}, {"table1", add_table1_command}, {"table2", add_table2_command},
+    {"figure", add_figure_command}, {"prove", add_prove_command},
+    {"render", add_render_command}, {"report", add_report_command},
+    {"table1", add_table1_command}, {"table2", add_table2_command},
     {"train", add_train_command},
 };
 

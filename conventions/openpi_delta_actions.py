@@ -2,7 +2,8 @@
 """openpi's DeltaActions (and LeRobot's to_relative_actions, which mirrors it) on an end-effector
 state [position, axis-angle]: every masked action dimension minus the same state dimension.
 
-Source   Physical-Intelligence/openpi (commit 099c772), src/openpi/transforms.py, class DeltaActions:
+Source   Physical-Intelligence/openpi (commit 099c772), src/openpi/transforms.py,
+         class DeltaActions:
          `actions[..., :dims] -= np.expand_dims(np.where(mask, state[..., :dims], 0), axis=-2)`;
          huggingface/lerobot, src/lerobot/processor/relative_action_processor.py,
          to_relative_actions: `actions[..., :dims] -= state_offset` ("Mirrors OpenPI's

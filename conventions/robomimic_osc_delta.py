@@ -5,7 +5,8 @@ an axis-angle rotation applied on the left, each normalized by the controller's 
 Source   ARISE-Initiative/robosuite (v1.4), robosuite/utils/control_utils.py,
          set_goal_orientation: `quat_error = trans.axisangle2quat(delta)`,
          `rotation_mat_error = trans.quat2mat(quat_error)`,
-         `goal_orientation = np.dot(rotation_mat_error, current_orientation)`, and set_goal_position:
+         `goal_orientation = np.dot(rotation_mat_error, current_orientation)`, and
+         set_goal_position:
          `goal_position = current_position + delta`; robomimic trains on these actions (its
          datasets store them in [-1, 1], scaled to output_max 0.05 m and 0.5 rad by the
          controller's default configuration).

@@ -92,14 +92,15 @@ Text witness_text(const props::Verdict& v) {
   g += ", translation " + vector_text(w.g.translation()) + " m";
   std::string scene = "scene: H = " + std::to_string(w.scene.history_length()) +
                       ", K = " + std::to_string(w.scene.chunk_length()) + ", " +
-                      std::to_string(w.scene.world_points.size()) + " world points, p_0 = " +
-                      vector_text(w.scene.world_T_hand0().translation()) + " m";
+                      std::to_string(w.scene.world_points.size()) +
+                      " world points, p_0 = " + vector_text(w.scene.world_T_hand0().translation()) +
+                      " m";
   std::string where;
   if (w.before.size() == w.after.size() && w.before.size() > 0) {
     Eigen::Index i = 0;
     (w.after - w.before).cwiseAbs().maxCoeff(&i);
-    where = "; largest difference at coordinate " + std::to_string(i) + ": " +
-            digits(w.before[i]) + " -> " + digits(w.after[i]);
+    where = "; largest difference at coordinate " + std::to_string(i) + ": " + digits(w.before[i]) +
+            " -> " + digits(w.after[i]);
   }
   out.push_back(plain("error " + digits(w.error) + " (tolerance " + digits(w.tolerance) + "); " +
                       g + "; " + scene + where));
@@ -150,7 +151,8 @@ Table summary_table(const std::vector<ConventionAudit>& conventions, props::View
   table.columns = {"convention"};
   for (props::Group group : props::all_groups()) table.columns.push_back(props::to_string(group));
   table.columns.push_back("injective");
-  table.columns.push_back("as expected");
+  // The Expect lines speak of the eye-in-hand view (Theorem 1's setting).
+  if (view == props::View::eye_in_hand) table.columns.push_back("as expected");
   for (const ConventionAudit& c : conventions) {
     std::vector<TableCell> row;
     TableCell name;
@@ -158,11 +160,13 @@ Table summary_table(const std::vector<ConventionAudit>& conventions, props::View
     row.push_back(std::move(name));
     for (props::Group group : props::all_groups()) row.push_back(group_cell(c, group, view));
     row.push_back(injectivity_cell(c));
-    // Whether the eye-in-hand cells are what the docstring's Expect line (the theory) says.
-    row.push_back(c.mismatches.empty()
-                      ? verdict_cell(true, "yes", "", "")
-                      : verdict_cell(false, std::to_string(c.mismatches.size()) + " differ", "",
-                                     "#conventions-" + c.name));
+    if (view == props::View::eye_in_hand) {
+      // Whether the eye-in-hand cells are what the docstring's Expect line (the theory) says.
+      row.push_back(c.mismatches.empty()
+                        ? verdict_cell(true, "", "", "")
+                        : verdict_cell(false, std::to_string(c.mismatches.size()) + " differ", "",
+                                       "#conventions-" + c.name));
+    }
     table.rows.push_back(std::move(row));
   }
   return table;
@@ -176,13 +180,13 @@ Section convention_section(const ConventionAudit& c) {
   out.title = c.name + ": " + c.title;
   out.level = 3;
   out.blocks.push_back(Preformatted{c.description});
-  Text injectivity = {bold("Injectivity: ")};
+  Text injectivity = {bold("Injectivity:"), plain(" ")};
   if (c.result.injectivity) {
     const props::Injectivity& inj = *c.result.injectivity;
     injectivity.push_back(plain(!inj.injective.has_value() ? "no loss found"
-                                : *inj.injective          ? "yes"
-                                                          : "NO"));
-    injectivity.push_back(plain(". " + inj.how));
+                                : *inj.injective           ? "yes"
+                                                           : "NO"));
+    injectivity.push_back(plain(" (" + inj.how + ")."));
     if (inj.resolution) {
       injectivity.push_back(plain(" Chunks that differ by up to " +
                                   props::format_resolution(*inj.resolution, inj.resolution_unit) +
@@ -192,10 +196,11 @@ Section convention_section(const ConventionAudit& c) {
   out.blocks.push_back(Paragraph{injectivity});
   List theory;
   for (const std::string& m : c.mismatches) theory.items.push_back({plain(m)});
-  out.blocks.push_back(Paragraph{
-      {bold("Against its Expect line: "),
-       plain(c.mismatches.empty() ? "every eye-in-hand cell as expected."
-                                  : std::to_string(c.mismatches.size()) + " cell(s) differ:")}});
+  out.blocks.push_back(
+      Paragraph{{bold("Against its Expect line:"),
+                 plain(c.mismatches.empty()
+                           ? " every eye-in-hand cell as expected."
+                           : " " + std::to_string(c.mismatches.size()) + " cell(s) differ:")}});
   if (!theory.items.empty()) out.blocks.push_back(std::move(theory));
   Table failing;
   failing.id = "conventions-" + c.name + "-witnesses";
@@ -208,8 +213,8 @@ Section convention_section(const ConventionAudit& c) {
             props::find_verdict(c.result, shown.component, shown.mode, group, view);
         if (v == nullptr || v->invariant) continue;
         TableCell what;
-        what.text.push_back(plain(std::string(shown.label) + ", " + props::to_string(group) +
-                                  ", " + view_title(view)));
+        what.text.push_back(plain(std::string(shown.label) + ", " + props::to_string(group) + ", " +
+                                  view_title(view)));
         TableCell method = text_cell(v->mode == props::Mode::pointwise
                                          ? "pointwise"
                                          : "in distribution, " + props::to_string(v->method));
@@ -237,7 +242,8 @@ Text how_made(const ConventionsOptions& options) {
     audit.seed = options.seed;
     return audit;
   }());
-  return {plain("Each row is a plug-in of "), code("conventions/"),
+  return {plain("Each row is a plug-in of "),
+          code("conventions/"),
           plain(" (this project's own code; each file's docstring, shown below, cites the "
                 "codebase, file and formula it follows) audited through the "),
           code("--exec"),
@@ -252,6 +258,12 @@ Text how_made(const ConventionsOptions& options) {
 }
 
 }  // namespace
+
+std::string convention_title(const std::string& docstring) {
+  std::string first = docstring.substr(0, docstring.find("\n\n"));
+  std::replace(first.begin(), first.end(), '\n', ' ');
+  return first.substr(0, first.find(": "));
+}
 
 std::vector<std::string> convention_plugins(const std::string& folder) {
   namespace fs = std::filesystem;
@@ -296,9 +308,10 @@ std::string convention_docstring(const std::string& path, const std::string& sou
 
 std::vector<props::Group> expected_groups(const std::string& path, const std::string& docstring,
                                           props::Component component) {
-  const std::string fix = "; write e.g. 'Expect   actions: translation; observation: none' "
-                          "(groups: translation, rotation, se2, se3, c8, all or none; "
-                          "conventions/README.md)";
+  const std::string fix =
+      "; write e.g. 'Expect   actions: translation; observation: none' "
+      "(groups: translation, rotation, se2, se3, c8, all or none; "
+      "conventions/README.md)";
   std::istringstream lines(docstring);
   std::string line;
   while (std::getline(lines, line) && line.rfind("Expect", 0) != 0) {
@@ -355,8 +368,8 @@ std::vector<std::string> expectation_mismatches(const std::string& path,
   for (const auto& cell : cells) {
     const std::vector<props::Group> expected = expected_groups(path, docstring, cell.expected_of);
     for (props::Group group : props::all_groups()) {
-      const props::Verdict* v = props::find_verdict(result, cell.component, cell.mode, group,
-                                                    props::View::eye_in_hand);
+      const props::Verdict* v =
+          props::find_verdict(result, cell.component, cell.mode, group, props::View::eye_in_hand);
       if (v == nullptr) continue;
       const bool expect = std::find(expected.begin(), expected.end(), group) != expected.end();
       if (v->invariant == expect) continue;
@@ -381,11 +394,12 @@ std::vector<ConventionAudit> audit_conventions(const ConventionsOptions& options
     ConventionAudit c;
     c.name = path.stem().string();
     c.description = convention_docstring(plugins[i], read_text(plugins[i]));
-    c.title = c.description.substr(0, c.description.find('\n'));
+    c.title = convention_title(c.description);
     // The Expect line is read before minutes of auditing, so that a typo fails at once.
     (void)expected_groups(plugins[i], c.description, props::Component::actions);
     (void)expected_groups(plugins[i], c.description, props::Component::observation);
-    if (options.progress) options.progress(c.name, static_cast<int>(i) + 1, static_cast<int>(plugins.size()));
+    if (options.progress)
+      options.progress(c.name, static_cast<int>(i) + 1, static_cast<int>(plugins.size()));
     // As `handcentric audit --exec` does (apps/cmd_audit.cpp): batched, with prefetch passes.
     auto plugin = std::make_shared<props::PipeRepresentation>(
         options.python + " " + shell_quoted(plugins[i]), options.timeout);

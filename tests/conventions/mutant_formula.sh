@@ -33,7 +33,11 @@ cat "$work/mutant.err"
 [ "$mutant" -eq 1 ] || { echo "the mutant is not reported"; exit 1; }
 grep -q "umi_relative: actions (pointwise, eye-in-hand) under rotation: the audit says NOT" \
   "$work/mutant.err" || { echo "the mutant's rotation cell is not named"; exit 1; }
-row() { grep "^| <a id=\"conventions-umi_relative\"\|^| \[umi\\\\_relative\]" "$1" | head -1; }
-grep "umi" "$work/original.md" | head -3
-cmp -s "$work/original.md" "$work/mutant.md" && { echo "the tables are the same"; exit 1; }
+# The convention's row of the eye-in-hand table (its first row in the file).
+row() { grep -F '[umi\_relative](#conventions-umi_relative) |' "$1" | head -1; }
+echo "original: $(row "$work/original.md")"
+echo "mutant:   $(row "$work/mutant.md")"
+[ -n "$(row "$work/original.md")" ] || { echo "no umi_relative row in the table"; exit 1; }
+[ "$(row "$work/original.md")" != "$(row "$work/mutant.md")" ] ||
+  { echo "the mutant's row is the original's"; exit 1; }
 echo "mutant caught"

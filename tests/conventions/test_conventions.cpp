@@ -48,8 +48,9 @@ ConventionAudit relative_convention(const std::string& doc) {
 }  // namespace
 
 TEST_CASE("conventions_docstring_is_read_and_must_cite_its_source_and_theory", "[unit]") {
-  CHECK(convention_docstring("a.py", "#!/usr/bin/env python3\n\"\"\"Title.\n\nSource x\nTheory "
-                                     "y\n\"\"\"\nimport numpy\n") == "Title.\n\nSource x\nTheory y");
+  CHECK(convention_docstring("a.py",
+                             "#!/usr/bin/env python3\n\"\"\"Title.\n\nSource x\nTheory "
+                             "y\n\"\"\"\nimport numpy\n") == "Title.\n\nSource x\nTheory y");
   CHECK_THROWS_WITH(convention_docstring("a.py", "import numpy\n"),
                     Catch::Contains("'a.py' has no docstring"));
   CHECK_THROWS_WITH(convention_docstring("a.py", "\"\"\"Title.\nTheory y\n\"\"\""),
@@ -67,9 +68,9 @@ TEST_CASE("conventions_expect_line_names_the_groups_or_says_what_is_wrong", "[un
                         Component::observation) == props::all_groups());
   CHECK_THROWS_WITH(expected_groups("a.py", "T\nTheory x", Component::actions),
                     Catch::Contains("'a.py' has no 'Expect' line"));
-  CHECK_THROWS_WITH(expected_groups("a.py", "T\nExpect   actions: rotate; observation: none",
-                                    Component::actions),
-                    Catch::Contains("unknown group 'rotate'"));
+  CHECK_THROWS_WITH(
+      expected_groups("a.py", "T\nExpect   actions: rotate; observation: none", Component::actions),
+      Catch::Contains("unknown group 'rotate'"));
   CHECK_THROWS_WITH(expected_groups("a.py", "T\nExpect   actions: none", Component::observation),
                     Catch::Contains("says nothing of observation"));
 }
@@ -97,9 +98,10 @@ TEST_CASE("conventions_table_links_each_no_to_its_witness_row", "[unit]") {
                                        "injective | as expected |"));
   CHECK_THAT(markdown,
              Catch::Contains("[NO](#conventions-relative-actions-rotation-pointwise-eye_in_hand)"));
-  CHECK_THAT(markdown, Catch::Contains(
-                           "| <a id=\"conventions-relative-actions-rotation-pointwise-eye_in_hand\">"
-                           "</a> actions, rotation, eye-in-hand |"));
+  CHECK_THAT(
+      markdown,
+      Catch::Contains("| <a id=\"conventions-relative-actions-rotation-pointwise-eye_in_hand\">"
+                      "</a> actions, rotation, eye-in-hand |"));
   CHECK_THAT(markdown, Catch::Contains("Expect   actions: translation; observation: none"));
   // Deterministic: the same results give the same bytes.
   CHECK(markdown == conventions_markdown({relative_convention(kRelativeDoc)}, options));
@@ -108,6 +110,7 @@ TEST_CASE("conventions_table_links_each_no_to_its_witness_row", "[unit]") {
       {relative_convention("T\nSource s\nTheory t\nExpect   actions: all; observation: all")},
       options);
   CHECK_THAT(wrong, Catch::Contains("13 differ"));
+  CHECK_THAT(markdown, Catch::Contains("| ✓ yes "));
 }
 
 TEST_CASE("conventions_first_difference_names_the_line", "[unit]") {
@@ -129,7 +132,8 @@ TEST_CASE("conventions_plugins_are_the_python_files_not_starting_with_underscore
     CHECK(std::filesystem::path(path).extension() == ".py");
     // Every committed plug-in cites its source and states its theory in a parsable line.
     std::ifstream in(path);
-    const std::string source((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string source((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
     const std::string doc = convention_docstring(path, source);
     CHECK_NOTHROW(expected_groups(path, doc, props::Component::actions));
   }

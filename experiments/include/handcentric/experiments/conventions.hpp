@@ -34,7 +34,7 @@ struct ConventionsOptions {
 
 struct ConventionAudit {
   std::string name;         ///< the file's stem, e.g. "umi_relative"
-  std::string title;        ///< the docstring's first line
+  std::string title;        ///< convention_title of the docstring
   std::string description;  ///< the whole docstring: source, formula, theory
   props::Classification result;
   /// Where the audit disagrees with the docstring's "Expect" line, one sentence each (empty:
@@ -63,6 +63,9 @@ std::vector<props::Group> expected_groups(const std::string& path, const std::st
 std::vector<std::string> expectation_mismatches(const std::string& path,
                                                 const std::string& docstring,
                                                 const props::Classification& result);
+
+/// A docstring's title: its first paragraph up to the first ": " ("UMI, pose_rep 'abs'").
+std::string convention_title(const std::string& docstring);
 
 /// Audits every plug-in of options.folder (all groups, both views, pointwise and in
 /// distribution, injectivity), each in its own process. Throws InvalidArgument for bad
