@@ -17,22 +17,22 @@
 namespace handcentric::experiments {
 namespace {
 
-const props::View kViews[] = {props::View::eye_in_hand, props::View::third_person};
+const props::View kConventionViews[] = {props::View::eye_in_hand, props::View::third_person};
 
 // What each cell of the table shows, in order: the convention itself (its actions, pointwise),
 // what a flow policy learns (the flow target's law), and what the policy is given.
-struct Shown {
+struct ShownCell {
   props::Component component;
   props::Mode mode;
   const char* label;
 };
-const Shown kShown[] = {
+const ShownCell kShownCells[] = {
     {props::Component::actions, props::Mode::pointwise, "actions"},
     {props::Component::flow_target, props::Mode::distribution, "target law"},
     {props::Component::observation, props::Mode::pointwise, "observation"},
 };
 
-std::string read_text(const std::string& path) {
+std::string read_plugin_text(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InvalidArgument("cannot read the plug-in '" + path + "'");
   std::ostringstream out;
@@ -50,7 +50,7 @@ std::string shell_quoted(const std::string& path) {
 // Three significant digits, and exact zeros for what is rounding noise at the scale of the
 // audit (below 1e-9): the printed witness is then the same on any machine that gets the same
 // doubles up to their last bits.
-std::string digits(double value) {
+std::string rounded(double value) {
   if (!std::isfinite(value)) return value > 0 ? "inf" : (value < 0 ? "-inf" : "nan");
   if (std::abs(value) < 1e-9) value = 0.0;
   char text[32];
@@ -58,23 +58,23 @@ std::string digits(double value) {
   return text;
 }
 
-std::string vector_text(const Eigen::Vector3d& v) {
-  return "(" + digits(v.x()) + ", " + digits(v.y()) + ", " + digits(v.z()) + ")";
+std::string rounded_vector(const Eigen::Vector3d& v) {
+  return "(" + rounded(v.x()) + ", " + rounded(v.y()) + ", " + rounded(v.z()) + ")";
 }
 
-std::string anchor(const std::string& name, const props::Verdict& v) {
+std::string witness_anchor(const std::string& name, const props::Verdict& v) {
   return "conventions-" + name + "-" + props::to_string(v.component) + "-" +
          props::to_string(v.group) + "-" + props::to_string(v.mode) + "-" +
          props::to_string(v.view);
 }
 
-std::string view_title(props::View view) {
+std::string view_words(props::View view) {
   return view == props::View::eye_in_hand ? "eye-in-hand" : "third-person";
 }
 
 // One line on a failing check: how large the difference was, for which g, on which scene, and
 // the first coordinate that differs (rounded: the full witness is in `audit --json`).
-Text witness_text(const props::Verdict& v) {
+Text witness_summary(const props::Verdict& v) {
   Text out;
   if (!v.witness) {
     out.push_back(plain("no witness (the check could not run)"));
@@ -85,24 +85,24 @@ Text witness_text(const props::Verdict& v) {
   const double angle = rotation.norm();
   std::string g = "g: ";
   if (angle > 1e-9) {
-    g += "rotation " + digits(angle) + " rad about " + vector_text(rotation / angle);
+    g += "rotation " + rounded(angle) + " rad about " + rounded_vector(rotation / angle);
   } else {
     g += "no rotation";
   }
-  g += ", translation " + vector_text(w.g.translation()) + " m";
+  g += ", translation " + rounded_vector(w.g.translation()) + " m";
   std::string scene = "scene: H = " + std::to_string(w.scene.history_length()) +
                       ", K = " + std::to_string(w.scene.chunk_length()) + ", " +
                       std::to_string(w.scene.world_points.size()) +
-                      " world points, p_0 = " + vector_text(w.scene.world_T_hand0().translation()) +
+                      " world points, p_0 = " + rounded_vector(w.scene.world_T_hand0().translation()) +
                       " m";
   std::string where;
   if (w.before.size() == w.after.size() && w.before.size() > 0) {
     Eigen::Index i = 0;
     (w.after - w.before).cwiseAbs().maxCoeff(&i);
-    where = "; largest difference at coordinate " + std::to_string(i) + ": " + digits(w.before[i]) +
-            " -> " + digits(w.after[i]);
+    where = "; largest difference at coordinate " + std::to_string(i) + ": " + rounded(w.before[i]) +
+            " -> " + rounded(w.after[i]);
   }
-  out.push_back(plain("error " + digits(w.error) + " (tolerance " + digits(w.tolerance) + "); " +
+  out.push_back(plain("error " + rounded(w.error) + " (tolerance " + rounded(w.tolerance) + "); " +
                       g + "; " + scene + where));
   return out;
 }
@@ -111,7 +111,7 @@ Text witness_text(const props::Verdict& v) {
 // to its witness's row.
 TableCell group_cell(const ConventionAudit& c, props::Group group, props::View view) {
   TableCell cell;
-  for (const Shown& shown : kShown) {
+  for (const ShownCell& shown : kShownCells) {
     if (!cell.text.empty()) cell.text.push_back(plain(" · "));
     const props::Verdict* v =
         props::find_verdict(c.result, shown.component, shown.mode, group, view);
@@ -120,7 +120,7 @@ TableCell group_cell(const ConventionAudit& c, props::Group group, props::View v
     } else if (v->invariant) {
       cell.text.push_back(plain("yes"));
     } else {
-      cell.text.push_back(plain("NO", "#" + anchor(c.name, *v)));
+      cell.text.push_back(plain("NO", "#" + witness_anchor(c.name, *v)));
     }
   }
   return cell;
@@ -145,7 +145,7 @@ Table summary_table(const std::vector<ConventionAudit>& conventions, props::View
   Table table;
   table.id = "conventions-" + props::to_string(view);
   table.kind = "conventions";
-  table.caption = "The " + view_title(view) +
+  table.caption = "The " + view_words(view) +
                   " view: each cell is actions (pointwise) · target law (in distribution) · "
                   "observation (pointwise)";
   table.columns = {"convention"};
@@ -206,22 +206,22 @@ Section convention_section(const ConventionAudit& c) {
   failing.id = "conventions-" + c.name + "-witnesses";
   failing.kind = "witnesses";
   failing.columns = {"check", "method", "witness"};
-  for (props::View view : kViews) {
-    for (const Shown& shown : kShown) {
+  for (props::View view : kConventionViews) {
+    for (const ShownCell& shown : kShownCells) {
       for (props::Group group : props::all_groups()) {
         const props::Verdict* v =
             props::find_verdict(c.result, shown.component, shown.mode, group, view);
         if (v == nullptr || v->invariant) continue;
         TableCell what;
         what.text.push_back(plain(std::string(shown.label) + ", " + props::to_string(group) + ", " +
-                                  view_title(view)));
+                                  view_words(view)));
         TableCell method = text_cell(v->mode == props::Mode::pointwise
                                          ? "pointwise"
                                          : "in distribution, " + props::to_string(v->method));
         TableCell witness;
-        witness.text = witness_text(*v);
+        witness.text = witness_summary(*v);
         failing.rows.push_back({std::move(what), std::move(method), std::move(witness)});
-        failing.row_ids.push_back(anchor(c.name, *v));
+        failing.row_ids.push_back(witness_anchor(c.name, *v));
       }
     }
   }
@@ -393,7 +393,7 @@ std::vector<ConventionAudit> audit_conventions(const ConventionsOptions& options
     const std::filesystem::path path(plugins[i]);
     ConventionAudit c;
     c.name = path.stem().string();
-    c.description = convention_docstring(plugins[i], read_text(plugins[i]));
+    c.description = convention_docstring(plugins[i], read_plugin_text(plugins[i]));
     c.title = convention_title(c.description);
     // The Expect line is read before minutes of auditing, so that a typo fails at once.
     (void)expected_groups(plugins[i], c.description, props::Component::actions);
@@ -435,7 +435,7 @@ std::vector<Section> conventions_sections(const std::vector<ConventionAudit>& co
                                 "\"no loss found\" means no collision in the searches (the "
                                 "plug-ins do not decode, so nothing proves the converse).")},
   }});
-  for (props::View view : kViews) top.blocks.push_back(summary_table(conventions, view));
+  for (props::View view : kConventionViews) top.blocks.push_back(summary_table(conventions, view));
   std::vector<Section> out = {std::move(top)};
   for (const ConventionAudit& c : conventions) out.push_back(convention_section(c));
   return out;

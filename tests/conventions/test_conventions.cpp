@@ -3,12 +3,14 @@
 // and its links, the first difference that an out-of-date check names, and the plug-in folder.
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/conventions.hpp"
+#include "handcentric/experiments/document_html.hpp"
 #include "handcentric/props/audit.hpp"
 
 using namespace handcentric;
@@ -75,7 +77,7 @@ TEST_CASE("conventions_expect_line_names_the_groups_or_says_what_is_wrong", "[un
                     Catch::Contains("says nothing of observation"));
 }
 
-TEST_CASE("conventions_verdicts_are_compared_with_the_expect_line", "[unit][property]") {
+TEST_CASE("conventions_verdicts_are_compared_with_the_expect_line", "[unit]") {
   // The audit of `relative` is what the theory says...
   CHECK(relative_convention(kRelativeDoc).mismatches.empty());
   // ...and a planted wrong theory (hand-centric's) is reported, cell by cell: actions and the
@@ -143,4 +145,22 @@ TEST_CASE("conventions_plugins_are_the_python_files_not_starting_with_underscore
   const std::filesystem::path empty = std::filesystem::temp_directory_path() / "hc_conv_empty";
   std::filesystem::create_directories(empty);
   CHECK_THROWS_WITH(convention_plugins(empty.string()), Catch::Contains("holds no convention"));
+}
+
+TEST_CASE("conventions_sections_render_on_the_report_page", "[unit]") {
+  ConventionsOptions options;
+  options.cases = 60;
+  Document page;
+  page.title = "report";
+  page.sections = conventions_sections({relative_convention(kRelativeDoc)}, options);
+  const std::string html = to_html(page);  // check(): every NO links to an id of the page
+  CHECK_THAT(html,
+             Catch::Contains("id=\"conventions-eye_in_hand\"") &&
+                 Catch::Contains("id=\"conventions-third_person\"") &&
+                 Catch::Contains(
+                     "<tr id=\"conventions-relative-actions-rotation-pointwise-eye_in_hand\">"));
+  // HANDCENTRIC_CONVENTIONS_PAGE=FILE keeps the page, to look at it in a browser.
+  if (const char* keep = std::getenv("HANDCENTRIC_CONVENTIONS_PAGE")) {
+    std::ofstream(keep) << html;
+  }
 }
