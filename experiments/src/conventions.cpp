@@ -92,15 +92,14 @@ Text witness_summary(const props::Verdict& v) {
   g += ", translation " + rounded_vector(w.g.translation()) + " m";
   std::string scene = "scene: H = " + std::to_string(w.scene.history_length()) +
                       ", K = " + std::to_string(w.scene.chunk_length()) + ", " +
-                      std::to_string(w.scene.world_points.size()) +
-                      " world points, p_0 = " + rounded_vector(w.scene.world_T_hand0().translation()) +
-                      " m";
+                      std::to_string(w.scene.world_points.size()) + " world points, p_0 = " +
+                      rounded_vector(w.scene.world_T_hand0().translation()) + " m";
   std::string where;
   if (w.before.size() == w.after.size() && w.before.size() > 0) {
     Eigen::Index i = 0;
     (w.after - w.before).cwiseAbs().maxCoeff(&i);
-    where = "; largest difference at coordinate " + std::to_string(i) + ": " + rounded(w.before[i]) +
-            " -> " + rounded(w.after[i]);
+    where = "; largest difference at coordinate " + std::to_string(i) + ": " +
+            rounded(w.before[i]) + " -> " + rounded(w.after[i]);
   }
   out.push_back(plain("error " + rounded(w.error) + " (tolerance " + rounded(w.tolerance) + "); " +
                       g + "; " + scene + where));
