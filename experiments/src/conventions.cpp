@@ -186,11 +186,6 @@ Section convention_section(const ConventionAudit& c) {
                                 : *inj.injective           ? "yes"
                                                            : "NO"));
     injectivity.push_back(plain(" (" + inj.how + ")."));
-    if (inj.resolution) {
-      injectivity.push_back(plain(" Chunks that differ by up to " +
-                                  props::format_resolution(*inj.resolution, inj.resolution_unit) +
-                                  " gave one action vector."));
-    }
   }
   out.blocks.push_back(Paragraph{injectivity});
   List theory;
