@@ -4,6 +4,7 @@
 //   handcentric conventions --out docs/CONVENTIONS.md       regenerate the committed file
 //   handcentric conventions --check docs/CONVENTIONS.md     exit 1 when it is out of date
 //   handcentric conventions                                 the Markdown on stdout
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -14,6 +15,7 @@
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/experiments/conventions.hpp"
+#include "handcentric/props/audit.hpp"
 
 namespace handcentric::apps {
 namespace {
@@ -35,6 +37,15 @@ int run_conventions(ConventionsCommandOptions options) {
     }
     committed.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
   }
+  if (!options.out.empty()) {
+    // Named before minutes of auditing; the file itself is written atomically at the end.
+    const std::filesystem::path parent = std::filesystem::absolute(options.out).parent_path();
+    if (!std::filesystem::is_directory(parent)) {
+      throw InvalidArgument("cannot write '" + options.out + "': the folder '" + parent.string() +
+                            "' does not exist; create it or name another file");
+    }
+  }
+  (void)props::checked_cases(options.table.cases);  // --cases 0: one line before any work
   options.table.progress = [](const std::string& name, int index, int count) {
     std::cerr << "conventions: " << name << " (" << index << "/" << count << ")\n";
   };

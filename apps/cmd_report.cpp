@@ -85,7 +85,7 @@ struct PageOptions {
   int jobs = 0;
   /// The public conventions' plug-ins (docs/CONVENTIONS.md): the source tree's by default.
   std::string conventions = HANDCENTRIC_CONVENTIONS_DIR;
-  std::string python = "python3";  ///< the interpreter that runs them
+  std::string python = experiments::ConventionsOptions{}.python;  ///< the interpreter of them
 };
 
 // Adam steps per Table 2 policy on the quick page: half the library's budget, with which
@@ -282,7 +282,16 @@ std::vector<Section> conventions_page_sections(const PageOptions& page) {
   options.progress = [](const std::string& name, int index, int count) {
     std::fprintf(stderr, "report: convention %s (%d/%d)\n", name.c_str(), index, count);
   };
-  return experiments::conventions_sections(experiments::audit_conventions(options), options);
+  try {
+    return experiments::conventions_sections(experiments::audit_conventions(options), options);
+  } catch (const Error& error) {
+    // The rest of the page stands without this table; say why it is missing, there and here.
+    std::fprintf(stderr, "report: the conventions' table is left out: %s\n", error.what());
+    Section note = section("conventions", "Public pose conventions, audited");
+    note.blocks.push_back(Paragraph{{plain("Not run: " + std::string(error.what()) + " ("),
+                                     code("--conventions DIR --python PYTHON"), plain(").")}});
+    return {std::move(note)};
+  }
 }
 
 int write_report_page(const ReportOptions& options, const PageOptions& page) {

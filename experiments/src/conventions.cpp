@@ -171,6 +171,44 @@ Table summary_table(const std::vector<ConventionAudit>& conventions, props::View
   return table;
 }
 
+// A docstring as the page shows it: its opening paragraph, then one item per paragraph that
+// starts with a word at the margin (Source, Formula, Assumed, Theory, Expect), that word in bold
+// and its lines joined. Not verbatim (<pre>): the page keeps <pre> for commands.
+void docstring_blocks(const std::string& docstring, std::vector<Block>& blocks) {
+  std::istringstream lines(docstring);
+  std::string line, opening;
+  List items;
+  auto add = [](std::string& to, const std::string& text) {
+    const std::size_t start = text.find_first_not_of(' ');
+    if (start == std::string::npos) return;
+    if (!to.empty()) to += ' ';
+    to += text.substr(start);
+  };
+  std::string keyword, body;
+  auto close = [&] {
+    if (!keyword.empty()) items.items.push_back({bold(keyword), plain(" " + body)});
+    keyword.clear();
+    body.clear();
+  };
+  while (std::getline(lines, line)) {
+    if (!line.empty() && line.front() != ' ') {
+      const std::size_t space = line.find(' ');
+      const std::string word = line.substr(0, space);
+      if (word == "Source" || word == "Formula" || word == "Assumed" || word == "Theory" ||
+          word == "Expect") {
+        close();
+        keyword = word;
+        add(body, space == std::string::npos ? "" : line.substr(space));
+        continue;
+      }
+    }
+    add(keyword.empty() ? opening : body, line);
+  }
+  close();
+  blocks.push_back(Paragraph{{plain(opening)}});
+  blocks.push_back(std::move(items));
+}
+
 // A convention's own section: what it is (its docstring), whether it keeps the chunk's
 // information, and each NO of the table with its witness, one anchored row each.
 Section convention_section(const ConventionAudit& c) {
@@ -178,7 +216,7 @@ Section convention_section(const ConventionAudit& c) {
   out.id = "conventions-" + c.name;
   out.title = c.name + ": " + c.title;
   out.level = 3;
-  out.blocks.push_back(Preformatted{c.description});
+  docstring_blocks(c.description, out.blocks);
   Text injectivity = {bold("Injectivity:"), plain(" ")};
   if (c.result.injectivity) {
     const props::Injectivity& inj = *c.result.injectivity;

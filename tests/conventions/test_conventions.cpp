@@ -104,7 +104,8 @@ TEST_CASE("conventions_table_links_each_no_to_its_witness_row", "[unit]") {
       markdown,
       Catch::Contains("| <a id=\"conventions-relative-actions-rotation-pointwise-eye_in_hand\">"
                       "</a> actions, rotation, eye-in-hand |"));
-  CHECK_THAT(markdown, Catch::Contains("Expect   actions: translation; observation: none"));
+  CHECK_THAT(markdown, Catch::Contains("- **Expect** actions: translation; observation: none\n"));
+  CHECK_THAT(markdown, Catch::Contains("- **Source** this library, core/\n"));
   // Deterministic: the same results give the same bytes.
   CHECK(markdown == conventions_markdown({relative_convention(kRelativeDoc)}, options));
   // A convention against its theory shows in the table.

@@ -24,7 +24,9 @@ inline constexpr int kConventionsCases = 300;
 
 struct ConventionsOptions {
   std::string folder = "conventions";  ///< the plug-ins: every *.py not starting with '_'
-  std::string python = "python3";      ///< the interpreter that runs them (with NumPy)
+  /// The interpreter that runs them, with NumPy: Debian's (another python3 may come first on
+  /// PATH without it).
+  std::string python = "/usr/bin/python3";
   int cases = kConventionsCases;
   std::uint64_t seed = 1;
   double timeout = 30.0;  ///< seconds per scene of a request (props::PipeRepresentation)
