@@ -22,6 +22,7 @@
 #include "handcentric/experiments/flow_figure.hpp"
 #include "handcentric/experiments/audit_page.hpp"
 #include "handcentric/experiments/claims_page.hpp"
+#include "handcentric/experiments/conventions.hpp"
 #include "handcentric/experiments/document_html.hpp"
 #include "handcentric/experiments/document_markdown.hpp"
 #include "handcentric/experiments/results_page.hpp"
@@ -82,6 +83,9 @@ struct PageOptions {
   int table2_demos = 100;             ///< Table 2's analogue (3D insertion)
   int steps = 0;                      ///< 0: the library's automatic training budget
   int jobs = 0;
+  /// The public conventions' plug-ins (docs/CONVENTIONS.md): the source tree's by default.
+  std::string conventions = HANDCENTRIC_CONVENTIONS_DIR;
+  std::string python = experiments::ConventionsOptions{}.python;  ///< the interpreter of them
 };
 
 // Adam steps per Table 2 policy on the quick page: half the library's budget, with which
@@ -262,6 +266,34 @@ Section sim_section(bool& passes) {
   return out;
 }
 
+// The table of public conventions, audited afresh from their plug-ins as docs/CONVENTIONS.md is
+// (experiments/conventions.hpp), at its cases and seed; a note instead when there is no folder.
+std::vector<Section> conventions_page_sections(const PageOptions& page) {
+  experiments::ConventionsOptions options;
+  options.folder = page.conventions;
+  options.python = page.python;
+  if (!std::filesystem::is_directory(options.folder)) {
+    Section note = section("conventions", "Public pose conventions, audited");
+    note.blocks.push_back(
+        Paragraph{{plain("Not run: no folder of convention plug-ins at " + options.folder + " ("),
+                   code("--conventions DIR"), plain(": the source tree's conventions/).")}});
+    return {std::move(note)};
+  }
+  options.progress = [](const std::string& name, int index, int count) {
+    std::fprintf(stderr, "report: convention %s (%d/%d)\n", name.c_str(), index, count);
+  };
+  try {
+    return experiments::conventions_sections(experiments::audit_conventions(options), options);
+  } catch (const Error& error) {
+    // The rest of the page stands without this table; say why it is missing, there and here.
+    std::fprintf(stderr, "report: the conventions' table is left out: %s\n", error.what());
+    Section note = section("conventions", "Public pose conventions, audited");
+    note.blocks.push_back(Paragraph{{plain("Not run: " + std::string(error.what()) + " ("),
+                                     code("--conventions DIR --python PYTHON"), plain(").")}});
+    return {std::move(note)};
+  }
+}
+
 int write_report_page(const ReportOptions& options, const PageOptions& page) {
   const auto start = std::chrono::steady_clock::now();
   if (page.table2_demos < 1 || page.table2_demos > 1000) {
@@ -278,6 +310,7 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
   std::vector<Section> sections = audit_sections(options, files, witnesses, audit_matches);
   sections.push_back(certificates_section(files, verified));
   sections.push_back(sim_section(sim_passes));
+  for (Section& s : conventions_page_sections(page)) sections.push_back(std::move(s));
 
   std::fprintf(stderr, "report: Fig. 3\n");
   experiments::write_flow_figure_png((dir / "fig3.png").string(),
@@ -439,6 +472,11 @@ void add_report_command(CLI::App& app, int& exit_code) {
                   "the quick Table 2: 15000)")
       ->capture_default_str();
   cmd->add_option("--jobs", page->jobs, "with --out: trainings at once (0: one per core)")
+      ->capture_default_str();
+  cmd->add_option("--conventions", page->conventions,
+                  "with --out: the folder of public-convention plug-ins (docs/CONVENTIONS.md)")
+      ->capture_default_str();
+  cmd->add_option("--python", page->python, "with --out: the interpreter of those plug-ins")
       ->capture_default_str();
   cmd->callback([options, page, &exit_code] {
     (void)props::checked_cases(options->cases);  // before any work: one line, exit 1

@@ -7,9 +7,11 @@ namespace {
 
 // Sorted by name: the order `handcentric --help` lists them in.
 constexpr Command kCommands[] = {
-    {"audit", add_audit_command},   {"demos", add_demos_command},   {"eval", add_eval_command},
-    {"figure", add_figure_command}, {"prove", add_prove_command},   {"render", add_render_command},
-    {"report", add_report_command}, {"table1", add_table1_command}, {"table2", add_table2_command},
+    {"audit", add_audit_command},   {"conventions", add_conventions_command},
+    {"demos", add_demos_command},   {"eval", add_eval_command},
+    {"figure", add_figure_command}, {"prove", add_prove_command},
+    {"render", add_render_command}, {"report", add_report_command},
+    {"table1", add_table1_command}, {"table2", add_table2_command},
     {"train", add_train_command},
 };
 

@@ -53,6 +53,7 @@ int run_main_report(std::ostream& out, const ReportOptions& options = {});
 
 // Defined in the cmd_*.cpp file of the same name.
 void add_audit_command(CLI::App& app, int& exit_code);
+void add_conventions_command(CLI::App& app, int& exit_code);
 void add_demos_command(CLI::App& app, int& exit_code);
 void add_eval_command(CLI::App& app, int& exit_code);
 void add_figure_command(CLI::App& app, int& exit_code);

@@ -76,9 +76,11 @@ void block_markdown(std::ostream& out, const Block& block) {
     out << "\n|";
     for (std::size_t c = 0; c < table->columns.size(); ++c) out << "---|";
     out << "\n";
-    for (const auto& row : table->rows) {
+    for (std::size_t r = 0; r < table->rows.size(); ++r) {
       out << "|";
-      for (const TableCell& cell : row) out << " " << cell_markdown(cell) << " |";
+      // A row's anchor opens its first cell, so that "#id" links reach the row here too.
+      if (!table->row_ids.empty()) out << " <a id=\"" << table->row_ids[r] << "\"></a>";
+      for (const TableCell& cell : table->rows[r]) out << " " << cell_markdown(cell) << " |";
       out << "\n";
     }
     out << "\n";
