@@ -115,6 +115,16 @@ std::vector<experiments::Row> table_into(const std::string& dir,
   return rows;
 }
 
+// What a Table 1 figure (experiments/plot.hpp) shows, up to its PNG link.
+std::string table1_figure_caption(std::size_t demo_counts) {
+  return std::string(demo_counts == 1
+                         ? "Success per method and head at one demo count: train scenes and "
+                           "independent OOD scenes, the paper's number as a black tick"
+                         : "Success against demos: train scenes solid, independent OOD scenes "
+                           "dashed") +
+         "; Wilson 95% bars (SVG; ";
+}
+
 using experiments::bold;
 using experiments::code;
 using experiments::Figure;
@@ -315,9 +325,10 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
        plain("table1/", "table1/table1.json"), plain(".")}});
   t1.blocks.push_back(
       experiments::table1_table(table1, "table1-rows", "Table 1: ours beside the paper"));
-  t1.blocks.push_back(Figure{"table1/table1.png",
+  t1.blocks.push_back(Figure{"table1/table1.svg",
                              "Table 1 plotted",
-                             {plain("Success against demos; OOD as a second marker, Wilson bars.")},
+                             {plain(table1_figure_caption(demo_counts.size())),
+                              plain("PNG", "table1/table1.png"), plain(").")},
                              0});
   sections.push_back(std::move(t1));
 
@@ -366,8 +377,11 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
              " rollouts per scene set. The paper's finding: the representation, not the learning "
              "algorithm, decides success.")}});
   fig5.blocks.push_back(experiments::table1_table(ablation, "fig5-rows", "Fig. 5's grid"));
-  fig5.blocks.push_back(
-      Figure{"fig5/table1.png", "Fig. 5", {plain("Success against demos per head.")}, 0});
+  fig5.blocks.push_back(Figure{"fig5/table1.svg",
+                               "Fig. 5",
+                               {plain(table1_figure_caption(ablation_counts.size())),
+                                plain("PNG", "fig5/table1.png"), plain(").")},
+                               0});
   sections.push_back(std::move(fig5));
   for (Section& s : witnesses) sections.push_back(std::move(s));
 
