@@ -119,6 +119,16 @@ std::vector<experiments::Row> table_into(const std::string& dir,
   return rows;
 }
 
+// What a Table 1 figure (experiments/plot.hpp) shows, up to its PNG link.
+std::string table1_figure_caption(std::size_t demo_counts) {
+  return std::string(demo_counts == 1
+                         ? "Success per method and head at one demo count: train scenes and "
+                           "independent OOD scenes, the paper's number as a black tick"
+                         : "Success against demos: train scenes solid, independent OOD scenes "
+                           "dashed") +
+         "; Wilson 95% bars (SVG; ";
+}
+
 using experiments::bold;
 using experiments::code;
 using experiments::Figure;
@@ -348,9 +358,10 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
        plain("table1/", "table1/table1.json"), plain(".")}});
   t1.blocks.push_back(
       experiments::table1_table(table1, "table1-rows", "Table 1: ours beside the paper"));
-  t1.blocks.push_back(Figure{"table1/table1.png",
+  t1.blocks.push_back(Figure{"table1/table1.svg",
                              "Table 1 plotted",
-                             {plain("Success against demos; OOD as a second marker, Wilson bars.")},
+                             {plain(table1_figure_caption(demo_counts.size())),
+                              plain("PNG", "table1/table1.png"), plain(").")},
                              0});
   sections.push_back(std::move(t1));
 
@@ -376,9 +387,11 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
              "train scene i. The paper's row is a real robot's (not rerunnable here). Files: "),
        plain("table2/", "table2/table2.json"), plain(".")}});
   t2.blocks.push_back(experiments::table2_table(table2, "table2-rows"));
-  t2.blocks.push_back(Figure{"table2/table2.png",
+  t2.blocks.push_back(Figure{"table2/table2.svg",
                              "Table 2 plotted",
-                             {plain("Success per method and scene set, Wilson bars.")},
+                             {plain("Success per method and scene set, Wilson 95% bars, the "
+                                    "paper's hand-centric numbers as black ticks (SVG; "),
+                              plain("PNG", "table2/table2.png"), plain(").")},
                              0});
   sections.push_back(std::move(t2));
 
@@ -399,8 +412,11 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
              " rollouts per scene set. The paper's finding: the representation, not the learning "
              "algorithm, decides success.")}});
   fig5.blocks.push_back(experiments::table1_table(ablation, "fig5-rows", "Fig. 5's grid"));
-  fig5.blocks.push_back(
-      Figure{"fig5/table1.png", "Fig. 5", {plain("Success against demos per head.")}, 0});
+  fig5.blocks.push_back(Figure{"fig5/table1.svg",
+                               "Fig. 5",
+                               {plain(table1_figure_caption(ablation_counts.size())),
+                                plain("PNG", "fig5/table1.png"), plain(").")},
+                               0});
   sections.push_back(std::move(fig5));
   for (Section& s : witnesses) sections.push_back(std::move(s));
 

@@ -22,6 +22,8 @@ struct Table1CommandOptions {
   std::string methods = "hand_centric,relative,absolute,c8_centre,c8_base,c8_averaged";
   std::string heads = "flow";
   std::string train_seeds = "1";
+  std::string protocol = "library";
+  bool recipe_flags = false;  ///< --no-mirror or --perturbed-copies given
   experiments::Table1Options table;
   bool plan = false;
   std::string collect;
@@ -39,6 +41,14 @@ int run_table1_command(Table1CommandOptions options) {
     return 0;
   }
   experiments::Table1Options& table = options.table;
+  if (experiments::parse_protocol(options.protocol) == experiments::Protocol::paper) {
+    if (options.recipe_flags) {
+      throw InvalidArgument(
+          "--protocol paper trains on the demos alone: drop --no-mirror and --perturbed-copies, "
+          "or use them with --protocol library");
+    }
+    table.data = experiments::training_data(experiments::Protocol::paper);
+  }
   table.demo_counts = experiments::parse_int_list(options.demos, "--demos");
   table.methods = experiments::parse_methods(options.methods);
   table.heads = experiments::parse_heads(options.heads);
@@ -53,7 +63,7 @@ int run_table1_command(Table1CommandOptions options) {
   }
   experiments::run_table1(table, grid);
   std::cout << experiments::collect_table1(grid.dir);
-  std::cout << "\nwrote " << grid.dir << "/table1.json, table1.md, table1.png\n";
+  std::cout << "\nwrote " << grid.dir << "/table1.json, table1.md, table1.png, table1.svg\n";
   return 0;
 }
 
@@ -92,12 +102,18 @@ void add_table1_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--jobs", t.jobs, "trainings at once (0: one per hardware thread)")
       ->capture_default_str();
   auto* out = cmd->add_option("--out", t.out, "output directory")->capture_default_str();
+  cmd->add_option("--protocol", options->protocol,
+                  "training data: library (demos, their mirror images, 4 recovery copies of each "
+                  "sample) or paper (the demos alone)")
+      ->capture_default_str();
   cmd->add_flag(
-      "--no-mirror{false}", t.data.mirror,
-      "train every cell on its demos only, not also on their mirror images about the hole axis");
+         "--no-mirror{false}", t.data.mirror,
+         "train every cell on its demos only, not also on their mirror images about the hole axis")
+      ->each([options](const std::string&) { options->recipe_flags = true; });
   cmd->add_option("--perturbed-copies", t.data.perturbed_copies,
                   "relabelled recovery copies of each training sample (0: none)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->each([options](const std::string&) { options->recipe_flags = true; });
   cmd->add_flag("--resume", t.resume, "reuse the models and results already in --out");
   auto* plan = cmd->add_flag("--plan", options->plan,
                              "write --out/jobs.txt (one shell line per cell) and stop");

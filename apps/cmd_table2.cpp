@@ -21,7 +21,8 @@ void add_table2_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--trials", options->trials, "rollouts per method and scene set")
       ->capture_default_str();
-  cmd->add_option("--out", options->out, "directory for table2.json, table2.md, table2.png")
+  cmd->add_option("--out", options->out,
+                  "directory for table2.json, table2.md, table2.png, table2.svg")
       ->capture_default_str();
   cmd->add_option("--seed", options->seed,
                   "seed of the demos and training; evaluation scenes use seed + 1")
@@ -48,7 +49,7 @@ void add_table2_command(CLI::App& app, int& exit_code) {
     const auto rows = experiments::run_table2(*options);
     std::cout << experiments::table2_markdown(rows) << "wrote " << options->out
               << "/table2.json, table2.md, "
-              << "table2.png\n";
+              << "table2.png, table2.svg\n";
     exit_code = 0;
   });
 }

@@ -22,6 +22,8 @@ packages=(
   clang libfuzzer-14-dev libclang-rt-14-dev
   # tests/support/check_style.py: the tracked files and their formatting
   git clang-format
+  # experiments/chart.hpp: the report's figures as PNG and SVG, in DejaVu Sans
+  libcairo2-dev fonts-dejavu-core
   # scripts/check_report_html.sh: the report page opened in headless Chromium (a ctest)
   chromium
 )

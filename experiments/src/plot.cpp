@@ -1,127 +1,101 @@
 #include "handcentric/experiments/plot.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <opencv2/imgproc.hpp>
 
-#include "drawing.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/methods.hpp"
 
 namespace handcentric::experiments {
 namespace {
 
-using drawing::dashed;
-using drawing::rgb;
-using drawing::text;
-
-// Colour-blind-safe (Okabe-Ito) colours, one per series in row order.
-const cv::Scalar kColours[] = {rgb(0, 114, 178),   rgb(213, 94, 0),  rgb(0, 158, 115),
-                               rgb(204, 121, 167), rgb(230, 159, 0), rgb(86, 180, 233),
-                               rgb(0, 0, 0)};
+ChartValue value_of(double value, const std::optional<Interval>& interval) {
+  return {value, interval};
+}
 
 }  // namespace
 
-sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
+std::variant<BarChart, LineChart> table1_chart(const std::vector<Row>& rows) {
   if (rows.empty())
     throw InvalidArgument("draw_table1: no rows to draw (no cell has a result yet)");
-  cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const int left = 70, right = width - 300, top = 70, bottom = height - 60;
-  int max_demos = 0;
-  for (const Row& r : rows) max_demos = std::max(max_demos, r.demos);
-  const double x_max = std::max(10, static_cast<int>(std::ceil(max_demos / 10.0)) * 10);
-  // `shift`: a horizontal offset in pixels, so that series and their OOD markers at one demo
-  // count stay apart whatever the axis' scale.
-  const auto px = [&](double demos, double success, int shift = 0) {
-    return cv::Point(static_cast<int>(std::lround(left + (right - left) * demos / x_max)) + shift,
-                     static_cast<int>(std::lround(bottom - (bottom - top) * success)));
-  };
-  // Axes, grid and ticks.
-  for (int k = 0; k <= 10; k += 2) {
-    const double y = k / 10.0;
-    cv::line(canvas, px(0, y), px(x_max, y), rgb(225, 225, 225), 1);
-    char label[8];
-    std::snprintf(label, sizeof label, "%.1f", y);
-    text(canvas, label, px(0, y) + cv::Point(-40, 5));
-  }
-  for (int d = 0; d <= x_max; d += static_cast<int>(x_max) / 10) {
-    cv::line(canvas, px(d, 0), px(d, 0) + cv::Point(0, 5), rgb(20, 20, 20), 1);
-    text(canvas, std::to_string(d), px(d, 0) + cv::Point(-10, 22));
-  }
-  cv::rectangle(canvas, px(0, 1), px(x_max, 0), rgb(20, 20, 20), 1);
-  text(canvas, "number of demos", cv::Point((left + right) / 2 - 60, height - 15), 0.55);
-  text(canvas, "success", cv::Point(8, top - 15), 0.55);
-  text(canvas, "Closed-loop success (bars: Wilson 95% intervals)", cv::Point(left, 28), 0.65);
-
-  std::vector<std::pair<std::string, std::string>> series;
-  for (const Row& r : rows) {
-    if (std::find(series.begin(), series.end(), std::make_pair(r.method, r.head)) == series.end()) {
-      series.emplace_back(r.method, r.head);
-    }
-  }
   const std::uint64_t seed = rows.front().train_seed;
-  for (std::size_t s = 0; s < series.size(); ++s) {
-    const cv::Scalar colour = kColours[s % std::size(kColours)];
-    std::vector<const Row*> points;
-    for (const Row& r : rows) {
-      if (r.method == series[s].first && r.head == series[s].second && r.train_seed == seed)
-        points.push_back(&r);
-    }
-    std::sort(points.begin(), points.end(),
-              [](const Row* a, const Row* b) { return a->demos < b->demos; });
-    const int shift =
-        static_cast<int>(std::lround((static_cast<double>(s) - 0.5 * (series.size() - 1)) * 5.0));
-    const int ood_shift = shift + 7;
-    const Row* previous = nullptr;
-    for (const Row* r : points) {
-      const double x = r->demos;
-      if (r->id_success) {
-        if (r->id_ci)
-          cv::line(canvas, px(x, r->id_ci->lo, shift), px(x, r->id_ci->hi, shift), colour, 1,
-                   cv::LINE_AA);
-        if (previous && previous->id_success) {
-          cv::line(canvas, px(previous->demos, *previous->id_success, shift),
-                   px(x, *r->id_success, shift), colour, 2, cv::LINE_AA);
-        }
-        cv::circle(canvas, px(x, *r->id_success, shift), 5, colour, cv::FILLED, cv::LINE_AA);
-      }
-      if (r->ood_success) {
-        if (r->ood_ci) {
-          cv::line(canvas, px(x, r->ood_ci->lo, ood_shift), px(x, r->ood_ci->hi, ood_shift), colour,
-                   1, cv::LINE_AA);
-        }
-        if (previous && previous->ood_success) {
-          dashed(canvas, px(previous->demos, *previous->ood_success, ood_shift),
-                 px(x, *r->ood_success, ood_shift), colour);
-        }
-        const cv::Point c = px(x, *r->ood_success, ood_shift);
-        cv::rectangle(canvas, c - cv::Point(5, 5), c + cv::Point(5, 5), rgb(255, 255, 255),
-                      cv::FILLED);
-        cv::rectangle(canvas, c - cv::Point(5, 5), c + cv::Point(5, 5), colour, 2, cv::LINE_AA);
-      }
-      previous = r;
-    }
-    // Legend.
-    const cv::Point at(right + 20, top + 20 + 28 * static_cast<int>(s));
-    cv::line(canvas, at, at + cv::Point(30, 0), colour, 2, cv::LINE_AA);
-    cv::circle(canvas, at + cv::Point(15, 0), 5, colour, cv::FILLED, cv::LINE_AA);
-    text(canvas, series[s].first + "/" + series[s].second, at + cv::Point(40, 5));
+  std::vector<std::pair<std::string, std::string>> series;  // (method, head), in row order
+  std::vector<int> counts;
+  for (const Row& r : rows) {
+    if (r.train_seed != seed) continue;
+    if (std::find(series.begin(), series.end(), std::make_pair(r.method, r.head)) == series.end())
+      series.emplace_back(r.method, r.head);
+    if (std::find(counts.begin(), counts.end(), r.demos) == counts.end()) counts.push_back(r.demos);
   }
-  const cv::Point key(right + 20, top + 40 + 28 * static_cast<int>(series.size()));
-  cv::circle(canvas, key + cv::Point(15, 0), 5, rgb(90, 90, 90), cv::FILLED, cv::LINE_AA);
-  text(canvas, "train-distribution scenes", key + cv::Point(40, 5));
-  cv::rectangle(canvas, key + cv::Point(10, 23), key + cv::Point(20, 33), rgb(90, 90, 90), 2,
-                cv::LINE_AA);
-  text(canvas, "OOD scenes (own seed)", key + cv::Point(40, 33));
-  char seed_text[64];
-  std::snprintf(seed_text, sizeof seed_text, "training seed %llu",
-                static_cast<unsigned long long>(seed));
-  text(canvas, seed_text, key + cv::Point(40, 61));
-
-  return drawing::to_image(canvas);
+  std::sort(counts.begin(), counts.end());
+  const auto find = [&](const std::pair<std::string, std::string>& s, int n) -> const Row* {
+    for (const Row& r : rows) {
+      if (r.method == s.first && r.head == s.second && r.demos == n && r.train_seed == seed)
+        return &r;
+    }
+    return nullptr;
+  };
+  const std::string seed_note = "training seed " + std::to_string(seed);
+  if (counts.size() == 1) {
+    const int n = counts.front();
+    BarChart chart;
+    chart.title = "Closed-loop success at " + std::to_string(n) + " demos";
+    chart.series = {"train-distribution scenes", "OOD scenes (own seed)"};
+    chart.reference_label = "the paper (Table 1)";
+    bool any_reference = false;
+    for (const auto& s : series) {
+      chart.groups.push_back(s.first + "\n" + s.second);
+      const Row* r = find(s, n);
+      std::vector<std::optional<ChartValue>> values(2);
+      if (r && r->id_success) values[0] = value_of(*r->id_success, r->id_ci);
+      if (r && r->ood_success) values[1] = value_of(*r->ood_success, r->ood_ci);
+      chart.values.push_back(values);
+      std::vector<std::optional<double>> reference(2);
+      const auto paper = paper_row(s.first, s.second);
+      const auto at = std::find(kPaperDemoCounts.begin(), kPaperDemoCounts.end(), n);
+      if (paper && at != kPaperDemoCounts.end())
+        reference[0] = paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())];
+      if (paper && n == 100) reference[1] = paper->ood_at_100;
+      any_reference = any_reference || reference[0] || reference[1];
+      chart.reference.push_back(reference);
+    }
+    if (!any_reference) chart.reference.clear();
+    chart.notes = {"bars: Wilson 95% intervals", seed_note};
+    return chart;
+  }
+  LineChart chart;
+  chart.title = "Closed-loop success against the number of demos";
+  chart.x_label = "number of demos";
+  chart.evenly_spaced_x = true;
+  for (std::size_t k = 0; k < series.size(); ++k) {
+    Curve id{series[k].first + "/" + series[k].second, {}, {}, static_cast<int>(k)};
+    Curve ood{"", {}, {}, static_cast<int>(k), Marker::square, true, false};
+    for (const int n : counts) {
+      const Row* r = find(series[k], n);
+      id.x.push_back(n);
+      ood.x.push_back(n);
+      id.y.push_back(r && r->id_success
+                         ? std::optional<ChartValue>(value_of(*r->id_success, r->id_ci))
+                         : std::nullopt);
+      ood.y.push_back(r && r->ood_success
+                          ? std::optional<ChartValue>(value_of(*r->ood_success, r->ood_ci))
+                          : std::nullopt);
+    }
+    ood.label = id.label + ", OOD";
+    chart.curves.push_back(std::move(id));
+    chart.curves.push_back(std::move(ood));
+  }
+  chart.notes = {"solid, dots: train scenes", "dashed, squares: OOD scenes",
+                 "bars: Wilson 95% intervals", seed_note};
+  return chart;
 }
 
-void write_table1_png(const std::string& path, const std::vector<Row>& rows) {
-  sim::write_png(path, draw_table1(rows));
+sim::Image draw_table1(const std::vector<Row>& rows, int width, int height) {
+  return std::visit([&](const auto& chart) { return render_chart(chart, width, height); },
+                    table1_chart(rows));
+}
+
+void write_table1_figure(const std::string& stem, const std::vector<Row>& rows) {
+  std::visit([&](const auto& chart) { write_chart(chart, stem); }, table1_chart(rows));
 }
 
 }  // namespace handcentric::experiments

@@ -159,7 +159,49 @@ std::string rate(const std::optional<double>& value) {
   return text;
 }
 
+// `data` with the perturbation seed of `reference`: the recipe without the per-cell seed.
+bool same_recipe(sim::TrainingData data, const sim::TrainingData& reference) {
+  data.perturbation_seed = reference.perturbation_seed;
+  return data.to_text() == reference.to_text();
+}
+
 }  // namespace
+
+std::string to_string(Protocol protocol) {
+  return protocol == Protocol::paper ? "paper" : "library";
+}
+
+Protocol parse_protocol(const std::string& text) {
+  if (text == "library") return Protocol::library;
+  if (text == "paper") return Protocol::paper;
+  throw InvalidArgument("--protocol '" + text +
+                        "' is unknown: use library (demos, mirror images, recovery copies) or "
+                        "paper (the demos alone)");
+}
+
+sim::TrainingData training_data(Protocol protocol) {
+  sim::TrainingData data;
+  if (protocol == Protocol::paper) {
+    data.mirror = false;
+    data.perturbed_copies = 0;
+  }
+  return data;
+}
+
+std::string describe_training_data(const sim::TrainingData& data) {
+  if (same_recipe(data, training_data(Protocol::paper)))
+    return "the demos alone (`--protocol paper`, as the paper trains)";
+  const std::string copies =
+      std::to_string(data.perturbed_copies) + " perturbed recovery copies of every sample";
+  if (same_recipe(data, training_data(Protocol::library))) {
+    return "the demos, their mirror images about the hole axis and " + copies +
+           " (`--protocol library`, this library's default)";
+  }
+  return std::string("the demos") + (data.mirror ? ", their mirror images" : "") + " and " +
+         copies + " (offset " + format_number(data.offset_cm) + " cm, " +
+         format_number(data.offset_deg) + " deg, recovery in " +
+         std::to_string(data.recovery_steps) + " steps; neither protocol)";
+}
 
 void Table1Options::validate() const {
   if (demo_counts.empty())
@@ -391,6 +433,8 @@ std::string collect_table1(const std::string& dir_text) {
   EvalSettings eval;
   std::uint64_t demo_seed = 0;
   std::vector<Row> rows;
+  std::string training;  // the cells' recipe when they share one
+  bool one_recipe = true;
   try {
     const nlohmann::json j = nlohmann::json::parse(read_text(cells_path));
     eval.trials = j.at("eval").at("trials").get<int>();
@@ -414,21 +458,25 @@ std::string collect_table1(const std::string& dir_text) {
       cell.data.offset_deg = c.value("offset_deg", cell.data.offset_deg);
       cell.data.recovery_steps = c.value("recovery_steps", cell.data.recovery_steps);
       cell.hash = c.at("hash").get<std::string>();
+      const std::string described = describe_training_data(cell.data);
+      if (rows.empty()) training = described;
+      one_recipe = one_recipe && described == training;
       rows.push_back(collect_row(cell, eval, dir.string()));
     }
   } catch (const nlohmann::json::exception& e) {
     throw InvalidArgument("'" + cells_path.string() + "' is damaged (" + e.what() +
                           "): run --plan or table1 again");
   }
-  const std::string markdown = table1_markdown(rows, eval, demo_seed);
+  if (!one_recipe) training = "a recipe of its own per cell (cells.json)";
+  const std::string markdown = table1_markdown(rows, eval, demo_seed, training);
   write_file_atomically((dir / "table1.json").string(), rows_json(rows));
   write_file_atomically((dir / "table1.md").string(), markdown);
-  write_table1_png((dir / "table1.png").string(), rows);
+  write_table1_figure((dir / "table1").string(), rows);
   return markdown;
 }
 
 std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval,
-                            std::uint64_t demo_seed) {
+                            std::uint64_t demo_seed, const std::string& training) {
   std::vector<int> counts;
   std::vector<std::pair<std::string, std::string>> series;  // (method, head) in row order
   std::set<std::uint64_t> seeds;
@@ -513,6 +561,7 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
       static_cast<unsigned long long>(eval.eval_seed),
       static_cast<unsigned long long>(eval.ood_seed), static_cast<unsigned long long>(demo_seed));
   text += line;
+  if (!training.empty()) text += "Training data of every cell: " + training + ".\n\n";
   if (audited) {
     std::snprintf(line, sizeof line,
                   "`audited symmetry`: each model's pointwise audit, eq. (4) with the same noise "

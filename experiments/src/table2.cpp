@@ -11,15 +11,14 @@
 #include <numbers>
 #include <random>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <thread>
 
-#include "drawing.hpp"
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/insert3d_key_points.hpp"
+#include "handcentric/experiments/results_page.hpp"
 #include "handcentric/experiments/wilson.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/insert3d/camera.hpp"
@@ -234,7 +233,7 @@ std::vector<Table2Row> run_table2(const Table2Options& options) {
   const std::filesystem::path dir(options.out);
   write_file_atomically((dir / "table2.json").string(), table2_json(rows) + "\n");
   write_file_atomically((dir / "table2.md").string(), table2_markdown(rows));
-  sim::write_png((dir / "table2.png").string(), draw_table2(rows));
+  write_chart(table2_chart(rows), (dir / "table2").string());
   return rows;
 }
 
@@ -288,52 +287,40 @@ std::string table2_markdown(const std::vector<Table2Row>& rows) {
   return md.str();
 }
 
-sim::Image draw_table2(const std::vector<Table2Row>& rows, int width, int height) {
-  using drawing::rgb;
-  using drawing::text;
+BarChart table2_chart(const std::vector<Table2Row>& rows) {
   if (rows.empty()) throw InvalidArgument("draw_table2: no rows to draw");
-  cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const int left = 70, right = width - 170, top = 60, bottom = height - 60;
-  const auto y_of = [&](double rate) {
-    return static_cast<int>(std::lround(bottom - (bottom - top) * rate));
-  };
-  for (int k = 0; k <= 10; k += 2) {
-    cv::line(canvas, {left, y_of(k / 10.0)}, {right, y_of(k / 10.0)}, rgb(225, 225, 225), 1);
-    char label[8];
-    std::snprintf(label, sizeof label, "%.1f", k / 10.0);
-    text(canvas, label, {left - 40, y_of(k / 10.0) + 5});
-  }
-  cv::rectangle(canvas, {left, y_of(1)}, {right, y_of(0)}, rgb(20, 20, 20), 1);
-  text(canvas, "Table 2 analogue (sim, 3D blade insertion): success, Wilson 95% bars", {left, 30},
-       0.6);
-  const cv::Scalar colours[3] = {rgb(0, 114, 178), rgb(213, 94, 0), rgb(0, 158, 115)};
-  const char* set_labels[3] = {"train", "ood", "random-se3"};
-  const double group = static_cast<double>(right - left) / static_cast<double>(rows.size());
-  const int bar = static_cast<int>(group / 4.5);
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const int x0 = left + static_cast<int>(group * static_cast<double>(r) + (group - 3 * bar) / 2);
+  BarChart chart;
+  chart.title = "Table 2 analogue (sim, 3D blade insertion): success";
+  chart.series = {"train", "ood", "random-se3"};
+  chart.reference_label = "the paper (real robot)";
+  for (const Table2Row& row : rows) {
+    chart.groups.push_back("flow\n" + row.method);
+    std::vector<std::optional<ChartValue>> values;
     for (int set = 0; set < 3; ++set) {
-      const Insert3dCounts& c = set_counts(rows[r], set);
-      const int x = x0 + set * bar;
-      cv::rectangle(canvas, {x + 2, y_of(c.success_rate())}, {x + bar - 2, y_of(0)}, colours[set],
-                    cv::FILLED);
-      const Interval ci = wilson_interval(c.success, c.trials);
-      const int xc = x + bar / 2;
-      cv::line(canvas, {xc, y_of(ci.lo)}, {xc, y_of(ci.hi)}, rgb(20, 20, 20), 2);
-      cv::line(canvas, {xc - 5, y_of(ci.lo)}, {xc + 5, y_of(ci.lo)}, rgb(20, 20, 20), 2);
-      cv::line(canvas, {xc - 5, y_of(ci.hi)}, {xc + 5, y_of(ci.hi)}, rgb(20, 20, 20), 2);
+      const Insert3dCounts& c = set_counts(row, set);
+      if (c.trials < 1) {
+        values.emplace_back(std::nullopt);
+        continue;
+      }
+      values.emplace_back(ChartValue{c.success_rate(), wilson_interval(c.success, c.trials)});
     }
-    text(canvas, rows[r].method, {x0, bottom + 25}, 0.55);
+    chart.values.push_back(values);
+    // The paper has a hand-centric row only: 26/30 in distribution, 5/5 out of it.
+    std::vector<std::optional<double>> reference(3);
+    if (row.method == "hand_centric") {
+      reference[0] =
+          static_cast<double>(kPaperTable2InDistribution[0]) / kPaperTable2InDistribution[1];
+      reference[1] =
+          static_cast<double>(kPaperTable2OutOfDistribution[0]) / kPaperTable2OutOfDistribution[1];
+    }
+    chart.reference.push_back(reference);
   }
-  for (int set = 0; set < 3; ++set) {
-    cv::rectangle(canvas, {right + 20, top + 30 * set}, {right + 38, top + 30 * set + 18},
-                  colours[set], cv::FILLED);
-    text(canvas, set_labels[set], {right + 45, top + 30 * set + 15});
-  }
-  text(canvas, "paper, real robot,", {right + 5, top + 130}, 0.4);
-  text(canvas, "hand-centric: 26/30", {right + 5, top + 148}, 0.4);
-  text(canvas, "in dist., 5/5 OOD", {right + 5, top + 166}, 0.4);
-  return drawing::to_image(canvas);
+  chart.notes = {"bars: Wilson 95% intervals", "paper: ood = horizontal stacks"};
+  return chart;
+}
+
+sim::Image draw_table2(const std::vector<Table2Row>& rows, int width, int height) {
+  return render_chart(table2_chart(rows), width, height);
 }
 
 }  // namespace handcentric::experiments

@@ -3,6 +3,7 @@
 // collect, resume) are CLI tests in CMakeLists.txt.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -10,11 +11,16 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/experiments/cell.hpp"
+#include "handcentric/experiments/chart.hpp"
 #include "handcentric/experiments/methods.hpp"
 #include "handcentric/experiments/plot.hpp"
 #include "handcentric/experiments/results.hpp"
 #include "handcentric/experiments/table1.hpp"
+#include "handcentric/sim/collision.hpp"
+#include "handcentric/sim/demos.hpp"
+#include "handcentric/sim/expert.hpp"
 #include "handcentric/sim/rollout.hpp"
+#include "handcentric/sim/scenes.hpp"
 #include "handcentric/experiments/wilson.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "throws.hpp"
@@ -148,6 +154,60 @@ TEST_CASE("table1_options_and_lists_reject_bad_values_naming_them", "[unit]") {
                   Contains("perturbed_copies") && Contains("got -1"));
 }
 
+namespace {
+
+// True when `data` makes exactly the demos' own training scenes, bit for bit (the paper's
+// protocol: no mirror images, no recovery copies).
+bool trains_on_demos_alone(const sim::TrainingData& data, const std::vector<sim::Demo>& demos) {
+  const std::vector<Scene> plain = sim::training_scenes(demos, 0, 4, 0);
+  const std::vector<Scene> scenes = sim::training_scenes(demos, 0, 4, 0, data);
+  if (scenes.size() != plain.size()) return false;
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    if (scenes[i].world_T_hand0().matrix() != plain[i].world_T_hand0().matrix()) return false;
+    const auto& chunk = scenes[i].world_T_hand_chunk;
+    if (chunk.size() != plain[i].world_T_hand_chunk.size()) return false;
+    for (std::size_t k = 0; k < chunk.size(); ++k)
+      if (chunk[k].matrix() != plain[i].world_T_hand_chunk[k].matrix()) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("the_paper_protocol_trains_on_the_demos_alone_and_the_library_one_adds_to_them",
+          "[unit]") {
+  const sim::CollisionChecker checker;
+  const sim::ExpertRun run =
+      sim::expert_demos(sim::sample_scenes(sim::SceneDistribution::train(), 2, 1), 1, checker);
+  REQUIRE(run.demos.size() == 2);
+  const sim::TrainingData paper = training_data(Protocol::paper);
+  CHECK(trains_on_demos_alone(paper, run.demos));
+  // Planted faults: the library's recipe, and either of its additions alone, fail the check.
+  CHECK_FALSE(trains_on_demos_alone(training_data(Protocol::library), run.demos));
+  sim::TrainingData mirror_only = paper;
+  mirror_only.mirror = true;
+  CHECK_FALSE(trains_on_demos_alone(mirror_only, run.demos));
+  sim::TrainingData one_copy = paper;
+  one_copy.perturbed_copies = 1;
+  CHECK_FALSE(trains_on_demos_alone(one_copy, run.demos));
+  // The library's protocol is sim::TrainingData's default, which `handcentric train` uses.
+  CHECK(training_data(Protocol::library).to_text() == sim::TrainingData().to_text());
+  // The paper's cells count their demo samples only in the automatic budget.
+  const Cell cell = make_cell("hand_centric", "hand_centric", "flow", 10, 1, 320, "00ff", 0, paper);
+  CHECK(cell.config.steps == policy::training_budget(320));
+  CHECK(cell.data.perturbation_seed == 1);
+  CHECK(parse_protocol("paper") == Protocol::paper);
+  CHECK(parse_protocol(to_string(Protocol::library)) == Protocol::library);
+  HC_CHECK_THROWS(parse_protocol("augmented"), InvalidArgument,
+                  Contains("'augmented'") && Contains("library") && Contains("paper"));
+  CHECK_THAT(describe_training_data(cell.data), Contains("demos alone"));
+  CHECK_THAT(describe_training_data(training_data(Protocol::library)),
+             Contains("mirror images") && Contains("--protocol library"));
+  CHECK_THAT(describe_training_data(one_copy), Contains("neither protocol"));
+  CHECK_THAT(table1_markdown({}, EvalSettings(), 1, describe_training_data(paper)),
+             Contains("Training data of every cell: the demos alone"));
+}
+
 TEST_CASE("eval_json_round_trips_its_counts_and_rejects_foreign_files", "[unit]") {
   sim::RolloutSummary summary;
   summary.trials = 7;
@@ -217,17 +277,90 @@ TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
   CHECK(c8.find("c8_base/c8ddpm | id") < paper_line);
 }
 
-TEST_CASE("the_figure_draws_one_colour_per_method_with_id_dots_and_ood_squares", "[unit]") {
+TEST_CASE("the_figure_draws_curves_for_several_demo_counts_with_every_mark_inside", "[unit]") {
   const std::vector<Row> rows = {row("hand_centric", 10, 0.5, 0.48),
-                                 row("hand_centric", 100, 0.97, 0.95),
-                                 row("absolute", 10, 0.0, 0.0), row("absolute", 100, 0.12, 0.01)};
+                                 row("hand_centric", 100, 0.97, 1.0), row("absolute", 10, 0.0, 0.0),
+                                 row("absolute", 100, 0.12, 0.01)};
+  const auto chart = table1_chart(rows);
+  REQUIRE(std::holds_alternative<LineChart>(chart));
+  const LineChart& lines = std::get<LineChart>(chart);
+  CHECK(lines.curves.size() == 4);  // id and OOD per method
+  const ChartLayout layout = chart_layout(lines, 900, 520);
+  CHECK(layout.marks.size() == 16);  // a marker and an interval per point
+  CHECK(mark_outside_axes(layout).empty());
+  // Planted fault: the old figure's axis, 0 to the largest count, puts 100 demos on the frame.
+  LineChart edge = lines;
+  edge.evenly_spaced_x = false;
+  edge.x_range = std::array<double, 2>{0.0, 100.0};
+  CHECK_THAT(mark_outside_axes(chart_layout(edge, 900, 520)),
+             Contains("at 100") && Contains("outside the axes"));
   const sim::Image image = draw_table1(rows);
-  CHECK(image.width == 960);
-  CHECK(image.height == 600);
+  CHECK(image.width == 900);
+  CHECK(image.height == 520);
   // Okabe-Ito blue (hand_centric) and vermillion (absolute) are both drawn.
   CHECK(image.count_pixels(0, 114, 178, 10) > 200);
   CHECK(image.count_pixels(213, 94, 0, 10) > 200);
   HC_CHECK_THROWS(draw_table1({}), InvalidArgument, Contains("no rows"));
+}
+
+TEST_CASE("the_figure_draws_grouped_bars_for_one_demo_count_with_the_papers_ticks", "[unit]") {
+  // The default report page's case: every row at 100 demos.
+  const std::vector<Row> rows = {row("hand_centric", 100, 0.97, 1.0),
+                                 row("absolute", 100, 0.0, 0.0), row("c8_averaged", 100, 0.3, 0.1)};
+  const auto chart = table1_chart(rows);
+  REQUIRE(std::holds_alternative<BarChart>(chart));
+  const BarChart& bars = std::get<BarChart>(chart);
+  CHECK(bars.groups ==
+        std::vector<std::string>{"hand_centric\nflow", "absolute\nflow", "c8_averaged\nc8ddpm"});
+  REQUIRE(bars.reference.size() == 3);
+  CHECK(bars.reference[0][0] == 0.98);  // the paper's hand-centric row at 100 demos
+  CHECK(bars.reference[0][1] == 0.96);  // and out of distribution
+  const ChartLayout layout = chart_layout(bars, 900, 520);
+  CHECK(layout.marks.size() == 12);
+  CHECK(mark_outside_axes(layout).empty());
+  // Planted fault: an axis too short for the values puts the bars above the frame.
+  BarChart short_axis = bars;
+  short_axis.y_max = 0.5;
+  CHECK_THAT(mark_outside_axes(chart_layout(short_axis, 900, 520)),
+             Contains("hand_centric") && Contains("outside the axes"));
+  const sim::Image image = draw_table1(rows);
+  CHECK(image.count_pixels(0, 114, 178, 10) > 500);  // the train-scene bars
+  CHECK(image.count_pixels(213, 94, 0, 10) > 500);   // the OOD bars
+}
+
+TEST_CASE("a_chart_is_written_as_png_and_svg_and_refuses_bad_input_naming_it", "[unit]") {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("handcentric_test_chart_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  LineChart chart;
+  chart.title = "t";
+  chart.curves.push_back({"a", {1.0, 2.0}, {ChartValue{0.5, Interval{0.4, 0.6}}, std::nullopt}});
+  write_chart(chart, (dir / "c").string());
+  std::ifstream png(dir / "c.png", std::ios::binary), svg(dir / "c.svg");
+  std::string png_bytes((std::istreambuf_iterator<char>(png)), {});
+  std::string svg_text((std::istreambuf_iterator<char>(svg)), {});
+  CHECK(png_bytes.substr(1, 3) == "PNG");
+  CHECK_THAT(svg_text, Contains("<svg") && Contains("width=\"900pt\""));
+  CHECK_THAT(svg_text, Contains("glyph"));  // text as outlines of a real font, not raster
+  Curve ragged{"ragged", {1.0, 2.0}, {ChartValue{0.5}}};
+  chart.curves.push_back(ragged);
+  HC_CHECK_THROWS(render_chart(chart), InvalidArgument,
+                  Contains("'ragged'") && Contains("2 x and 1 y"));
+  chart.curves.pop_back();
+  HC_CHECK_THROWS(render_chart(chart, 100, 520), InvalidArgument, Contains("100 x 520"));
+  chart.curves[0].y[0] = ChartValue{std::nan("")};
+  HC_CHECK_THROWS(render_chart(chart), InvalidArgument, Contains("not finite"));
+  BarChart bars;
+  bars.groups = {"g"};
+  bars.series = {"s1", "s2"};
+  bars.values = {{ChartValue{0.5}}};
+  HC_CHECK_THROWS(render_chart(bars), InvalidArgument,
+                  Contains("group 'g'") && Contains("1 values for 2 series"));
+  // A path that cannot be written: a typed error naming it, nothing left behind.
+  HC_CHECK_THROWS(write_chart(LineChart{"t", "", "", {{"a", {1.0}, {ChartValue{0.5}}}}},
+                              (dir / "missing" / "c").string()),
+                  FileError, Contains("missing"));
+  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("collect_builds_the_table_from_whatever_results_exist", "[unit]") {
@@ -258,6 +391,7 @@ TEST_CASE("collect_builds_the_table_from_whatever_results_exist", "[unit]") {
   CHECK_THAT(text, Contains("\"id_success\": 0.4"));
   CHECK_THAT(text, Contains("\"ood_success\": null"));
   CHECK(std::filesystem::exists(dir / "table1.png"));
+  CHECK(std::filesystem::exists(dir / "table1.svg"));
   std::filesystem::remove_all(dir);
 }
 

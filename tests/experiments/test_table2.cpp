@@ -93,6 +93,13 @@ TEST_CASE("table2_figure_draws_one_bar_per_method_and_set", "[unit]") {
   CHECK(image.height == 520);
   CHECK(image.count_pixels(0, 114, 178) > 1000);  // the train bars' colour
   CHECK_THROWS_AS(draw_table2({}), InvalidArgument);
+  // Every bar inside its axes; the paper's real-robot numbers on the hand-centric group only.
+  const BarChart chart =
+      table2_chart({sample_row("hand_centric", 20, 20, 20), sample_row("absolute", 20, 0, 0)});
+  CHECK(mark_outside_axes(chart_layout(chart, 900, 520)).empty());
+  REQUIRE(chart.reference.size() == 2);
+  CHECK(chart.reference[0][0] == Approx(26.0 / 30.0));
+  CHECK_FALSE(chart.reference[1][0].has_value());
 }
 
 TEST_CASE("table2_options_name_the_bad_value", "[unit]") {

@@ -11,7 +11,7 @@
 //   DIR/cells.json            the grid and the evaluation settings (what collect reads)
 //   DIR/models/<hash>.hcm     trained models, named by cell_hash
 //   DIR/results/<hash>.<set>-s<seed>-n<trials>.json   `handcentric eval --json` of each set
-//   DIR/table1.json, table1.md, table1.png
+//   DIR/table1.json, table1.md, table1.png and table1.svg (plot.hpp)
 // Every file is written to a temporary file and renamed, so a killed run leaves no half file
 // and `resume` redoes only the missing models and results.
 #include <cstdint>
@@ -24,6 +24,21 @@
 
 namespace handcentric::experiments {
 
+/// Which training data every cell trains on (`handcentric table1 --protocol`).
+///   library : this library's default, sim::TrainingData{}: the demos, their mirror images about
+///             the hole axis and 4 perturbed recovery copies of every sample;
+///   paper   : the demos alone, as the paper trains its policies (Sec. 4.2): no mirror images,
+///             no recovery copies, so the automatic budget counts the demo samples only.
+enum class Protocol { library, paper };
+std::string to_string(Protocol protocol);
+/// "library" or "paper"; throws InvalidArgument naming the text and both names.
+Protocol parse_protocol(const std::string& text);
+/// The training data recipe of `protocol` (perturbation_seed 1; each cell sets its own).
+sim::TrainingData training_data(Protocol protocol);
+/// One line saying what `data` trains on, naming its protocol when it is one of them (the
+/// perturbation seed aside, which each cell sets to its training seed).
+std::string describe_training_data(const sim::TrainingData& data);
+
 struct Table1Options {
   std::vector<int> demo_counts = {kPaperDemoCounts.begin(), kPaperDemoCounts.end()};
   std::vector<Method> methods = table1_methods();
@@ -32,8 +47,9 @@ struct Table1Options {
   std::vector<std::uint64_t> train_seeds = {1};
   EvalSettings eval;
   int steps = 0;  ///< Adam steps per cell; 0: the library's automatic budget (PolicyConfig)
-  sim::TrainingData data;  ///< every cell's training data recipe (the demos' mirror images too)
-  int jobs = 0;            ///< trainings at once; 0: one per hardware thread
+  /// Every cell's training data recipe; training_data(Protocol::library) by default.
+  sim::TrainingData data;
+  int jobs = 0;  ///< trainings at once; 0: one per hardware thread
   std::string out = "table1";
   bool resume = false;
   bool quiet = false;
@@ -70,14 +86,16 @@ void run_table1(const Table1Options& options, const Table1Grid& grid);
 int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::string& cli);
 
 /// The rows from DIR/cells.json and whatever result files exist; writes DIR/table1.json,
-/// table1.md and table1.png; returns the markdown (our table beside the paper's). Throws
-/// InvalidArgument when DIR has no cells.json.
+/// table1.md, table1.png and table1.svg; returns the markdown (our table beside the paper's).
+/// Throws InvalidArgument when DIR has no cells.json.
 std::string collect_table1(const std::string& dir);
 
 /// The markdown of `rows`: per method and head, the id success (mean over training seeds) at
 /// each demo count and the OOD success (independent, and paired) at each count, with the
 /// paper's row beside it.
+/// `training`, when not empty, is said under the title (collect_table1 passes
+/// describe_training_data of the cells' recipe when they share one).
 std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval,
-                            std::uint64_t demo_seed);
+                            std::uint64_t demo_seed, const std::string& training = "");
 
 }  // namespace handcentric::experiments

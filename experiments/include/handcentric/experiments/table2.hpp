@@ -14,13 +14,14 @@
 //   DIR/table2.json  {"rows": [{"method", "demos", "trials", "train_success", "ood_success",
 //                     "random_se3_success", "<set>_wilson95": [lo, hi], ...}], ...}
 //   DIR/table2.md    the table beside the paper's Table 2
-//   DIR/table2.png   success per method and scene set, Wilson 95% bars
+//   DIR/table2.png, table2.svg   success per method and scene set, Wilson 95% bars
 // Every file is written atomically (write_file_atomically, write_png).
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "handcentric/core/chunk_policy.hpp"
+#include "handcentric/experiments/chart.hpp"
 #include "handcentric/policy/config.hpp"
 #include "handcentric/sim/draw.hpp"
 #include "handcentric/sim/insert3d/demos.hpp"
@@ -104,15 +105,18 @@ struct Table2Row {
   Insert3dCounts train, ood, random_se3;
 };
 
-/// Trains and evaluates every method (options.jobs at a time), writes DIR/table2.json, .md and
-/// .png (DIR created when missing) and returns the rows in method order.
+/// Trains and evaluates every method (options.jobs at a time), writes DIR/table2.json, .md,
+/// .png and .svg (DIR created when missing) and returns the rows in method order.
 std::vector<Table2Row> run_table2(const Table2Options& options);
 
 /// The rows as the table2.json document.
 std::string table2_json(const std::vector<Table2Row>& rows);
 /// The rows as Markdown beside the paper's Table 2.
 std::string table2_markdown(const std::vector<Table2Row>& rows);
-/// Success per method and scene set with Wilson 95% bars. Throws InvalidArgument for no rows.
+/// Success per method and scene set as grouped bars with Wilson 95% intervals, the paper's
+/// hand-centric numbers as ticks (chart.hpp). Throws InvalidArgument for no rows.
+BarChart table2_chart(const std::vector<Table2Row>& rows);
+/// table2_chart as an RGB image.
 sim::Image draw_table2(const std::vector<Table2Row>& rows, int width = 900, int height = 520);
 
 }  // namespace handcentric::experiments
