@@ -6,6 +6,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "handcentric/experiments/insert3d_drawing.hpp"
 #include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/sim/insert3d/rollout.hpp"
 #include "handcentric/sim/insert3d/scenes.hpp"
@@ -87,4 +88,24 @@ TEST_CASE("the_hand_camera_renders_any_four_points_and_refuses_other_counts", "[
   Eigen::VectorXd image(camera.shape().size());
   CHECK_THROWS_AS(camera.render(observation, image), InvalidScene);
   CHECK_THROWS_AS(parse_insert3d_image_channels("rgb"), InvalidArgument);
+}
+
+TEST_CASE("the_camera_frames_show_every_fourth_pose_and_the_last", "[unit]") {
+  const insert3d::TaskScene scene =
+      insert3d::sample_scene(insert3d::SceneDistribution::train(), 11, 2);
+  insert3d::Rollout rollout;
+  for (int t = 0; t < 10; ++t) {
+    rollout.world_T_hand.push_back(
+        scene.world_T_hand_start *
+        RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -0.5 * t)));
+  }
+  // Steps 0, 4, 8 and 9: four panels of 128 x 96 in one row, 6 pixels apart, 18 for the label.
+  const sim::Image sheet = draw_insert3d_camera_frames(scene, rollout);
+  CHECK(sheet.width == 4 * (128 + 6) + 6);
+  CHECK(sheet.height == 96 + 18 + 2 * 6);
+  const sim::Image two_rows = draw_insert3d_camera_frames(scene, rollout, 4, 2);
+  CHECK(two_rows.width == 2 * (128 + 6) + 6);
+  CHECK(two_rows.height == 2 * (96 + 18 + 6) + 6);
+  CHECK_THROWS_AS(draw_insert3d_camera_frames(scene, rollout, 0), InvalidArgument);
+  CHECK_THROWS_AS(draw_insert3d_camera_frames(scene, insert3d::Rollout{}), InvalidArgument);
 }
