@@ -44,17 +44,23 @@ double learning_rate_at(const PolicyConfig& config, int step) {
   return config.learning_rate;
 }
 
+namespace {
+void require_camera(const ImageSource* camera) {
+  if (camera == nullptr) {
+    throw InvalidArgument(
+        "train_policy: an image policy (observation = image) needs the camera that renders its "
+        "observations: pass an ImageSource");
+  }
+}
+}  // namespace
+
 LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes,
                            std::uint64_t seed, const ProgressCallback& progress, int report_every,
                            std::shared_ptr<const ImageSource> camera) {
   config.validate();
   const auto representation = make_representation(config.representation);
   const bool image = config.observation == ObservationKind::image;
-  if (image && !camera) {
-    throw InvalidArgument(
-        "train_policy: an image policy (observation = image) needs the camera "
-        "that renders its observations: pass an ImageSource");
-  }
+  if (image) require_camera(camera.get());
   return train_policy(config,
                       encode_scenes(*representation, scenes, config.history_length,
                                     config.chunk_length, image ? camera.get() : nullptr),
@@ -66,11 +72,7 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
                            std::shared_ptr<const ImageSource> camera) {
   config.validate();
   if (config.observation == ObservationKind::image) {
-    if (!camera) {
-      throw InvalidArgument(
-          "train_policy: an image policy (observation = image) needs the camera "
-          "that renders its observations: pass an ImageSource");
-    }
+    require_camera(camera.get());
     const ImageShape shape = camera->shape();
     config.image_channels = shape.channels;
     config.image_height = shape.height;
