@@ -8,6 +8,7 @@
 //   handcentric audit --exec 'python3 examples/python_representation/repr.py' --json
 //   handcentric audit --policy-exec 'python3 my_policy.py' --expect se3
 //   handcentric audit --model hc.model
+//   handcentric audit --model image.model --floor   # the hand camera sees the table too
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -44,6 +45,7 @@ struct AuditCommandOptions {
   std::string workspace, witness_dir, observations;
   bool json = false;
   bool pointwise = false;
+  bool floor = false;
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
 };
@@ -286,7 +288,8 @@ int run_audit(const AuditCommandOptions& options) {
   } else if (!options.model.empty()) {
     if (plugin_names)
       throw InvalidArgument("--extra-poses and --scalars are for plug-ins; a model reads neither");
-    auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(options.model));
+    // An image model sees every scene through its hand camera (and the table with --floor).
+    auto model = experiments::load_audited_model(options.model, options.floor);
     planar_model = model->config().task == policy::kTaskPeg2d;
     audit.groups =
         experiments::model_groups(model->config(), audit.groups, options.group, options.model);
@@ -296,7 +299,7 @@ int run_audit(const AuditCommandOptions& options) {
     audit.views = classifier.views;
     results.push_back(
         props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier));
-    results.back().name = "model " + options.model + " (" + model->name() + ")";
+    results.back().name = experiments::audited_model_name(options.model, *model);
     policies = true;
   } else {
     if (plugin_names)
@@ -412,6 +415,11 @@ void add_audit_command(CLI::App& app, int& exit_code) {
                       "world chunk for an observation and a noise vector (docs/AUDIT.md)");
   auto* model =
       cmd->add_option("--model", options->model, "audit a trained model of this library (eq. 4)");
+  auto* floor = cmd->add_flag(
+      "--floor", options->floor,
+      "--model of an image policy of the 3D task: its hand camera also sees a table fixed in the "
+      "world (z <= 0), which g does not move with the scene");
+  floor->needs(model);
   exec->excludes(repr)->excludes(policy_exec)->excludes(model);
   policy_exec->excludes(repr)->excludes(model);
   model->excludes(repr);

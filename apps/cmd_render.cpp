@@ -37,6 +37,7 @@ struct RenderOptions {
   int max_demos = 20;
   int size = 800;
   std::string out;
+  std::string camera_frames;  ///< 3D rollouts: also the hand camera's images along it, as a PNG
 };
 
 // The 3D task: scene --index of --dist or --rotate-deg, alone (--scene) or with a rollout.
@@ -74,6 +75,11 @@ int run_insert3d_render(const RenderOptions& options) {
                               std::to_string(options.seed) + "): " + what;
   sim::write_png(options.out, experiments::draw_insert3d_rollout(scene, rollout, caption));
   std::cout << "wrote " << what << " to " << options.out << "\n";
+  if (!options.camera_frames.empty()) {
+    sim::write_png(options.camera_frames, experiments::draw_insert3d_camera_frames(scene, rollout));
+    std::cout << "wrote the hand camera's images of " << rollout.world_T_hand.size()
+              << " poses (every 4th and the last) to " << options.camera_frames << "\n";
+  }
   return 0;
 }
 
@@ -85,6 +91,10 @@ int run_render(const RenderOptions& options) {
           : resolve_task(options.task, options.rollout ? model_task(options.model) : "",
                          "--model '" + options.model + "', a model");
   if (task == policy::kTaskInsert3d) return run_insert3d_render(options);
+  if (!options.camera_frames.empty())
+    throw InvalidArgument(
+        "--camera-frames draws the 3D task's hand camera: add --task insert3d "
+        "or give an insert3d model");
   refuse_3d_options(options.dist, options.rotate_deg);
   const sim::CollisionChecker checker;
   sim::Image image;
@@ -155,6 +165,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--size", options->size, "image width and height in pixels")
       ->capture_default_str();
   cmd->add_option("--out", options->out, "output PNG (written atomically)")->required();
+  cmd->add_option("--camera-frames", options->camera_frames,
+                  "insert3d: also a PNG of the hand camera's depth images along the rollout "
+                  "(every 4th pose and the last), what an image policy sees");
   cmd->callback([options, &exit_code] {
     if (!options->scene && options->demos.empty() && !options->rollout)
       throw CLI::RequiredError("--scene, --demos or --rollout");

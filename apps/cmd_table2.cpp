@@ -3,6 +3,7 @@
 // scenes, each evaluated on train, ood and random-se3 scenes.
 //
 //   handcentric table2 --demos 100 --trials 100 --out table2 --seed 1 --jobs 2
+//   handcentric table2 --observation key_points,image   # also from the hand camera's pixels
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -14,6 +15,8 @@
 namespace handcentric::apps {
 void add_table2_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<experiments::Table2Options>();
+  auto observations = std::make_shared<std::vector<std::string>>(
+      std::vector<std::string>{policy::to_string(policy::ObservationKind::key_points)});
   CLI::App* cmd = app.add_subcommand(
       "table2",
       "Table 2's analogue: hand-centric, relative, absolute flow policies on the 3D insertion");
@@ -44,8 +47,17 @@ void add_table2_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--perturb-deg", options->perturbation.max_deg,
                   "largest turn of a copy's hand, per rotation-vector axis (deg)")
       ->capture_default_str();
+  cmd->add_option("--observation", *observations,
+                  "key_points and/or image (the hand camera's depth image through a CNN), one "
+                  "set of rows each (comma-separated)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"key_points", "image"}))
+      ->capture_default_str();
   cmd->add_flag("--quiet", options->quiet, "no progress lines on stderr");
-  cmd->callback([options, &exit_code] {
+  cmd->callback([options, observations, &exit_code] {
+    options->observations.clear();
+    for (const std::string& name : *observations)
+      options->observations.push_back(policy::parse_observation(name));
     const auto rows = experiments::run_table2(*options);
     std::cout << experiments::table2_markdown(rows) << "wrote " << options->out
               << "/table2.json, table2.md, "

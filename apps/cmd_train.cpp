@@ -3,6 +3,7 @@
 //
 //   handcentric train --demos demos.jsonl --out m.model   # the library defaults (PolicyConfig)
 //   handcentric train --demos d3.jsonl --out m3.hcm   # a 3D demo file: the 3D blade insertion
+//   handcentric train --demos d3.jsonl --out i3.hcm --observation image   # from the hand camera
 //
 // The task is the one the demo file records (--task may repeat it; naming another is an error
 // naming both), and the model records it (PolicyConfig::task). The 3D task has no mirror images
@@ -24,6 +25,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/cell.hpp"
+#include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -42,6 +44,8 @@ struct TrainOptions {
   std::string head = policy::to_string(config.head);
   std::string lr_schedule = policy::to_string(config.lr_schedule);
   std::string ddpm_prediction = policy::to_string(config.ddpm_prediction);
+  std::string observation = policy::to_string(config.observation);
+  std::string image_channels = "depth";
   std::uint64_t seed = 1;
   int max_demos = 0;
   sim::TrainingData data;
@@ -68,6 +72,9 @@ int run_train(const TrainOptions& options) {
   config.head = policy::parse_head(options.head);
   config.lr_schedule = policy::parse_schedule(options.lr_schedule);
   config.ddpm_prediction = policy::parse_ddpm_prediction(options.ddpm_prediction);
+  config.observation = policy::parse_observation(options.observation);
+  const bool image = config.observation == policy::ObservationKind::image;
+  const auto channels = experiments::parse_insert3d_image_channels(options.image_channels);
   make_representation(config.representation);  // an unknown name fails before the demos load
   if (config.steps < 0) {
     throw InvalidArgument("--steps must be >= 1, or 0 for the automatic budget, got " +
@@ -83,6 +90,11 @@ int run_train(const TrainOptions& options) {
   config.task = resolve_task(options.task, demo_task(options.demos),
                              "--demos '" + options.demos + "', a demo file");
   const bool planar = config.task == policy::kTaskPeg2d;
+  if (image && planar) {
+    throw InvalidArgument(
+        "--observation image: the 2D task (peg2d) has no camera; train on a 3D "
+        "demo file (task insert3d) or leave --observation key_points");
+  }
   // The 2D task's recipe (mirror images, perturbed copies); the 3D task trains on its demos.
   sim::TrainingData data = options.data;
   data.mirror = planar && options.data.mirror;
@@ -105,9 +117,11 @@ int run_train(const TrainOptions& options) {
     const std::vector<sim::insert3d::Demo> demos = sim::insert3d::load_demos(options.demos);
     demo_count = demos.size();
     check_max_demos(options, demo_count);
-    // The policy input of the 3D task: the corners and the slot points computed from them.
-    scenes = experiments::with_slot_key_points(sim::insert3d::training_scenes(
-        demos, config.history_length, config.chunk_length, options.max_demos));
+    scenes = sim::insert3d::training_scenes(demos, config.history_length, config.chunk_length,
+                                            options.max_demos);
+    // The key-point policy input of the 3D task: the corners and the slot points computed from
+    // them. An image policy sees the hand camera's image of the corners' slot instead.
+    if (!image) scenes = experiments::with_slot_key_points(scenes);
     demo_samples = static_cast<long long>(scenes.size());
   }
   const std::size_t used =
@@ -128,8 +142,14 @@ int run_train(const TrainOptions& options) {
     if (terminal && p.step == p.steps) std::fprintf(stderr, "\n");
   };
   const auto start = std::chrono::steady_clock::now();
+  std::shared_ptr<const policy::ImageSource> camera;
+  if (image) {
+    experiments::Insert3dHandCameraOptions camera_options;
+    camera_options.channels = channels;
+    camera = std::make_shared<const experiments::Insert3dHandCamera>(camera_options);
+  }
   const policy::LearnedPolicy trained =
-      policy::train_policy(config, scenes, options.seed, progress, report_every);
+      policy::train_policy(config, scenes, options.seed, progress, report_every, camera);
   policy::save_model(trained, options.out);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -138,8 +158,10 @@ int run_train(const TrainOptions& options) {
             << (data.perturbed_copies > 0
                     ? " (" + std::to_string(data.perturbed_copies) + " perturbed copies each)"
                     : "")
-            << " (task " << config.task << "): " << config.steps << " steps, final loss "
-            << last_loss << ", " << static_cast<long>(last_rate) << " samples/s ("
+            << " (task " << config.task
+            << (image ? ", " + camera->name() + ", encoder " + config.encoder : std::string())
+            << "): " << config.steps << " steps, final loss " << last_loss << ", "
+            << static_cast<long>(last_rate) << " samples/s ("
             << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
             << " -> " << options.out << "\n";
   return 0;
@@ -217,6 +239,19 @@ void add_train_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--time-embedding", config.time_embedding,
                   "sinusoidal features of t (even), 0 for t itself")
+      ->capture_default_str();
+  cmd->add_option("--observation", options->observation,
+                  "key_points, or image: the 3D task's hand camera through a CNN encoder trained "
+                  "end to end (head flow)")
+      ->check(CLI::IsMember({"key_points", "image"}))
+      ->capture_default_str();
+  cmd->add_option("--encoder", config.encoder,
+                  "--observation image: out channels of each 3x3 stride-2 convolution, "
+                  "comma-separated")
+      ->capture_default_str();
+  cmd->add_option("--image-channels", options->image_channels,
+                  "--observation image: depth, or rgbd (the camera's shaded colour and depth)")
+      ->check(CLI::IsMember({"depth", "rgbd"}))
       ->capture_default_str();
   cmd->add_flag("--quiet", options->quiet, "no progress display");
   cmd->callback([options, &exit_code] { exit_code = run_train(*options); });

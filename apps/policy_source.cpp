@@ -1,6 +1,6 @@
 #include "policy_source.hpp"
 
-#include "handcentric/experiments/insert3d_key_points.hpp"
+#include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/experiments/table2.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -28,14 +28,15 @@ LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
                                           const policy::SamplingOverrides& overrides) {
   LoadedInsert3dPolicy loaded;
   if (model_path.empty()) {
-    loaded.policy = std::make_unique<sim::insert3d::ClosedLoopExpert>();
+    loaded.policy = std::make_shared<const sim::insert3d::ClosedLoopExpert>();
     return loaded;
   }
   auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
   policy::require_task(*model, policy::kTaskInsert3d, model_path);
   loaded.rollout_options = experiments::insert3d_rollout_options(model->config());
-  // 3D models are trained on the corners and the slot points computed from them (cmd_train).
-  loaded.policy = std::make_unique<experiments::SlotKeyPointPolicy>(std::move(model));
+  // Each 3D model with the input it was trained on: the hand camera's image, or the corners and
+  // the slot points computed from them (cmd_train).
+  loaded.policy = experiments::insert3d_model_policy(std::move(model));
   return loaded;
 }
 

@@ -29,7 +29,7 @@ LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string&
 /// The same for the 3D task: the model in `model_path` (which must be an insert3d model, else
 /// TaskMismatch) with its H, execute and replans, or the closed-loop 3D expert when it is empty.
 struct LoadedInsert3dPolicy {
-  std::unique_ptr<ChunkPolicy> policy;
+  std::shared_ptr<const ChunkPolicy> policy;
   sim::insert3d::RolloutOptions rollout_options;
 };
 LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,

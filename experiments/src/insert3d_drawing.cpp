@@ -61,15 +61,14 @@ void draw_box(cv::Mat& canvas, const ViewCamera& view, const RigidTransform& wor
   }
 }
 
-// The depth image, enlarged, near bright: depth d maps to 255 (1 - d / max_range).
-cv::Mat depth_panel(const CameraImage& image, double max_range) {
-  cv::Mat panel(image.height * kDepthScale, image.width * kDepthScale, CV_8UC3);
+// The depth image, enlarged `scale` times, near bright: depth d maps to 255 (1 - d / max_range).
+cv::Mat depth_panel(const CameraImage& image, double max_range, int scale = kDepthScale) {
+  cv::Mat panel(image.height * scale, image.width * scale, CV_8UC3);
   for (int row = 0; row < image.height; ++row) {
     for (int col = 0; col < image.width; ++col) {
       const double shade = 255.0 * std::clamp(1.0 - image.depth_at(row, col) / max_range, 0.0, 1.0);
       const cv::Scalar grey(shade, shade, shade);
-      cv::rectangle(panel, cv::Rect(col * kDepthScale, row * kDepthScale, kDepthScale, kDepthScale),
-                    grey, cv::FILLED);
+      cv::rectangle(panel, cv::Rect(col * scale, row * scale, scale, scale), grey, cv::FILLED);
     }
   }
   return panel;
@@ -135,6 +134,42 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
   if (n > 1) {
     paste(rollout.world_T_hand.back(), 60 + camera.height * kDepthScale + 60,
           "hand camera depth, last pose");
+  }
+  return drawing::to_image(canvas);
+}
+
+sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
+                                       const insert3d::Rollout& rollout, int every, int columns,
+                                       const insert3d::BladeSlotGeometry& geometry,
+                                       const insert3d::DepthCamera& camera) {
+  using drawing::text;
+  if (rollout.world_T_hand.empty())
+    throw InvalidArgument("draw_insert3d_camera_frames: the rollout has no pose");
+  if (every < 1 || columns < 1) {
+    throw InvalidArgument("draw_insert3d_camera_frames: every " + std::to_string(every) +
+                          " and columns " + std::to_string(columns) + " must be >= 1");
+  }
+  std::vector<std::size_t> steps;
+  for (std::size_t t = 0; t < rollout.world_T_hand.size(); t += static_cast<std::size_t>(every))
+    steps.push_back(t);
+  if (steps.back() + 1 != rollout.world_T_hand.size())
+    steps.push_back(rollout.world_T_hand.size() - 1);
+  constexpr int kScale = 4, kLabel = 18, kGap = 6;
+  const int panel_w = camera.width * kScale, panel_h = camera.height * kScale;
+  const int cols = std::min<int>(columns, static_cast<int>(steps.size()));
+  const int rows = (static_cast<int>(steps.size()) + cols - 1) / cols;
+  cv::Mat canvas(rows * (panel_h + kLabel + kGap) + kGap, cols * (panel_w + kGap) + kGap, CV_8UC3,
+                 cv::Scalar(255, 255, 255));
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const int x = kGap + static_cast<int>(i % static_cast<std::size_t>(cols)) * (panel_w + kGap);
+    const int y =
+        kGap + static_cast<int>(i / static_cast<std::size_t>(cols)) * (panel_h + kLabel + kGap);
+    const cv::Mat panel =
+        depth_panel(insert3d::render_depth(geometry, camera, rollout.world_T_hand[steps[i]],
+                                           scene.world_T_slot),
+                    camera.max_range, kScale);
+    panel.copyTo(canvas(cv::Rect(x, y + kLabel, panel_w, panel_h)));
+    text(canvas, "step " + std::to_string(steps[i]), {x, y + kLabel - 5}, 0.4);
   }
   return drawing::to_image(canvas);
 }

@@ -4,6 +4,7 @@
 #include <mutex>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
 #include "handcentric/props/policy_audit.hpp"
@@ -52,12 +53,30 @@ props::ClassifierOptions model_classifier_options(const policy::PolicyConfig& co
   return classifier;
 }
 
+std::shared_ptr<policy::LearnedPolicy> load_audited_model(const std::string& path, bool floor) {
+  const policy::LearnedPolicy model = policy::load_model(path);
+  const bool image = model.config().task == policy::kTaskInsert3d &&
+                     model.config().observation == policy::ObservationKind::image;
+  if (floor && !image) {
+    throw InvalidArgument("--floor puts a table in the hand camera's view, but " + path + " is a " +
+                          policy::to_string(model.config().observation) + " model of " +
+                          model.config().task +
+                          ": give an image model of the 3D task (train --observation image)");
+  }
+  return std::make_shared<policy::LearnedPolicy>(with_task_camera(model, floor));
+}
+
+std::string audited_model_name(const std::string& path, const policy::LearnedPolicy& model) {
+  return "model " + path + " (" + model.name() +
+         (model.camera() ? ", " + model.camera()->name() : std::string()) + ")";
+}
+
 std::string table1_model_audit_json(const std::string& dir, const std::string& path, int cases) {
   // RapidCheck's search keeps process-wide state: Table 1's trainings run on several threads,
   // their audits one at a time.
   static std::mutex one_at_a_time;
   const std::lock_guard lock(one_at_a_time);
-  auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(dir + "/" + path));
+  auto model = load_audited_model(dir + "/" + path);
   props::AuditOptions audit;
   audit.groups = model_groups(model->config(), props::all_groups(), "all", path);
   audit.views = {props::View::eye_in_hand};
@@ -67,7 +86,7 @@ std::string table1_model_audit_json(const std::string& dir, const std::string& p
   classifier.in_distribution = false;
   props::Classification result =
       props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier);
-  result.name = "model " + path + " (" + model->name() + ")";
+  result.name = audited_model_name(path, *model);
   return props::policy_audit_json({result});
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -17,6 +18,7 @@
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/experiments/results_page.hpp"
 #include "handcentric/experiments/wilson.hpp"
@@ -139,6 +141,8 @@ void Table2Options::validate() const {
     throw InvalidArgument("--steps " + std::to_string(steps) +
                           " is negative: use 0 (automatic) or more");
   if (methods.empty()) throw InvalidArgument("table2: no method: give at least one representation");
+  if (observations.empty())
+    throw InvalidArgument("table2: no observation: give key_points, image or both");
   for (const std::string& method : methods) make_representation(method);  // names the valid ones
   perturbation.validate();
 }
@@ -152,17 +156,27 @@ const Insert3dCounts& set_counts(const Table2Row& row, int set) {
 }
 
 Table2Row run_method(const Table2Options& options, const std::string& method,
-                     const std::vector<Scene>& scenes) {
+                     policy::ObservationKind observation, const std::vector<Scene>& scenes) {
   policy::PolicyConfig config;
   config.task = policy::kTaskInsert3d;
   config.representation = method;
   config.steps = options.steps;
+  config.observation = observation;
+  const bool image = observation == policy::ObservationKind::image;
+  const auto start = std::chrono::steady_clock::now();
   const auto model = std::make_shared<const policy::LearnedPolicy>(
-      policy::train_policy(config, with_slot_key_points(scenes), options.seed));
-  const SlotKeyPointPolicy trained(model);
+      image ? policy::train_policy(config, scenes, options.seed, {}, 100,
+                                   std::make_shared<const Insert3dHandCamera>())
+            : policy::train_policy(config, with_slot_key_points(scenes), options.seed));
+  const double train_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const std::shared_ptr<const ChunkPolicy> policy = insert3d_model_policy(model);
+  const ChunkPolicy& trained = *policy;
   const insert3d::RolloutOptions rollout_options = insert3d_rollout_options(model->config());
   Table2Row row;
   row.method = method;
+  row.observation = observation;
+  row.train_seconds = train_seconds;
   row.demos = options.demos;
   row.seed = options.seed;
   row.steps = model->config().steps;
@@ -174,6 +188,10 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
   row.random_se3 = evaluate_insert3d(trained, insert3d::SceneDistribution::random_se3(),
                                      options.trials, eval_seed, rollout_options);
   return row;
+}
+
+std::string row_label(const Table2Row& row) {
+  return row.observation == policy::ObservationKind::image ? row.method + " (image)" : row.method;
 }
 
 std::string percent(double rate) {
@@ -198,22 +216,26 @@ std::vector<Table2Row> run_table2(const Table2Options& options) {
       demos, defaults.history_length, defaults.chunk_length, options.perturbation, options.seed);
   if (!options.quiet) {
     std::cerr << "table2: " << demos.size() << " demos (" << scenes.size() << " training samples), "
-              << options.methods.size() << " methods, " << options.trials
-              << " trials per scene set\n";
+              << options.methods.size() << " methods x " << options.observations.size()
+              << " observations, " << options.trials << " trials per scene set\n";
   }
-  std::vector<Table2Row> rows(options.methods.size());
-  std::vector<std::exception_ptr> errors(options.methods.size());
+  // Rows in order: every method for the first observation, then for the next.
+  const std::size_t count = options.methods.size() * options.observations.size();
+  std::vector<Table2Row> rows(count);
+  std::vector<std::exception_ptr> errors(count);
   std::atomic<std::size_t> next{0};
   std::mutex print;
   const auto worker = [&] {
-    for (std::size_t m = next++; m < options.methods.size(); m = next++) {
+    for (std::size_t m = next++; m < count; m = next++) {
       try {
-        rows[m] = run_method(options, options.methods[m], scenes);
+        rows[m] = run_method(options, options.methods[m % options.methods.size()],
+                             options.observations[m / options.methods.size()], scenes);
         if (!options.quiet) {
           const std::lock_guard<std::mutex> lock(print);
-          std::cerr << "table2: " << rows[m].method << " train " << rows[m].train.success_rate()
-                    << " ood " << rows[m].ood.success_rate() << " random-se3 "
-                    << rows[m].random_se3.success_rate() << "\n";
+          std::cerr << "table2: " << row_label(rows[m]) << " (trained in "
+                    << static_cast<long>(rows[m].train_seconds) << " s) train "
+                    << rows[m].train.success_rate() << " ood " << rows[m].ood.success_rate()
+                    << " random-se3 " << rows[m].random_se3.success_rate() << "\n";
         }
       } catch (...) {
         errors[m] = std::current_exception();
@@ -240,10 +262,15 @@ std::vector<Table2Row> run_table2(const Table2Options& options) {
 std::string table2_json(const std::vector<Table2Row>& rows) {
   nlohmann::json out = {{"task", "insert3d"}, {"rows", nlohmann::json::array()}};
   for (const Table2Row& row : rows) {
-    nlohmann::json r = {{"method", row.method}, {"head", "flow"},
-                        {"demos", row.demos},   {"trials", row.train.trials},
-                        {"seed", row.seed},     {"eval_seed", row.seed + 1},
-                        {"steps", row.steps}};
+    nlohmann::json r = {{"method", row.method},
+                        {"observation", policy::to_string(row.observation)},
+                        {"head", "flow"},
+                        {"demos", row.demos},
+                        {"trials", row.train.trials},
+                        {"seed", row.seed},
+                        {"eval_seed", row.seed + 1},
+                        {"steps", row.steps},
+                        {"train_seconds", row.train_seconds}};
     for (int set = 0; set < 3; ++set) {
       const Insert3dCounts& c = set_counts(row, set);
       const Interval ci = wilson_interval(c.success, c.trials);
@@ -272,10 +299,17 @@ std::string table2_markdown(const std::vector<Table2Row>& rows) {
        << "; ood and random-se3 scene i is a global transform of train scene i). Success rate "
           "[Wilson 95%].\n\n";
   }
+  for (const Table2Row& row : rows) {
+    if (row.observation != policy::ObservationKind::image) continue;
+    md << "Rows marked (image) see no key points: the hand camera's depth image (32 x 24) "
+          "through a small CNN trained end to end with the flow head "
+          "(experiments/insert3d_image.hpp).\n\n";
+    break;
+  }
   md << "| method | demos | steps | train | ood (slot on its side) | random-se3 |\n";
   md << "|---|---|---|---|---|---|\n";
   for (const Table2Row& row : rows) {
-    md << "| flow / " << row.method << " | " << row.demos << " | " << row.steps << " | "
+    md << "| flow / " << row_label(row) << " | " << row.demos << " | " << row.steps << " | "
        << rate_with_interval(row.train) << " | " << rate_with_interval(row.ood) << " | "
        << rate_with_interval(row.random_se3) << " |\n";
   }
@@ -294,7 +328,7 @@ BarChart table2_chart(const std::vector<Table2Row>& rows) {
   chart.series = {"train", "ood", "random-se3"};
   chart.reference_label = "the paper (real robot)";
   for (const Table2Row& row : rows) {
-    chart.groups.push_back("flow\n" + row.method);
+    chart.groups.push_back("flow\n" + row_label(row));
     std::vector<std::optional<ChartValue>> values;
     for (int set = 0; set < 3; ++set) {
       const Insert3dCounts& c = set_counts(row, set);

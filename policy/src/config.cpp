@@ -1,5 +1,6 @@
 #include "handcentric/policy/config.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -68,6 +69,16 @@ LearningRateSchedule parse_schedule(const std::string& name) {
 
 std::string to_string(DdpmPrediction prediction) {
   return prediction == DdpmPrediction::sample ? "sample" : "epsilon";
+}
+
+std::string to_string(ObservationKind kind) {
+  return kind == ObservationKind::image ? "image" : "key_points";
+}
+
+ObservationKind parse_observation(const std::string& name) {
+  if (name == "key_points") return ObservationKind::key_points;
+  if (name == "image") return ObservationKind::image;
+  throw InvalidArgument("unknown observation '" + name + "': use key_points or image");
 }
 
 DdpmPrediction parse_ddpm_prediction(const std::string& name) {
@@ -160,6 +171,13 @@ const std::vector<Field>& fields() {
       HC_INT_FIELD(execute),
       HC_DOUBLE_FIELD(c8_centre_x),
       HC_DOUBLE_FIELD(c8_centre_y),
+      Field{"observation", [](const PolicyConfig& c) { return to_string(c.observation); },
+            [](PolicyConfig& c, const std::string& v) { c.observation = parse_observation(v); }},
+      HC_INT_FIELD(image_channels),
+      HC_INT_FIELD(image_height),
+      HC_INT_FIELD(image_width),
+      Field{"encoder", [](const PolicyConfig& c) { return c.encoder; },
+            [](PolicyConfig& c, const std::string& v) { c.encoder = v; }},
   };
   return all;
 }
@@ -218,6 +236,41 @@ void PolicyConfig::validate() const {
           format_number(cvae_kl_weight), "a finite number >= 0");
   require(std::abs(c8_centre_x) <= 1e6, "c8_centre_x", format_number(c8_centre_x), "[-1e6, 1e6]");
   require(std::abs(c8_centre_y) <= 1e6, "c8_centre_y", format_number(c8_centre_y), "[-1e6, 1e6]");
+  if (observation == ObservationKind::image) {
+    require(head == HeadKind::flow, "head", to_string(head),
+            "flow (the only head with an image encoder; or use observation key_points)");
+    require(image_channels == 0 || image_channels == 1 || image_channels == 4, "image_channels",
+            s(image_channels), "1 (depth) or 4 (rgbd), 0 before training");
+    require(image_height >= 0 && image_height <= 4096, "image_height", s(image_height), "0..4096");
+    require(image_width >= 0 && image_width <= 4096, "image_width", s(image_width), "0..4096");
+    parse_encoder_channels(encoder);  // names the bad entry
+    require(observation_dimension == 0 || observation_dimension >= image_size(),
+            "observation_dimension", s(observation_dimension),
+            ">= the image's " + s(image_size()) + " values");
+  }
+}
+
+std::vector<int> parse_encoder_channels(const std::string& text) {
+  std::vector<int> channels;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', begin), text.size());
+    const std::string item = text.substr(begin, comma - begin);
+    int value = 0;
+    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
+    if (ec != std::errc() || end != item.data() + item.size() || value < 1 || value > 256) {
+      throw InvalidArgument("encoder '" + text + "': '" + item +
+                            "' is not a channel count 1..256; give the out_channels of each layer "
+                            "comma-separated, e.g. 8,16");
+    }
+    channels.push_back(value);
+    begin = comma + 1;
+  }
+  if (channels.size() > 6) {
+    throw InvalidArgument("encoder '" + text + "' has " + std::to_string(channels.size()) +
+                          " layers: give 1 to 6");
+  }
+  return channels;
 }
 
 std::string PolicyConfig::to_text() const {
@@ -226,6 +279,9 @@ std::string PolicyConfig::to_text() const {
     if (!is_c8_planar(head) && field.key.starts_with("c8_")) continue;  // see config.hpp
     if (field.key == "task" && task == kTaskPeg2d) continue;            // absent reads as peg2d
     if (field.key == "ddpm_prediction" && head != HeadKind::ddpm) continue;  // see config.hpp
+    if (observation == ObservationKind::key_points &&
+        (field.key == "observation" || field.key.starts_with("image_") || field.key == "encoder"))
+      continue;  // see config.hpp
     text += field.key + "=" + field.get(*this) + "\n";
   }
   return text;

@@ -3,11 +3,12 @@
 #include <string>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/policy/image_source.hpp"
 
 namespace handcentric::policy {
 
 Dataset encode_scenes(const Representation& representation, const std::vector<Scene>& scenes,
-                      int history_length, int chunk_length) {
+                      int history_length, int chunk_length, const ImageSource* camera) {
   if (scenes.empty())
     throw InvalidScene("no training scenes: give at least one demonstration step");
   Dataset data;
@@ -38,7 +39,9 @@ Dataset encode_scenes(const Representation& representation, const std::vector<Sc
                          ": every scene needs the same points");
     }
     const Eigen::VectorXd a = representation.encode_actions(scene);
-    const Eigen::VectorXd o = representation.encode_observation(scene);
+    const Eigen::VectorXd o = camera == nullptr
+                                  ? representation.encode_observation(scene)
+                                  : encode_image_observation(representation, *camera, scene);
     if (j == 0) {
       data.actions.resize(a.size(), n);
       data.observations.resize(o.size(), n);

@@ -22,6 +22,12 @@ double FlowHead::train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixX
 }
 
 double FlowHead::train_normalized(std::mt19937_64& rng) {
+  draw_flow_sample(rng);
+  assemble(x_, t_, o_, input_);
+  return regress(network_.forward(input_), target_);
+}
+
+void FlowHead::draw_flow_sample(std::mt19937_64& rng) {
   const Eigen::Index batch = a_.cols();
   noise_.resize(a_.rows(), batch);
   fill_standard_normal(rng, noise_);
@@ -34,8 +40,6 @@ double FlowHead::train_normalized(std::mt19937_64& rng) {
     x_.col(j) = t * a_.col(j) + (1.0f - t) * noise_.col(j);  // eq. (5): a(t) = t a + (1 - t) eps
   }
   target_ = a_ - noise_;  // d/dt a(t) = a - eps
-  assemble(x_, t_, o_, input_);
-  return regress(network_.forward(input_), target_);
 }
 
 Eigen::MatrixXf FlowHead::normalized_velocity(const Eigen::MatrixXf& x, double t,
@@ -49,6 +53,10 @@ Eigen::MatrixXf FlowHead::normalized_velocity(const Eigen::MatrixXf& x, double t
 Eigen::MatrixXf FlowHead::sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const {
   Eigen::MatrixXf o = observations;
   observation_normalizer_.normalize(o);
+  return sample_normalized(o, rng);
+}
+
+Eigen::MatrixXf FlowHead::sample_normalized(const Eigen::MatrixXf& o, std::mt19937_64& rng) const {
   const Eigen::Index batch = o.cols();
   Eigen::MatrixXf x(config_.action_dimension, batch);
   fill_standard_normal(rng, x);

@@ -18,6 +18,11 @@ class FlowHead : public NetworkHead {
                                       const Eigen::MatrixXf& o) const;
 
  protected:
+  /// The Euler sampler on normalized network observations (the MLP's observation rows).
+  Eigen::MatrixXf sample_normalized(const Eigen::MatrixXf& o, std::mt19937_64& rng) const;
+  /// Eq. (5)'s training sample for the normalized actions a_: noise_ (eps), t_, x_ = a(t) and
+  /// target_ = a - eps.
+  void draw_flow_sample(std::mt19937_64& rng);
   /// One step on already normalized actions a_ and observations o_ (the buffers).
   double train_normalized(std::mt19937_64& rng);
 };

@@ -4,6 +4,7 @@
 #include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/losses.hpp"
 #include "handcentric/policy/time_embedding.hpp"
+#include "image_flow_head.hpp"
 #include "network_head.hpp"
 #include "normalizer_io.hpp"
 
@@ -14,6 +15,22 @@ std::unique_ptr<Head> make_ddpm_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_cvae_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_c8_flow_head(const PolicyConfig& config);
 std::unique_ptr<Head> make_c8_planar_head(const PolicyConfig& config);
+std::unique_ptr<Head> make_image_flow_head(const PolicyConfig& config);
+
+namespace {
+// An image config describes its image and an observation vector with rows for the
+// proprioception (at least T_0) besides it.
+void check_image_config(const PolicyConfig& config, const std::string& where) {
+  if (config.image_size() < 1 || config.proprio_dimension() < 1) {
+    throw InvalidArgument(
+        where + ": an image policy's image (" + std::to_string(config.image_channels) + " x " +
+        std::to_string(config.image_height) + " x " + std::to_string(config.image_width) +
+        ") and observation_dimension " + std::to_string(config.observation_dimension) +
+        " leave no image or no proprioception: set them from the camera and "
+        "the training data");
+  }
+}
+}  // namespace
 
 std::unique_ptr<Head> make_head(const PolicyConfig& config) {
   config.validate();
@@ -22,6 +39,10 @@ std::unique_ptr<Head> make_head(const PolicyConfig& config) {
                           " and observation_dimension " +
                           std::to_string(config.observation_dimension) +
                           " must be set (>= 1) from the training data first");
+  }
+  if (config.observation == ObservationKind::image) {
+    check_image_config(config, "make_head");
+    return make_image_flow_head(config);  // validate(): image policies have head flow
   }
   switch (config.head) {
     case HeadKind::flow:
@@ -72,13 +93,22 @@ std::uint64_t parameter_count(const PolicyConfig& config) {
     return mlp_parameter_count(actions + observations, config, 2 * latent) +
            mlp_parameter_count(latent + observations, config, actions);
   }
+  if (config.observation == ObservationKind::image) {
+    check_image_config(config, "parameter_count");
+    const ConvEncoder encoder = config_encoder(config);
+    return mlp_parameter_count(
+               actions + time +
+                   static_cast<std::uint64_t>(config.proprio_dimension() + encoder.output_size()),
+               config, actions) +
+           static_cast<std::uint64_t>(encoder.parameter_count());
+  }
   return mlp_parameter_count(actions + time + observations, config, actions);
 }
 
 namespace {
-std::vector<int> network_widths(const PolicyConfig& config, int output) {
+std::vector<int> network_widths(const PolicyConfig& config, int observation_rows, int output) {
   std::vector<int> widths{config.action_dimension + time_feature_count(config.time_embedding) +
-                          config.observation_dimension};
+                          observation_rows};
   for (int l = 0; l < config.hidden_layers; ++l) widths.push_back(config.hidden_width);
   widths.push_back(output);
   return widths;
@@ -86,10 +116,14 @@ std::vector<int> network_widths(const PolicyConfig& config, int output) {
 }  // namespace
 
 NetworkHead::NetworkHead(const PolicyConfig& config)
+    : NetworkHead(config, config.observation_dimension) {}
+
+NetworkHead::NetworkHead(const PolicyConfig& config, int network_observation_rows)
     : config_(config),
       action_normalizer_(config.action_dimension),
       observation_normalizer_(config.observation_dimension),
-      network_(network_widths(config, config.action_dimension), config.activation),
+      network_(network_widths(config, network_observation_rows, config.action_dimension),
+               config.activation),
       adam_(network_.parameter_count(),
             AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}),
       average_(config.ema_decay) {}

@@ -8,10 +8,12 @@ namespace handcentric::policy {
 
 LearnedPolicy::LearnedPolicy(PolicyConfig config,
                              std::shared_ptr<const Representation> representation,
-                             std::shared_ptr<const Head> head)
+                             std::shared_ptr<const Head> head,
+                             std::shared_ptr<const ImageSource> camera)
     : config_(std::move(config)),
       representation_(std::move(representation)),
-      head_(std::move(head)) {
+      head_(std::move(head)),
+      camera_(config_.observation == ObservationKind::image ? std::move(camera) : nullptr) {
   if (!representation_ || !head_)
     throw InvalidArgument("LearnedPolicy: null representation or head");
   if (representation_->name() != config_.representation || head_->kind() != config_.head) {
@@ -19,6 +21,22 @@ LearnedPolicy::LearnedPolicy(PolicyConfig config,
                           config_.representation + " but got " + to_string(head_->kind()) + "/" +
                           representation_->name());
   }
+  if (camera_) {
+    const ImageShape shape = camera_->shape();
+    if (shape.channels != config_.image_channels || shape.height != config_.image_height ||
+        shape.width != config_.image_width) {
+      throw InvalidArgument(
+          "LearnedPolicy: " + camera_->name() + " renders " + std::to_string(shape.channels) +
+          " x " + std::to_string(shape.height) + " x " + std::to_string(shape.width) +
+          " images but " + name() + " was trained on " + std::to_string(config_.image_channels) +
+          " x " + std::to_string(config_.image_height) + " x " +
+          std::to_string(config_.image_width) + ": give it a camera of its training shape");
+    }
+  }
+}
+
+LearnedPolicy LearnedPolicy::with_camera(std::shared_ptr<const ImageSource> camera) const {
+  return LearnedPolicy(config_, representation_, head_, std::move(camera));
 }
 
 std::string LearnedPolicy::name() const {
@@ -39,8 +57,19 @@ Eigen::VectorXd LearnedPolicy::action_vector(const Scene& observation,
                        std::to_string(config_.world_points) +
                        ": give observations shaped like the training data");
   }
-  // Step 1: the observation in the representation's frame (hand-centric: eq. (3)).
-  const Eigen::MatrixXd o = representation_->encode_observation(observation);
+  // Step 1: the observation in the representation's frame (hand-centric: eq. (3)); an image
+  // policy's points reach it only through its camera's image (image_source.hpp).
+  Eigen::MatrixXd o;
+  if (config_.observation == ObservationKind::image) {
+    if (!camera_) {
+      throw InvalidArgument(name() +
+                            " is an image policy without its camera: load it with the "
+                            "task's camera attached (experiments/insert3d_image.hpp)");
+    }
+    o = encode_image_observation(*representation_, *camera_, observation);
+  } else {
+    o = representation_->encode_observation(observation);
+  }
   // Step 2: the head, with noise from the caller's seed.
   std::mt19937_64 rng(noise_seed);
   const Eigen::VectorXd a = head_->sample_double(o, rng).col(0);

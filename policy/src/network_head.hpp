@@ -15,6 +15,9 @@ namespace handcentric::policy {
 class NetworkHead : public Head {
  public:
   explicit NetworkHead(const PolicyConfig& config);
+  /// With an MLP that sees `network_observation_rows` observation rows rather than
+  /// config.observation_dimension (an image head's features in place of its pixels).
+  NetworkHead(const PolicyConfig& config, int network_observation_rows);
   void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
                std::mt19937_64& rng) override;
   void write(ByteWriter& out) const override;

@@ -44,18 +44,48 @@ double learning_rate_at(const PolicyConfig& config, int step) {
   return config.learning_rate;
 }
 
+namespace {
+void require_camera(const ImageSource* camera) {
+  if (camera == nullptr) {
+    throw InvalidArgument(
+        "train_policy: an image policy (observation = image) needs the camera that renders its "
+        "observations: pass an ImageSource");
+  }
+}
+}  // namespace
+
 LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes,
-                           std::uint64_t seed, const ProgressCallback& progress, int report_every) {
+                           std::uint64_t seed, const ProgressCallback& progress, int report_every,
+                           std::shared_ptr<const ImageSource> camera) {
   config.validate();
   const auto representation = make_representation(config.representation);
-  return train_policy(
-      config, encode_scenes(*representation, scenes, config.history_length, config.chunk_length),
-      seed, progress, report_every);
+  const bool image = config.observation == ObservationKind::image;
+  if (image) require_camera(camera.get());
+  return train_policy(config,
+                      encode_scenes(*representation, scenes, config.history_length,
+                                    config.chunk_length, image ? camera.get() : nullptr),
+                      seed, progress, report_every, camera);
 }
 
 LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64_t seed,
-                           const ProgressCallback& progress, int report_every) {
+                           const ProgressCallback& progress, int report_every,
+                           std::shared_ptr<const ImageSource> camera) {
   config.validate();
+  if (config.observation == ObservationKind::image) {
+    require_camera(camera.get());
+    const ImageShape shape = camera->shape();
+    config.image_channels = shape.channels;
+    config.image_height = shape.height;
+    config.image_width = shape.width;
+    if (data.observations.rows() <= shape.size()) {
+      throw InvalidArgument("train_policy: observations of " +
+                            std::to_string(data.observations.rows()) + " rows hold no " +
+                            camera->name() + " image of " + std::to_string(shape.size()) +
+                            " values after the proprioception: encode them with this camera");
+    }
+  } else {
+    camera = nullptr;  // a key-point policy looks through no camera
+  }
   std::shared_ptr<const Representation> representation = make_representation(config.representation);
   if (data.size() == 0)
     throw InvalidScene("no training samples: give at least one demonstration step");
@@ -117,7 +147,7 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
     }
   }
   head->finish_training();  // the weight average, when config.ema_decay > 0
-  return LearnedPolicy(config, representation, head);
+  return LearnedPolicy(config, representation, head, camera);
 }
 
 }  // namespace handcentric::policy

@@ -112,6 +112,9 @@ TEST_CASE("table2_options_name_the_bad_value", "[unit]") {
   options = Table2Options();
   options.methods = {"hand_centric", "bogus"};
   CHECK_THROWS_WITH(options.validate(), Contains("bogus"));
+  options = Table2Options();
+  options.observations.clear();
+  CHECK_THROWS_WITH(options.validate(), Contains("no observation"));
 }
 
 TEST_CASE("table2_noise_injected_copies_move_the_hand_and_keep_the_demos_chunk", "[unit]") {

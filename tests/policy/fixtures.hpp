@@ -1,12 +1,15 @@
 #pragma once
 // Small configs and data sets for the policy suite: tiny networks and few steps, so that every
 // training in the suite takes well under a second.
+#include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/policy/config.hpp"
 #include "handcentric/policy/dataset.hpp"
+#include "handcentric/policy/image_source.hpp"
 
 namespace handcentric::test {
 
@@ -51,5 +54,41 @@ inline policy::Dataset two_mode_data(int count, std::uint64_t seed) {
   }
   return data;
 }
+
+/// A small image policy: small_config with an image of the hand points through a 2-layer encoder.
+inline policy::PolicyConfig small_image_config(const std::string& representation, int steps) {
+  policy::PolicyConfig config = small_config(policy::HeadKind::flow, representation, steps);
+  config.observation = policy::ObservationKind::image;
+  config.encoder = "4,8";
+  return config;
+}
+
+/// A camera for the policy suite (the tasks' cameras live in experiments/): one 8 x 10 channel,
+/// a blob of light where each point falls, seen from the hand (eye_in_hand: the eye-in-hand
+/// points as they are, what a hand camera sees) or from the world (the points at T_0 p, a camera
+/// fixed in the world, whose image moves with g: a planted fault for Theorem 1).
+class BlobCamera final : public policy::ImageSource {
+ public:
+  explicit BlobCamera(bool eye_in_hand = true) : eye_in_hand_(eye_in_hand) {}
+  std::string name() const override {
+    return eye_in_hand_ ? "blob camera (hand)" : "blob camera (world)";
+  }
+  policy::ImageShape shape() const override { return {1, 8, 10}; }
+  void render(const Scene& observation, Eigen::Ref<Eigen::VectorXd> image) const override {
+    image.setZero();
+    for (const Eigen::Vector3d& hand_p : observation.hand_points) {
+      const Eigen::Vector3d p = eye_in_hand_ ? hand_p : observation.world_T_hand0() * hand_p;
+      for (int row = 0; row < 8; ++row) {
+        for (int col = 0; col < 10; ++col) {
+          const double dy = p.y() - (row - 3.5) * 0.5, dx = p.x() - (col - 4.5) * 0.5;
+          image[row * 10 + col] += std::exp(-(dx * dx + dy * dy) - 0.1 * p.z() * p.z());
+        }
+      }
+    }
+  }
+
+ private:
+  bool eye_in_hand_;
+};
 
 }  // namespace handcentric::test

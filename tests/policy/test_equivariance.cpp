@@ -139,3 +139,30 @@ TEST_CASE("trained_hand_centric_policy_passes_the_props_equivariance_check", "[p
   CHECK(absolute.max_error > kEquivarianceTolerance);
   CHECK(absolute.witness.has_value());
 }
+
+// Image policies (Sec. 4.3's setting): the observation is the proprioception in the
+// representation's frame and a camera's image through a CNN trained end to end. With a hand
+// camera the hand-centric policy is equivariant whatever the encoder learned; an absolute
+// policy, or a hand-centric one looking through a camera fixed in the world, is not.
+TEST_CASE("trained_hand_centric_image_policies_are_se3_equivariant", "[property]") {
+  const auto camera = std::make_shared<const test::BlobCamera>();
+  const auto policy =
+      std::make_shared<LearnedPolicy>(train_policy(test::small_image_config("hand_centric", 100),
+                                                   test::small_scenes(64, 21), 5, {}, 100, camera));
+  props::require_property("flow/hand_centric on a hand camera's image: act(g o) = g act(o)",
+                          outer_policy_equivariant(policy, props::Group::se3));
+}
+
+TEST_CASE("mutant_absolute_and_world_camera_image_policies_are_not_se3_equivariant", "[property]") {
+  const std::vector<Scene> scenes = test::small_scenes(64, 21);
+  const auto hand_camera = std::make_shared<const test::BlobCamera>(true);
+  const auto absolute = std::make_shared<LearnedPolicy>(
+      train_policy(test::small_image_config("absolute", 100), scenes, 5, {}, 100, hand_camera));
+  props::require_falsified("flow/absolute on a hand camera's image under se3",
+                           outer_policy_equivariant(absolute, props::Group::se3));
+  const auto world_camera = std::make_shared<const test::BlobCamera>(false);
+  const auto fixed = std::make_shared<LearnedPolicy>(train_policy(
+      test::small_image_config("hand_centric", 100), scenes, 5, {}, 100, world_camera));
+  props::require_falsified("flow/hand_centric on a world-fixed camera's image under se3",
+                           outer_policy_equivariant(fixed, props::Group::se3));
+}

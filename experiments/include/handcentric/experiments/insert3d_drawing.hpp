@@ -25,4 +25,13 @@ sim::Image draw_insert3d_rollout(const sim::insert3d::TaskScene& scene,
                                  const sim::insert3d::BladeSlotGeometry& geometry = {},
                                  const sim::insert3d::DepthCamera& camera = {});
 
+/// The hand camera's depth images along `rollout`, every `every`-th pose and the last, in rows of
+/// `columns` panels (4x enlarged, near bright, each labelled with its step): what an image
+/// policy saw. Throws InvalidArgument for an empty rollout, every < 1 or columns < 1.
+sim::Image draw_insert3d_camera_frames(const sim::insert3d::TaskScene& scene,
+                                       const sim::insert3d::Rollout& rollout, int every = 4,
+                                       int columns = 8,
+                                       const sim::insert3d::BladeSlotGeometry& geometry = {},
+                                       const sim::insert3d::DepthCamera& camera = {});
+
 }  // namespace handcentric::experiments

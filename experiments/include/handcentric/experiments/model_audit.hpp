@@ -6,6 +6,7 @@
 // rotating about z at z = 0, points at z = 0) under the groups that keep them planar
 // (translation in the plane, se2, c8): rotation and se3 tilt the plane, which no peg2d scene
 // is and which the planar C8 heads cannot even encode.
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,16 @@ std::vector<props::Group> model_groups(const policy::PolicyConfig& config,
 /// Throws InvalidArgument when none of classifier.views is that view.
 props::ClassifierOptions model_classifier_options(const policy::PolicyConfig& config,
                                                   props::ClassifierOptions classifier);
+
+/// The model file `path` as the audit checks it: an image model of the 3D task looking through
+/// its hand camera, which renders every scene the audit draws (insert3d_image.hpp), with the
+/// table in view when `floor`; any other model as it is. Throws InvalidModelFile for a bad file,
+/// InvalidArgument for `floor` on a model without a camera.
+std::shared_ptr<policy::LearnedPolicy> load_audited_model(const std::string& path,
+                                                          bool floor = false);
+
+/// "model PATH (head/representation)", and the camera an image model looks through.
+std::string audited_model_name(const std::string& path, const policy::LearnedPolicy& model);
 
 /// The pointwise audit Table 1 records for the model file DIR/PATH: eye-in-hand view, the
 /// groups of its task, `cases` cases per group from RapidCheck seed 1, float64 tolerance, no

@@ -87,26 +87,33 @@ struct Table2Options {
   int jobs = 0;   ///< trainings at once; 0: one per hardware thread
   int steps = 0;  ///< Adam steps per policy; 0: the library's automatic budget
   std::vector<std::string> methods = {"hand_centric", "relative", "absolute"};
+  /// What the policies see, one set of rows each: the key points (insert3d_key_points.hpp)
+  /// and/or the hand camera's depth image through a CNN trained end to end (insert3d_image.hpp).
+  std::vector<policy::ObservationKind> observations = {policy::ObservationKind::key_points};
   /// Two noise-injected copies by default: on the tuning seeds relative learns the train scenes
   /// with them (0.10 -> 0.66) and hand-centric goes 0.98 -> 1.00 (docs/EXPERIMENTS.md).
   Perturbation perturbation{2, 0.15, 1.0};
   bool quiet = false;
 
   /// Throws InvalidArgument naming the bad value and the fix (demos outside 1..1000, trials
-  /// outside 1..100000, jobs < 0, steps < 0, no method or an unknown representation).
+  /// outside 1..100000, jobs < 0, steps < 0, no method or an unknown representation, no
+  /// observation).
   void validate() const;
 };
 
 struct Table2Row {
   std::string method;  ///< the representation: hand_centric, relative or absolute
+  policy::ObservationKind observation = policy::ObservationKind::key_points;
   int demos = 0;
   std::uint64_t seed = 0;
-  int steps = 0;  ///< Adam steps run
+  int steps = 0;               ///< Adam steps run
+  double train_seconds = 0.0;  ///< wall-clock time of the training
   Insert3dCounts train, ood, random_se3;
 };
 
-/// Trains and evaluates every method (options.jobs at a time), writes DIR/table2.json, .md,
-/// .png and .svg (DIR created when missing) and returns the rows in method order.
+/// Trains and evaluates every method for every observation (options.jobs at a time), writes
+/// DIR/table2.json, .md, .png and .svg (DIR created when missing) and returns the rows in method
+/// order.
 std::vector<Table2Row> run_table2(const Table2Options& options);
 
 /// The rows as the table2.json document.

@@ -3,6 +3,7 @@
 // files as "key=value" lines (to_text / from_text).
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace handcentric::policy {
 
@@ -26,6 +27,12 @@ enum class LearningRateSchedule { constant, cosine };
 /// as `prediction_type`). Either gives the other through x_k = sqrt(abar) x0 + sqrt(1 - abar) eps.
 enum class DdpmPrediction { epsilon, sample };
 
+/// What the network sees besides the representation's proprioception: the key points the
+/// representation encodes (key_points), or an image of the hand camera (image) passed through a
+/// ConvEncoder (conv_encoder.hpp) trained end to end with the head; the points are then left out
+/// of the observation vector and only drive the camera (image_source.hpp).
+enum class ObservationKind { key_points, image };
+
 /// "flow", "ddpm", "cvae", "c8flow", "c8ddpm", "c8flow_planar", "c8ddpm_avg".
 std::string to_string(HeadKind kind);
 /// Throws InvalidArgument naming the value and the valid names.
@@ -43,6 +50,13 @@ LearningRateSchedule parse_schedule(const std::string& name);
 std::string to_string(DdpmPrediction prediction);
 /// Throws InvalidArgument naming the value and the valid names.
 DdpmPrediction parse_ddpm_prediction(const std::string& name);
+/// "key_points", "image".
+std::string to_string(ObservationKind kind);
+/// Throws InvalidArgument naming the value and the valid names.
+ObservationKind parse_observation(const std::string& name);
+/// PolicyConfig::encoder's channel counts ("8,16" -> {8, 16}). Throws InvalidArgument naming
+/// the bad entry unless it is 1 to 6 counts of 1..256.
+std::vector<int> parse_encoder_channels(const std::string& text);
 
 /// The tasks a model can be trained for: the 2D peg-in-hole ("peg2d", Sec. 4.2) and the 3D blade
 /// insertion ("insert3d", Table 2's analogue). Observations of the two differ in shape and
@@ -120,6 +134,29 @@ struct PolicyConfig {
   /// Stored only for that head, so other heads' configs (and Table 1 hashes) are unchanged.
   double c8_centre_x = 0.0;
   double c8_centre_y = 0.0;
+  /// key_points (the default) or image. The image fields below are written for image models
+  /// only, so key-point model files (and Table 1's hashes) are unchanged and a file without
+  /// them reads as key_points. Image models: head flow only.
+  ObservationKind observation = ObservationKind::key_points;
+  /// The camera's image, set by the trainer from the ImageSource: 1 channel (depth) or 4
+  /// (red, green, blue, depth), height x width pixels.
+  int image_channels = 0;
+  int image_height = 0;
+  int image_width = 0;
+  /// The encoder's layers: their out_channels, comma-separated, each a 3 x 3 convolution of
+  /// stride 2 and padding 1 (conv_encoder.hpp). Three layers of 8, 16 and 16 turn a 32 x 24
+  /// depth image into 16 x 4 x 3 = 192 features in ~3.6k weights: the MLP's first layer then
+  /// costs about what the key points' does (768 features after two layers would quadruple it).
+  std::string encoder = "8,16,16";
+
+  /// The image's shape (image_channels, image_height, image_width).
+  int image_size() const { return image_channels * image_height * image_width; }
+  /// Rows of the observation vector the representation encodes: observation_dimension less the
+  /// image for an image model.
+  int proprio_dimension() const {
+    return observation == ObservationKind::image ? observation_dimension - image_size()
+                                                 : observation_dimension;
+  }
 
   /// Throws InvalidArgument naming the first out-of-range field and its valid range.
   void validate() const;

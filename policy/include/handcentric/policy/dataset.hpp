@@ -17,10 +17,14 @@ struct Dataset {
   Eigen::Index size() const { return actions.cols(); }
 };
 
-/// Encodes every scene. Throws InvalidScene naming the scene index and the fix for: no scenes,
-/// an invalid scene, a history length != H, a chunk length != K, or point counts that differ
-/// from the first scene's (all samples of a policy share one observation layout).
+class ImageSource;
+
+/// Encodes every scene; with a camera, each observation is encode_image_observation's
+/// (proprioception, then the camera's image; image_source.hpp). Throws InvalidScene naming the
+/// scene index and the fix for: no scenes, an invalid scene, a history length != H, a chunk length
+/// != K, or point counts that differ from the first scene's (all samples of a policy share one
+/// observation layout).
 Dataset encode_scenes(const Representation& representation, const std::vector<Scene>& scenes,
-                      int history_length, int chunk_length);
+                      int history_length, int chunk_length, const ImageSource* camera = nullptr);
 
 }  // namespace handcentric::policy

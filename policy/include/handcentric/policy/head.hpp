@@ -69,6 +69,11 @@ class Head {
 /// or c8ddpm with a representation other than "absolute".
 std::unique_ptr<Head> make_head(const PolicyConfig& config);
 
+class ConvEncoder;
+/// The image encoder of an image policy's head (config.observation = image), to inspect its
+/// weights; null for every other head.
+const ConvEncoder* image_encoder(const Head& head);
+
 /// The number of float32 weights make_head(config) holds (and a model file stores), computed
 /// without allocating anything. Throws InvalidArgument for a config make_head refuses.
 std::uint64_t parameter_count(const PolicyConfig& config);

@@ -16,20 +16,28 @@
 #include "handcentric/core/representation.hpp"
 #include "handcentric/policy/config.hpp"
 #include "handcentric/policy/head.hpp"
+#include "handcentric/policy/image_source.hpp"
 
 namespace handcentric::policy {
 
 class LearnedPolicy final : public ChunkPolicy {
  public:
   /// Throws InvalidArgument for a null representation or head, or one whose name / kind does
-  /// not match `config`.
+  /// not match `config`. An image policy (config.observation = image) acts only once it has a
+  /// camera of config's image shape (here or with_camera; a model file stores no camera, the
+  /// task gives it: experiments/insert3d_image.hpp); a camera of another shape is an
+  /// InvalidArgument, and a key-point policy ignores the camera.
   LearnedPolicy(PolicyConfig config, std::shared_ptr<const Representation> representation,
-                std::shared_ptr<const Head> head);
+                std::shared_ptr<const Head> head, std::shared_ptr<const ImageSource> camera = {});
+
+  /// The same policy looking through `camera` (the checks of the constructor).
+  LearnedPolicy with_camera(std::shared_ptr<const ImageSource> camera) const;
 
   /// "<head>/<representation>", e.g. "flow/hand_centric".
   std::string name() const override;
 
-  /// Throws InvalidScene for an invalid observation or one whose H or point counts differ from
+  /// Throws InvalidArgument for an image policy without a camera, InvalidScene for an invalid
+  /// observation or one whose H or point counts differ from
   /// training, and NonFiniteAction (an InvalidScene) for a non-finite output (an observation far
   /// outside the training data, or diverged weights).
   std::vector<RigidTransform> act(const Scene& observation,
@@ -43,11 +51,14 @@ class LearnedPolicy final : public ChunkPolicy {
   const Head& head() const { return *head_; }
   std::shared_ptr<const Head> shared_head() const { return head_; }
   std::shared_ptr<const Representation> shared_representation() const { return representation_; }
+  /// The camera of an image policy; null for a key-point policy or one not given its camera yet.
+  const std::shared_ptr<const ImageSource>& camera() const { return camera_; }
 
  private:
   PolicyConfig config_;
   std::shared_ptr<const Representation> representation_;
   std::shared_ptr<const Head> head_;
+  std::shared_ptr<const ImageSource> camera_;
 };
 
 }  // namespace handcentric::policy

@@ -4,11 +4,13 @@
 // config, scenes and seed give the same weights, bit for bit (on one thread).
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "handcentric/core/scene.hpp"
 #include "handcentric/policy/config.hpp"
 #include "handcentric/policy/dataset.hpp"
+#include "handcentric/policy/image_source.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 
 namespace handcentric::policy {
@@ -50,17 +52,22 @@ inline constexpr int kC8BudgetMaxSteps = 10000;
 double learning_rate_at(const PolicyConfig& config, int step);
 
 /// Trains `config.head` on `scenes` with `config.representation` (config.steps = 0: the
-/// automatic budget for scenes.size() samples). Dimensions and point counts
+/// automatic budget for scenes.size() samples). An image policy (config.observation = image)
+/// needs `camera`, which renders each scene's image (image_source.hpp); the trainer sets
+/// config.image_* from it, and the policy returned keeps it. The encoder is trained end to end
+/// with the head. Dimensions and point counts
 /// in the returned policy's config come from the data. `progress` (optional) is called about
 /// every `report_every` steps and after the last step. Throws InvalidArgument for a bad config
 /// or a non-finite loss (diverged training), InvalidScene for bad scenes (dataset.hpp).
 LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes,
                            std::uint64_t seed, const ProgressCallback& progress = {},
-                           int report_every = 100);
+                           int report_every = 100,
+                           std::shared_ptr<const ImageSource> camera = nullptr);
 
 /// The same on already encoded data (benchmarks; `config.representation` must still name the
 /// representation that encoded it).
 LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64_t seed,
-                           const ProgressCallback& progress = {}, int report_every = 100);
+                           const ProgressCallback& progress = {}, int report_every = 100,
+                           std::shared_ptr<const ImageSource> camera = nullptr);
 
 }  // namespace handcentric::policy

@@ -1,0 +1,138 @@
+#include "handcentric/experiments/insert3d_image.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/insert3d_key_points.hpp"
+#include "handcentric/sim/insert3d/rollout.hpp"
+
+namespace handcentric::experiments {
+
+std::string to_string(Insert3dImageChannels channels) {
+  return channels == Insert3dImageChannels::rgbd ? "rgbd" : "depth";
+}
+
+Insert3dImageChannels parse_insert3d_image_channels(const std::string& name) {
+  if (name == "depth") return Insert3dImageChannels::depth;
+  if (name == "rgbd") return Insert3dImageChannels::rgbd;
+  throw InvalidArgument("unknown image channels '" + name + "': use depth or rgbd");
+}
+
+namespace {
+
+// hand_T_slot from the four eye-in-hand points as the expert reads it
+// (hand_T_slot_from_corners); points that span no plane get the axes they lack fixed, so that
+// every finite observation renders (the audit's scenes are not all slot openings).
+RigidTransform hand_T_slot_of(const std::vector<Eigen::Vector3d>& hand_points) {
+  if (hand_points.size() != 4) {
+    throw InvalidScene(
+        "the 3D task's hand camera renders the slot from its 4 eye-in-hand points "
+        "(the opening's corners), got " +
+        std::to_string(hand_points.size()));
+  }
+  constexpr double kTiny = 1e-9;
+  const Eigen::Vector3d along_x = hand_points[1] - hand_points[0];
+  const Eigen::Vector3d along_y = hand_points[3] - hand_points[0];
+  const Eigen::Vector3d x =
+      along_x.norm() > kTiny ? along_x.normalized() : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d off_x = along_y - along_y.dot(x) * x;
+  if (along_x.norm() > kTiny && off_x.norm() > kTiny * (1.0 + along_y.norm()))
+    return sim::insert3d::hand_T_slot_from_corners(hand_points);
+  const Eigen::Vector3d other =
+      std::abs(x.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d y = (other - other.dot(x) * x).normalized();
+  Eigen::Matrix3d R;
+  R << x, y, x.cross(y);
+  return RigidTransform::unchecked(
+      R, 0.25 * (hand_points[0] + hand_points[1] + hand_points[2] + hand_points[3]));
+}
+
+}  // namespace
+
+Insert3dHandCamera::Insert3dHandCamera(Insert3dHandCameraOptions options)
+    : options_(std::move(options)) {
+  options_.camera.validate();
+  if (!std::isfinite(options_.table_z)) throw InvalidArgument("the table's height must be finite");
+}
+
+std::string Insert3dHandCamera::name() const {
+  return "insert3d hand camera (" + to_string(options_.channels) + ", " +
+         std::to_string(options_.camera.width) + " x " + std::to_string(options_.camera.height) +
+         (options_.floor ? ", with the table" : "") + ")";
+}
+
+policy::ImageShape Insert3dHandCamera::shape() const {
+  return policy::ImageShape{options_.channels == Insert3dImageChannels::rgbd ? 4 : 1,
+                            options_.camera.height, options_.camera.width};
+}
+
+CameraImage Insert3dHandCamera::render_image(const Scene& observation) const {
+  observation.validate_observation();
+  const RigidTransform hand_T_slot = hand_T_slot_of(observation.hand_points);
+  const sim::insert3d::BladeSlotGeometry geometry;
+  std::vector<Solid> solids = sim::insert3d::task_solids_in_hand(geometry, hand_T_slot);
+  if (options_.floor) {
+    // The table stays in the world: the hand sees it at T_0^-1 world_T_table.
+    const RigidTransform world_T_table =
+        RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, options_.table_z));
+    solids.push_back(Solid::plane(observation.world_T_hand0().inverse_compose(world_T_table),
+                                  Eigen::Vector3d(0.5, 0.4, 0.3)));
+  }
+  return handcentric::render(solids, options_.camera, options_.camera.hand_T_camera);
+}
+
+void Insert3dHandCamera::render(const Scene& observation, Eigen::Ref<Eigen::VectorXd> image) const {
+  const policy::ImageShape image_shape = shape();
+  if (image.size() != image_shape.size()) {
+    throw InvalidArgument(name() + ": an image of " + std::to_string(image_shape.size()) +
+                          " values, got room for " + std::to_string(image.size()));
+  }
+  const CameraImage picture = render_image(observation);
+  const Eigen::Index pixels = static_cast<Eigen::Index>(picture.width) * picture.height;
+  Eigen::Index channel = 0;
+  if (options_.channels == Insert3dImageChannels::rgbd) {
+    for (int c = 0; c < 3; ++c, ++channel) {
+      for (Eigen::Index p = 0; p < pixels; ++p)
+        image[channel * pixels + p] = picture.rgb[static_cast<std::size_t>(3 * p + c)];
+    }
+  }
+  for (Eigen::Index p = 0; p < pixels; ++p)
+    image[channel * pixels + p] = picture.depth[static_cast<std::size_t>(p)];
+}
+
+std::shared_ptr<const Insert3dHandCamera> insert3d_camera_of(const policy::PolicyConfig& config,
+                                                             bool floor) {
+  if (config.task != policy::kTaskInsert3d ||
+      config.observation != policy::ObservationKind::image) {
+    throw InvalidArgument("insert3d_camera_of: a " + config.task + " model with observation " +
+                          policy::to_string(config.observation) +
+                          " has no hand camera: give an image model of the 3D task (insert3d)");
+  }
+  Insert3dHandCameraOptions options;
+  options.channels =
+      config.image_channels == 4 ? Insert3dImageChannels::rgbd : Insert3dImageChannels::depth;
+  options.camera.width = config.image_width;
+  options.camera.height = config.image_height;
+  options.floor = floor;
+  return std::make_shared<const Insert3dHandCamera>(options);
+}
+
+policy::LearnedPolicy with_task_camera(const policy::LearnedPolicy& model, bool floor) {
+  const policy::PolicyConfig& config = model.config();
+  if (config.task != policy::kTaskInsert3d || config.observation != policy::ObservationKind::image)
+    return model;
+  return model.with_camera(insert3d_camera_of(config, floor));
+}
+
+std::shared_ptr<const ChunkPolicy> insert3d_model_policy(
+    std::shared_ptr<const policy::LearnedPolicy> model) {
+  if (model->config().observation == policy::ObservationKind::image) {
+    if (model->camera()) return model;
+    return std::make_shared<const policy::LearnedPolicy>(with_task_camera(*model));
+  }
+  // Key-point models are trained on the corners and the slot points computed from them.
+  return std::make_shared<const SlotKeyPointPolicy>(std::move(model));
+}
+
+}  // namespace handcentric::experiments

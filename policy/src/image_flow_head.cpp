@@ -1,0 +1,136 @@
+// The image policy's flow head (image_flow_head.hpp): eq. (5) with the observation's image
+// encoded by a ConvEncoder trained end to end.
+#include "image_flow_head.hpp"
+
+#include <cmath>
+#include <string>
+
+#include "handcentric/core/errors.hpp"
+#include "handcentric/policy/losses.hpp"
+
+namespace handcentric::policy {
+
+ImageShape config_image_shape(const PolicyConfig& config) {
+  return ImageShape{config.image_channels, config.image_height, config.image_width};
+}
+
+std::vector<ConvLayerSpec> config_encoder_layers(const PolicyConfig& config) {
+  std::vector<ConvLayerSpec> layers;
+  for (int channels : parse_encoder_channels(config.encoder))
+    layers.push_back(ConvLayerSpec{channels, 3, 2, 1});
+  return layers;
+}
+
+ConvEncoder config_encoder(const PolicyConfig& config) {
+  return ConvEncoder(config_image_shape(config), config_encoder_layers(config));
+}
+
+namespace {
+int network_observation_rows(const PolicyConfig& config) {
+  return config.proprio_dimension() + static_cast<int>(config_encoder(config).output_size());
+}
+}  // namespace
+
+ImageFlowHead::ImageFlowHead(const PolicyConfig& config)
+    : FlowHead(config, network_observation_rows(config)),
+      proprio_rows_(config.proprio_dimension()),
+      encoder_(config_encoder(config)),
+      encoder_adam_(encoder_.parameter_count(),
+                    AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}),
+      encoder_average_(config.ema_decay) {}
+
+void ImageFlowHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+                            std::mt19937_64& rng) {
+  FlowHead::prepare(actions, observations, rng);
+  encoder_.initialize(rng);
+}
+
+Eigen::MatrixXf ImageFlowHead::network_observation(ConvEncoder& encoder,
+                                                   const Eigen::MatrixXf& o) const {
+  const Eigen::MatrixXf& features = encoder.forward(o.bottomRows(o.rows() - proprio_rows_));
+  Eigen::MatrixXf out(proprio_rows_ + features.rows(), o.cols());
+  out.topRows(proprio_rows_) = o.topRows(proprio_rows_);
+  out.bottomRows(features.rows()) = features;
+  return out;
+}
+
+double ImageFlowHead::train_step(const Eigen::MatrixXf& actions,
+                                 const Eigen::MatrixXf& observations, std::mt19937_64& rng) {
+  a_ = actions;
+  o_ = observations;
+  action_normalizer_.normalize(a_);
+  observation_normalizer_.normalize(o_);
+  network_o_ = network_observation(encoder_, o_);
+  draw_flow_sample(rng);
+  assemble(x_, t_, network_o_, input_);
+  const double loss = mse_loss<float>(network_.forward(input_), target_, d_output_);
+  // End to end: the MLP's input gradient, its feature rows (the last ones), into the encoder.
+  const Eigen::MatrixXf& d_input = network_.backward(d_output_);
+  const Eigen::Index feature_rows = encoder_.output_size();
+  encoder_.backward_parameters(d_input.bottomRows(feature_rows));
+  // One clip over both gradients: the norm of their concatenation.
+  double scale = 1.0;
+  if (config_.gradient_clip > 0.0) {
+    const double norm = std::sqrt(static_cast<double>(network_.gradient().squaredNorm()) +
+                                  static_cast<double>(encoder_.gradient().squaredNorm()));
+    if (norm > config_.gradient_clip) scale = config_.gradient_clip / norm;
+  }
+  adam_.step(network_.parameters(), network_.gradient(), static_cast<float>(scale));
+  encoder_adam_.set_learning_rate(adam_.learning_rate());
+  encoder_adam_.step(encoder_.parameters(), encoder_.gradient(), static_cast<float>(scale));
+  average_.update(network_.parameters());
+  encoder_average_.update(encoder_.parameters());
+  return loss;
+}
+
+Eigen::MatrixXf ImageFlowHead::sample(const Eigen::MatrixXf& observations,
+                                      std::mt19937_64& rng) const {
+  Eigen::MatrixXf o = observations;
+  observation_normalizer_.normalize(o);
+  // forward() keeps its activations, so a const sampler runs a copy (a few thousand weights):
+  // one policy may act from several threads.
+  ConvEncoder encoder = encoder_;
+  const Eigen::MatrixXf network_o = network_observation(encoder, o);
+  return sample_normalized(network_o, rng);
+}
+
+void ImageFlowHead::finish_training() {
+  FlowHead::finish_training();
+  if (encoder_average_.updates() > 0) encoder_.parameters() = encoder_average_.average();
+}
+
+void ImageFlowHead::write(ByteWriter& out) const {
+  FlowHead::write(out);
+  encoder_.write(out);
+}
+
+void ImageFlowHead::read(ByteReader& in) {
+  FlowHead::read(in);
+  ConvEncoder stored = ConvEncoder::read(in);
+  const ConvEncoder expected = config_encoder(config_);
+  bool same = stored.input_shape() == expected.input_shape() &&
+              stored.layers().size() == expected.layers().size();
+  for (std::size_t l = 0; same && l < stored.layers().size(); ++l) {
+    const Conv2d &a = stored.layers()[l], &b = expected.layers()[l];
+    same = a.out_channels() == b.out_channels() && a.kernel() == b.kernel() &&
+           a.stride() == b.stride() && a.padding() == b.padding();
+  }
+  if (!same) {
+    in.fail("the image encoder stored is not the one its config describes (encoder " +
+            config_.encoder + " on " + std::to_string(config_.image_channels) + " x " +
+            std::to_string(config_.image_height) + " x " + std::to_string(config_.image_width) +
+            " images)");
+  }
+  encoder_ = std::move(stored);
+}
+
+const ConvEncoder* image_encoder(const Head& head) {
+  const auto* image = dynamic_cast<const ImageFlowHead*>(&head);
+  return image == nullptr ? nullptr : &image->encoder();
+}
+
+std::unique_ptr<Head> make_image_flow_head(const PolicyConfig& config) {
+  return std::make_unique<ImageFlowHead>(config);
+}
+
+}  // namespace handcentric::policy

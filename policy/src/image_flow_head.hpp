@@ -1,0 +1,55 @@
+#pragma once
+// Private: the rectified-flow head of an image policy (PolicyConfig::observation = image). The
+// observation columns are [proprioception; image] (image_source.hpp); the image goes through a
+// ConvEncoder whose features take its place in the MLP's input:
+//
+//   MLP input = [x (actions), time features, proprioception, encoder(image) features]
+//
+// Trained end to end: eq. (5)'s loss is backpropagated through the MLP into the features and on
+// through the encoder (ConvEncoder::backward_parameters); the MLP's and the encoder's gradients
+// are clipped together by their joint norm, and each set of weights takes the same Adam step (Adam
+// is elementwise, so two Adams are one Adam over both). Both normalizers see the whole
+// observation: each pixel is shifted and scaled by its training mean and spread, a constant map
+// that keeps an invariant image invariant (normalizer.hpp).
+#include <vector>
+
+#include "flow_head.hpp"
+#include "handcentric/policy/conv_encoder.hpp"
+
+namespace handcentric::policy {
+
+/// config's image (image_channels, image_height, image_width).
+ImageShape config_image_shape(const PolicyConfig& config);
+/// config.encoder as layers: each a 3 x 3 convolution, stride 2, padding 1.
+std::vector<ConvLayerSpec> config_encoder_layers(const PolicyConfig& config);
+/// The encoder an image config describes (weights zero). Throws InvalidArgument for a bad one.
+ConvEncoder config_encoder(const PolicyConfig& config);
+
+class ImageFlowHead final : public FlowHead {
+ public:
+  explicit ImageFlowHead(const PolicyConfig& config);
+  void prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
+               std::mt19937_64& rng) override;
+  double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
+                    std::mt19937_64& rng) override;
+  Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override;
+  void finish_training() override;
+  /// NetworkHead's record, then the encoder's (ConvEncoder::write).
+  void write(ByteWriter& out) const override;
+  /// Also refuses an encoder whose architecture is not the config's.
+  void read(ByteReader& in) override;
+
+  const ConvEncoder& encoder() const { return encoder_; }
+
+ private:
+  /// [proprioception; features] of normalized observations o, with `encoder` run forward.
+  Eigen::MatrixXf network_observation(ConvEncoder& encoder, const Eigen::MatrixXf& o) const;
+
+  int proprio_rows_ = 0;
+  ConvEncoder encoder_;
+  Adam encoder_adam_;
+  WeightAverage encoder_average_;
+  Eigen::MatrixXf network_o_;
+};
+
+}  // namespace handcentric::policy

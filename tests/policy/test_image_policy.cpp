@@ -1,0 +1,124 @@
+// Image policies (PolicyConfig::observation = image): the encoder is trained end to end with the
+// flow head, model files record it (and damage to it is a typed error), and a policy acts only
+// through a camera of its training shape.
+#include <catch2/catch.hpp>
+
+#include <cstring>
+
+#include "fixtures.hpp"
+#include "handcentric/core/errors.hpp"
+#include "handcentric/policy/binary_io.hpp"
+#include "handcentric/policy/conv_encoder.hpp"
+#include "handcentric/policy/errors.hpp"
+#include "handcentric/policy/model_file.hpp"
+#include "handcentric/policy/trainer.hpp"
+#include "throws.hpp"
+
+using namespace handcentric;
+using namespace handcentric::policy;
+
+namespace {
+
+LearnedPolicy image_policy(int steps) {
+  return train_policy(test::small_image_config("hand_centric", steps), test::small_scenes(32, 2), 3,
+                      {}, 100, std::make_shared<const test::BlobCamera>());
+}
+
+// The largest change of any encoder weight between two trainings.
+float encoder_change(const LearnedPolicy& a, const LearnedPolicy& b) {
+  const ConvEncoder* before = image_encoder(a.head());
+  const ConvEncoder* after = image_encoder(b.head());
+  REQUIRE(before != nullptr);
+  REQUIRE(after != nullptr);
+  return (before->parameters() - after->parameters()).cwiseAbs().maxCoeff();
+}
+
+std::string rechecksummed(std::string bytes) {
+  const std::uint64_t hash = fnv1a64(bytes.data(), bytes.size() - 8);
+  std::memcpy(bytes.data() + bytes.size() - 8, &hash, 8);
+  return bytes;
+}
+
+}  // namespace
+
+TEST_CASE("image_policies_train_their_encoder_end_to_end", "[unit]") {
+  const LearnedPolicy one = image_policy(1), many = image_policy(40);
+  const PolicyConfig& config = many.config();
+  CHECK(config.image_channels == 1);
+  CHECK(config.image_height == 8);
+  CHECK(config.image_width == 10);
+  CHECK(config.observation_dimension == config.proprio_dimension() + 80);
+  CHECK(image_encoder(many.head())->layers().size() == 2);
+  // The loss reaches the encoder: its weights move from step 1 to step 40 (same seed, so the
+  // same initialization). The planted fault: one training against itself shows no change.
+  CHECK(encoder_change(one, many) > 1e-4f);
+  CHECK(encoder_change(many, many) == 0.0f);
+  // A key-point head has no encoder.
+  const LearnedPolicy points = train_policy(test::small_config(HeadKind::flow, "hand_centric", 2),
+                                            test::small_scenes(8, 2), 3);
+  CHECK(image_encoder(points.head()) == nullptr);
+}
+
+TEST_CASE("image_models_record_their_encoder_and_need_their_camera", "[unit]") {
+  const LearnedPolicy policy = image_policy(20);
+  const std::string bytes = serialize_model(policy);
+  const LearnedPolicy loaded = deserialize_model(bytes, "image.model");
+  CHECK(loaded.config().observation == ObservationKind::image);
+  CHECK(encoder_change(policy, loaded) == 0.0f);
+  const Scene scene = test::small_scenes(1, 9).front();
+  // A model file holds no camera: the task gives it back.
+  HC_CHECK_THROWS(loaded.action_vector(scene, 4), InvalidArgument,
+                  Catch::Contains("without its camera"));
+  const LearnedPolicy seeing = loaded.with_camera(std::make_shared<const test::BlobCamera>());
+  CHECK(seeing.action_vector(scene, 4) == policy.action_vector(scene, 4));
+  // A camera of another shape is refused by name.
+  class WideCamera final : public ImageSource {
+   public:
+    std::string name() const override { return "wide camera"; }
+    ImageShape shape() const override { return {1, 8, 12}; }
+    void render(const Scene&, Eigen::Ref<Eigen::VectorXd> image) const override { image.setZero(); }
+  };
+  HC_CHECK_THROWS(loaded.with_camera(std::make_shared<const WideCamera>()), InvalidArgument,
+                  Catch::Contains("wide camera renders 1 x 8 x 12"));
+}
+
+TEST_CASE("damaged_image_model_files_are_typed_errors", "[unit]") {
+  const std::string bytes = serialize_model(image_policy(5));
+  for (std::size_t length : {bytes.size() / 2, bytes.size() - 9, bytes.size() - 1}) {
+    INFO("truncated to " << length);
+    HC_CHECK_THROWS(deserialize_model(bytes.substr(0, length), "cut.model"), InvalidModelFile,
+                    Catch::Contains("cut.model"));
+  }
+  // A config that describes another encoder than the one stored (8 -> 9 channels in layer 2).
+  std::string edited = bytes;
+  const std::size_t at = edited.find("encoder=4,8");
+  REQUIRE(at != std::string::npos);
+  edited[at + std::strlen("encoder=4,")] = '9';
+  CHECK_THROWS_AS(deserialize_model(rechecksummed(edited), "edited.model"), InvalidModelFile);
+  // An encoder of a head that has none: refused before any weight is read.
+  edited = bytes;
+  const std::size_t head = edited.find("head=flow");
+  REQUIRE(head != std::string::npos);
+  edited.replace(head, std::strlen("head=flow"), "head=ddpm");
+  HC_CHECK_THROWS(deserialize_model(rechecksummed(edited), "ddpm.model"), InvalidModelFile,
+                  Catch::Contains("flow"));
+}
+
+TEST_CASE("image_configs_out_of_range_are_typed_errors", "[unit]") {
+  PolicyConfig config = test::small_image_config("hand_centric", 2);
+  config.encoder = "4,,8";
+  HC_CHECK_THROWS(config.validate(), InvalidArgument, Catch::Contains("'4,,8'"));
+  config.encoder = "4,999";
+  HC_CHECK_THROWS(config.validate(), InvalidArgument, Catch::Contains("'999'"));
+  config = test::small_image_config("hand_centric", 2);
+  config.head = HeadKind::cvae;
+  HC_CHECK_THROWS(config.validate(), InvalidArgument, Catch::Contains("flow"));
+  // Without a camera there is nothing to train on.
+  HC_CHECK_THROWS(
+      train_policy(test::small_image_config("hand_centric", 2), test::small_scenes(8, 2), 3),
+      InvalidArgument, Catch::Contains("ImageSource"));
+  // The config text round-trips, and a key-point config writes none of the image keys.
+  const PolicyConfig trained = image_policy(2).config();
+  CHECK(PolicyConfig::from_text(trained.to_text()).to_text() == trained.to_text());
+  CHECK(PolicyConfig().to_text().find("encoder") == std::string::npos);
+}
