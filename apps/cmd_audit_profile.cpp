@@ -86,8 +86,12 @@ std::vector<props::Profile> model_profiles(const ProfileCommand& command, props:
                                            props::ProfileOptions options) {
   auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(command.model));
   const policy::PolicyConfig& config = model->config();
-  // A peg2d model is profiled on planar scenes, under the groups that keep them planar.
-  (void)experiments::model_groups(config, props::all_groups(), command.group, command.model);
+  // A peg2d model is profiled on planar scenes, under the groups that keep them planar
+  // (experiments/model_audit.hpp).
+  if (experiments::model_groups(config, {group}, "all", command.model).empty())
+    throw InvalidArgument("--profile " + command.group + ": " + command.model +
+                          " is a model of the 2D task (peg2d), whose scenes lie in a plane that " +
+                          command.group + " tilts; profile it under translation, se2 or c8");
   // The model's own H, point counts and view (its world points or none), as `audit --model`.
   props::ClassifierOptions classifier;
   classifier.views = {props::View::eye_in_hand, props::View::third_person};
@@ -99,7 +103,8 @@ std::vector<props::Profile> model_profiles(const ProfileCommand& command, props:
   }
   props::Profile profile =
       props::profile_policy(props::SeededPolicy(model), group, options);
-  profile.name = "model " + command.model + " (" + model->name() + ")";
+  profile.name = "model " + std::filesystem::path(command.model).filename().string() + " (" +
+                 model->name() + ")";
   return {profile};
 }
 

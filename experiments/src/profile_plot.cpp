@@ -23,10 +23,36 @@ const cv::Scalar kProfileColours[] = {rgb(68, 119, 170),  rgb(238, 102, 119), rg
 
 constexpr double kLowestDecade = -16.0;
 
-std::string label_of(const props::Profile& p) {
-  std::string name = p.name;
-  if (name.size() > 30) name = "..." + name.substr(name.size() - 27);
-  return name + " " + props::to_string(p.component);
+// The legend's label of a profile, wrapped at spaces into at most two lines of kLabelChars (the
+// legend's width at its font), the second shortened from the front if it is still too long. A
+// policy's component goes without saying.
+constexpr std::size_t kLabelChars = 31;
+
+std::vector<std::string> label_of(const props::Profile& p) {
+  std::string label = p.name;
+  if (p.component != props::Component::policy) {
+    label.push_back(' ');
+    label.append(props::to_string(p.component));
+  }
+  std::vector<std::string> lines;
+  std::string line;
+  std::size_t at = 0;
+  while (at < label.size()) {
+    std::size_t end = label.find(' ', at);
+    if (end == std::string::npos) end = label.size();
+    const std::string word = label.substr(at, end - at);
+    if (!line.empty() && line.size() + 1 + word.size() > kLabelChars && lines.empty()) {
+      lines.push_back(line);
+      line.clear();
+    }
+    if (!line.empty()) line.push_back(' ');
+    line.append(word);
+    at = end + 1;
+  }
+  lines.push_back(line);
+  for (std::string& l : lines)
+    if (l.size() > kLabelChars) l.replace(0, l.size() - (kLabelChars - 3), "...");
+  return lines;
 }
 
 }  // namespace
@@ -55,7 +81,8 @@ sim::Image draw_profiles(const std::vector<props::Profile>& profiles, int width,
   // x: log decades around the sizes (c8: 0 to the next multiple of 45 deg); y: decades.
   const double ax_lo = c8 ? 0.0 : std::floor(std::log10(x_lo));
   const double ax_hi = c8 ? 45.0 * std::ceil(x_hi / 45.0) : std::ceil(std::log10(x_hi));
-  const double ay_hi = std::max(0.0, std::ceil(std::log10(y_hi)));
+  // A decade of headroom when the largest value sits near the top, so its mark stays inside.
+  const double ay_hi = std::max(0.0, std::ceil(std::log10(y_hi) + 0.15));
   const double ay_lo = kLowestDecade;
   cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   const int left = 80, right = width - 290, top = 60, bottom = height - 60;
@@ -98,6 +125,7 @@ sim::Image draw_profiles(const std::vector<props::Profile>& profiles, int width,
                    std::to_string(profiles.front().scenes) + " scenes per size)",
        {left, 30}, 0.65);
 
+  int legend_y = top + 12;
   for (std::size_t s = 0; s < profiles.size(); ++s) {
     const props::Profile& p = profiles[s];
     const cv::Scalar colour = kProfileColours[s % std::size(kProfileColours)];
@@ -117,12 +145,16 @@ sim::Image draw_profiles(const std::vector<props::Profile>& profiles, int width,
         previous_law = law;
       }
     }
-    const cv::Point key(right + 15, top + 12 + 22 * static_cast<int>(s));
+    const cv::Point key(right + 15, legend_y);
     cv::line(canvas, key, key + cv::Point(22, 0), colour, 2, cv::LINE_AA);
     cv::circle(canvas, key + cv::Point(11, 0), 4, colour, cv::FILLED, cv::LINE_AA);
-    text(canvas, label_of(p), key + cv::Point(30, 5), 0.42);
+    for (const std::string& line : label_of(p)) {
+      text(canvas, line, {key.x + 30, legend_y + 5}, 0.42);
+      legend_y += 17;
+    }
+    legend_y += 5;
   }
-  const cv::Point key(right + 15, top + 12 + 22 * static_cast<int>(profiles.size()) + 14);
+  const cv::Point key(right + 15, legend_y + 14);
   const cv::Scalar grey = rgb(90, 90, 90);
   cv::circle(canvas, key + cv::Point(11, 0), 4, grey, cv::FILLED, cv::LINE_AA);
   text(canvas, "pointwise, median", key + cv::Point(30, 5), 0.42);
