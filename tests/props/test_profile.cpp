@@ -5,6 +5,8 @@
 // that a profile that ignores g, or divides by the wrong scale, fails here.
 #include <catch2/catch.hpp>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numbers>
@@ -13,6 +15,7 @@
 #include "handcentric/core/representations.hpp"
 #include "handcentric/props/profile.hpp"
 #include "handcentric/props/random_network.hpp"
+#include "run_command.hpp"
 
 using namespace handcentric;
 using props::Group;
@@ -284,4 +287,60 @@ TEST_CASE("profile_transform_has_the_documented_size", "[unit]") {
   CHECK(se2.rotation().log().normalized().z() == Approx(1.0));
   CHECK(props::profile_size_in_group(Group::c8, 3 * std::numbers::pi / 4));
   CHECK_FALSE(props::profile_size_in_group(Group::c8, 3 * std::numbers::pi / 8));
+}
+
+TEST_CASE("audit_profile_writes_json_and_png_and_names_bad_input", "[unit]") {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "handcentric_test_profile_cli";
+  fs::remove_all(dir);
+  const auto ok = test::run_command(test::cli() + " audit --profile rotation --repr relative " +
+                                    "--repr hand_centric --profile-scenes 4 --out " + dir.string());
+  REQUIRE(ok.exit_code == 0);
+  CHECK_THAT(ok.out, Catch::Matchers::Contains("relative actions: pointwise"));
+  std::ifstream json_file(dir / "profile.json");
+  const nlohmann::json json = nlohmann::json::parse(json_file);
+  REQUIRE(json.at("profiles").size() == 2);
+  CHECK(json["profiles"][1]["name"] == "hand_centric");
+  CHECK(json["profiles"][0]["scenes"] == 4);
+  std::ifstream png(dir / "profile.png", std::ios::binary);
+  std::string magic(4, '\0');
+  png.read(magic.data(), 4);
+  CHECK(magic == "\x89PNG");
+  // A plug-in over the pipe: the Python example is hand-centric, flat at rounding.
+  const auto plugin = test::run_command(test::cli() + " audit --profile se3 --profile-scenes 3 " +
+                                        "--out " + (dir / "exec").string() + " --exec '" +
+                                        test::python_example() + "'");
+  REQUIRE(plugin.exit_code == 0);
+  std::ifstream plugin_file(dir / "exec" / "profile.json");
+  const nlohmann::json exec_json = nlohmann::json::parse(plugin_file);
+  for (double e : exec_json["profiles"][0]["pointwise"]["max"].get<std::vector<double>>())
+    CHECK(e < 1e-10);
+
+  const fs::path bad = dir / "bad";
+  const auto negative =
+      test::run_command(test::cli() + " audit --profile rotation --profile-sizes 0.1,-1 --out " +
+                        bad.string());
+  CHECK(negative.exit_code == 1);
+  CHECK_THAT(negative.err, Catch::Matchers::Contains("size -1"));
+  CHECK(negative.err.find('\n') == negative.err.size() - 1);
+  CHECK_FALSE(fs::exists(bad / "profile.json"));  // nothing half-written
+  const auto all = test::run_command(test::cli() + " audit --profile all --out " + bad.string());
+  CHECK(all.exit_code == 1);
+  CHECK_THAT(all.err, Catch::Matchers::Contains("--profile all"));
+  const auto unknown =
+      test::run_command(test::cli() + " audit --profile so3 --out " + bad.string());
+  CHECK(unknown.exit_code == 1);
+  CHECK_THAT(unknown.err, Catch::Matchers::Contains("so3"));
+  const auto folder =
+      test::run_command(test::cli() + " audit --profile rotation --out /proc/no_such/dir");
+  CHECK(folder.exit_code == 1);
+  CHECK_THAT(folder.err, Catch::Matchers::Contains("/proc/no_such/dir"));
+  CHECK(test::run_command(test::cli() + " audit --profile rotation").exit_code == 2);
+  CHECK(test::run_command(test::cli() + " audit --profile rotation --json --out " + bad.string())
+            .exit_code == 2);
+  const auto workspace = test::run_command(test::cli() + " audit --profile rotation --out " +
+                                           bad.string() + " --workspace -1,-1,-1,1,1,1");
+  CHECK(workspace.exit_code == 1);
+  CHECK_THAT(workspace.err, Catch::Matchers::Contains("--workspace"));
+  fs::remove_all(dir);
 }
