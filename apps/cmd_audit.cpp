@@ -58,8 +58,8 @@ ProfileCommand profile_command(const AuditCommandOptions& options) {
     throw InvalidArgument(
         "--profile draws g by its size and writes --out; leave out --workspace, --witness-dir, "
         "--expect, --extra-poses and --scalars");
-  return {options.profile,      options.view,       options.out,  options.representations,
-          options.exec,         options.policy_exec, options.model, options.seed,
+  return {options.profile,        options.view,          options.out,    options.representations,
+          options.exec,           options.policy_exec,   options.model,  options.seed,
           options.profile_scenes, options.profile_sizes, options.timeout};
 }
 
@@ -373,7 +373,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
          "for one component), e.g. --expect se3 or --expect actions:se3,observation:translation")
       ->delimiter(',');
   auto* json = cmd->add_flag("--json", options->json,
-                "print the JSON document of docs/AUDIT.md instead of tables");
+                             "print the JSON document of docs/AUDIT.md instead of tables");
   auto* pointwise = cmd->add_flag(
       "--pointwise", options->pointwise,
       "--model only: the pointwise cells alone, no in-distribution ones (Table 1's audit)");
@@ -405,9 +405,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   profile->needs(out)->excludes(json)->excludes(pointwise);
   out->needs(profile);
   cmd->callback([options, &exit_code] {
-    exit_code = options->profile.empty()
-                    ? run_audit(*options)
-                    : run_audit_profile(profile_command(*options));
+    exit_code = options->profile.empty() ? run_audit(*options)
+                                         : run_audit_profile(profile_command(*options));
   });
 }
 

@@ -46,9 +46,8 @@ std::vector<props::Profile> builtin_profiles(const ProfileCommand& command, prop
 
 std::vector<props::Profile> exec_profiles(const ProfileCommand& command, props::Group group,
                                           props::ProfileOptions options) {
-  auto plugin = std::make_shared<props::PipeRepresentation>(command.exec, command.timeout,
-                                                            std::vector<std::string>{},
-                                                            std::vector<std::string>{});
+  auto plugin = std::make_shared<props::PipeRepresentation>(
+      command.exec, command.timeout, std::vector<std::string>{}, std::vector<std::string>{});
   const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
   options.shape.extra_pose_names = capabilities.extra_pose_names;
   options.shape.scalar_names = capabilities.scalar_names;
@@ -68,9 +67,8 @@ std::vector<props::Profile> exec_profiles(const ProfileCommand& command, props::
 
 std::vector<props::Profile> policy_exec_profiles(const ProfileCommand& command, props::Group group,
                                                  props::ProfileOptions options) {
-  auto plugin = std::make_shared<props::PipePolicy>(command.policy_exec, command.timeout,
-                                                    std::vector<std::string>{},
-                                                    std::vector<std::string>{});
+  auto plugin = std::make_shared<props::PipePolicy>(
+      command.policy_exec, command.timeout, std::vector<std::string>{}, std::vector<std::string>{});
   const props::PluginCapabilities& capabilities = plugin->capabilities();
   options.shape.extra_pose_names = capabilities.extra_pose_names;
   options.shape.scalar_names = capabilities.scalar_names;
@@ -101,8 +99,7 @@ std::vector<props::Profile> model_profiles(const ProfileCommand& command, props:
     const Eigen::Vector2d centre = policy::c8::centre_of(config);
     options.centre = Eigen::Vector3d(centre.x(), centre.y(), 0.0);
   }
-  props::Profile profile =
-      props::profile_policy(props::SeededPolicy(model), group, options);
+  props::Profile profile = props::profile_policy(props::SeededPolicy(model), group, options);
   profile.name = "model " + std::filesystem::path(command.model).filename().string() + " (" +
                  model->name() + ")";
   return {profile};

@@ -298,19 +298,18 @@ Every view in `views` must hold.
           .c_str());
   m.def(
       "equivariance_profile",
-      [](py::object what, const std::string& group, const std::string& component,
-         py::handle noise, py::object observation, py::handle sizes, int scenes,
-         std::uint64_t seed, int samples, const std::string& view,
-         HANDCENTRIC_SETUP_PARAMETERS) {
+      [](py::object what, const std::string& group, const std::string& component, py::handle noise,
+         py::object observation, py::handle sizes, int scenes, std::uint64_t seed, int samples,
+         const std::string& view, HANDCENTRIC_SETUP_PARAMETERS) {
         return equivariance_profile(std::move(what), group, component, noise,
                                     std::move(observation), sizes, scenes, seed, samples, view,
                                     HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy_or_representation"), py::arg("group"), py::kw_only(),
       py::arg("component") = "actions", py::arg("noise") = py::none(),
-      py::arg("observation") = py::none(), py::arg("sizes") = py::none(),
-      py::arg("scenes") = 16, py::arg("seed") = 1, py::arg("samples") = 32,
-      py::arg("view") = "eye_in_hand", HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("observation") = py::none(), py::arg("sizes") = py::none(), py::arg("scenes") = 16,
+      py::arg("seed") = 1, py::arg("samples") = 32, py::arg("view") = "eye_in_hand",
+      HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(How far from equivariant: the error against the size of g.
 
 Returns one profile of `handcentric audit --profile` (docs/AUDIT.md, "Profiles") as a dict:

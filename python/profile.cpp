@@ -33,14 +33,15 @@ std::vector<double> sizes_of(py::handle sizes) {
 props::Component component_of(const std::string& name) {
   if (name == "actions") return props::Component::actions;
   if (name == "observation") return props::Component::observation;
-  throw InvalidArgument("component '" + name + "' cannot be profiled here; use \"actions\" or " +
-                        "\"observation\" (a policy's is its chunk, an \"actionflow\" target's its " +
-                        "regression target)");
+  throw InvalidArgument(
+      "component '" + name + "' cannot be profiled here; use \"actions\" or " +
+      "\"observation\" (a policy's is its chunk, an \"actionflow\" target's its " +
+      "regression target)");
 }
 
 py::dict as_dict(const props::Profile& profile) {
-  return py::module_::import("json")
-      .attr("loads")(props::profile_json({profile}))["profiles"][py::int_(0)];
+  return py::module_::import("json").attr("loads")(
+      props::profile_json({profile}))["profiles"][py::int_(0)];
 }
 
 }  // namespace
@@ -53,7 +54,8 @@ py::dict equivariance_profile(py::object what, const std::string& group,
   require_numpy("equivariance_profile");
   const props::Group parsed_group = props::parse_group(group);
   if (view != "eye_in_hand" && view != "third_person")
-    throw InvalidArgument("view '" + view + "' is not one; use \"eye_in_hand\" or \"third_person\"");
+    throw InvalidArgument("view '" + view +
+                          "' is not one; use \"eye_in_hand\" or \"third_person\"");
   const props::View parsed_view =
       view == "third_person" ? props::View::third_person : props::View::eye_in_hand;
   const CommonOptions o =

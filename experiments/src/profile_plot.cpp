@@ -17,8 +17,8 @@ using drawing::rgb;
 using drawing::text;
 
 // Paul Tol's "bright" scheme (colour-blind safe), one per profile in order.
-const cv::Scalar kProfileColours[] = {rgb(68, 119, 170),  rgb(238, 102, 119), rgb(34, 136, 51),
-                                      rgb(204, 187, 68),  rgb(102, 204, 238), rgb(170, 51, 119),
+const cv::Scalar kProfileColours[] = {rgb(68, 119, 170), rgb(238, 102, 119), rgb(34, 136, 51),
+                                      rgb(204, 187, 68), rgb(102, 204, 238), rgb(170, 51, 119),
                                       rgb(60, 60, 60)};
 
 constexpr double kLowestDecade = -16.0;
@@ -117,12 +117,13 @@ sim::Image draw_profiles(const std::vector<props::Profile>& profiles, int width,
     }
   }
   cv::rectangle(canvas, {left, top}, {right, bottom}, rgb(20, 20, 20), 1);
-  const std::string unit = c8 ? "deg about z (C8's elements: the blue lines)"
-                              : props::profile_unit(group);
+  const std::string unit =
+      c8 ? "deg about z (C8's elements: the blue lines)" : props::profile_unit(group);
   text(canvas, "size of g: " + unit, {left, height - 18}, 0.5);
   text(canvas, "error / chunk scale", {8, top - 12}, 0.5);
-  text(canvas, "How far from " + props::to_string(group) + "-equivariant (" +
-                   std::to_string(profiles.front().scenes) + " scenes per size)",
+  text(canvas,
+       "How far from " + props::to_string(group) + "-equivariant (" +
+           std::to_string(profiles.front().scenes) + " scenes per size)",
        {left, 30}, 0.65);
 
   int legend_y = top + 12;
@@ -140,8 +141,7 @@ sim::Image draw_profiles(const std::vector<props::Profile>& profiles, int width,
       if (point.distribution) {
         const cv::Point law(x_of(point.size), y_of(point.distribution->median));
         if (k > 0) dashed(canvas, previous_law, law, colour);
-        cv::rectangle(canvas, law - cv::Point(4, 4), law + cv::Point(4, 4), colour, 1,
-                      cv::LINE_AA);
+        cv::rectangle(canvas, law - cv::Point(4, 4), law + cv::Point(4, 4), colour, 1, cv::LINE_AA);
         previous_law = law;
       }
     }

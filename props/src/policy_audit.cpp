@@ -75,14 +75,16 @@ Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
     detail::PointwiseSides sides;
     sides.compare = [&](const Scene& s, Witness& witness) {
-      const std::vector<RigidTransform> g_a = detail::moved_by(g, detail::checked_act(policy, s, noise));
+      const std::vector<RigidTransform> g_a =
+          detail::moved_by(g, detail::checked_act(policy, s, noise));
       const std::vector<RigidTransform> a_g = detail::checked_act(policy, g * s, noise);
       witness.before = detail::flatten(g_a);
       witness.after = detail::flatten(a_g);
       witness.error = detail::chunk_distance(g_a, a_g);  // eq. (4)
     };
     sides.response = [&](const Scene& a, const Scene& b) {
-      return detail::chunk_distance(detail::checked_act(policy, a, noise), detail::checked_act(policy, b, noise));
+      return detail::chunk_distance(detail::checked_act(policy, a, noise),
+                                    detail::checked_act(policy, b, noise));
     };
     sides.ask = [&](const Scene& s) { (void)policy.act(s, noise); };
     return detail::decide_pointwise(sides, scene, g, options);

@@ -59,8 +59,7 @@ Eigen::Vector3d unit_vector(std::mt19937_64& rng, bool in_plane) {
   }
 }
 
-RigidTransform profile_transform_about_origin(Group group, double size,
-                                              const Eigen::Vector3d& axis,
+RigidTransform profile_transform_about_origin(Group group, double size, const Eigen::Vector3d& axis,
                                               const Eigen::Vector3d& direction) {
   const Eigen::Vector3d in_plane(direction.x(), direction.y(), 0.0);
   const Eigen::Vector3d planar =
@@ -293,8 +292,8 @@ std::vector<ProfileCase> profile_cases(const ProfileOptions& options) {
   std::mt19937_64 rng(options.seed ^ 0x9e3779b97f4a7c15ULL);
   std::vector<ProfileCase> cases;
   for (Scene& s : scenes) {
-    const Eigen::Vector3d axis = options.shape.planar ? Eigen::Vector3d::UnitZ()
-                                                      : unit_vector(rng, false);
+    const Eigen::Vector3d axis =
+        options.shape.planar ? Eigen::Vector3d::UnitZ() : unit_vector(rng, false);
     const Eigen::Vector3d direction = unit_vector(rng, options.shape.planar);
     cases.push_back({std::move(s), axis, direction});
   }
@@ -305,10 +304,8 @@ RigidTransform profile_transform(Group group, double size, const Eigen::Vector3d
                                  const Eigen::Vector3d& direction, const Eigen::Vector3d& centre) {
   const RigidTransform about_origin = profile_transform_about_origin(group, size, axis, direction);
   const Eigen::Matrix3d& R = about_origin.rotation().matrix();
-  return RigidTransform(about_origin.rotation(),
-                        about_origin.translation() + centre - R * centre);
+  return RigidTransform(about_origin.rotation(), about_origin.translation() + centre - R * centre);
 }
-
 
 std::string profile_unit(Group group) {
   switch (group) {
@@ -462,8 +459,9 @@ std::string profile_json(const std::vector<Profile>& profiles) {
         {"median", p.slope.median},
         {"max", p.slope.max},
         {"step", p.slope_step},
-        {"method", "central difference at +-step along the scene's unit generator, divided by "
-                   "2 step c (Gruver et al. 2023)"}};
+        {"method",
+         "central difference at +-step along the scene's unit generator, divided by "
+         "2 step c (Gruver et al. 2023)"}};
     list.push_back(j);
   }
   out["profiles"] = list;

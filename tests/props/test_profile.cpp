@@ -37,11 +37,11 @@ props::SceneFunction profile_leaky_hand_centric(double leak) {
   };
 }
 
-// A small "network" on the world-frame chunk positions, m(s) = [relu(x_k), relu(y_k), z_k], averaged
-// over C8's orbit about world z: f(s) = 1/8 sum_k m(g_k s) is invariant under C8 (g_j permutes
-// the terms), up to the rounding of g_k g_j against g_(k+j), and not under the rotations between
-// (the ReLU has harmonics of order 8 in the angle, which the average keeps; a linear m would
-// average to a map invariant under every rotation about z).
+// A small "network" on the world-frame chunk positions, m(s) = [relu(x_k), relu(y_k), z_k],
+// averaged over C8's orbit about world z: f(s) = 1/8 sum_k m(g_k s) is invariant under C8 (g_j
+// permutes the terms), up to the rounding of g_k g_j against g_(k+j), and not under the rotations
+// between (the ReLU has harmonics of order 8 in the angle, which the average keeps; a linear m
+// would average to a map invariant under every rotation about z).
 props::SceneFunction profile_c8_symmetrized() {
   const auto m = [](const Scene& s) {
     Eigen::VectorXd v(3 * static_cast<Eigen::Index>(s.world_T_hand_chunk.size()));
@@ -55,9 +55,9 @@ props::SceneFunction profile_c8_symmetrized() {
   return [m](const Scene& s) {
     Eigen::VectorXd sum = Eigen::VectorXd::Zero(m(s).size());
     for (int k = 0; k < 8; ++k)
-      sum += m(RigidTransform(Rotation::about_z(k * std::numbers::pi / 4.0),
-                              Eigen::Vector3d::Zero()) *
-               s);
+      sum +=
+          m(RigidTransform(Rotation::about_z(k * std::numbers::pi / 4.0), Eigen::Vector3d::Zero()) *
+            s);
     return Eigen::VectorXd(sum / 8.0);
   };
 }
@@ -156,8 +156,8 @@ TEST_CASE("profile_of_a_planted_leak_is_the_one_the_test_computes_itself", "[pro
   CHECK(p.slope.median == Approx(profile_median(slopes)).epsilon(1e-6));
   // The same leak in a map 1000 times larger is the same relative error.
   const props::SceneFunction scaled = [f](const Scene& s) { return Eigen::VectorXd(1e3 * f(s)); };
-  const props::Profile q = props::profile_function(scaled, "leaky x 1000", props::Component::actions,
-                                                   Group::translation, options);
+  const props::Profile q = props::profile_function(
+      scaled, "leaky x 1000", props::Component::actions, Group::translation, options);
   for (std::size_t k = 0; k < p.points.size(); ++k)
     CHECK(q.points[k].pointwise.median == Approx(p.points[k].pointwise.median).epsilon(1e-9));
 }
@@ -231,9 +231,9 @@ TEST_CASE("profile_is_deterministic_and_its_json_lists_every_size", "[unit]") {
   props::ProfileOptions options;
   options.scenes = 4;
   const auto once = [&] {
-    return props::profile_json({props::profile_function(
-        props::actions_of(make_representation("relative")), "relative", props::Component::actions,
-        Group::se2, options)});
+    return props::profile_json(
+        {props::profile_function(props::actions_of(make_representation("relative")), "relative",
+                                 props::Component::actions, Group::se2, options)});
   };
   const std::string a = once();
   CHECK(a == once());
@@ -251,18 +251,18 @@ TEST_CASE("profile_refuses_bad_options_naming_the_value", "[unit]") {
   const props::SceneFunction f = props::actions_of(make_representation("relative"));
   props::ProfileOptions options;
   options.sizes = {0.1, -1.0};
-  CHECK_THROWS_WITH(props::profile_function(f, "r", props::Component::actions, Group::rotation,
-                                            options),
-                    Catch::Matchers::Contains("size -1") && Catch::Matchers::Contains("(0, 1000]"));
+  CHECK_THROWS_WITH(
+      props::profile_function(f, "r", props::Component::actions, Group::rotation, options),
+      Catch::Matchers::Contains("size -1") && Catch::Matchers::Contains("(0, 1000]"));
   options.sizes = {std::nan("")};
   CHECK_THROWS_AS(
       props::profile_function(f, "r", props::Component::actions, Group::rotation, options),
       InvalidArgument);
   options = {};
   options.scenes = 0;
-  CHECK_THROWS_WITH(props::profile_function(f, "r", props::Component::actions, Group::rotation,
-                                            options),
-                    Catch::Matchers::Contains("scenes 0"));
+  CHECK_THROWS_WITH(
+      props::profile_function(f, "r", props::Component::actions, Group::rotation, options),
+      Catch::Matchers::Contains("scenes 0"));
   options = {};
   options.slope_step = 0.0;
   CHECK_THROWS_AS(
@@ -270,9 +270,9 @@ TEST_CASE("profile_refuses_bad_options_naming_the_value", "[unit]") {
       InvalidArgument);
   options = {};
   options.shape.workspace = props::Workspace::parse("-1,-1,-1,1,1,1");
-  CHECK_THROWS_WITH(props::profile_function(f, "r", props::Component::actions, Group::rotation,
-                                            options),
-                    Catch::Matchers::Contains("workspace"));
+  CHECK_THROWS_WITH(
+      props::profile_function(f, "r", props::Component::actions, Group::rotation, options),
+      Catch::Matchers::Contains("workspace"));
 }
 
 TEST_CASE("profile_transform_has_the_documented_size", "[unit]") {
@@ -307,9 +307,9 @@ TEST_CASE("audit_profile_writes_json_and_png_and_names_bad_input", "[unit]") {
   png.read(magic.data(), 4);
   CHECK(magic == "\x89PNG");
   // A plug-in over the pipe: the Python example is hand-centric, flat at rounding.
-  const auto plugin = test::run_command(test::cli() + " audit --profile se3 --profile-scenes 3 " +
-                                        "--out " + (dir / "exec").string() + " --exec '" +
-                                        test::python_example() + "'");
+  const auto plugin =
+      test::run_command(test::cli() + " audit --profile se3 --profile-scenes 3 " + "--out " +
+                        (dir / "exec").string() + " --exec '" + test::python_example() + "'");
   REQUIRE(plugin.exit_code == 0);
   std::ifstream plugin_file(dir / "exec" / "profile.json");
   const nlohmann::json exec_json = nlohmann::json::parse(plugin_file);
@@ -317,9 +317,8 @@ TEST_CASE("audit_profile_writes_json_and_png_and_names_bad_input", "[unit]") {
     CHECK(e < 1e-10);
 
   const fs::path bad = dir / "bad";
-  const auto negative =
-      test::run_command(test::cli() + " audit --profile rotation --profile-sizes 0.1,-1 --out " +
-                        bad.string());
+  const auto negative = test::run_command(
+      test::cli() + " audit --profile rotation --profile-sizes 0.1,-1 --out " + bad.string());
   CHECK(negative.exit_code == 1);
   CHECK_THAT(negative.err, Catch::Matchers::Contains("size -1"));
   CHECK(negative.err.find('\n') == negative.err.size() - 1);
