@@ -105,7 +105,7 @@ std::vector<props::Profile> model_profiles(const ProfileCommand& command, props:
   return {profile};
 }
 
-std::string format_number(double x) {
+std::string two_digits(double x) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.2g", x);
   return buffer;
@@ -154,16 +154,16 @@ int run_audit_profile(const ProfileCommand& command) {
             << "; error / chunk scale, median (max) over the scenes (docs/AUDIT.md, Profiles)\n";
   for (const props::Profile& p : profiles) {
     std::cout << "  " << p.name << " " << props::to_string(p.component) << ": pointwise "
-              << format_number(p.points.front().pointwise.median) << " at "
-              << format_number(p.points.front().size) << " .. "
-              << format_number(p.points.back().pointwise.median) << " at "
-              << format_number(p.points.back().size);
+              << two_digits(p.points.front().pointwise.median) << " at "
+              << two_digits(p.points.front().size) << " .. "
+              << two_digits(p.points.back().pointwise.median) << " at "
+              << two_digits(p.points.back().size);
     if (p.points.back().distribution)
       std::cout << "; in distribution (" << p.distribution_method << ") "
-                << format_number(p.points.front().distribution->median) << " .. "
-                << format_number(p.points.back().distribution->median);
-    std::cout << "; Lie derivative " << format_number(p.slope.median) << " ("
-              << format_number(p.slope.max) << ")\n";
+                << two_digits(p.points.front().distribution->median) << " .. "
+                << two_digits(p.points.back().distribution->median);
+    std::cout << "; Lie derivative " << two_digits(p.slope.median) << " ("
+              << two_digits(p.slope.max) << ")\n";
   }
   std::cout << "wrote " << (std::filesystem::path(command.out) / "profile.json").string()
             << " and profile.png\n";

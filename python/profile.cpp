@@ -30,7 +30,7 @@ std::vector<double> sizes_of(py::handle sizes) {
   return out;
 }
 
-props::Component component_of(const std::string& name) {
+props::Component profiled_component(const std::string& name) {
   if (name == "actions") return props::Component::actions;
   if (name == "observation") return props::Component::observation;
   throw InvalidArgument(
@@ -75,7 +75,7 @@ py::dict equivariance_profile(py::object what, const std::string& group,
       return as_dict(props::profile_flow(std::make_shared<ActionFlowTarget>(),
                                          props::Component::flow_target, parsed_group, options));
     std::shared_ptr<const Representation> representation = make_representation(name);
-    const props::Component c_name = component_of(component);
+    const props::Component c_name = profiled_component(component);
     return as_dict(props::profile_function(c_name == props::Component::actions
                                                ? props::actions_of(representation)
                                                : props::observation_of(representation),
@@ -88,7 +88,7 @@ py::dict equivariance_profile(py::object what, const std::string& group,
     auto policy = batched_policy(what, noise_of(noise), o);
     return as_dict(props::profile_policy(*policy, parsed_group, options));
   }
-  const props::Component c_name = component_of(component);
+  const props::Component c_name = profiled_component(component);
   if (c_name == props::Component::observation && observation.is_none())
     throw InvalidArgument(
         "component \"observation\" needs observation=, the observation function to profile");

@@ -115,8 +115,8 @@ std::vector<Eigen::VectorXd> normal_draws(Eigen::Index n, int count, std::uint64
   return draws;
 }
 
-Eigen::MatrixXd rows_of(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
-                        const std::vector<Eigen::VectorXd>& draws, const std::string& name) {
+Eigen::MatrixXd sample_rows(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
+                            const std::vector<Eigen::VectorXd>& draws, const std::string& name) {
   prefetch(draws, f);
   Eigen::MatrixXd rows;
   for (std::size_t i = 0; i < draws.size(); ++i) {
@@ -150,8 +150,8 @@ LawDistance law_distance(const detail::NoisePair& pair, double tolerance, std::u
     return {std::max(d.mean, spread), true};
   }
   const std::vector<Eigen::VectorXd> draws = normal_draws(pair.noise_dimension, samples, seed + 1);
-  const Eigen::MatrixXd x = rows_of(pair.before, draws, pair.name);
-  const Eigen::MatrixXd y = rows_of(pair.after, draws, pair.name);
+  const Eigen::MatrixXd x = sample_rows(pair.before, draws, pair.name);
+  const Eigen::MatrixXd y = sample_rows(pair.after, draws, pair.name);
   if (x.cols() != y.cols()) return {std::numeric_limits<double>::infinity(), false};
   return {std::max(0.0, energy_distance(x, y)), false};
 }
@@ -159,9 +159,9 @@ LawDistance law_distance(const detail::NoisePair& pair, double tolerance, std::u
 // The energy distance between two independent samples of the left side at g = I.
 double sampling_floor(const detail::NoisePair& pair, std::uint64_t seed, int samples) {
   const Eigen::MatrixXd x =
-      rows_of(pair.before, normal_draws(pair.noise_dimension, samples, seed + 1), pair.name);
+      sample_rows(pair.before, normal_draws(pair.noise_dimension, samples, seed + 1), pair.name);
   const Eigen::MatrixXd y =
-      rows_of(pair.before, normal_draws(pair.noise_dimension, samples, seed + 2), pair.name);
+      sample_rows(pair.before, normal_draws(pair.noise_dimension, samples, seed + 2), pair.name);
   return std::max(0.0, energy_distance(x, y));
 }
 
