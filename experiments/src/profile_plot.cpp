@@ -22,6 +22,9 @@ const cv::Scalar kProfileColours[] = {rgb(68, 119, 170), rgb(238, 102, 119), rgb
                                       rgb(60, 60, 60)};
 
 constexpr double kLowestDecade = -16.0;
+// Pixels between the axes' box and the outermost grid line, so that a mark on the first or last
+// size, or on the bottom decade, stays inside the box.
+constexpr int kInset = 12;
 
 // The legend's label of a profile, wrapped at spaces into at most two lines of kLabelChars (the
 // legend's width at its font), the second shortened from the front if it is still too long. A
@@ -88,13 +91,15 @@ sim::Image draw_profiles(const std::vector<props::Profile>& profiles, int width,
   const int left = 80, right = width - 290, top = 60, bottom = height - 60;
   const auto x_of = [&](double size) {
     const double x = c8 ? size * 180.0 / std::numbers::pi : std::log10(size);
-    return static_cast<int>(std::lround(left + (right - left) * (x - ax_lo) / (ax_hi - ax_lo)));
+    return static_cast<int>(
+        std::lround(left + kInset + (right - left - 2 * kInset) * (x - ax_lo) / (ax_hi - ax_lo)));
   };
   const auto y_of = [&](double value) {
     const double y = value > 0.0 && std::isfinite(value)
                          ? std::clamp(std::log10(value), ay_lo, ay_hi)
                          : (std::isfinite(value) ? ay_lo : ay_hi);
-    return static_cast<int>(std::lround(bottom - (bottom - top) * (y - ay_lo) / (ay_hi - ay_lo)));
+    return static_cast<int>(
+        std::lround(bottom - kInset - (bottom - top - 2 * kInset) * (y - ay_lo) / (ay_hi - ay_lo)));
   };
   // Grid and ticks.
   const int y_step = ay_hi - ay_lo > 10 ? 2 : 1;
@@ -162,7 +167,7 @@ sim::Image draw_profiles(const std::vector<props::Profile>& profiles, int width,
   text(canvas, "pointwise, max", key + cv::Point(30, 27), 0.42);
   cv::rectangle(canvas, key + cv::Point(7, 40), key + cv::Point(15, 48), grey, 1, cv::LINE_AA);
   text(canvas, "in distribution, median", key + cv::Point(30, 49), 0.42);
-  text(canvas, "bottom edge: 1e-16 or below", key + cv::Point(0, 75), 0.42);
+  text(canvas, "on 1e-16: 1e-16 or below (0 too)", key + cv::Point(0, 75), 0.42);
   return drawing::to_image(canvas);
 }
 
