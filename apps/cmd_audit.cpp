@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "audit_profile.hpp"
 #include "commands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
@@ -48,7 +49,21 @@ struct AuditCommandOptions {
   bool floor = false;
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
+  std::string profile, out;  // --profile GROUP --out DIR (audit_profile.hpp)
+  int profile_scenes = 16;
+  std::vector<double> profile_sizes;
 };
+
+ProfileCommand profile_command(const AuditCommandOptions& options) {
+  if (!options.workspace.empty() || !options.witness_dir.empty() || !options.expect.empty() ||
+      !options.extra_poses.empty() || !options.scalars.empty())
+    throw InvalidArgument(
+        "--profile draws g by its size and writes --out; leave out --workspace, --witness-dir, "
+        "--expect, --extra-poses and --scalars");
+  return {options.profile,        options.view,          options.out,    options.representations,
+          options.exec,           options.policy_exec,   options.model,  options.seed,
+          options.profile_scenes, options.profile_sizes, options.timeout};
+}
 
 // One camera image as a PNG: the colour image beside its depth (near bright, black at the
 // camera's range), each pixel 4 x 4, so that a 64 x 48 image reads at a glance.
@@ -400,8 +415,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
          "a gate: exit 1 with the witness unless every check under GROUP holds (COMPONENT:GROUP "
          "for one component), e.g. --expect se3 or --expect actions:se3,observation:translation")
       ->delimiter(',');
-  cmd->add_flag("--json", options->json,
-                "print the JSON document of docs/AUDIT.md instead of tables");
+  auto* json = cmd->add_flag("--json", options->json,
+                             "print the JSON document of docs/AUDIT.md instead of tables");
   auto* pointwise = cmd->add_flag(
       "--pointwise", options->pointwise,
       "--model only: the pointwise cells alone, no in-distribution ones (Table 1's audit)");
@@ -424,7 +439,23 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   policy_exec->excludes(repr)->excludes(model);
   model->excludes(repr);
   pointwise->needs(model);
-  cmd->callback([options, &exit_code] { exit_code = run_audit(*options); });
+  auto* profile = cmd->add_option(
+      "--profile", options->profile,
+      "GROUP: how far from equivariant, the error against the size of g (rad, m or the C8 "
+      "element) with its slope at the identity; writes DIR/profile.json and DIR/profile.png");
+  auto* out = cmd->add_option("--out", options->out, "with --profile: the folder to write");
+  cmd->add_option("--profile-scenes", options->profile_scenes,
+                  "with --profile: scenes per size, 1 to 10^4")
+      ->capture_default_str();
+  cmd->add_option("--profile-sizes", options->profile_sizes,
+                  "with --profile: the sizes of g, e.g. 0.01,0.1,1 (default: the group's grid)")
+      ->delimiter(',');
+  profile->needs(out)->excludes(json)->excludes(pointwise);
+  out->needs(profile);
+  cmd->callback([options, &exit_code] {
+    exit_code = options->profile.empty() ? run_audit(*options)
+                                         : run_audit_profile(profile_command(*options));
+  });
 }
 
 }  // namespace handcentric::apps

@@ -51,6 +51,7 @@
 #include "assertions.hpp"
 #include "callables.hpp"
 #include "options.hpp"
+#include "profile.hpp"
 
 namespace handcentric::python {
 namespace {
@@ -302,6 +303,34 @@ The error carries the shrunk witness.
 mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which
 implies the law's), "distribution" (independent noise: the laws compared) or "both".
 Every view in `views` must hold.
+)doc") +
+       kSetupDoc)
+          .c_str());
+  m.def(
+      "equivariance_profile",
+      [](py::object what, const std::string& group, const std::string& component, py::handle noise,
+         py::object observation, py::handle sizes, int scenes, std::uint64_t seed, int samples,
+         const std::string& view, HANDCENTRIC_SETUP_PARAMETERS) {
+        return equivariance_profile(std::move(what), group, component, noise,
+                                    std::move(observation), sizes, scenes, seed, samples, view,
+                                    HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("policy_or_representation"), py::arg("group"), py::kw_only(),
+      py::arg("component") = "actions", py::arg("noise") = py::none(),
+      py::arg("observation") = py::none(), py::arg("sizes") = py::none(), py::arg("scenes") = 16,
+      py::arg("seed") = 1, py::arg("samples") = 32, py::arg("view") = "eye_in_hand",
+      HANDCENTRIC_SETUP_ARGUMENTS,
+      (std::string(R"doc(How far from equivariant: the error against the size of g.
+
+Returns one profile of `handcentric audit --profile` (docs/AUDIT.md, "Profiles") as a dict:
+sizes (rad for rotation and c8, m for translation, both at once for se2 and se3), in_group,
+pointwise {median, max} and distribution (None, or {method, median, max, floor}) per size, each
+divided by the chunk's scale, and lie_derivative {median, max, step, method} (the slope at the
+identity, Gruver et al. 2023). policy_or_representation: a built-in's name (REPRESENTATIONS or
+"actionflow"), a policy(history, hand_points, world_points, noise) -> (K, 4, 4) when noise= (its
+length) is given, else a representation's actions function (component="observation" profiles
+observation= instead). sizes=None: the group's grid; scenes: 1 to 10**4 per size; samples: draws
+per side of the energy distance. Deterministic given seed.
 )doc") +
        kSetupDoc)
           .c_str());

@@ -9,6 +9,7 @@
 
 #include "handcentric/props/check.hpp"
 #include "handcentric/props/distribution.hpp"
+#include "handcentric/props/policy_audit.hpp"
 
 namespace handcentric::props::detail {
 
@@ -90,6 +91,20 @@ double inf_distance(const Eigen::VectorXd& a, const Eigen::VectorXd& b);
 
 /// max_k distance(a_k, b_k) of two chunks; infinite for different lengths.
 double chunk_distance(const std::vector<RigidTransform>& a, const std::vector<RigidTransform>& b);
+
+/// g * T_k for each pose of a chunk.
+std::vector<RigidTransform> moved_by(const RigidTransform& g,
+                                     const std::vector<RigidTransform>& chunk);
+
+/// Each pose as [p, R row-major]: 12 numbers on which g acts affinely (R -> R~ R, p -> R~ p + p~),
+/// so a chunk affine in the noise stays affine after g.
+Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk);
+
+/// policy.act(observation, noise), each pose checked: a chunk pose that is not a rigid transform
+/// (a rotation block scaled by a bug) cannot be compared as one, so it stops the audit
+/// (InvalidArgument naming the pose).
+std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& observation,
+                                        const Eigen::VectorXd& noise);
 
 /// Runs a RapidCheck property (it calls RC_FAIL to fail) for `cases` cases from `seed`, printing
 /// nothing: the caller records what it needs from inside the property.

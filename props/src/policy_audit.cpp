@@ -12,6 +12,10 @@ namespace {
 
 constexpr int kShrinkBudget = 1000;
 
+}  // namespace
+
+namespace detail {
+
 std::vector<RigidTransform> moved_by(const RigidTransform& g,
                                      const std::vector<RigidTransform>& chunk) {
   std::vector<RigidTransform> out;
@@ -20,8 +24,6 @@ std::vector<RigidTransform> moved_by(const RigidTransform& g,
   return out;
 }
 
-// Each pose as [p, R row-major]: 12 numbers on which g acts affinely (R -> R~ R, p -> R~ p + p~),
-// so a chunk affine in the noise stays affine after g.
 Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk) {
   Eigen::VectorXd v(12 * static_cast<Eigen::Index>(chunk.size()));
   for (std::size_t k = 0; k < chunk.size(); ++k) {
@@ -33,8 +35,6 @@ Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk) {
   return v;
 }
 
-// policy.act(observation, noise), each pose checked: a chunk pose that is not a rigid transform
-// (a rotation block scaled by a bug) cannot be compared as one, so it stops the audit.
 std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& observation,
                                         const Eigen::VectorXd& noise) {
   std::vector<RigidTransform> chunk = policy.act(observation, noise);
@@ -50,7 +50,7 @@ std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& 
   return chunk;
 }
 
-}  // namespace
+}  // namespace detail
 
 SeededPolicy::SeededPolicy(std::shared_ptr<const ChunkPolicy> policy) : policy_(std::move(policy)) {
   if (!policy_) throw InvalidArgument("SeededPolicy needs a policy, got null");
@@ -75,14 +75,16 @@ Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
     detail::PointwiseSides sides;
     sides.compare = [&](const Scene& s, Witness& witness) {
-      const std::vector<RigidTransform> g_a = moved_by(g, checked_act(policy, s, noise));
-      const std::vector<RigidTransform> a_g = checked_act(policy, g * s, noise);
+      const std::vector<RigidTransform> g_a =
+          detail::moved_by(g, detail::checked_act(policy, s, noise));
+      const std::vector<RigidTransform> a_g = detail::checked_act(policy, g * s, noise);
       witness.before = detail::flatten(g_a);
       witness.after = detail::flatten(a_g);
       witness.error = detail::chunk_distance(g_a, a_g);  // eq. (4)
     };
     sides.response = [&](const Scene& a, const Scene& b) {
-      return detail::chunk_distance(checked_act(policy, a, noise), checked_act(policy, b, noise));
+      return detail::chunk_distance(detail::checked_act(policy, a, noise),
+                                    detail::checked_act(policy, b, noise));
     };
     sides.ask = [&](const Scene& s) { (void)policy.act(s, noise); };
     return detail::decide_pointwise(sides, scene, g, options);
@@ -100,10 +102,10 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
     const Scene moved = g * scene;
     detail::NoisePair pair;
     pair.before = [&policy, &scene, g](const Eigen::VectorXd& noise) {
-      return flatten_affine(moved_by(g, checked_act(policy, scene, noise)));
+      return detail::flatten_affine(detail::moved_by(g, detail::checked_act(policy, scene, noise)));
     };
     pair.after = [&policy, &moved](const Eigen::VectorXd& noise) {
-      return flatten_affine(checked_act(policy, moved, noise));
+      return detail::flatten_affine(detail::checked_act(policy, moved, noise));
     };
     pair.noise_dimension = policy.noise_dimension();
     pair.name = policy.name() + ": the chunk";

@@ -16,6 +16,7 @@
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/profile.hpp"
 #include "throws.hpp"
 
 using namespace handcentric;
@@ -128,6 +129,28 @@ TEST_CASE("c8ddpm_avg_is_c8_equivariant_pointwise_and_not_se2_equivariant", "[un
     CHECK(loaded.head().kind() == HeadKind::c8ddpm_avg);
     const Scene scene = planar_training_scenes(1, 99)[0];
     CHECK(loaded.action_vector(scene, 3) == model->action_vector(scene, 3));
+  }
+}
+
+TEST_CASE("c8ddpm_avg_profile_is_zero_on_c8_and_not_between", "[unit][property]") {
+  // How far from equivariant (props/profile.hpp), on a trained model: at the multiples of 45 deg
+  // about its centre the chunk moves with g up to rounding; at the angles between it does not.
+  auto model = std::make_shared<LearnedPolicy>(trained(HeadKind::c8ddpm_avg, 0.0));
+  props::ProfileOptions options;
+  options.scenes = 4;
+  options.samples = 4;
+  options.shape.planar = true;
+  options.shape.min_history = options.shape.max_history = 2;
+  options.shape.min_hand_points = options.shape.max_hand_points = 2;
+  options.shape.max_chunk = 4;
+  const props::Profile p =
+      props::profile_policy(props::SeededPolicy(model), props::Group::c8, options);
+  for (const props::ProfilePoint& point : p.points) {
+    INFO("angle " << point.size << ": " << point.pointwise.median);
+    if (point.in_group)
+      CHECK(point.pointwise.max < 1e-9);
+    else
+      CHECK(point.pointwise.median > 1e-3);
   }
 }
 

@@ -1,0 +1,102 @@
+#include "profile.hpp"
+
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <vector>
+
+#include "arrays.hpp"
+#include "handcentric/core/errors.hpp"
+#include "handcentric/core/representations.hpp"
+#include "handcentric/props/profile.hpp"
+
+namespace handcentric::python {
+namespace {
+
+std::vector<double> sizes_of(py::handle sizes) {
+  if (sizes.is_none()) return {};
+  std::vector<double> out;
+  try {
+    for (py::handle size : sizes) out.push_back(py::cast<double>(size));
+  } catch (const py::error_already_set&) {
+    throw DtypeError("sizes must be an iterable of numbers (rad, m or the C8 angle), got a " +
+                     type_name(sizes));
+  } catch (const py::cast_error&) {
+    throw DtypeError("sizes must be an iterable of numbers (rad, m or the C8 angle), got " +
+                     py::repr(sizes).cast<std::string>());
+  }
+  if (out.empty())
+    throw InvalidArgument("sizes is empty; give at least one size, or None for the defaults");
+  return out;
+}
+
+props::Component profiled_component(const std::string& name) {
+  if (name == "actions") return props::Component::actions;
+  if (name == "observation") return props::Component::observation;
+  throw InvalidArgument(
+      "component '" + name + "' cannot be profiled here; use \"actions\" or " +
+      "\"observation\" (a policy's is its chunk, an \"actionflow\" target's its " +
+      "regression target)");
+}
+
+py::dict as_dict(const props::Profile& profile) {
+  return py::module_::import("json").attr("loads")(
+      props::profile_json({profile}))["profiles"][py::int_(0)];
+}
+
+}  // namespace
+
+py::dict equivariance_profile(py::object what, const std::string& group,
+                              const std::string& component, py::handle noise,
+                              py::object observation, py::handle sizes, int scenes,
+                              std::uint64_t seed, int samples, const std::string& view,
+                              const Setup& setup) {
+  require_numpy("equivariance_profile");
+  const props::Group parsed_group = props::parse_group(group);
+  if (view != "eye_in_hand" && view != "third_person")
+    throw InvalidArgument("view '" + view +
+                          "' is not one; use \"eye_in_hand\" or \"third_person\"");
+  const props::View parsed_view =
+      view == "third_person" ? props::View::third_person : props::View::eye_in_hand;
+  const CommonOptions o =
+      common_options(py::make_tuple(group), py::make_tuple(view), py::int_(1), seed, std::nullopt,
+                     "float64", py::tuple(), py::tuple(), setup);
+  props::ProfileOptions options;
+  options.sizes = sizes_of(sizes);
+  options.scenes = scenes;
+  options.seed = seed;
+  options.samples = samples;
+  const props::ClassifierOptions c = classifier_for(o);
+  options.shape = props::with_view(c.check, parsed_view).shape;
+  options.prefetch = o.batch_size.has_value();
+  if (py::isinstance<py::str>(what)) {
+    const std::string name = what.cast<std::string>();
+    if (name == "actionflow")
+      return as_dict(props::profile_flow(std::make_shared<ActionFlowTarget>(),
+                                         props::Component::flow_target, parsed_group, options));
+    std::shared_ptr<const Representation> representation = make_representation(name);
+    const props::Component c_name = profiled_component(component);
+    return as_dict(props::profile_function(c_name == props::Component::actions
+                                               ? props::actions_of(representation)
+                                               : props::observation_of(representation),
+                                           name, c_name, parsed_group, options));
+  }
+  if (!PyCallable_Check(what.ptr()))
+    throw DtypeError("equivariance_profile takes a callable or a built-in's name, got a " +
+                     type_name(what));
+  if (!noise.is_none()) {
+    auto policy = batched_policy(what, noise_of(noise), o);
+    return as_dict(props::profile_policy(*policy, parsed_group, options));
+  }
+  const props::Component c_name = profiled_component(component);
+  if (c_name == props::Component::observation && observation.is_none())
+    throw InvalidArgument(
+        "component \"observation\" needs observation=, the observation function to profile");
+  auto representation = batched_representation(what, observation, py::none(), o);
+  return as_dict(props::profile_function(c_name == props::Component::actions
+                                             ? props::actions_of(representation)
+                                             : props::observation_of(representation),
+                                         representation->name(), c_name, parsed_group, options));
+}
+
+}  // namespace handcentric::python
