@@ -80,16 +80,19 @@ std::vector<props::Profile> policy_exec_profiles(const ProfileCommand& command, 
   return {props::profile_policy(*profiled, group, options)};
 }
 
-std::vector<props::Profile> model_profiles(const ProfileCommand& command, props::Group group,
-                                           props::ProfileOptions options) {
-  auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(command.model));
+}  // namespace
+
+props::Profile profile_model(const std::string& path, props::Group group,
+                             props::ProfileOptions options) {
+  auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(path));
   const policy::PolicyConfig& config = model->config();
   // A peg2d model is profiled on planar scenes, under the groups that keep them planar
   // (experiments/model_audit.hpp).
-  if (experiments::model_groups(config, {group}, "all", command.model).empty())
-    throw InvalidArgument("--profile " + command.group + ": " + command.model +
+  if (experiments::model_groups(config, {group}, "all", path).empty())
+    throw InvalidArgument("--profile " + props::to_string(group) + ": " + path +
                           " is a model of the 2D task (peg2d), whose scenes lie in a plane that " +
-                          command.group + " tilts; profile it under translation, se2 or c8");
+                          props::to_string(group) +
+                          " tilts; profile it under translation, se2 or c8");
   // The model's own H, point counts and view (its world points or none), as `audit --model`.
   props::ClassifierOptions classifier;
   classifier.views = {props::View::eye_in_hand, props::View::third_person};
@@ -100,9 +103,16 @@ std::vector<props::Profile> model_profiles(const ProfileCommand& command, props:
     options.centre = Eigen::Vector3d(centre.x(), centre.y(), 0.0);
   }
   props::Profile profile = props::profile_policy(props::SeededPolicy(model), group, options);
-  profile.name = "model " + std::filesystem::path(command.model).filename().string() + " (" +
-                 model->name() + ")";
-  return {profile};
+  profile.name =
+      "model " + std::filesystem::path(path).filename().string() + " (" + model->name() + ")";
+  return profile;
+}
+
+namespace {
+
+std::vector<props::Profile> model_profiles(const ProfileCommand& command, props::Group group,
+                                           const props::ProfileOptions& options) {
+  return {profile_model(command.model, group, options)};
 }
 
 std::string two_digits(double x) {

@@ -7,6 +7,7 @@
 // demo counts, trials and steps, said on the page; --full: the paper's grids) and Fig. 5. The
 // page is one document (experiments/document.hpp) rendered twice, DIR/index.html and
 // DIR/index.md, with its pictures and CLAIMS.md beside them.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "audit_profile.hpp"
 #include "commands.hpp"
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
@@ -27,6 +29,7 @@
 #include "handcentric/experiments/document_markdown.hpp"
 #include "handcentric/experiments/results_page.hpp"
 #include "handcentric/experiments/methods.hpp"
+#include "handcentric/experiments/profile_plot.hpp"
 #include "handcentric/experiments/table1.hpp"
 #include "handcentric/proofs/claims.hpp"
 #include "handcentric/props/audit.hpp"
@@ -98,7 +101,8 @@ std::vector<experiments::Row> table_into(const std::string& dir,
                                          const std::vector<int>& demo_counts, int trials,
                                          const std::vector<experiments::Method>& methods,
                                          const std::vector<std::string>& heads,
-                                         const PageOptions& page) {
+                                         const PageOptions& page,
+                                         std::vector<experiments::Cell>* cells = nullptr) {
   experiments::Table1Options table;
   table.demo_counts = demo_counts;
   table.eval.trials = trials;
@@ -116,6 +120,7 @@ std::vector<experiments::Row> table_into(const std::string& dir,
   std::vector<experiments::Row> rows;
   for (const experiments::Cell& cell : grid.cells)
     rows.push_back(experiments::collect_row(cell, table.eval, grid.dir));
+  if (cells != nullptr) *cells = grid.cells;
   return rows;
 }
 
@@ -304,6 +309,59 @@ std::vector<Section> conventions_page_sections(const PageOptions& page) {
   }
 }
 
+// How far from equivariant each Table 1 row's model is (props/profile.hpp), under the groups
+// that keep the 2D task's plane: one figure per group, the model of each method at the largest
+// demo count and the first training seed. Figures go to DIR/profiles/<group>.png.
+Section profiles_section(const std::filesystem::path& dir,
+                         const std::vector<experiments::Cell>& cells) {
+  Section out = section("profiles", "How far from equivariant: Table 1's models");
+  int demos = 0;
+  for (const experiments::Cell& cell : cells) demos = std::max(demos, cell.demos);
+  std::vector<const experiments::Cell*> models;  // one per method, in Table 1's order
+  for (const experiments::Cell& cell : cells) {
+    if (cell.demos != demos) continue;
+    bool seen = false;
+    for (const experiments::Cell*& m : models) {
+      if (m->method != cell.method) continue;
+      seen = true;
+      if (cell.train_seed < m->train_seed) m = &cell;
+    }
+    if (!seen) models.push_back(&cell);
+  }
+  out.blocks.push_back(Paragraph{
+      {plain("The normalized error of each model's chunk, |g a(o, n) - a(g o, n)| over the "
+             "chunk's reach, against the size of g (median over 8 scenes of the task's own "
+             "planar kind; in distribution too where the head is affine in its noise), as "),
+       code("handcentric audit --model M --profile GROUP"),
+       plain(" draws it; the models are Table 1's at " + std::to_string(demos) +
+             " demos. Theorem 1 makes the hand-centric model flat at rounding; an absolute model "
+             "grows with any g; a C8 model is zero at the multiples of 45 degrees about its "
+             "centre only. How a profile is made: docs/AUDIT.md, \"Profiles\".")}});
+  std::filesystem::create_directories(dir / "profiles");
+  for (const props::Group group :
+       {props::Group::translation, props::Group::se2, props::Group::c8}) {
+    props::ProfileOptions options;
+    options.scenes = 8;
+    std::vector<props::Profile> profiles;
+    for (const experiments::Cell* cell : models) {
+      props::Profile p =
+          profile_model((dir / "table1" / cell->model_path()).string(), group, options);
+      p.name = cell->method;
+      profiles.push_back(std::move(p));
+    }
+    if (profiles.empty()) continue;
+    const std::string name = props::to_string(group);
+    experiments::write_profiles_png((dir / "profiles" / (name + ".png")).string(), profiles);
+    out.blocks.push_back(Figure{"profiles/" + name + ".png",
+                                "profiles of Table 1's models under " + name,
+                                {plain("Under " + name + " (" + props::profile_unit(group) +
+                                       "): filled dots the pointwise median, open circles its "
+                                       "maximum, hollow squares the in-distribution median.")},
+                                0});
+  }
+  return out;
+}
+
 int write_report_page(const ReportOptions& options, const PageOptions& page) {
   const auto start = std::chrono::steady_clock::now();
   if (page.table2_demos < 1 || page.table2_demos > 1000) {
@@ -342,8 +400,10 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
   const int trials = page.full ? 100 : page.trials;
   std::fprintf(stderr, "report: Table 1 (%zu demo counts, %d trials per scene set)\n",
                demo_counts.size(), trials);
-  const auto table1 = table_into((dir / "table1").string(), demo_counts, trials,
-                                 experiments::parse_methods(page.methods), {"flow"}, page);
+  std::vector<experiments::Cell> table1_cells;
+  const auto table1 =
+      table_into((dir / "table1").string(), demo_counts, trials,
+                 experiments::parse_methods(page.methods), {"flow"}, page, &table1_cells);
   Section t1 = section("table1", std::string("Table 1") + (page.full ? "" : " (quick)") +
                                      ": success on the 2D task against the paper's");
   t1.blocks.push_back(Paragraph{
@@ -364,6 +424,8 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
                               plain("PNG", "table1/table1.png"), plain(").")},
                              0});
   sections.push_back(std::move(t1));
+  std::fprintf(stderr, "report: the profiles of Table 1's models\n");
+  sections.push_back(profiles_section(dir, table1_cells));
 
   experiments::Table2Options t2options;
   t2options.demos = page.table2_demos;
