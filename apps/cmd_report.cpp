@@ -335,8 +335,10 @@ Section profiles_section(const std::filesystem::path& dir,
        code("handcentric audit --model M --profile GROUP"),
        plain(" draws it; the models are Table 1's at " + std::to_string(demos) +
              " demos. Theorem 1 makes the hand-centric model flat at rounding; an absolute model "
-             "grows with any g; a C8 model is zero at the multiples of 45 degrees about its "
-             "centre only. How a profile is made: docs/AUDIT.md, \"Profiles\".")}});
+             "grows with any g; a model made C8-equivariant by construction (c8_averaged, "
+             "with --methods) is zero at the multiples of 45 degrees about its centre only, "
+             "and the C8 stand-ins trained with rotated copies only as far as they learned it. "
+             "How a profile is made: docs/AUDIT.md, \"Profiles\".")}});
   std::filesystem::create_directories(dir / "profiles");
   for (const props::Group group :
        {props::Group::translation, props::Group::se2, props::Group::c8}) {
