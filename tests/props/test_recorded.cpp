@@ -114,7 +114,10 @@ TEST_CASE("recorded_cases_are_the_datas_observations_and_g_leaves_the_held_parts
   props::SceneShape shape;
   shape.recorded = std::make_shared<RecordedObservations>(log);
   props::require_property("from the data", [&] {
-    const auto [o, g] = *props::recorded_case(shape, Group::se3);
+    // Not a structured binding: clang 14 cannot capture one in the lambda below.
+    const std::pair<Scene, RigidTransform> drawn = *props::recorded_case(shape, Group::se3);
+    const Scene& o = drawn.first;
+    const RigidTransform& g = drawn.second;
     const auto same = [&](const Scene& s) {
       return s.world_T_hand0().matrix() == o.world_T_hand0().matrix();
     };
