@@ -56,10 +56,10 @@ struct AuditCommandOptions {
 
 ProfileCommand profile_command(const AuditCommandOptions& options) {
   if (!options.workspace.empty() || !options.witness_dir.empty() || !options.expect.empty() ||
-      !options.extra_poses.empty() || !options.scalars.empty())
+      !options.extra_poses.empty() || !options.scalars.empty() || !options.observations.empty())
     throw InvalidArgument(
         "--profile draws g by its size and writes --out; leave out --workspace, --witness-dir, "
-        "--expect, --extra-poses and --scalars");
+        "--expect, --extra-poses, --scalars and --observations");
   return {options.profile,        options.view,          options.out,    options.representations,
           options.exec,           options.policy_exec,   options.model,  options.seed,
           options.profile_scenes, options.profile_sizes, options.timeout};

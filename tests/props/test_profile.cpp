@@ -341,5 +341,10 @@ TEST_CASE("audit_profile_writes_json_and_png_and_names_bad_input", "[unit]") {
                                            bad.string() + " --workspace -1,-1,-1,1,1,1");
   CHECK(workspace.exit_code == 1);
   CHECK_THAT(workspace.err, Catch::Matchers::Contains("--workspace"));
+  // Recorded observations are not drawn by a profile: refused, not ignored.
+  const auto recorded = test::run_command(test::cli() + " audit --profile rotation --out " +
+                                          bad.string() + " --observations log.jsonl");
+  CHECK(recorded.exit_code == 1);
+  CHECK_THAT(recorded.err, Catch::Matchers::Contains("--observations"));
   fs::remove_all(dir);
 }
