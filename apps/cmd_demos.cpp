@@ -7,10 +7,12 @@
 #include <string>
 
 #include "commands.hpp"
+#include "difficulty_options.hpp"
 #include "insert3d_options.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
+#include "handcentric/sim/difficulty.hpp"
 #include "handcentric/sim/expert.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
 #include "handcentric/sim/scenes.hpp"
@@ -28,6 +30,7 @@ struct DemosOptions {
   std::string rotate_deg;
   std::string out;
   bool json = false;
+  sim::Difficulty difficulty;
 };
 
 template <typename Run>
@@ -69,14 +72,17 @@ int run_insert3d_demos(const DemosOptions& options) {
 int run_demos(const DemosOptions& options) {
   if (options.n < 1)
     throw InvalidArgument("--n must be at least 1, got " + std::to_string(options.n));
-  if (options.task == "insert3d") return run_insert3d_demos(options);
+  if (options.task == "insert3d") {
+    refuse_2d_difficulty(options.difficulty);
+    return run_insert3d_demos(options);
+  }
   refuse_3d_options(options.dist, options.rotate_deg);
-  const sim::SceneDistribution distribution =
-      sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist);
+  const sim::SceneDistribution distribution = options.difficulty.apply(
+      sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist));
   auto scenes = sim::sample_scenes(distribution, options.n, options.seed);
   if (!options.transform.empty())
     scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
-  const sim::CollisionChecker checker;
+  const sim::CollisionChecker checker(options.difficulty.geometry());
   const sim::ExpertRun run = sim::expert_demos(scenes, options.seed, checker);
   sim::save_demos(options.out, run.demos, checker.geometry());
   return report(options, distribution.name, run);
@@ -110,6 +116,7 @@ void add_demos_command(CLI::App& app, int& exit_code) {
       "insert3d: train scenes under the global rotation RX,RY,RZ (XYZ Euler, degrees)");
   rotate->excludes(dist);
   rotate->excludes(angle);
+  add_difficulty_options(*cmd, options->difficulty);
   cmd->add_option("--seed", options->seed, "seed of the scenes and of the expert")
       ->capture_default_str();
   cmd->add_option("--out", options->out, "output file (written atomically)")->required();

@@ -16,6 +16,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "difficulty_options.hpp"
 #include "task_of_files.hpp"
 #include "insert3d_options.hpp"
 #include "policy_source.hpp"
@@ -23,6 +24,7 @@
 #include "handcentric/experiments/results.hpp"
 #include "handcentric/experiments/table2.hpp"
 #include "handcentric/sim/collision.hpp"
+#include "handcentric/sim/difficulty.hpp"
 #include "handcentric/sim/expert_check.hpp"
 #include "handcentric/sim/insert3d/rollout.hpp"
 #include "handcentric/sim/policies.hpp"
@@ -47,6 +49,7 @@ struct EvalOptions {
   int euler_steps = 0;                                            // 0: the model's own
   bool strict = false;
   std::string rotate_deg;
+  sim::Difficulty difficulty;
 };
 
 // The 3D blade insertion: closed-loop rollouts of the expert or a 3D model on --dist
@@ -96,10 +99,13 @@ int run_eval(const EvalOptions& options) {
     throw InvalidArgument("--trials must be at least 1, got " + std::to_string(options.trials));
   const std::string task = resolve_task(options.task, model_task(options.model),
                                         "--model '" + options.model + "', a model");
-  if (task == policy::kTaskInsert3d) return run_insert3d_eval(options);
+  if (task == policy::kTaskInsert3d) {
+    refuse_2d_difficulty(options.difficulty);
+    return run_insert3d_eval(options);
+  }
   refuse_3d_options(options.dist, options.rotate_deg);
-  const sim::SceneDistribution distribution =
-      sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist);
+  const sim::SceneDistribution distribution = options.difficulty.apply(
+      sim::SceneDistribution::parse(options.dist.empty() ? options.hole_angle_deg : options.dist));
   policy::SamplingOverrides overrides;
   if (!std::isnan(options.noise_scale)) overrides.noise_scale = options.noise_scale;
   if (options.execute != 0) overrides.execute = options.execute;
@@ -110,7 +116,7 @@ int run_eval(const EvalOptions& options) {
   auto scenes = sim::sample_scenes(distribution, options.trials, options.seed);
   if (!options.transform.empty())
     scenes = sim::transform_scenes(sim::parse_planar_transform(options.transform), scenes);
-  const sim::CollisionChecker checker;
+  const sim::CollisionChecker checker(options.difficulty.geometry());
   sim::RolloutOptions rollout_options = loaded.rollout_options;
   rollout_options.stop_on_invalid = options.strict;
   const sim::RolloutSummary summary =
@@ -169,6 +175,7 @@ void add_eval_command(CLI::App& app, int& exit_code) {
   cmd->add_option(
       "--transform", options->transform,
       "apply the global planar transform DEG,X,Y (degrees about z, then cm) to every scene");
+  add_difficulty_options(*cmd, options->difficulty);
   cmd->add_option("--seed", options->seed, "seed of the scenes and of the policy's noise")
       ->capture_default_str();
   cmd->add_option("--noise-scale", options->noise_scale,

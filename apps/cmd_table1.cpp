@@ -11,6 +11,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "difficulty_options.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/experiments/table1.hpp"
 
@@ -97,6 +98,7 @@ void add_table1_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--ood-seed", t.eval.ood_seed, "seed of the independent OOD scenes")
       ->capture_default_str();
+  add_difficulty_options(*cmd, t.difficulty);
   cmd->add_option("--steps", t.steps, "Adam steps per cell (0: the library's automatic budget)")
       ->capture_default_str();
   cmd->add_option("--jobs", t.jobs, "trainings at once (0: one per hardware thread)")

@@ -107,8 +107,9 @@ int run_train(const TrainOptions& options) {
     const std::vector<sim::Demo> demos = sim::load_demos(options.demos);
     demo_count = demos.size();
     check_max_demos(options, demo_count);
+    // Recovery copies must clear the hole the demos were made with.
     scenes = sim::training_scenes(demos, config.history_length, config.chunk_length,
-                                  options.max_demos, data);
+                                  options.max_demos, data, sim::demo_file_geometry(options.demos));
     const std::size_t used =
         options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
     for (std::size_t i = 0; i < used; ++i)

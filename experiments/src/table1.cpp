@@ -56,8 +56,9 @@ double cell_work(const Cell& cell, const EvalSettings& eval) {
   return cell.config.steps + 3.0 * eval.trials * kStepsPerRollout;
 }
 
-sim::SceneDistribution distribution_of(SceneSet set) {
-  return set == SceneSet::id ? sim::SceneDistribution::train() : sim::SceneDistribution::ood();
+sim::SceneDistribution distribution_of(SceneSet set, const sim::Difficulty& difficulty) {
+  return difficulty.apply(set == SceneSet::id ? sim::SceneDistribution::train()
+                                              : sim::SceneDistribution::ood());
 }
 
 bool cell_done(const Cell& cell, const EvalSettings& eval, const fs::path& dir) {
@@ -68,24 +69,26 @@ bool cell_done(const Cell& cell, const EvalSettings& eval, const fs::path& dir) 
 }
 
 // Trains (or loads) the cell's model and writes each missing result file.
-void run_cell(const Cell& cell, const EvalSettings& eval, const fs::path& dir,
-              const std::vector<sim::Demo>& demos) {
+void run_cell(const Cell& cell, const EvalSettings& eval, const sim::Difficulty& difficulty,
+              const fs::path& dir, const std::vector<sim::Demo>& demos) {
   const fs::path model_path = dir / cell.model_path();
   const policy::LearnedPolicy trained = [&] {
     if (fs::exists(model_path)) return policy::load_model(model_path.string());
-    const auto scenes = sim::training_scenes(demos, cell.config.history_length,
-                                             cell.config.chunk_length, cell.demos, cell.data);
+    const auto scenes =
+        sim::training_scenes(demos, cell.config.history_length, cell.config.chunk_length,
+                             cell.demos, cell.data, difficulty.geometry());
     policy::LearnedPolicy model = policy::train_policy(cell.config, scenes, cell.train_seed);
     policy::save_model(model, model_path.string());
     return model;
   }();
   const sim::RolloutOptions rollout_options =
       sim::RolloutOptions::for_policy(trained.config().history_length, trained.config().execute);
-  const sim::CollisionChecker checker;  // one per thread: it counts its queries
+  // one per thread: it counts its queries
+  const sim::CollisionChecker checker(difficulty.geometry());
   for (const SceneSet set : kSceneSets) {
     const fs::path result = dir / cell.result_path(set, eval);
     if (fs::exists(result)) continue;
-    const sim::SceneDistribution distribution = distribution_of(set);
+    const sim::SceneDistribution distribution = distribution_of(set, difficulty);
     const std::uint64_t seed = eval.seed(set);
     const auto scenes = sim::sample_scenes(distribution, eval.trials, seed);
     const sim::RolloutSummary summary =
@@ -136,6 +139,8 @@ nlohmann::json cells_json(const Table1Grid& grid, const EvalSettings& eval,
           {"version", 1},
           {"demo_file", grid.demo_file},
           {"demo_seed", demo_seed},
+          {"workspace_cm", grid.difficulty.workspace_cm},
+          {"clearance_cm", grid.difficulty.clearance_cm},
           {"eval",
            {{"trials", eval.trials},
             {"eval_seed", eval.eval_seed},
@@ -237,6 +242,7 @@ void Table1Options::validate() const {
   // Before anything is written: a bad recipe would otherwise fail only when the first cell
   // trains, after the demo file and cells.json.
   data.validate();
+  difficulty.validate();
 }
 
 std::vector<int> parse_int_list(const std::string& text, const std::string& option) {
@@ -297,13 +303,20 @@ Table1Grid prepare_table1(const Table1Options& options) {
                     "): check --out");
   }
   const int largest = *std::max_element(options.demo_counts.begin(), options.demo_counts.end());
-  grid.demo_file =
-      "demos-seed" + std::to_string(options.demo_seed) + "-n" + std::to_string(largest) + ".jsonl";
+  grid.difficulty = options.difficulty;
+  // The default keeps its old name, so earlier runs resume; another difficulty gets its own file.
+  grid.demo_file = "demos-seed" + std::to_string(options.demo_seed) + "-n" +
+                   std::to_string(largest) +
+                   (options.difficulty.is_default()
+                        ? std::string()
+                        : "-w" + format_shortest(options.difficulty.workspace_cm) + "-c" +
+                              format_shortest(options.difficulty.clearance_cm)) +
+                   ".jsonl";
   const fs::path demo_path = dir / grid.demo_file;
   if (!fs::exists(demo_path)) {
-    const sim::CollisionChecker checker;
-    const auto scenes =
-        sim::sample_scenes(sim::SceneDistribution::train(), largest, options.demo_seed);
+    const sim::CollisionChecker checker(options.difficulty.geometry());
+    const auto scenes = sim::sample_scenes(distribution_of(SceneSet::id, options.difficulty),
+                                           largest, options.demo_seed);
     const sim::ExpertRun run = sim::expert_demos(scenes, options.demo_seed, checker);
     if (static_cast<int>(run.demos.size()) < largest) {
       throw InvalidArgument("the expert solved " + std::to_string(run.demos.size()) + " of " +
@@ -366,7 +379,7 @@ void run_table1(const Table1Options& options, const Table1Grid& grid) {
       progress.start(id, cell.describe());
       const bool skipped = cell_done(cell, options.eval, dir);
       try {
-        if (!skipped) run_cell(cell, options.eval, dir, demos);
+        if (!skipped) run_cell(cell, options.eval, grid.difficulty, dir, demos);
       } catch (const std::exception& e) {
         const std::lock_guard lock(error_mutex);
         if (!failed.exchange(true))
@@ -385,6 +398,11 @@ void run_table1(const Table1Options& options, const Table1Grid& grid) {
 
 int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::string& cli) {
   const fs::path dir = grid.dir;
+  const std::string difficulty_flags =
+      grid.difficulty.is_default()
+          ? std::string()
+          : " --workspace " + format_shortest(grid.difficulty.workspace_cm) + " --clearance " +
+                format_shortest(grid.difficulty.clearance_cm);
   std::string lines;
   int count = 0;
   for (const Cell& cell : grid.cells) {
@@ -404,7 +422,7 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
       const std::string result = cell.result_path(set, eval);
       line += " && { test -f " + result + " || { " + shell_quote(cli) + " eval --model " +
               cell.model_path() + " --dist " + (set == SceneSet::id ? "train" : "ood") +
-              " --trials " + std::to_string(eval.trials) + " --seed " +
+              " --trials " + std::to_string(eval.trials) + difficulty_flags + " --seed " +
               std::to_string(eval.seed(set)) + " --json > " + result + ".tmp && mv " + result +
               ".tmp " + result + "; }; }";
     }
@@ -431,6 +449,7 @@ std::string collect_table1(const std::string& dir_text) {
         "' holds no cells.json: give the --out of a `handcentric table1` or --plan run");
   }
   EvalSettings eval;
+  sim::Difficulty difficulty;
   std::uint64_t demo_seed = 0;
   std::vector<Row> rows;
   std::string training;  // the cells' recipe when they share one
@@ -443,6 +462,10 @@ std::string collect_table1(const std::string& dir_text) {
     // Runs written before the audit column have no audits.
     eval.audit_cases = j.at("eval").value("audit_cases", 0);
     demo_seed = j.at("demo_seed").get<std::uint64_t>();
+    // Runs written before the difficulty options ran the paper's.
+    difficulty.workspace_cm = j.value("workspace_cm", difficulty.workspace_cm);
+    difficulty.clearance_cm = j.value("clearance_cm", difficulty.clearance_cm);
+    difficulty.validate();
     for (const auto& c : j.at("cells")) {
       Cell cell;
       cell.method = c.at("method").get<std::string>();
@@ -468,7 +491,7 @@ std::string collect_table1(const std::string& dir_text) {
                           "): run --plan or table1 again");
   }
   if (!one_recipe) training = "a recipe of its own per cell (cells.json)";
-  const std::string markdown = table1_markdown(rows, eval, demo_seed, training);
+  const std::string markdown = table1_markdown(rows, eval, demo_seed, training, difficulty);
   write_file_atomically((dir / "table1.json").string(), rows_json(rows));
   write_file_atomically((dir / "table1.md").string(), markdown);
   write_table1_figure((dir / "table1").string(), rows);
@@ -476,7 +499,8 @@ std::string collect_table1(const std::string& dir_text) {
 }
 
 std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval,
-                            std::uint64_t demo_seed, const std::string& training) {
+                            std::uint64_t demo_seed, const std::string& training,
+                            const sim::Difficulty& difficulty) {
   std::vector<int> counts;
   std::vector<std::pair<std::string, std::string>> series;  // (method, head) in row order
   std::set<std::uint64_t> seeds;
@@ -561,6 +585,10 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
       static_cast<unsigned long long>(eval.eval_seed),
       static_cast<unsigned long long>(eval.ood_seed), static_cast<unsigned long long>(demo_seed));
   text += line;
+  if (!difficulty.is_default()) {
+    text += "Task: " + difficulty.describe() +
+            " (the paper's task: workspace 100 cm, clearance 0.1 cm).\n\n";
+  }
   if (!training.empty()) text += "Training data of every cell: " + training + ".\n\n";
   if (audited) {
     std::snprintf(line, sizeof line,

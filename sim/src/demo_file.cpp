@@ -294,6 +294,22 @@ std::string demo_file_task(const std::string& path, const DemoFileLimits& limits
   return detail::task_of(detail::read_header(in, path, limits));
 }
 
+PegHoleGeometry demo_file_geometry(const std::string& path, const DemoFileLimits& limits) {
+  std::ifstream in = detail::open_demo_file(path);
+  const nlohmann::json header = detail::read_header(in, path, limits);
+  PegHoleGeometry geometry;
+  if (!header.contains("clearance")) return geometry;
+  const nlohmann::json& clearance = header["clearance"];
+  if (!clearance.is_number() || !(clearance.get<double>() > 0.0) ||
+      !(clearance.get<double>() < kPegWidth)) {
+    detail::fail(path, "line 1 (header)",
+                 "\"clearance\" " + clearance.dump() + " is not a number in (0, " +
+                     format_number(kPegWidth) + ") cm: fix the header or make the demos again");
+  }
+  geometry.clearance = clearance.get<double>();
+  return geometry;
+}
+
 }  // namespace handcentric::sim
 
 namespace handcentric::sim::detail {

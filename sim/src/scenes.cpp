@@ -90,8 +90,14 @@ TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed
   const std::size_t pick = static_cast<std::size_t>(rng() % distribution.hole_angles.size());
   const AngleRange& range = distribution.hole_angles[pick];
   const double hole_angle = radians(uniform(rng, range.min_deg, range.max_deg));
-  const double hole_x = uniform(rng, -kWorkspaceHalfWidth, kWorkspaceHalfWidth);
-  const double hole_y = uniform(rng, -kWorkspaceHalfWidth, kWorkspaceHalfWidth);
+  const double half_width = distribution.workspace_half_width;
+  if (!std::isfinite(half_width) || half_width <= 0.0) {
+    throw InvalidArgument("scene distribution '" + distribution.name +
+                          "' has workspace half-width " + format_number(half_width) +
+                          " cm; it must be a positive number");
+  }
+  const double hole_x = uniform(rng, -half_width, half_width);
+  const double hole_y = uniform(rng, -half_width, half_width);
   const RigidTransform world_T_hole = RigidTransform::planar(hole_angle, hole_x, hole_y);
   return TaskScene{world_T_hole, world_T_hole * hole_T_hand_start};
 }

@@ -495,3 +495,17 @@ TEST_CASE("mutant_numerics_a_validator_without_a_finiteness_check_accepts_nan", 
   props::require_falsified("lenient validator rejects invalid input",
                            constructors_reject_invalid_input(test::lenient_from_matrix));
 }
+
+TEST_CASE("format_shortest_reads_back_exactly_and_is_as_short_as_typed", "[unit]") {
+  CHECK(format_shortest(0.3) == "0.3");
+  CHECK(format_shortest(25.0) == "25");
+  CHECK(format_shortest(-1e-300) == "-1e-300");
+  CHECK(format_shortest(std::nan("")) == "nan");
+  CHECK(format_shortest(-INFINITY) == "-inf");
+  // Round trip on awkward values (the planted fault, 6 digits, loses the last two).
+  for (const double value : {0.1 + 0.2, std::numbers::pi, 1.0 / 3.0, DBL_MIN, DBL_MAX})
+    CHECK(std::strtod(format_shortest(value).c_str(), nullptr) == value);
+  char six_digits[32];
+  std::snprintf(six_digits, sizeof six_digits, "%g", 0.1 + 0.2);
+  CHECK(std::strtod(six_digits, nullptr) != 0.1 + 0.2);
+}

@@ -75,6 +75,29 @@ TEST_CASE("saved_demos_load_back_bit_for_bit", "[unit]") {
   std::filesystem::remove(path);
 }
 
+TEST_CASE("a_demo_file_gives_back_the_hole_it_was_made_with", "[unit]") {
+  const auto demos = some_demos(1);
+  REQUIRE(demos.size() == 1);
+  const std::string path = temp_path("clearance.jsonl");
+  PegHoleGeometry wide;
+  wide.clearance = 0.3;
+  save_demos(path, demos, wide);
+  CHECK(demo_file_geometry(path).clearance == 0.3);
+  const std::string good = read(path);
+  // A header written without the clearance is the paper's hole.
+  write(path, with_line(good, 0, R"({"format": "handcentric-demos", "version": 1, "count": 1})"));
+  CHECK(demo_file_geometry(path).clearance == kDefaultClearance);
+  for (const char* bad : {"-1", "\"wide\"", "2.5"}) {
+    write(path, with_line(good, 0,
+                          std::string(R"({"format": "handcentric-demos", "version": 1, )") +
+                              R"("count": 1, "clearance": )" + bad + "}"));
+    CHECK_THROWS_AS(demo_file_geometry(path), InvalidDemoFile);
+    CHECK_THROWS_WITH(demo_file_geometry(path),
+                      Contains(std::string("\"clearance\" ") + bad) && Contains(path));
+  }
+  std::filesystem::remove(path);
+}
+
 TEST_CASE("bad_demo_files_give_an_error_naming_the_record", "[unit]") {
   const std::string path = temp_path("bad.jsonl");
   save_demos(path, some_demos(2));

@@ -5,6 +5,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric//core/sampling.hpp"
+#include "handcentric/sim/difficulty.hpp"
 #include "handcentric/sim/geometry.hpp"
 #include "handcentric/sim/scenes.hpp"
 
@@ -136,4 +137,58 @@ TEST_CASE("a_scene_set_can_be_moved_by_any_global_planar_transform", "[unit]") {
     INFO(bad);
     CHECK_THROWS_WITH(parse_planar_transform(bad), Catch::Matchers::Contains("DEG,X,Y"));
   }
+}
+
+namespace {
+
+/// The largest |x| or |y| of the hole openings of `n` scenes of `distribution`.
+double widest_opening(const SceneDistribution& distribution, int n) {
+  double widest = 0.0;
+  for (const auto& scene : sample_scenes(distribution, n, 3)) {
+    const Eigen::Vector3d hole = planar_coordinates(scene.world_T_hole);
+    widest = std::max({widest, std::abs(hole(1)), std::abs(hole(2))});
+  }
+  return widest;
+}
+
+}  // namespace
+
+TEST_CASE("a_smaller_workspace_places_every_hole_inside_it_and_keeps_the_relative_starts",
+          "[property]") {
+  const Difficulty quarter{25.0, kDefaultClearance};
+  const SceneDistribution narrow = quarter.apply(SceneDistribution::train());
+  CHECK(widest_opening(narrow, 1000) <= 12.5);
+  // The planted fault, the distribution without the workspace: its holes leave the 25 cm square.
+  CHECK(widest_opening(SceneDistribution::train(), 1000) > 40.0);
+  // Scene i keeps its start relative to the hole and its hole angle: only the position shrinks,
+  // so a hand-centric policy meets the same problems in every workspace.
+  for (std::uint64_t i = 0; i < 200; ++i) {
+    const TaskScene wide = sample_scene(SceneDistribution::train(), 7, i);
+    const TaskScene small = sample_scene(narrow, 7, i);
+    CHECK(distance(wide.world_T_hole.inverse_compose(wide.world_T_hand_start),
+                   small.world_T_hole.inverse_compose(small.world_T_hand_start)) < 1e-12);
+    CHECK(planar_coordinates(wide.world_T_hole)(0) == planar_coordinates(small.world_T_hole)(0));
+  }
+  // The default difficulty is the paper's task, bit for bit.
+  const auto before = sample_scenes(SceneDistribution::train(), 20, 5);
+  const auto after = sample_scenes(Difficulty{}.apply(SceneDistribution::train()), 20, 5);
+  for (std::size_t i = 0; i < before.size(); ++i)
+    CHECK(before[i].world_T_hole.matrix() == after[i].world_T_hole.matrix());
+}
+
+TEST_CASE("a_bad_difficulty_is_refused_naming_the_value", "[unit]") {
+  CHECK_THROWS_WITH(
+      (Difficulty{0.5, 0.1}.validate()),
+      Catch::Matchers::Contains("--workspace 0.5") && Catch::Matchers::Contains("[1, 1000]"));
+  CHECK_THROWS_AS((Difficulty{std::nan(""), 0.1}.validate()), InvalidArgument);
+  CHECK_THROWS_WITH((Difficulty{100.0, 0.0}.validate()),
+                    Catch::Matchers::Contains("--clearance 0"));
+  CHECK_THROWS_AS((Difficulty{100.0, kPegWidth}.validate()), InvalidArgument);
+  CHECK_THROWS_AS((Difficulty{100.0, -1.0}.geometry()), InvalidArgument);
+  CHECK(Difficulty{}.is_default());
+  CHECK_FALSE((Difficulty{50.0, 0.1}.is_default()));
+  CHECK((Difficulty{100.0, 0.3}.geometry().clearance == 0.3));
+  SceneDistribution broken = SceneDistribution::train();
+  broken.workspace_half_width = -1.0;
+  CHECK_THROWS_WITH(sample_scene(broken, 1, 0), Catch::Matchers::Contains("half-width -1"));
 }

@@ -9,6 +9,10 @@ namespace handcentric {
 /// A double with 17 significant digits ("nan", "inf" spelled out).
 std::string format_number(double value);
 
+/// The shortest text that reads back as exactly `value` ("0.3", not format_number's
+/// "0.29999999999999999"): for values a person typed, in file names, flags and titles.
+std::string format_shortest(double value);
+
 /// A matrix as [[a, b, c], [d, e, f], ...]; a column vector as [a, b, c].
 std::string format_matrix(const Eigen::Ref<const Eigen::MatrixXd>& matrix);
 

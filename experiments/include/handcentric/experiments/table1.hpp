@@ -21,6 +21,7 @@
 #include "handcentric/experiments/cell.hpp"
 #include "handcentric/experiments/methods.hpp"
 #include "handcentric/experiments/results.hpp"
+#include "handcentric/sim/difficulty.hpp"
 
 namespace handcentric::experiments {
 
@@ -49,6 +50,9 @@ struct Table1Options {
   int steps = 0;  ///< Adam steps per cell; 0: the library's automatic budget (PolicyConfig)
   /// Every cell's training data recipe; training_data(Protocol::library) by default.
   sim::TrainingData data;
+  /// The task's workspace and clearance, shared by the demos, the scenes and the checker
+  /// (`--workspace`, `--clearance`; the paper's 100 cm and 0.1 cm by default).
+  sim::Difficulty difficulty;
   int jobs = 0;  ///< trainings at once; 0: one per hardware thread
   std::string out = "table1";
   bool resume = false;
@@ -56,7 +60,7 @@ struct Table1Options {
 
   /// Throws InvalidArgument naming the first bad value and the fix (a demo count outside
   /// 1..1000 or repeated, steps < 0, no method, no training seed, trials < 1, jobs < 0, ood_seed
-  /// equal to eval_seed: the OOD set would be the paired one).
+  /// equal to eval_seed: the OOD set would be the paired one, a bad difficulty).
   void validate() const;
 };
 
@@ -68,10 +72,12 @@ std::vector<std::uint64_t> parse_seed_list(const std::string& text, const std::s
 struct Table1Grid {
   std::string dir;        ///< options.out, absolute
   std::string demo_file;  ///< relative to dir
+  sim::Difficulty difficulty;
   std::vector<Cell> cells;
 };
 
-/// Creates DIR, its demos (or reuses them when present) and DIR/cells.json. Without
+/// Creates DIR, its demos (or reuses them when present; a non-default difficulty is in the demo
+/// file's name) and DIR/cells.json. Without
 /// options.resume a DIR that already holds cells.json is an error (pass --resume or another
 /// --out). Throws InvalidArgument when the expert leaves too few demos.
 Table1Grid prepare_table1(const Table1Options& options);
@@ -95,7 +101,9 @@ std::string collect_table1(const std::string& dir);
 /// paper's row beside it.
 /// `training`, when not empty, is said under the title (collect_table1 passes
 /// describe_training_data of the cells' recipe when they share one).
+/// A non-default `difficulty` is said under the title too.
 std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval,
-                            std::uint64_t demo_seed, const std::string& training = "");
+                            std::uint64_t demo_seed, const std::string& training = "",
+                            const sim::Difficulty& difficulty = {});
 
 }  // namespace handcentric::experiments

@@ -67,6 +67,12 @@ std::vector<Demo> load_demos(const std::string& path,
 std::string demo_file_task(const std::string& path,
                            const DemoFileLimits& limits = DemoFileLimits());
 
+/// The 2D task's hole a demo file records in its header ("clearance"; the paper's 0.1 for a
+/// header without one), reading the header line only: the hole its recovery copies must clear.
+/// Throws InvalidDemoFile as load_demos does, and for a clearance outside (0, kPegWidth).
+PegHoleGeometry demo_file_geometry(const std::string& path,
+                                   const DemoFileLimits& limits = DemoFileLimits());
+
 /// load_demos on a file's bytes already in memory (received, embedded, or a fuzzer's input);
 /// `source` names them in errors as the path would. Same checks, limits and errors.
 std::vector<Demo> parse_demos(const std::string& bytes, const std::string& source,

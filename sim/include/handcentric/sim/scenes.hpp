@@ -28,6 +28,14 @@ struct TaskScene {
 /// g * scene: both poses move (the whole scene is transformed rigidly).
 TaskScene operator*(const RigidTransform& g, const TaskScene& scene);
 
+/// Workspace half-width (cm) of the hole's opening position (the default; a distribution may
+/// narrow it, sim/difficulty.hpp), and the start-pose ranges.
+constexpr double kWorkspaceHalfWidth = 50.0;
+constexpr double kStartMaxAbsX = 6.0;
+constexpr double kStartMinY = 12.0;
+constexpr double kStartMaxY = 20.0;
+constexpr double kStartMaxAbsAngleDeg = 40.0;
+
 struct AngleRange {
   double min_deg = 0.0;
   double max_deg = 0.0;
@@ -38,6 +46,8 @@ struct SceneDistribution {
   /// Hole-angle ranges; a scene picks one uniformly at random, then an angle uniformly in it.
   /// "train" lists up, up, +90, -90 so that up gets half the scenes.
   std::vector<AngleRange> hole_angles;
+  /// The opening's position is uniform in [-w, w]^2 for this w (cm).
+  double workspace_half_width = kWorkspaceHalfWidth;
 
   static SceneDistribution train();
   static SceneDistribution ood();
@@ -46,13 +56,6 @@ struct SceneDistribution {
   /// "train", "ood" or "A:B" (degrees). Throws InvalidArgument naming the text and the forms.
   static SceneDistribution parse(const std::string& text);
 };
-
-/// Workspace half-width (cm) of the hole's opening position, and the start-pose ranges.
-constexpr double kWorkspaceHalfWidth = 50.0;
-constexpr double kStartMaxAbsX = 6.0;
-constexpr double kStartMinY = 12.0;
-constexpr double kStartMaxY = 20.0;
-constexpr double kStartMaxAbsAngleDeg = 40.0;
 
 /// Scene `index` of the stream `seed`.
 TaskScene sample_scene(const SceneDistribution& distribution, std::uint64_t seed,
