@@ -573,7 +573,7 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
     return text;
   };
   std::string text = "# Table 1 on this library\n\n";
-  char line[512];
+  char line[1024];
   std::snprintf(
       line, sizeof line,
       "Success over %d closed-loop rollouts per cell (mean over %zu training seed%s). Scenes: `id` "
@@ -596,7 +596,9 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
                   "on both sides (`handcentric audit --model M --view eye_in_hand --pointwise`, "
                   "%d cases per group, planar scenes for the 2D task): per group yes when every "
                   "model of the row is equivariant, and the largest error over them (the task's "
-                  "units).\n\n",
+                  "units). A `no`'s number is the error of the first failing case, and the audit "
+                  "draws small g first: it shows the group is broken, not by how much "
+                  "(`handcentric audit --profile` measures that).\n\n",
                   eval.audit_cases);
     text += line;
   }
