@@ -38,8 +38,8 @@ Eigen::Index total_parameters(const std::vector<Conv2d>& layers) {
   return count;
 }
 
-// The patches of `layer` over `batch` images whose pixel (c, y, x) of sample b is at
-// b sample_stride + c channel_stride + y row_stride + x column_stride.
+// The patches of `layer` over `batch` images whose pixel (c, y, x) of sample b
+// is at b sample_stride + c channel_stride + y row_stride + x column_stride.
 kernels::ConvPatches patches_of(const Conv2d& layer, int batch, long sample_stride,
                                 long channel_stride, long row_stride, long column_stride) {
   kernels::ConvPatches g;
@@ -66,17 +66,18 @@ kernels::ConvPatches image_patches(const Conv2d& layer, int batch, long sample_s
                     1);
 }
 
-// A hidden map, (height, width, channels) per sample, channels fastest: as the layer before
-// wrote it (out_channels x N, column-major).
+// A hidden map, (height, width, channels) per sample, channels fastest: as the
+// layer before wrote it (out_channels x N, column-major).
 kernels::ConvPatches map_patches(const Conv2d& layer, int batch) {
   const ImageShape& in = layer.input();
   return patches_of(layer, batch, in.size(), 1, static_cast<long>(in.width) * in.channels,
                     in.channels);
 }
 
-// Samples per chunk of the batch whose patch matrix (K x pixels each) fills about half of a
-// 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and the product reads it back from
-// there, and backward's col2im reads its gradient from there; at least one sample.
+// Samples per chunk of the batch whose patch matrix (K x pixels each) fills
+// about half of a 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and
+// the product reads it back from there, and backward's col2im reads its
+// gradient from there; at least one sample.
 int samples_per_chunk(const Conv2d& layer) {
   constexpr Eigen::Index kChunkFloats = Eigen::Index{1} << 17;  // 512 KB
   const Eigen::Index per_sample =
@@ -165,8 +166,8 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
         set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
                    patches);
       }
-      // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), while the
-      // chunk's patches are still in L2.
+      // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(),
+      // while the chunk's patches are still in L2.
       const Eigen::Index first = b0 * layer.output().size();
       kernels::Gemm product{Op::none,
                             Op::none,
@@ -201,13 +202,16 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
                           std::to_string(batch_) + " (call forward() first)");
   }
   delta_.back() = d_features;
+  // Through the last layer's SiLU: delta *= SiLU'(z) = s + a (1 - s). The
+  // layers below get theirs chunk by chunk, right after col2im completes their
+  // delta (below).
+  set.silu_backward(delta_.back().size(), activation_.back().data(), sigmoid_.back().data(),
+                    delta_.back().data());
   for (int l = static_cast<int>(layers_.size()) - 1; l >= 0; --l) {
     const Conv2d& layer = layers_[l];
     const int n = batch_ * layer.output().height * layer.output().width;
     const int k = layer.patch_size(), out = layer.out_channels();
-    Matrix& delta = delta_[l];
-    // Through SiLU: delta *= SiLU'(z) = s + a (1 - s).
-    set.silu_backward(delta.size(), activation_[l].data(), sigmoid_[l].data(), delta.data());
+    const Matrix& delta = delta_[l];
     float* d_weights = gradient_.data() + offsets_[l];
     float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
     // dW (out x K) = delta patches^T; db = delta 1.
@@ -217,14 +221,19 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     set.gemm(
         {Op::none, Op::none, out, 1, n, delta.data(), out, ones_.data(), n, nullptr, d_bias, out});
     if (l == 0 && !input_gradient) break;
-    // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from: a
-    // chunk of samples at a time, so that col2im reads the patches from L2.
+    // d patches (K x N) = W^T delta, then each entry back to the pixel it was
+    // read from: a chunk of samples at a time, so that col2im reads the patches
+    // from L2. A chunk's pixels receive only its own patches, so after its
+    // col2im they are complete: the chunk is zeroed just before (in cache, not
+    // a pass over the whole map) and, below the first layer, multiplied by the
+    // layer below's SiLU' just after.
+    const Eigen::Index below = layer.input().size();
     float* target = nullptr;
     if (l == 0) {
-      d_images_.setZero(input_size(), batch_);
+      d_images_.resize(below, batch_);
       target = d_images_.data();
     } else {
-      delta_[l - 1].setZero(layer.input().size(), batch_);
+      delta_[l - 1].resize(below, batch_);
       target = delta_[l - 1].data();
     }
     const int pixels = layer.output().height * layer.output().width;
@@ -235,11 +244,14 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
       set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
                 out, delta.data() + b0 * layer.output().size(), out, nullptr, d_patches_.data(),
                 k});
-      float* samples = target + b0 * layer.input().size();
+      const Eigen::Index first = b0 * below, size = count * below;
+      std::fill(target + first, target + first + size, 0.0f);
       if (l == 0) {
-        set.col2im(image_patches(layer, count, input_size()), d_patches_.data(), samples);
+        set.col2im(image_patches(layer, count, input_size()), d_patches_.data(), target + first);
       } else {
-        set.col2im(map_patches(layer, count), d_patches_.data(), samples);
+        set.col2im(map_patches(layer, count), d_patches_.data(), target + first);
+        set.silu_backward(size, activation_[l - 1].data() + first, sigmoid_[l - 1].data() + first,
+                          target + first);
       }
     }
   }
@@ -262,8 +274,9 @@ void ConvEncoder::write(ByteWriter& out) const {
 
 namespace {
 
-// A u32 of the architecture as an int; values past INT32_MAX are refused here and small
-// negative ones never occur, so Conv2d's checks see every value that could be meant.
+// A u32 of the architecture as an int; values past INT32_MAX are refused here
+// and small negative ones never occur, so Conv2d's checks see every value that
+// could be meant.
 int read_dimension(ByteReader& in, const std::string& what) {
   const std::uint32_t value = in.u32();
   if (value > 1u << 20) {
@@ -300,7 +313,8 @@ ConvEncoder ConvEncoder::read(ByteReader& in) {
   } catch (const InvalidArgument& error) {
     in.fail(std::string("the image encoder's architecture is refused: ") + error.what());
   }
-  // Before allocating: the parameters the architecture describes must be in the bytes that follow.
+  // Before allocating: the parameters the architecture describes must be in the
+  // bytes that follow.
   const Eigen::Index parameters = total_parameters(layers);
   if (static_cast<std::uint64_t>(parameters) > in.remaining() / sizeof(float)) {
     in.fail("the image encoder's architecture has " + std::to_string(parameters) +
