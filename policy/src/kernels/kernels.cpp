@@ -23,7 +23,7 @@ HWY_BEFORE_NAMESPACE();
 namespace handcentric::policy::kernels::HWY_NAMESPACE {
 
 const KernelSet* TargetKernels() {
-  static constexpr KernelSet kSet{vector_gemm<GemmKernel>,
+  static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel>,
                                   SiluForward,
                                   SiluBackward,
                                   SiluInPlace,
