@@ -38,8 +38,8 @@ Eigen::Index total_parameters(const std::vector<Conv2d>& layers) {
   return count;
 }
 
-// The patches of `layer` over `batch` images whose pixel (c, y, x) of sample b
-// is at b sample_stride + c channel_stride + y row_stride + x column_stride.
+// The patches of `layer` over `batch` images whose pixel (c, y, x) of sample b is at
+// b sample_stride + c channel_stride + y row_stride + x column_stride.
 kernels::ConvPatches patches_of(const Conv2d& layer, int batch, long sample_stride,
                                 long channel_stride, long row_stride, long column_stride) {
   kernels::ConvPatches g;
@@ -66,18 +66,17 @@ kernels::ConvPatches image_patches(const Conv2d& layer, int batch, long sample_s
                     1);
 }
 
-// A hidden map, (height, width, channels) per sample, channels fastest: as the
-// layer before wrote it (out_channels x N, column-major).
+// A hidden map, (height, width, channels) per sample, channels fastest: as the layer before
+// wrote it (out_channels x N, column-major).
 kernels::ConvPatches map_patches(const Conv2d& layer, int batch) {
   const ImageShape& in = layer.input();
   return patches_of(layer, batch, in.size(), 1, static_cast<long>(in.width) * in.channels,
                     in.channels);
 }
 
-// Samples per chunk of the batch whose patch matrix (K x pixels each) fills
-// about half of a 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and
-// the product reads it back from there, and backward's col2im reads its
-// gradient from there; at least one sample.
+// Samples per chunk of the batch whose patch matrix (K x pixels each) fills about half of a
+// 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and the product reads it back from
+// there, and backward's col2im reads its gradient from there; at least one sample.
 int samples_per_chunk(const Conv2d& layer) {
   constexpr Eigen::Index kChunkFloats = Eigen::Index{1} << 17;  // 512 KB
   const Eigen::Index per_sample =
@@ -158,29 +157,39 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
     const int chunk = samples_per_chunk(layer);
     for (int b0 = 0; b0 < batch_; b0 += chunk) {
       const int count = std::min(chunk, batch_ - b0);
-      float* patches = patches_[l].data() + b0 * per_sample;
-      if (l == 0) {
-        set.im2col(image_patches(layer, count, input_sample_stride_),
-                   images.data() + b0 * input_sample_stride_, patches);
-      } else {
-        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
-                   patches);
-      }
-      // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(),
-      // while the chunk's patches are still in L2.
+      // The first layer reads the input, (channels, height, width): its patches are stored
+      // transposed (N x K, im2row), where a patch entry over a row of output pixels is one
+      // strided image row; the hidden maps' patches are runs of channels (K x N, im2col).
+      // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), while the
+      // chunk's patches are still in L2.
+      const float* weights = parameters_.data() + offsets_[l];
       const Eigen::Index first = b0 * layer.output().size();
       kernels::Gemm product{Op::none,
                             Op::none,
                             out,
                             count * pixels,
                             k,
-                            parameters_.data() + offsets_[l],
+                            weights,
                             out,
-                            patches,
+                            nullptr,  // the patches, below
                             k,
-                            parameters_.data() + offsets_[l] + static_cast<Eigen::Index>(out) * k,
+                            weights + static_cast<Eigen::Index>(out) * k,
                             activation_[l].data() + first,
                             out};
+      if (l == 0) {
+        float* rows = patches_[0].data() + b0 * pixels;
+        const long ld = static_cast<long>(batch_) * pixels;
+        set.im2row(image_patches(layer, count, input_sample_stride_),
+                   images.data() + b0 * input_sample_stride_, rows, ld);
+        product.op_b = Op::transpose;
+        product.b = rows;
+        product.ldb = static_cast<int>(ld);
+      } else {
+        float* columns = patches_[l].data() + b0 * per_sample;
+        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
+                   columns);
+        product.b = columns;
+      }
       product.epilogue = kernels::Epilogue::silu;
       product.sigmoid = sigmoid_[l].data() + first;
       product.lds = out;
@@ -202,9 +211,8 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
                           std::to_string(batch_) + " (call forward() first)");
   }
   delta_.back() = d_features;
-  // Through the last layer's SiLU: delta *= SiLU'(z) = s + a (1 - s). The
-  // layers below get theirs chunk by chunk, right after col2im completes their
-  // delta (below).
+  // Through the last layer's SiLU: delta *= SiLU'(z) = s + a (1 - s). The layers below get
+  // theirs chunk by chunk, right after col2im completes their delta (below).
   set.silu_backward(delta_.back().size(), activation_.back().data(), sigmoid_.back().data(),
                     delta_.back().data());
   for (int l = static_cast<int>(layers_.size()) - 1; l >= 0; --l) {
@@ -214,19 +222,23 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     const Matrix& delta = delta_[l];
     float* d_weights = gradient_.data() + offsets_[l];
     float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
-    // dW (out x K) = delta patches^T; db = delta 1.
-    set.gemm({Op::none, Op::transpose, out, k, n, delta.data(), out, patches_[l].data(), k, nullptr,
-              d_weights, out});
+    // dW (out x K) = delta patches^T (the first layer stores patches^T, N x K); db = delta 1.
+    if (l == 0) {
+      set.gemm({Op::none, Op::none, out, k, n, delta.data(), out, patches_[0].data(), n, nullptr,
+                d_weights, out});
+    } else {
+      set.gemm({Op::none, Op::transpose, out, k, n, delta.data(), out, patches_[l].data(), k,
+                nullptr, d_weights, out});
+    }
     if (ones_.size() < n) ones_ = Vector::Ones(n);
     set.gemm(
         {Op::none, Op::none, out, 1, n, delta.data(), out, ones_.data(), n, nullptr, d_bias, out});
     if (l == 0 && !input_gradient) break;
-    // d patches (K x N) = W^T delta, then each entry back to the pixel it was
-    // read from: a chunk of samples at a time, so that col2im reads the patches
-    // from L2. A chunk's pixels receive only its own patches, so after its
-    // col2im they are complete: the chunk is zeroed just before (in cache, not
-    // a pass over the whole map) and, below the first layer, multiplied by the
-    // layer below's SiLU' just after.
+    // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from: a
+    // chunk of samples at a time, so that col2im reads the patches from L2. A chunk's pixels
+    // receive only its own patches, so after its col2im they are complete: the chunk is
+    // zeroed just before (in cache, not a pass over the whole map) and, below the first layer,
+    // multiplied by the layer below's SiLU' just after.
     const Eigen::Index below = layer.input().size();
     float* target = nullptr;
     if (l == 0) {
@@ -241,14 +253,20 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
     for (int b0 = 0; b0 < batch_; b0 += chunk) {
       const int count = std::min(chunk, batch_ - b0);
-      set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
-                out, delta.data() + b0 * layer.output().size(), out, nullptr, d_patches_.data(),
-                k});
+      const float* delta_chunk = delta.data() + b0 * layer.output().size();
       const Eigen::Index first = b0 * below, size = count * below;
-      std::fill(target + first, target + first + size, 0.0f);
       if (l == 0) {
-        set.col2im(image_patches(layer, count, input_size()), d_patches_.data(), target + first);
+        // d patches^T (N x K) = delta^T W, back onto the image rows by row2im.
+        set.gemm({Op::transpose, Op::none, count * pixels, k, out, delta_chunk, out,
+                  parameters_.data() + offsets_[l], out, nullptr, d_patches_.data(),
+                  count * pixels});
+        std::fill(target + first, target + first + size, 0.0f);
+        set.row2im(image_patches(layer, count, input_size()), d_patches_.data(), count * pixels,
+                   target + first);
       } else {
+        set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
+                  out, delta_chunk, out, nullptr, d_patches_.data(), k});
+        std::fill(target + first, target + first + size, 0.0f);
         set.col2im(map_patches(layer, count), d_patches_.data(), target + first);
         set.silu_backward(size, activation_[l - 1].data() + first, sigmoid_[l - 1].data() + first,
                           target + first);
@@ -274,9 +292,8 @@ void ConvEncoder::write(ByteWriter& out) const {
 
 namespace {
 
-// A u32 of the architecture as an int; values past INT32_MAX are refused here
-// and small negative ones never occur, so Conv2d's checks see every value that
-// could be meant.
+// A u32 of the architecture as an int; values past INT32_MAX are refused here and small
+// negative ones never occur, so Conv2d's checks see every value that could be meant.
 int read_dimension(ByteReader& in, const std::string& what) {
   const std::uint32_t value = in.u32();
   if (value > 1u << 20) {
@@ -313,8 +330,7 @@ ConvEncoder ConvEncoder::read(ByteReader& in) {
   } catch (const InvalidArgument& error) {
     in.fail(std::string("the image encoder's architecture is refused: ") + error.what());
   }
-  // Before allocating: the parameters the architecture describes must be in the
-  // bytes that follow.
+  // Before allocating: the parameters the architecture describes must be in the bytes that follow.
   const Eigen::Index parameters = total_parameters(layers);
   if (static_cast<std::uint64_t>(parameters) > in.remaining() / sizeof(float)) {
     in.fail("the image encoder's architecture has " + std::to_string(parameters) +

@@ -31,6 +31,8 @@ const KernelSet* TargetKernels() {
                                   Adam,
                                   Im2col,
                                   Col2im,
+                                  Im2row,
+                                  Row2im,
                                   HWY_TARGET};
   return &kSet;
 }
