@@ -11,10 +11,9 @@
 # As bench/vs_pytorch.sh: /usr/bin/python3 (Debian's torch imports only there), both sides
 # pinned with taskset when it exists, ours on core 0, PyTorch on core 0 (1 thread) and cores 0
 # and 1 (2 threads), in both memory formats (its best is taken). PyTorch's Linear layers run on
-# the BLAS it loads (printed): with only the reference BLAS they are slow, which would flatter
-# us. bench/vs_pytorch.sh installs OpenBLAS system-wide; without root, or to leave the
-# machine's BLAS alone, unpack it anywhere (apt-get download libopenblas0-pthread; dpkg -x) and
-# give its folder:  PYTORCH_BLAS_DIR=.../usr/lib/x86_64-linux-gnu/openblas-pthread
+# the BLAS it loads (printed): scripts/install-deps.sh installs OpenBLAS (libopenblas0), which
+# the alternatives system then prefers; a run on the reference BLAS, whose slow Linear layers
+# would flatter us, is flagged in the output.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 build="${1:-$here/../build}"
@@ -35,9 +34,6 @@ pin() { if command -v taskset >/dev/null; then taskset -c "$1" "${@:2}"; else "$
 
 ours_json="$(pin 0 "$bench" --benchmark_filter='BM_conv_train_step' \
   --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"
-if [[ -n "${PYTORCH_BLAS_DIR:-}" ]]; then
-  export LD_LIBRARY_PATH="$PYTORCH_BLAS_DIR${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
-fi
 torch_lines="$(pin 0 "$python" "$here/vs_pytorch_conv.py" --threads 1
                pin 0,1 "$python" "$here/vs_pytorch_conv.py" --threads 2)"
 echo "$torch_lines" | sed 's/^/pytorch: /'

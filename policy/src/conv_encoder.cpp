@@ -157,29 +157,39 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
     const int chunk = samples_per_chunk(layer);
     for (int b0 = 0; b0 < batch_; b0 += chunk) {
       const int count = std::min(chunk, batch_ - b0);
-      float* patches = patches_[l].data() + b0 * per_sample;
-      if (l == 0) {
-        set.im2col(image_patches(layer, count, input_sample_stride_),
-                   images.data() + b0 * input_sample_stride_, patches);
-      } else {
-        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
-                   patches);
-      }
+      // The first layer reads the input, (channels, height, width): its patches are stored
+      // transposed (N x K, im2row), where a patch entry over a row of output pixels is one
+      // strided image row; the hidden maps' patches are runs of channels (K x N, im2col).
       // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), while the
       // chunk's patches are still in L2.
+      const float* weights = parameters_.data() + offsets_[l];
       const Eigen::Index first = b0 * layer.output().size();
       kernels::Gemm product{Op::none,
                             Op::none,
                             out,
                             count * pixels,
                             k,
-                            parameters_.data() + offsets_[l],
+                            weights,
                             out,
-                            patches,
+                            nullptr,  // the patches, below
                             k,
-                            parameters_.data() + offsets_[l] + static_cast<Eigen::Index>(out) * k,
+                            weights + static_cast<Eigen::Index>(out) * k,
                             activation_[l].data() + first,
                             out};
+      if (l == 0) {
+        float* rows = patches_[0].data() + b0 * pixels;
+        const long ld = static_cast<long>(batch_) * pixels;
+        set.im2row(image_patches(layer, count, input_sample_stride_),
+                   images.data() + b0 * input_sample_stride_, rows, ld);
+        product.op_b = Op::transpose;
+        product.b = rows;
+        product.ldb = static_cast<int>(ld);
+      } else {
+        float* columns = patches_[l].data() + b0 * per_sample;
+        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
+                   columns);
+        product.b = columns;
+      }
       product.epilogue = kernels::Epilogue::silu;
       product.sigmoid = sigmoid_[l].data() + first;
       product.lds = out;
@@ -201,30 +211,41 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
                           std::to_string(batch_) + " (call forward() first)");
   }
   delta_.back() = d_features;
+  // Through the last layer's SiLU: delta *= SiLU'(z) = s + a (1 - s). The layers below get
+  // theirs chunk by chunk, right after col2im completes their delta (below).
+  set.silu_backward(delta_.back().size(), activation_.back().data(), sigmoid_.back().data(),
+                    delta_.back().data());
   for (int l = static_cast<int>(layers_.size()) - 1; l >= 0; --l) {
     const Conv2d& layer = layers_[l];
     const int n = batch_ * layer.output().height * layer.output().width;
     const int k = layer.patch_size(), out = layer.out_channels();
-    Matrix& delta = delta_[l];
-    // Through SiLU: delta *= SiLU'(z) = s + a (1 - s).
-    set.silu_backward(delta.size(), activation_[l].data(), sigmoid_[l].data(), delta.data());
+    const Matrix& delta = delta_[l];
     float* d_weights = gradient_.data() + offsets_[l];
     float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
-    // dW (out x K) = delta patches^T; db = delta 1.
-    set.gemm({Op::none, Op::transpose, out, k, n, delta.data(), out, patches_[l].data(), k, nullptr,
-              d_weights, out});
+    // dW (out x K) = delta patches^T (the first layer stores patches^T, N x K); db = delta 1.
+    if (l == 0) {
+      set.gemm({Op::none, Op::none, out, k, n, delta.data(), out, patches_[0].data(), n, nullptr,
+                d_weights, out});
+    } else {
+      set.gemm({Op::none, Op::transpose, out, k, n, delta.data(), out, patches_[l].data(), k,
+                nullptr, d_weights, out});
+    }
     if (ones_.size() < n) ones_ = Vector::Ones(n);
     set.gemm(
         {Op::none, Op::none, out, 1, n, delta.data(), out, ones_.data(), n, nullptr, d_bias, out});
     if (l == 0 && !input_gradient) break;
     // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from: a
-    // chunk of samples at a time, so that col2im reads the patches from L2.
+    // chunk of samples at a time, so that col2im reads the patches from L2. A chunk's pixels
+    // receive only its own patches, so after its col2im they are complete: the chunk is
+    // zeroed just before (in cache, not a pass over the whole map) and, below the first layer,
+    // multiplied by the layer below's SiLU' just after.
+    const Eigen::Index below = layer.input().size();
     float* target = nullptr;
     if (l == 0) {
-      d_images_.setZero(input_size(), batch_);
+      d_images_.resize(below, batch_);
       target = d_images_.data();
     } else {
-      delta_[l - 1].setZero(layer.input().size(), batch_);
+      delta_[l - 1].resize(below, batch_);
       target = delta_[l - 1].data();
     }
     const int pixels = layer.output().height * layer.output().width;
@@ -232,14 +253,23 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
     for (int b0 = 0; b0 < batch_; b0 += chunk) {
       const int count = std::min(chunk, batch_ - b0);
-      set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
-                out, delta.data() + b0 * layer.output().size(), out, nullptr, d_patches_.data(),
-                k});
-      float* samples = target + b0 * layer.input().size();
+      const float* delta_chunk = delta.data() + b0 * layer.output().size();
+      const Eigen::Index first = b0 * below, size = count * below;
       if (l == 0) {
-        set.col2im(image_patches(layer, count, input_size()), d_patches_.data(), samples);
+        // d patches^T (N x K) = delta^T W, back onto the image rows by row2im.
+        set.gemm({Op::transpose, Op::none, count * pixels, k, out, delta_chunk, out,
+                  parameters_.data() + offsets_[l], out, nullptr, d_patches_.data(),
+                  count * pixels});
+        std::fill(target + first, target + first + size, 0.0f);
+        set.row2im(image_patches(layer, count, input_size()), d_patches_.data(), count * pixels,
+                   target + first);
       } else {
-        set.col2im(map_patches(layer, count), d_patches_.data(), samples);
+        set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
+                  out, delta_chunk, out, nullptr, d_patches_.data(), k});
+        std::fill(target + first, target + first + size, 0.0f);
+        set.col2im(map_patches(layer, count), d_patches_.data(), target + first);
+        set.silu_backward(size, activation_[l - 1].data() + first, sigmoid_[l - 1].data() + first,
+                          target + first);
       }
     }
   }

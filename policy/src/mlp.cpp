@@ -30,6 +30,7 @@ MlpT<Scalar>::MlpT(std::vector<int> widths, Activation activation)
   z_.resize(layers());
   sigmoid_.resize(layers());
   a_.resize(layers() + 1);
+  delta_.resize(layers() + 1);
 }
 
 template <typename Scalar>
@@ -194,7 +195,8 @@ const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::forward(const Eigen::Ref<cons
 template <typename Scalar>
 const typename MlpT<Scalar>::Matrix& MlpT<Scalar>::backward(
     const Eigen::Ref<const Matrix>& d_output) {
-  return delta_[propagate(d_output, true)];
+  propagate(d_output, true);
+  return delta_[0];
 }
 
 template <typename Scalar>
@@ -203,7 +205,7 @@ void MlpT<Scalar>::backward_parameters(const Eigen::Ref<const Matrix>& d_output)
 }
 
 template <typename Scalar>
-int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input_gradient) {
+void MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input_gradient) {
   const Eigen::Index batch = a_[0].cols();
   if (d_output.rows() != output_size() || d_output.cols() != batch) {
     throw InvalidArgument("Mlp::backward: d_output is " + std::to_string(d_output.rows()) + "x" +
@@ -211,14 +213,13 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
                           std::to_string(output_size()) + "x" + std::to_string(batch) +
                           " (call forward() first)");
   }
-  int current = 0;
-  delta_[current] = d_output;
+  delta_[layers()] = d_output;
   // float with SiLU: the product W^T delta that hands delta to the layer below also multiplies
   // it by that layer's SiLU' (the GEMM's epilogue), so the derivative is already applied here.
   constexpr bool kFloat = std::is_same_v<Scalar, float>;
   const bool fused_derivative = kFloat && activation_ == Activation::silu;
   for (int l = layers() - 1; l >= 0; --l) {
-    Matrix& delta = delta_[current];
+    Matrix& delta = delta_[l + 1];
     if (l + 1 < layers() && !fused_derivative) {
       if (activation_ == Activation::silu) {
         // SiLU'(z) = s (1 + z (1 - s)) = s + a (1 - s), s = sigmoid(z) kept by forward().
@@ -249,13 +250,11 @@ int MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool input
     }
     if (l == 0 && !input_gradient) break;
     if (fused_derivative && l > 0) {
-      transposed<Scalar>(W(l), delta, delta_[1 - current], a_[l].data(), sigmoid_[l - 1].data());
+      transposed<Scalar>(W(l), delta, delta_[l], a_[l].data(), sigmoid_[l - 1].data());
     } else {
-      transposed<Scalar>(W(l), delta, delta_[1 - current]);
+      transposed<Scalar>(W(l), delta, delta_[l]);
     }
-    current = 1 - current;
   }
-  return current;
 }
 
 template <typename Scalar>

@@ -1,11 +1,12 @@
 // The image encoder (ConvEncoder, conv2d.hpp) on the float32 kernels of every Highway target
 // this build compiled and this CPU runs, against a naive double-precision convolution written
 // here from the definition (direct sums, its own (c, y, x) storage): forward, the gradients of
-// the weights, biases and input, with odd sizes, stride 1 and 2, no padding, a kernel of 2 and
+// the weights, biases and input, with odd sizes, stride 1, 2 and 3, no padding, a kernel of 2 and
 // images with a column stride. The reference's backward is checked by central differences of
 // its forward, and the float encoder's by directional differences of its own. Each check is seen
-// failing on kernel sets with a planted fault (a mutant im2col, col2im, product or SiLU'), on
-// every target. Then the model-file record of the encoder and the typed errors of bad shapes.
+// failing on kernel sets with a planted fault (a mutant im2col, col2im, im2row, row2im, product
+// or SiLU'), on every target. Then the model-file record of the encoder and the typed errors of
+// bad shapes.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -181,7 +182,7 @@ struct Case {
   int batch;
 };
 
-// Odd sizes and channel counts that fill no vector, stride 1 and 2, no padding, kernels 1, 2,
+// Odd sizes and channel counts that fill no vector, stride 1, 2 and 3, no padding, kernels 1, 2,
 // 3 and 5, a 1 x 1 output; the image policies' depth and RGB-D encoders.
 const std::vector<Case> kCases = {
     {"odd sizes", {3, 13, 11}, {{5, 3, 1, 1}, {7, 2, 2, 0}, {6, 3, 2, 1}}, 3},
@@ -191,6 +192,8 @@ const std::vector<Case> kCases = {
     {"rgb-d 48 x 64", {4, 48, 64}, {{16, 3, 2, 1}, {32, 3, 2, 1}, {32, 3, 2, 1}}, 2},
     // Patches of more than half a megabyte per image: the encoder works one image at a time.
     {"chunks of one image", {4, 64, 64}, {{8, 3, 1, 1}, {8, 3, 2, 1}}, 3},
+    // A first layer of stride 3: im2row's strided copy (stride 1 copies, stride 2 deinterleaves).
+    {"stride 3", {2, 11, 10}, {{4, 3, 3, 1}, {5, 2, 1, 0}}, 2},
 };
 
 // The results of one encoder run: features, parameter gradient, image gradient.
@@ -246,13 +249,26 @@ void gemm_short_k(const kernels::Gemm& problem) {
 }
 void gemm_untransposed_weights(const kernels::Gemm& problem) {
   kernels::Gemm wrong = problem;
-  // The input-gradient product W^T delta read as W delta. It stays inside W's storage only
-  // when K >= out_channels, which every case's layers have.
+  // The input-gradient product W^T delta read as W delta (the first layer's delta^T W as
+  // delta W). It stays inside the storage of W (of delta) only when K (the pixels of a chunk)
+  // >= out_channels, which every case's layers have.
   if (wrong.op_a == kernels::Op::transpose && wrong.op_b == kernels::Op::none &&
       wrong.m >= wrong.k) {
     wrong.op_a = kernels::Op::none;
   }
   g_base->gemm(wrong);
+}
+void im2row_stride_off_by_one(const kernels::ConvPatches& shape, const float* image, float* rows,
+                              long ld) {
+  kernels::ConvPatches wrong = shape;
+  wrong.stride += 1;
+  g_base->im2row(wrong, image, rows, ld);
+}
+void row2im_window_shifted(const kernels::ConvPatches& shape, const float* rows, long ld,
+                           float* image) {
+  kernels::ConvPatches wrong = shape;
+  wrong.padding -= 1;
+  g_base->row2im(wrong, rows, ld, image);
 }
 void silu_backward_left_out(std::ptrdiff_t, const float*, const float*, float*) {}
 
@@ -263,20 +279,25 @@ struct Mutant {
 };
 
 std::vector<Mutant> mutants_of(const kernels::KernelSet& base) {
-  std::vector<Mutant> mutants(5, {"", base, false});
-  mutants[0].name = "im2col stride off by one";
-  mutants[0].set.im2col = im2col_stride_off_by_one;
-  mutants[0].forward_wrong = true;
-  mutants[1].name = "col2im window shifted";
-  mutants[1].set.col2im = col2im_window_shifted;
-  mutants[2].name = "product one k term short";
-  mutants[2].set.gemm = gemm_short_k;
-  mutants[2].forward_wrong = true;
-  mutants[3].name = "input gradient through W, not W^T";
-  mutants[3].set.gemm = gemm_untransposed_weights;
-  mutants[4].name = "SiLU' left out";
-  mutants[4].set.silu_backward = silu_backward_left_out;
-  return mutants;
+  using Set = kernels::KernelSet;
+  const auto mutant = [&](std::string name, bool forward_wrong, void (*plant)(Set&)) {
+    Mutant m{std::move(name), base, forward_wrong};
+    plant(m.set);
+    return m;
+  };
+  return {
+      mutant("im2col stride off by one", true,
+             [](Set& set) { set.im2col = im2col_stride_off_by_one; }),
+      mutant("col2im window shifted", false, [](Set& set) { set.col2im = col2im_window_shifted; }),
+      mutant("im2row stride off by one", true,
+             [](Set& set) { set.im2row = im2row_stride_off_by_one; }),
+      mutant("row2im window shifted", false, [](Set& set) { set.row2im = row2im_window_shifted; }),
+      mutant("product one k term short", true, [](Set& set) { set.gemm = gemm_short_k; }),
+      mutant("input gradient through W, not W^T", false,
+             [](Set& set) { set.gemm = gemm_untransposed_weights; }),
+      // Last: the gradient check below takes it.
+      mutant("SiLU' left out", false,
+             [](Set& set) { set.silu_backward = silu_backward_left_out; })};
 }
 
 ConvEncoder encoder_of(const Case& c, std::uint64_t seed) {

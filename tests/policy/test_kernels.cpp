@@ -116,8 +116,8 @@ struct Shape {
   int m, n, k;
 };
 
-// Edges of the blocking of both vector sets (MR 32 / 16, NR 12 / 6, KC 256, NC 384) and the
-// network's own shapes (57 -> 256 -> 256 -> 24 at batch 256 and 1).
+// Edges of the blocking of both vector sets (MR 32 / 16, NR 12 / 6, KC 256, NC 384; the short
+// tile's MR 16 / 8) and the network's own shapes (57 -> 256 -> 256 -> 24 at batch 256 and 1).
 const std::vector<Shape> kShapes = {
     {1, 1, 1},
     {3, 2, 5},
@@ -144,7 +144,14 @@ const std::vector<Shape> kShapes = {
     {260, 8, 40},
     {33, 9, 17},
     {400, 16, 5},
-    {17, 15, 64}};
+    {17, 15, 64},
+    // the one-vector tile of short products (m <= the lanes of a vector: 16 on AVX-512, 8 on
+    // AVX2, 4 on SSE4, 1 for the scalar code), beyond one k block and one column block
+    {16, 40, 300},
+    {9, 37, 20},
+    {8, 400, 31},
+    {4, 30, 5},
+    {1, 25, 9}};
 
 }  // namespace
 
@@ -175,7 +182,9 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
   std::mt19937_64 rng(12);
   for (const auto& [name, set] : every_target()) {
     INFO("target " << name);
-    for (const Shape& shape : {Shape{33, 13, 31}, Shape{256, 1, 256}}) {
+    // The blocked, narrow and short-tile products (m = 1, 4, 8, 16: each target's one vector).
+    for (const Shape& shape : {Shape{33, 13, 31}, Shape{256, 1, 256}, Shape{16, 40, 31},
+                               Shape{8, 40, 31}, Shape{4, 40, 31}, Shape{1, 40, 31}}) {
       GemmProblem problem(Op::none, Op::none, shape.m, shape.n, shape.k, 0, false, rng);
       set->gemm(problem.gemm());
       CHECK(gemm_error(problem) <= 1.0);

@@ -1,5 +1,5 @@
-// Private, per target: im2col and col2im (kernel_set.hpp, ConvPatches), the data movement around
-// the convolution's products; the products themselves are the GEMM driver's.
+// Private, per target: im2col and col2im, im2row and row2im (kernel_set.hpp, ConvPatches), the
+// data movement around the convolution's products; the products themselves are the GEMM driver's.
 
 #include <algorithm>
 #include <cstddef>
@@ -99,6 +99,95 @@ inline void Col2im(const ConvPatches& g, const float* patches, float* image) {
       }
     }
   }
+}
+
+/// For every patch entry p = (ky, kx, c) and every row of output pixels (b, oy): the output
+/// columns whose input column ox stride - padding + kx lies in the image, [ox_begin, ox_end), go
+/// to run(p, j, pixel, count): `count` pixels from output pixel j (the index (b, oy, ox) of
+/// ConvPatches) read image[pixel + i stride column_stride], i < count; the others, in the padding,
+/// go to padding(p, j, count).
+template <class Run, class Pad>
+HWY_INLINE void ForEachPatchLine(const ConvPatches& g, Run&& run, Pad&& padding) {
+  const int s = g.stride;
+  for (int ky = 0; ky < g.kernel; ++ky) {
+    for (int kx = 0; kx < g.kernel; ++kx) {
+      const int before = g.padding - kx, last = g.width - 1 + g.padding - kx;
+      const int ox_begin = std::min(g.out_width, before > 0 ? (before + s - 1) / s : 0);
+      const int ox_end = std::max(ox_begin, last < 0 ? 0 : std::min(g.out_width, last / s + 1));
+      const long column = static_cast<long>(ox_begin * s - g.padding + kx) * g.column_stride;
+      for (int c = 0; c < g.channels; ++c) {
+        const long p = (static_cast<long>(ky) * g.kernel + kx) * g.channels + c;
+        for (int b = 0; b < g.batch; ++b) {
+          for (int oy = 0; oy < g.out_height; ++oy) {
+            const long j = (static_cast<long>(b) * g.out_height + oy) * g.out_width;
+            const int iy = oy * s - g.padding + ky;
+            if (iy < 0 || iy >= g.height) {
+              padding(p, j, g.out_width);
+              continue;
+            }
+            padding(p, j, ox_begin);
+            run(p, j + ox_begin,
+                b * g.sample_stride + c * g.channel_stride + iy * g.row_stride + column,
+                ox_end - ox_begin);
+            padding(p, j + ox_end, g.out_width - ox_end);
+          }
+        }
+      }
+    }
+  }
+}
+
+/// out[i] = in[2 i], i < n: the even lanes of two vectors of `in` (its last odd entry unread).
+inline void CopyEvens(const float* in, float* out, std::ptrdiff_t n) {
+#if HWY_TARGET == HWY_SCALAR
+  for (std::ptrdiff_t i = 0; i < n; ++i) out[i] = in[2 * i];
+#else
+  const hn::ScalableTag<float> d;
+  const std::ptrdiff_t lanes = static_cast<std::ptrdiff_t>(hn::Lanes(d));
+  ForEachVector(d, n, [&](std::ptrdiff_t i, std::size_t count) HWY_ATTR {
+    const std::ptrdiff_t needed = 2 * static_cast<std::ptrdiff_t>(count) - 1;  // in[2i .. )
+    const auto lo = LoadPart(d, in + 2 * i, static_cast<std::size_t>(std::min(needed, lanes)));
+    const auto hi = needed > lanes
+                        ? LoadPart(d, in + 2 * i + lanes, static_cast<std::size_t>(needed - lanes))
+                        : hn::Zero(d);
+    StorePart(d, hn::ConcatEven(d, hi, lo), out + i, count);
+  });
+#endif
+}
+
+inline void Im2row(const ConvPatches& g, const float* image, float* rows, long ld) {
+  const hn::ScalableTag<float> d;
+  const long step = g.stride * g.column_stride;
+  ForEachPatchLine(
+      g,
+      [&](long p, long j, long pixel, int count) HWY_ATTR {
+        const float* in = image + pixel;
+        float* out = rows + j + p * ld;
+        if (step == 1) {
+          ForEachVector(d, count, [&](std::ptrdiff_t i, std::size_t n) HWY_ATTR {
+            StorePart(d, LoadPart(d, in + i, n), out + i, n);
+          });
+        } else if (step == 2) {
+          CopyEvens(in, out, count);
+        } else {
+          for (int i = 0; i < count; ++i) out[i] = in[i * step];
+        }
+      },
+      [&](long p, long j, int count) {
+        std::fill(rows + j + p * ld, rows + j + p * ld + count, 0.0f);
+      });
+}
+
+// Only the input gradient of a first layer runs it (training does not): a plain loop.
+inline void Row2im(const ConvPatches& g, const float* rows, long ld, float* image) {
+  const long step = g.stride * g.column_stride;
+  ForEachPatchLine(
+      g,
+      [&](long p, long j, long pixel, int count) {
+        const float* in = rows + j + p * ld;
+        for (int i = 0; i < count; ++i) image[pixel + i * step] += in[i];
+      },
+      [](long, long, int) {});
 }
 
 }  // namespace handcentric::policy::kernels::HWY_NAMESPACE

@@ -71,22 +71,27 @@ void NarrowProduct(int shift, int rows, int k, const float* a, long lda, const f
   }
 }
 
-/// The `Kernel` of gemm.hpp's driver. The register tile is two vectors of rows by NR columns:
-/// 2 NR accumulators plus two vectors of A and one broadcast of B, so NR = 12 uses 27 of
-/// AVX-512's 32 registers and NR = 6 uses 15 of AVX2's 16. Per k: 2 loads of A, NR broadcasts of
-/// B, 2 NR FMAs.
-struct GemmKernel {
-  static constexpr int MR = 2 * kLanes, NR = kRegisters == 32 ? 12 : 6;
+/// The `Kernel` of gemm.hpp's driver. The register tile is V vectors of rows by NR columns:
+/// V NR accumulators plus V vectors of A and one broadcast of B, so with V = 2, NR = 12 uses 27
+/// of AVX-512's 32 registers and NR = 6 uses 15 of AVX2's 16. Per k: V loads of A, NR broadcasts
+/// of B, V NR FMAs. V = 2 is the product's tile; V = 1 serves products of at most one vector of
+/// rows (a layer of 16 filters on AVX-512), which the two-vector tile would compute half of in
+/// zero padding. Each entry of C is the same sum in the same order whatever V, so both tiles give
+/// the same bits.
+template <int V>
+struct GemmKernelOf {
+  static_assert(V == 1 || V == 2, "one or two vectors of rows");
+  static constexpr int MR = V * kLanes, NR = kRegisters == 32 ? 12 : 6;
   static constexpr int kNarrowLanes = kLanes, kNarrowAccumulators = kRegisters == 32 ? 24 : 12;
   static constexpr int kNarrowGroup = kRegisters == 32 ? 8 : 4;
   /// Whether the narrow products start a shifted, masked head at a vector boundary: only where
   /// a masked load is one instruction; elsewhere the head would go through a buffer every k.
   static constexpr bool kAlignedHeads = kMaskedLoadInstructions;
-  template <int N, int V>
-  static constexpr auto narrow_block = &NarrowProduct<N, V>;
+  template <int N, int W>
+  static constexpr auto narrow_block = &NarrowProduct<N, W>;
   static constexpr SiluFunctions kSilu{SiluForward, SiluInPlace, SiluBackward};
 
-  // pack_a<MR> with vector moves: op(A) = A copies two (partial) vectors per k; op(A) = A^T
+  // pack_a<MR> with vector moves: op(A) = A copies V (partial) vectors per k; op(A) = A^T
   // gathers each row panel's k-th column (kLanes rows at stride lda) from rows that stay in L1.
   static void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out) {
     // Gather offsets are int32 byte offsets: beyond them, the scalar packing.
@@ -99,21 +104,25 @@ struct GemmKernel {
     const auto row_offsets = hn::Mul(hn::Iota(di, 0), hn::Set(di, lda));
     for (int panel = 0; panel < mc; panel += MR) {
       const int rows = std::min(MR, mc - panel);
-      const int rows0 = std::min(rows, kLanes), rows1 = rows - rows0;  // in each half of the panel
+      int part[V];  // the rows in each vector of the panel
+#pragma GCC unroll 2
+      for (int v = 0; v < V; ++v) part[v] = std::clamp(rows - v * kLanes, 0, kLanes);
       if (op == Op::none) {
         const float* column = a + (i0 + panel) + static_cast<long>(p0) * lda;
         for (int p = 0; p < kc; ++p, column += lda) {
-          hn::Store(LoadPart(d, column, rows0), d, out + p * MR);
-          hn::Store(LoadPart(d, column + kLanes, rows1), d, out + p * MR + kLanes);
+#pragma GCC unroll 2
+          for (int v = 0; v < V; ++v)
+            hn::Store(LoadPart(d, column + v * kLanes, part[v]), d, out + p * MR + v * kLanes);
         }
       } else {
-        const auto lanes0 = FirstLanes(d, rows0), lanes1 = FirstLanes(d, rows1);
-        // op(A)(i, p) = a[p + i lda]
+        // op(A)(i, p) = a[p + i lda]; a vector without rows gathers the first row again, masked.
         const float* row0 = a + p0 + static_cast<long>(i0 + panel) * lda;
-        const float* row1 = rows1 > 0 ? row0 + static_cast<long>(kLanes) * lda : row0;
-        for (int p = 0; p < kc; ++p) {
-          hn::Store(GatherRows(d, row0 + p, row_offsets, lanes0), d, out + p * MR);
-          hn::Store(GatherRows(d, row1 + p, row_offsets, lanes1), d, out + p * MR + kLanes);
+#pragma GCC unroll 2
+        for (int v = 0; v < V; ++v) {
+          const auto lanes = FirstLanes(d, part[v]);
+          const float* rows_v = part[v] > 0 ? row0 + static_cast<long>(v) * kLanes * lda : row0;
+          for (int p = 0; p < kc; ++p)
+            hn::Store(GatherRows(d, rows_v + p, row_offsets, lanes), d, out + p * MR + v * kLanes);
         }
       }
       out += static_cast<long>(kc) * MR;
@@ -125,39 +134,47 @@ struct GemmKernel {
   static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc,
                    bool accumulate, const float* bias) {
     const FloatTag d;
-    hn::Vec<FloatTag> acc[NR][2];
+    hn::Vec<FloatTag> acc[NR][V];
 #pragma GCC unroll 32
-    for (int j = 0; j < NR; ++j) acc[j][0] = acc[j][1] = hn::Zero(d);
+    for (int j = 0; j < NR; ++j) {
+#pragma GCC unroll 2
+      for (int v = 0; v < V; ++v) acc[j][v] = hn::Zero(d);
+    }
     for (int p = 0; p < kc; ++p) {
-      const auto a0 = hn::Load(d, a), a1 = hn::Load(d, a + kLanes);
+      hn::Vec<FloatTag> a_v[V];
+#pragma GCC unroll 2
+      for (int v = 0; v < V; ++v) a_v[v] = hn::Load(d, a + v * kLanes);
       hwy::Prefetch(a + 8 * MR);
 #pragma GCC unroll 32
       for (int j = 0; j < NR; ++j) {
         const auto bj =
             hn::Set(d, layout == BLayout::columns ? b[j * static_cast<long>(ldb)] : b[j]);
-        acc[j][0] = hn::MulAdd(a0, bj, acc[j][0]);
-        acc[j][1] = hn::MulAdd(a1, bj, acc[j][1]);
+#pragma GCC unroll 2
+        for (int v = 0; v < V; ++v) acc[j][v] = hn::MulAdd(a_v[v], bj, acc[j][v]);
       }
       a += MR;
       b += layout == BLayout::packed ? NR : layout == BLayout::rows ? ldb : 1;
     }
-    auto add0 = hn::Zero(d), add1 = hn::Zero(d);
-    if (!accumulate && bias != nullptr) {
-      add0 = hn::LoadU(d, bias);
-      add1 = hn::LoadU(d, bias + kLanes);
+    hn::Vec<FloatTag> add[V];
+#pragma GCC unroll 2
+    for (int v = 0; v < V; ++v) {
+      add[v] = !accumulate && bias != nullptr ? hn::LoadU(d, bias + v * kLanes) : hn::Zero(d);
     }
 #pragma GCC unroll 32
     for (int j = 0; j < NR; ++j) {
       float* cj = c + static_cast<long>(j) * ldc;
-      if (accumulate) {
-        add0 = hn::LoadU(d, cj);
-        add1 = hn::LoadU(d, cj + kLanes);
+#pragma GCC unroll 2
+      for (int v = 0; v < V; ++v) {
+        if (accumulate) add[v] = hn::LoadU(d, cj + v * kLanes);
+        hn::StoreU(hn::Add(acc[j][v], add[v]), d, cj + v * kLanes);
       }
-      hn::StoreU(hn::Add(acc[j][0], add0), d, cj);
-      hn::StoreU(hn::Add(acc[j][1], add1), d, cj + kLanes);
     }
   }
 };
+
+/// The product's register tile (two vectors of rows) and the one for short products.
+using GemmKernel = GemmKernelOf<2>;
+using ShortGemmKernel = GemmKernelOf<1>;
 
 }  // namespace handcentric::policy::kernels::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();

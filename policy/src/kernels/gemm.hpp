@@ -249,14 +249,19 @@ void narrow_gemm(const Gemm& g) {
 }
 
 /// KernelSet::gemm of a vector set: the degenerate shapes, the narrow products, or the blocked
-/// product, then the epilogue where the blocked nest has not applied it.
-template <typename Kernel>
+/// product, then the epilogue where the blocked nest has not applied it. The blocked product runs
+/// on ShortKernel, a tile of fewer rows (ShortKernel::MR < Kernel::MR), when op(A) has no more
+/// rows than it: Kernel's tile would spend the rest of its rows on zero padding.
+template <typename Kernel, typename ShortKernel>
 void vector_gemm(const Gemm& g) {
+  static_assert(ShortKernel::MR < Kernel::MR, "the short tile has fewer rows");
   if (trivial_gemm(g)) {
     apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
   } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
     narrow_gemm<Kernel>(g);
     apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
+  } else if (g.m <= ShortKernel::MR) {
+    blocked_gemm<ShortKernel>(g);
   } else {
     blocked_gemm<Kernel>(g);
   }

@@ -84,7 +84,7 @@ struct ExpPolynomial {
                                   4.1665795894e-2f, 1.6666665459e-1f, 5.0000001201e-1f};
 };
 
-/// The patches of a 2D convolution over a batch of images (conv_layer.hpp). Pixel (c, y, x) of
+/// The patches of a 2D convolution over a batch of images (conv2d.hpp). Pixel (c, y, x) of
 /// sample b is image[b sample_stride + c channel_stride + y row_stride + x column_stride], so one
 /// function reads both the encoder's input (channels, height, width) and its hidden maps (height,
 /// width, channels; channel_stride 1). Output pixel (oy, ox) sees input rows
@@ -117,6 +117,15 @@ struct KernelSet {
   /// col2im, im2col's adjoint: adds each entry of the K x N `patches` to the pixel it was read
   /// from (entries of the padding are dropped). `image` is accumulated into, not cleared.
   void (*col2im)(const ConvPatches& shape, const float* patches, float* image);
+  /// im2row: the patch matrix transposed, N x K with leading dimension `ld` >= N: entry (pixel j,
+  /// patch entry p) at rows[j + p ld], for a product that reads it as op(B) = B^T. A patch entry
+  /// over a row of output pixels reads one image row at the stride, which vector moves copy
+  /// (stride 1) or deinterleave (stride 2) where the columns are contiguous (column_stride 1: the
+  /// encoder's (channels, height, width) input, whose im2col would copy one float at a time).
+  void (*im2row)(const ConvPatches& shape, const float* image, float* rows, long ld);
+  /// row2im, im2row's adjoint: adds each entry of the N x K `rows` (ld) to the pixel it was read
+  /// from (padding dropped); `image` is accumulated into.
+  void (*row2im)(const ConvPatches& shape, const float* rows, long ld, float* image);
   /// The Highway target (HWY_AVX3, HWY_AVX2, ...) the functions are compiled for.
   std::int64_t target;
 };

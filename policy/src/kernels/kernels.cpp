@@ -23,7 +23,7 @@ HWY_BEFORE_NAMESPACE();
 namespace handcentric::policy::kernels::HWY_NAMESPACE {
 
 const KernelSet* TargetKernels() {
-  static constexpr KernelSet kSet{vector_gemm<GemmKernel>,
+  static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel>,
                                   SiluForward,
                                   SiluBackward,
                                   SiluInPlace,
@@ -31,6 +31,8 @@ const KernelSet* TargetKernels() {
                                   Adam,
                                   Im2col,
                                   Col2im,
+                                  Im2row,
+                                  Row2im,
                                   HWY_TARGET};
   return &kSet;
 }

@@ -10,8 +10,9 @@
 // (y out_width + x) out_channels + c.
 // All parameters live in one flat vector (W_1, b_1, W_2, b_2, ...), as the MLP keeps them
 // (conv2d.hpp gives a layer's layout), so that Adam, clipping and model files see one array.
-// float32 on the run-time dispatched kernels (kernels.hpp): im2col, then one product per layer
-// with the bias and SiLU in its epilogue; backward the two products of the gradients and col2im.
+// float32 on the run-time dispatched kernels (kernels.hpp): im2col (the first layer, which reads
+// the (channels, height, width) input: im2row, its transpose), then one product per layer with
+// the bias and SiLU in its epilogue; backward the two products of the gradients and col2im.
 #include <Eigen/Core>
 #include <random>
 #include <vector>
@@ -92,8 +93,9 @@ class ConvEncoder {
   std::vector<Eigen::Index> offsets_;
   Vector parameters_;
   Vector gradient_;
-  int batch_ = 0;                   ///< of the last forward()
-  std::vector<Vector> patches_;     ///< each layer's patch matrix (K x N) of the last forward()
+  int batch_ = 0;  ///< of the last forward()
+  /// each layer's patch matrix of the last forward(): K x N, the first layer's N x K (im2row)
+  std::vector<Vector> patches_;
   std::vector<Matrix> sigmoid_;     ///< sigmoid(z) of each layer (out size x B)
   std::vector<Matrix> activation_;  ///< SiLU(z) of each layer; the last one is the features
   std::vector<Matrix> delta_;  ///< d loss / d (each layer's output), kept: no reallocation per step

@@ -60,8 +60,9 @@ class MlpT {
   int layers() const { return static_cast<int>(widths_.size()) - 1; }
   Eigen::Map<const Matrix> W(int layer) const;
   Eigen::Map<const Vector> b(int layer) const;
-  /// The backward pass; returns the index into delta_ of d loss / d input when input_gradient.
-  int propagate(const Eigen::Ref<const Matrix>& d_output, bool input_gradient);
+  /// The backward pass: delta_[l + 1] = d loss / d z_l, and delta_[0] = d loss / d input when
+  /// input_gradient.
+  void propagate(const Eigen::Ref<const Matrix>& d_output, bool input_gradient);
 
   std::vector<int> widths_;
   Activation activation_ = Activation::silu;
@@ -71,7 +72,9 @@ class MlpT {
   std::vector<Matrix> z_;        ///< pre-activations of the last forward()
   std::vector<Matrix> sigmoid_;  ///< SiLU only: sigmoid(z_[l]) of the last forward()
   std::vector<Matrix> a_;        ///< a_[0] = input, a_[l] = act(z_[l-1])
-  Matrix delta_[2];
+  /// One buffer per layer boundary, each of one size: no reallocation from step to step
+  /// (delta_[0] is d loss / d input, delta_[l + 1] d loss / d z_l).
+  std::vector<Matrix> delta_;
   Vector ones_;  ///< float: batch ones, for db = delta 1
 };
 
