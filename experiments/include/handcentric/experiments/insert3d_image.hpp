@@ -78,6 +78,7 @@ struct Insert3dImageSettings {
   Insert3dImageChannels channels = Insert3dImageChannels::normals;
   int width = 32;
   int height = 24;
+  /// 50 deg scored the same within 30 trials (19 against 20 of 30 at 16000 steps).
   double fov_deg = 70.0;
   std::string encoder = "8,16,16";
   policy::ImageFeatures features = policy::ImageFeatures::flatten;
