@@ -162,12 +162,15 @@ const Insert3dCounts& set_counts(const Table2Row& row, int set) {
   return set == 0 ? row.train : set == 1 ? row.ood : row.random_se3;
 }
 
-// "depth 32 x 24, 70 deg, encoder 8,16,16, flatten"
+// "depth and surface normals, 32 x 24, 70 deg, encoder 8,16,16, flatten"
 std::string image_summary(const policy::PolicyConfig& config) {
+  const Insert3dImageChannels channels = insert3d_camera_of(config)->options().channels;
   std::ostringstream text;
-  text << to_string(insert3d_camera_of(config)->options().channels) << " " << config.image_width
-       << " x " << config.image_height << ", " << config.image_fov_deg << " deg, encoder "
-       << config.encoder << ", " << policy::to_string(config.image_features);
+  text << (channels == Insert3dImageChannels::normals ? "depth and surface normals"
+           : channels == Insert3dImageChannels::rgbd  ? "colour and depth"
+                                                      : "depth")
+       << ", " << config.image_width << " x " << config.image_height << ", " << config.image_fov_deg
+       << " deg, encoder " << config.encoder << ", " << policy::to_string(config.image_features);
   return text.str();
 }
 

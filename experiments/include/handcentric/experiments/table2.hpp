@@ -107,7 +107,7 @@ struct Table2Options {
 struct Table2Row {
   std::string method;  ///< the representation: hand_centric, relative or absolute
   policy::ObservationKind observation = policy::ObservationKind::key_points;
-  std::string image;  ///< image rows: the camera and encoder, e.g. "depth 32 x 24, 70 deg, ..."
+  std::string image;  ///< image rows: the camera and encoder, e.g. "depth, 32 x 24, 70 deg, ..."
   int demos = 0;
   std::uint64_t seed = 0;
   int steps = 0;               ///< Adam steps run
