@@ -74,7 +74,8 @@ class Insert3dHandCamera final : public policy::ImageSource {
 /// `train --observation image` and `table2 --observation image` (docs/SIM.md, "Image policies").
 struct Insert3dImageSettings {
   /// normals: on the tuning seeds (8000 steps) the hand-centric image policy inserts 14 of 30
-  /// with them and 2 of 30 with depth alone (docs/SIM.md, "Image policies").
+  /// with them and 2 of 30 with depth alone, 20 of 30 at the automatic budget (docs/SIM.md,
+  /// "Image policies").
   Insert3dImageChannels channels = Insert3dImageChannels::normals;
   int width = 32;
   int height = 24;
