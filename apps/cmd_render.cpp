@@ -57,12 +57,14 @@ int run_insert3d_render(const RenderOptions& options) {
   const sim::insert3d::TaskScene scene =
       sim::insert3d::sample_scene(distribution, options.seed, options.index);
   sim::insert3d::Rollout rollout;
+  sim::insert3d::DepthCamera camera;
   std::string what = "scene";
   if (options.scene) {
     rollout.world_T_hand = {scene.world_T_hand_start};
   } else {
     const LoadedInsert3dPolicy loaded = load_insert3d_policy(options.model);
     const ChunkPolicy& policy = *loaded.policy;
+    camera = loaded.camera;
     const sim::insert3d::CollisionChecker checker;
     rollout = sim::insert3d::rollout(policy, scene, sim::stream_seed(options.seed, options.index),
                                      checker, loaded.rollout_options);
@@ -76,7 +78,8 @@ int run_insert3d_render(const RenderOptions& options) {
   sim::write_png(options.out, experiments::draw_insert3d_rollout(scene, rollout, caption));
   std::cout << "wrote " << what << " to " << options.out << "\n";
   if (!options.camera_frames.empty()) {
-    sim::write_png(options.camera_frames, experiments::draw_insert3d_camera_frames(scene, rollout));
+    sim::write_png(options.camera_frames,
+                   experiments::draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, camera));
     std::cout << "wrote the hand camera's images of " << rollout.world_T_hand.size()
               << " poses (every 4th and the last) to " << options.camera_frames << "\n";
   }

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "image_options.hpp"
 #include "handcentric/experiments/table2.hpp"
 
 namespace handcentric::apps {
@@ -48,13 +49,16 @@ void add_table2_command(CLI::App& app, int& exit_code) {
                   "largest turn of a copy's hand, per rotation-vector axis (deg)")
       ->capture_default_str();
   cmd->add_option("--observation", *observations,
-                  "key_points and/or image (the hand camera's depth image through a CNN), one "
+                  "key_points and/or image (the hand camera's image through a CNN), one "
                   "set of rows each (comma-separated)")
       ->delimiter(',')
       ->check(CLI::IsMember({"key_points", "image"}))
       ->capture_default_str();
+  auto image = std::make_shared<ImageFlags>();
+  add_image_options(cmd, image);
   cmd->add_flag("--quiet", options->quiet, "no progress lines on stderr");
-  cmd->callback([options, observations, &exit_code] {
+  cmd->callback([options, observations, image, &exit_code] {
+    options->image = image->resolve();
     options->observations.clear();
     for (const std::string& name : *observations)
       options->observations.push_back(policy::parse_observation(name));

@@ -21,6 +21,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "image_options.hpp"
 #include "task_of_files.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
@@ -45,7 +46,7 @@ struct TrainOptions {
   std::string lr_schedule = policy::to_string(config.lr_schedule);
   std::string ddpm_prediction = policy::to_string(config.ddpm_prediction);
   std::string observation = policy::to_string(config.observation);
-  std::string image_channels = "depth";
+  std::shared_ptr<ImageFlags> image = std::make_shared<ImageFlags>();
   std::uint64_t seed = 1;
   int max_demos = 0;
   sim::TrainingData data;
@@ -74,7 +75,8 @@ int run_train(const TrainOptions& options) {
   config.ddpm_prediction = policy::parse_ddpm_prediction(options.ddpm_prediction);
   config.observation = policy::parse_observation(options.observation);
   const bool image = config.observation == policy::ObservationKind::image;
-  const auto channels = experiments::parse_insert3d_image_channels(options.image_channels);
+  std::shared_ptr<const experiments::Insert3dHandCamera> camera;
+  if (image) camera = options.image->resolve().apply(config);
   make_representation(config.representation);  // an unknown name fails before the demos load
   if (config.steps < 0) {
     throw InvalidArgument("--steps must be >= 1, or 0 for the automatic budget, got " +
@@ -143,12 +145,6 @@ int run_train(const TrainOptions& options) {
     if (terminal && p.step == p.steps) std::fprintf(stderr, "\n");
   };
   const auto start = std::chrono::steady_clock::now();
-  std::shared_ptr<const policy::ImageSource> camera;
-  if (image) {
-    experiments::Insert3dHandCameraOptions camera_options;
-    camera_options.channels = channels;
-    camera = std::make_shared<const experiments::Insert3dHandCamera>(camera_options);
-  }
   const policy::LearnedPolicy trained =
       policy::train_policy(config, scenes, options.seed, progress, report_every, camera);
   policy::save_model(trained, options.out);
@@ -160,7 +156,9 @@ int run_train(const TrainOptions& options) {
                     ? " (" + std::to_string(data.perturbed_copies) + " perturbed copies each)"
                     : "")
             << " (task " << config.task
-            << (image ? ", " + camera->name() + ", encoder " + config.encoder : std::string())
+            << (image ? ", " + camera->name() + ", encoder " + config.encoder + " " +
+                            policy::to_string(config.image_features)
+                      : std::string())
             << "): " << config.steps << " steps, final loss " << last_loss << ", "
             << static_cast<long>(last_rate) << " samples/s ("
             << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
@@ -246,14 +244,7 @@ void add_train_command(CLI::App& app, int& exit_code) {
                   "end to end (head flow)")
       ->check(CLI::IsMember({"key_points", "image"}))
       ->capture_default_str();
-  cmd->add_option("--encoder", config.encoder,
-                  "--observation image: out channels of each 3x3 stride-2 convolution, "
-                  "comma-separated")
-      ->capture_default_str();
-  cmd->add_option("--image-channels", options->image_channels,
-                  "--observation image: depth, or rgbd (the camera's shaded colour and depth)")
-      ->check(CLI::IsMember({"depth", "rgbd"}))
-      ->capture_default_str();
+  add_image_options(cmd, options->image);
   cmd->add_flag("--quiet", options->quiet, "no progress display");
   cmd->callback([options, &exit_code] { exit_code = run_train(*options); });
 }

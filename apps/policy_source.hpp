@@ -6,6 +6,7 @@
 
 #include "handcentric/core/chunk_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
+#include "handcentric/sim/insert3d/camera.hpp"
 #include "handcentric/sim/insert3d/rollout.hpp"
 #include "handcentric/sim/rollout.hpp"
 
@@ -31,6 +32,9 @@ LoadedPolicy load_chunk_policy(const std::string& model_path, const std::string&
 struct LoadedInsert3dPolicy {
   std::shared_ptr<const ChunkPolicy> policy;
   sim::insert3d::RolloutOptions rollout_options;
+  /// The camera the frames of a rollout are drawn with: an image model's own (its size and
+  /// field of view), else the task's.
+  sim::insert3d::DepthCamera camera;
 };
 LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
                                           const policy::SamplingOverrides& overrides = {});

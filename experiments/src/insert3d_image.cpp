@@ -1,6 +1,7 @@
 #include "handcentric/experiments/insert3d_image.hpp"
 
 #include <Eigen/Geometry>
+#include <charconv>
 #include <cmath>
 
 #include "handcentric/core/errors.hpp"
@@ -10,13 +11,22 @@
 namespace handcentric::experiments {
 
 std::string to_string(Insert3dImageChannels channels) {
-  return channels == Insert3dImageChannels::rgbd ? "rgbd" : "depth";
+  switch (channels) {
+    case Insert3dImageChannels::rgbd:
+      return "rgbd";
+    case Insert3dImageChannels::normals:
+      return "normals";
+    case Insert3dImageChannels::depth:
+      break;
+  }
+  return "depth";
 }
 
 Insert3dImageChannels parse_insert3d_image_channels(const std::string& name) {
   if (name == "depth") return Insert3dImageChannels::depth;
   if (name == "rgbd") return Insert3dImageChannels::rgbd;
-  throw InvalidArgument("unknown image channels '" + name + "': use depth or rgbd");
+  if (name == "normals") return Insert3dImageChannels::normals;
+  throw InvalidArgument("unknown image channels '" + name + "': use depth, rgbd or normals");
 }
 
 namespace {
@@ -50,6 +60,50 @@ RigidTransform hand_T_slot_of(const std::vector<Eigen::Vector3d>& hand_points) {
 
 }  // namespace
 
+// The points depth * pixel_ray of the pixel's neighbours, along each axis the neighbour whose
+// depth is nearest the pixel's (the same surface, but at a one-pixel sliver), crossed and turned
+// toward the camera.
+std::vector<Eigen::Vector3d> normals_from_depth(const CameraImage& picture,
+                                                const PinholeCamera& camera) {
+  const int w = picture.width, h = picture.height;
+  const auto point = [&](int row, int col) {
+    return Eigen::Vector3d(picture.depth_at(row, col) * camera.pixel_ray(row, col));
+  };
+  const auto seen = [&](int row, int col) { return picture.depth_at(row, col) < camera.max_range; };
+  // The step (+-1) toward the neighbour along one axis nearest in depth, or 0 for none seen.
+  const auto step = [&](int row, int col, int d_row, int d_col) {
+    int best = 0;
+    double nearest = INFINITY;
+    for (int s : {1, -1}) {
+      const int r = row + s * d_row, c = col + s * d_col;
+      if (r < 0 || r >= h || c < 0 || c >= w || !seen(r, c)) continue;
+      const double gap = std::abs(picture.depth_at(r, c) - picture.depth_at(row, col));
+      if (gap < nearest) {
+        nearest = gap;
+        best = s;
+      }
+    }
+    return best;
+  };
+  std::vector<Eigen::Vector3d> normals(static_cast<std::size_t>(w) * h, Eigen::Vector3d::Zero());
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      if (!seen(row, col)) continue;
+      const int sx = step(row, col, 0, 1), sy = step(row, col, 1, 0);
+      if (sx == 0 || sy == 0) continue;
+      const Eigen::Vector3d p = point(row, col);
+      const Eigen::Vector3d along_x = sx * (point(row, col + sx) - p);
+      const Eigen::Vector3d along_y = sy * (point(row + sy, col) - p);
+      Eigen::Vector3d n = along_x.cross(along_y);
+      if (!(n.norm() > 1e-12)) continue;
+      n.normalize();
+      if (n.dot(p) > 0.0) n = -n;  // toward the camera
+      normals[static_cast<std::size_t>(row) * w + col] = n;
+    }
+  }
+  return normals;
+}
+
 Insert3dHandCamera::Insert3dHandCamera(Insert3dHandCameraOptions options)
     : options_(std::move(options)) {
   options_.camera.validate();
@@ -63,8 +117,10 @@ std::string Insert3dHandCamera::name() const {
 }
 
 policy::ImageShape Insert3dHandCamera::shape() const {
-  return policy::ImageShape{options_.channels == Insert3dImageChannels::rgbd ? 4 : 1,
-                            options_.camera.height, options_.camera.width};
+  const int channels = options_.channels == Insert3dImageChannels::rgbd      ? 4
+                       : options_.channels == Insert3dImageChannels::normals ? 3
+                                                                             : 1;
+  return policy::ImageShape{channels, options_.camera.height, options_.camera.width};
 }
 
 CameraImage Insert3dHandCamera::render_image(const Scene& observation) const {
@@ -97,6 +153,13 @@ void Insert3dHandCamera::render(const Scene& observation, Eigen::Ref<Eigen::Vect
         image[channel * pixels + p] = picture.rgb[static_cast<std::size_t>(3 * p + c)];
     }
   }
+  if (options_.channels == Insert3dImageChannels::normals) {
+    const std::vector<Eigen::Vector3d> normals = normals_from_depth(picture, options_.camera);
+    for (int c = 0; c < 2; ++c, ++channel) {
+      for (Eigen::Index p = 0; p < pixels; ++p)
+        image[channel * pixels + p] = normals[static_cast<std::size_t>(p)][c];
+    }
+  }
   for (Eigen::Index p = 0; p < pixels; ++p)
     image[channel * pixels + p] = picture.depth[static_cast<std::size_t>(p)];
 }
@@ -110,12 +173,52 @@ std::shared_ptr<const Insert3dHandCamera> insert3d_camera_of(const policy::Polic
                           " has no hand camera: give an image model of the 3D task (insert3d)");
   }
   Insert3dHandCameraOptions options;
-  options.channels =
-      config.image_channels == 4 ? Insert3dImageChannels::rgbd : Insert3dImageChannels::depth;
+  options.channels = config.image_channels == 4   ? Insert3dImageChannels::rgbd
+                     : config.image_channels == 3 ? Insert3dImageChannels::normals
+                                                  : Insert3dImageChannels::depth;
   options.camera.width = config.image_width;
   options.camera.height = config.image_height;
+  options.camera.horizontal_fov_deg = config.image_fov_deg;
   options.floor = floor;
   return std::make_shared<const Insert3dHandCamera>(options);
+}
+
+std::shared_ptr<const Insert3dHandCamera> Insert3dImageSettings::apply(
+    policy::PolicyConfig& config) const {
+  Insert3dHandCameraOptions options;
+  options.channels = channels;
+  options.camera.width = width;
+  options.camera.height = height;
+  options.camera.horizontal_fov_deg = fov_deg;
+  auto camera = std::make_shared<const Insert3dHandCamera>(options);  // checks the camera
+  config.observation = policy::ObservationKind::image;
+  const policy::ImageShape shape = camera->shape();
+  config.image_channels = shape.channels;
+  config.image_height = shape.height;
+  config.image_width = shape.width;
+  config.image_fov_deg = fov_deg;
+  config.encoder = encoder;
+  config.image_features = features;
+  return camera;
+}
+
+std::pair<int, int> parse_image_size(const std::string& text) {
+  const std::size_t x = text.find('x');
+  int width = 0, height = 0;
+  bool ok = x != std::string::npos;
+  if (ok) {
+    const auto [w_end, w_ec] = std::from_chars(text.data(), text.data() + x, width);
+    const auto [h_end, h_ec] =
+        std::from_chars(text.data() + x + 1, text.data() + text.size(), height);
+    ok = w_ec == std::errc() && h_ec == std::errc() && w_end == text.data() + x &&
+         h_end == text.data() + text.size() && width >= 1 && height >= 1 && width <= 4096 &&
+         height <= 4096;
+  }
+  if (!ok) {
+    throw InvalidArgument("image size '" + text +
+                          "' is not WIDTHxHEIGHT with each 1..4096: give e.g. 64x48");
+  }
+  return {width, height};
 }
 
 policy::LearnedPolicy with_task_camera(const policy::LearnedPolicy& model, bool floor) {

@@ -145,6 +145,13 @@ void Table2Options::validate() const {
     throw InvalidArgument("table2: no observation: give key_points, image or both");
   for (const std::string& method : methods) make_representation(method);  // names the valid ones
   perturbation.validate();
+  if (std::find(observations.begin(), observations.end(), policy::ObservationKind::image) !=
+      observations.end()) {
+    policy::PolicyConfig config;
+    config.task = policy::kTaskInsert3d;
+    image.apply(config);
+    config.validate();
+  }
 }
 
 namespace {
@@ -155,6 +162,18 @@ const Insert3dCounts& set_counts(const Table2Row& row, int set) {
   return set == 0 ? row.train : set == 1 ? row.ood : row.random_se3;
 }
 
+// "depth and surface normals, 32 x 24, 70 deg, encoder 8,16,16, flatten"
+std::string image_summary(const policy::PolicyConfig& config) {
+  const Insert3dImageChannels channels = insert3d_camera_of(config)->options().channels;
+  std::ostringstream text;
+  text << (channels == Insert3dImageChannels::normals ? "depth and surface normals"
+           : channels == Insert3dImageChannels::rgbd  ? "colour and depth"
+                                                      : "depth")
+       << ", " << config.image_width << " x " << config.image_height << ", " << config.image_fov_deg
+       << " deg, encoder " << config.encoder << ", " << policy::to_string(config.image_features);
+  return text.str();
+}
+
 Table2Row run_method(const Table2Options& options, const std::string& method,
                      policy::ObservationKind observation, const std::vector<Scene>& scenes) {
   policy::PolicyConfig config;
@@ -163,10 +182,11 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
   config.steps = options.steps;
   config.observation = observation;
   const bool image = observation == policy::ObservationKind::image;
+  std::shared_ptr<const Insert3dHandCamera> camera;
+  if (image) camera = options.image.apply(config);
   const auto start = std::chrono::steady_clock::now();
   const auto model = std::make_shared<const policy::LearnedPolicy>(
-      image ? policy::train_policy(config, scenes, options.seed, {}, 100,
-                                   std::make_shared<const Insert3dHandCamera>())
+      image ? policy::train_policy(config, scenes, options.seed, {}, 100, camera)
             : policy::train_policy(config, with_slot_key_points(scenes), options.seed));
   const double train_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -176,6 +196,7 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
   Table2Row row;
   row.method = method;
   row.observation = observation;
+  if (image) row.image = image_summary(model->config());
   row.train_seconds = train_seconds;
   row.demos = options.demos;
   row.seed = options.seed;
@@ -271,6 +292,7 @@ std::string table2_json(const std::vector<Table2Row>& rows) {
                         {"eval_seed", row.seed + 1},
                         {"steps", row.steps},
                         {"train_seconds", row.train_seconds}};
+    if (!row.image.empty()) r["image"] = row.image;
     for (int set = 0; set < 3; ++set) {
       const Insert3dCounts& c = set_counts(row, set);
       const Interval ci = wilson_interval(c.success, c.trials);
@@ -301,8 +323,8 @@ std::string table2_markdown(const std::vector<Table2Row>& rows) {
   }
   for (const Table2Row& row : rows) {
     if (row.observation != policy::ObservationKind::image) continue;
-    md << "Rows marked (image) see no key points: the hand camera's depth image (32 x 24) "
-          "through a small CNN trained end to end with the flow head "
+    md << "Rows marked (image) see no key points: the hand camera's image (" << row.image
+       << ") through a small CNN trained end to end with the flow head "
           "(experiments/insert3d_image.hpp).\n\n";
     break;
   }

@@ -81,6 +81,16 @@ ObservationKind parse_observation(const std::string& name) {
   throw InvalidArgument("unknown observation '" + name + "': use key_points or image");
 }
 
+std::string to_string(ImageFeatures features) {
+  return features == ImageFeatures::spatial_softmax ? "spatial_softmax" : "flatten";
+}
+
+ImageFeatures parse_image_features(const std::string& name) {
+  if (name == "flatten") return ImageFeatures::flatten;
+  if (name == "spatial_softmax") return ImageFeatures::spatial_softmax;
+  throw InvalidArgument("unknown image features '" + name + "': use flatten or spatial_softmax");
+}
+
 DdpmPrediction parse_ddpm_prediction(const std::string& name) {
   if (name == "epsilon") return DdpmPrediction::epsilon;
   if (name == "sample") return DdpmPrediction::sample;
@@ -178,6 +188,11 @@ const std::vector<Field>& fields() {
       HC_INT_FIELD(image_width),
       Field{"encoder", [](const PolicyConfig& c) { return c.encoder; },
             [](PolicyConfig& c, const std::string& v) { c.encoder = v; }},
+      Field{"image_features", [](const PolicyConfig& c) { return to_string(c.image_features); },
+            [](PolicyConfig& c, const std::string& v) {
+              c.image_features = parse_image_features(v);
+            }},
+      HC_DOUBLE_FIELD(image_fov_deg),
   };
   return all;
 }
@@ -239,38 +254,49 @@ void PolicyConfig::validate() const {
   if (observation == ObservationKind::image) {
     require(head == HeadKind::flow, "head", to_string(head),
             "flow (the only head with an image encoder; or use observation key_points)");
-    require(image_channels == 0 || image_channels == 1 || image_channels == 4, "image_channels",
-            s(image_channels), "1 (depth) or 4 (rgbd), 0 before training");
+    require(
+        image_channels == 0 || image_channels == 1 || image_channels == 3 || image_channels == 4,
+        "image_channels", s(image_channels),
+        "1 (depth), 3 (depth with normals) or 4 (rgbd), 0 before training");
     require(image_height >= 0 && image_height <= 4096, "image_height", s(image_height), "0..4096");
     require(image_width >= 0 && image_width <= 4096, "image_width", s(image_width), "0..4096");
-    parse_encoder_channels(encoder);  // names the bad entry
+    parse_encoder(encoder);  // names the bad entry
+    require(std::isfinite(image_fov_deg) && image_fov_deg > 0.0 && image_fov_deg < 170.0,
+            "image_fov_deg", format_number(image_fov_deg), "(0, 170)");
     require(observation_dimension == 0 || observation_dimension >= image_size(),
             "observation_dimension", s(observation_dimension),
             ">= the image's " + s(image_size()) + " values");
   }
 }
 
-std::vector<int> parse_encoder_channels(const std::string& text) {
-  std::vector<int> channels;
+std::vector<EncoderLayerSetting> parse_encoder(const std::string& text) {
+  std::vector<EncoderLayerSetting> layers;
   std::size_t begin = 0;
   while (begin <= text.size()) {
     const std::size_t comma = std::min(text.find(',', begin), text.size());
-    const std::string item = text.substr(begin, comma - begin);
-    int value = 0;
-    const auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), value);
-    if (ec != std::errc() || end != item.data() + item.size() || value < 1 || value > 256) {
-      throw InvalidArgument("encoder '" + text + "': '" + item +
-                            "' is not a channel count 1..256; give the out_channels of each layer "
-                            "comma-separated, e.g. 8,16");
+    std::string item = text.substr(begin, comma - begin);
+    EncoderLayerSetting layer;
+    std::string count = item;
+    if (count.size() > 2 && count.ends_with("/1")) {
+      count.resize(count.size() - 2);
+      layer.stride = 1;
     }
-    channels.push_back(value);
+    const auto [end, ec] =
+        std::from_chars(count.data(), count.data() + count.size(), layer.channels);
+    if (ec != std::errc() || end != count.data() + count.size() || layer.channels < 1 ||
+        layer.channels > 256) {
+      throw InvalidArgument("encoder '" + text + "': '" + item +
+                            "' is not a channel count 1..256 (with /1 for stride 1); give the "
+                            "out_channels of each layer comma-separated, e.g. 8,16/1");
+    }
+    layers.push_back(layer);
     begin = comma + 1;
   }
-  if (channels.size() > 6) {
-    throw InvalidArgument("encoder '" + text + "' has " + std::to_string(channels.size()) +
+  if (layers.size() > 6) {
+    throw InvalidArgument("encoder '" + text + "' has " + std::to_string(layers.size()) +
                           " layers: give 1 to 6");
   }
-  return channels;
+  return layers;
 }
 
 std::string PolicyConfig::to_text() const {

@@ -95,12 +95,11 @@ std::uint64_t parameter_count(const PolicyConfig& config) {
   }
   if (config.observation == ObservationKind::image) {
     check_image_config(config, "parameter_count");
-    const ConvEncoder encoder = config_encoder(config);
+    const auto features = static_cast<std::uint64_t>(image_feature_rows(config));
     return mlp_parameter_count(
-               actions + time +
-                   static_cast<std::uint64_t>(config.proprio_dimension() + encoder.output_size()),
+               actions + time + static_cast<std::uint64_t>(config.proprio_dimension()) + features,
                config, actions) +
-           static_cast<std::uint64_t>(encoder.parameter_count());
+           static_cast<std::uint64_t>(config_encoder(config).parameter_count());
   }
   return mlp_parameter_count(actions + time + observations, config, actions);
 }

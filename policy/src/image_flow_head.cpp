@@ -16,8 +16,8 @@ ImageShape config_image_shape(const PolicyConfig& config) {
 
 std::vector<ConvLayerSpec> config_encoder_layers(const PolicyConfig& config) {
   std::vector<ConvLayerSpec> layers;
-  for (int channels : parse_encoder_channels(config.encoder))
-    layers.push_back(ConvLayerSpec{channels, 3, 2, 1});
+  for (const EncoderLayerSetting& layer : parse_encoder(config.encoder))
+    layers.push_back(ConvLayerSpec{layer.channels, 3, layer.stride, 1});
   return layers;
 }
 
@@ -25,9 +25,16 @@ ConvEncoder config_encoder(const PolicyConfig& config) {
   return ConvEncoder(config_image_shape(config), config_encoder_layers(config));
 }
 
+int image_feature_rows(const PolicyConfig& config) {
+  const ConvEncoder encoder = config_encoder(config);
+  return static_cast<int>(config.image_features == ImageFeatures::spatial_softmax
+                              ? 2 * encoder.output_shape().channels
+                              : encoder.output_size());
+}
+
 namespace {
 int network_observation_rows(const PolicyConfig& config) {
-  return config.proprio_dimension() + static_cast<int>(config_encoder(config).output_size());
+  return config.proprio_dimension() + image_feature_rows(config);
 }
 }  // namespace
 
@@ -35,6 +42,8 @@ ImageFlowHead::ImageFlowHead(const PolicyConfig& config)
     : FlowHead(config, network_observation_rows(config)),
       proprio_rows_(config.proprio_dimension()),
       encoder_(config_encoder(config)),
+      keypoints_(config.image_features == ImageFeatures::spatial_softmax),
+      spatial_softmax_(encoder_.output_shape()),
       encoder_adam_(encoder_.parameter_count(),
                     AdamOptions{config.learning_rate, 0.9, 0.999, 1e-8, config.weight_decay}),
       encoder_average_(config.ema_decay) {}
@@ -45,9 +54,10 @@ void ImageFlowHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixX
   encoder_.initialize(rng);
 }
 
-Eigen::MatrixXf ImageFlowHead::network_observation(ConvEncoder& encoder,
+Eigen::MatrixXf ImageFlowHead::network_observation(ConvEncoder& encoder, SpatialSoftmax& softmax,
                                                    const Eigen::MatrixXf& o) const {
-  const Eigen::MatrixXf& features = encoder.forward(o.bottomRows(o.rows() - proprio_rows_));
+  const Eigen::MatrixXf& maps = encoder.forward(o.bottomRows(o.rows() - proprio_rows_));
+  const Eigen::MatrixXf& features = keypoints_ ? softmax.forward(maps) : maps;
   Eigen::MatrixXf out(proprio_rows_ + features.rows(), o.cols());
   out.topRows(proprio_rows_) = o.topRows(proprio_rows_);
   out.bottomRows(features.rows()) = features;
@@ -60,14 +70,18 @@ double ImageFlowHead::train_step(const Eigen::MatrixXf& actions,
   o_ = observations;
   action_normalizer_.normalize(a_);
   observation_normalizer_.normalize(o_);
-  network_o_ = network_observation(encoder_, o_);
+  network_o_ = network_observation(encoder_, spatial_softmax_, o_);
   draw_flow_sample(rng);
   assemble(x_, t_, network_o_, input_);
   const double loss = mse_loss<float>(network_.forward(input_), target_, d_output_);
   // End to end: the MLP's input gradient, its feature rows (the last ones), into the encoder.
   const Eigen::MatrixXf& d_input = network_.backward(d_output_);
-  const Eigen::Index feature_rows = encoder_.output_size();
-  encoder_.backward_parameters(d_input.bottomRows(feature_rows));
+  const Eigen::Index features = network_o_.rows() - proprio_rows_;
+  if (keypoints_) {
+    encoder_.backward_parameters(spatial_softmax_.backward(d_input.bottomRows(features)));
+  } else {
+    encoder_.backward_parameters(d_input.bottomRows(features));
+  }
   // One clip over both gradients: the norm of their concatenation.
   double scale = 1.0;
   if (config_.gradient_clip > 0.0) {
@@ -90,7 +104,8 @@ Eigen::MatrixXf ImageFlowHead::sample(const Eigen::MatrixXf& observations,
   // forward() keeps its activations, so a const sampler runs a copy (a few thousand weights):
   // one policy may act from several threads.
   ConvEncoder encoder = encoder_;
-  const Eigen::MatrixXf network_o = network_observation(encoder, o);
+  SpatialSoftmax softmax = spatial_softmax_;
+  const Eigen::MatrixXf network_o = network_observation(encoder, softmax, o);
   return sample_normalized(network_o, rng);
 }
 

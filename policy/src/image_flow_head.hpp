@@ -5,6 +5,9 @@
 //
 //   MLP input = [x (actions), time features, proprioception, encoder(image) features]
 //
+// The features are the encoder's last map flattened, or with image_features = spatial_softmax
+// one soft-argmax point (x, y) per channel of it (spatial_softmax.hpp).
+//
 // Trained end to end: eq. (5)'s loss is backpropagated through the MLP into the features and on
 // through the encoder (ConvEncoder::backward_parameters); the MLP's and the encoder's gradients
 // are clipped together by their joint norm, and each set of weights takes the same Adam step (Adam
@@ -15,15 +18,19 @@
 
 #include "flow_head.hpp"
 #include "handcentric/policy/conv_encoder.hpp"
+#include "handcentric/policy/spatial_softmax.hpp"
 
 namespace handcentric::policy {
 
 /// config's image (image_channels, image_height, image_width).
 ImageShape config_image_shape(const PolicyConfig& config);
-/// config.encoder as layers: each a 3 x 3 convolution, stride 2, padding 1.
+/// config.encoder as layers: each a 3 x 3 convolution, stride 2 (or 1), padding 1.
 std::vector<ConvLayerSpec> config_encoder_layers(const PolicyConfig& config);
 /// The encoder an image config describes (weights zero). Throws InvalidArgument for a bad one.
 ConvEncoder config_encoder(const PolicyConfig& config);
+/// The features the MLP gets in the pixels' place: the encoder's output, or 2 per channel of
+/// its last map with spatial_softmax.
+int image_feature_rows(const PolicyConfig& config);
 
 class ImageFlowHead final : public FlowHead {
  public:
@@ -42,11 +49,15 @@ class ImageFlowHead final : public FlowHead {
   const ConvEncoder& encoder() const { return encoder_; }
 
  private:
-  /// [proprioception; features] of normalized observations o, with `encoder` run forward.
-  Eigen::MatrixXf network_observation(ConvEncoder& encoder, const Eigen::MatrixXf& o) const;
+  /// [proprioception; features] of normalized observations o, with `encoder` (and `softmax`
+  /// for spatial_softmax features) run forward.
+  Eigen::MatrixXf network_observation(ConvEncoder& encoder, SpatialSoftmax& softmax,
+                                      const Eigen::MatrixXf& o) const;
 
   int proprio_rows_ = 0;
   ConvEncoder encoder_;
+  bool keypoints_ = false;  ///< image_features = spatial_softmax
+  SpatialSoftmax spatial_softmax_;
   Adam encoder_adam_;
   WeightAverage encoder_average_;
   Eigen::MatrixXf network_o_;

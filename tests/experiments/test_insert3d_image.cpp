@@ -4,6 +4,9 @@
 // Theorem 1), and a table fixed in the world, in view, breaks that for every g that tilts it.
 #include <catch2/catch.hpp>
 
+#include <numbers>
+#include <utility>
+
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/experiments/insert3d_drawing.hpp"
@@ -108,4 +111,91 @@ TEST_CASE("the_camera_frames_show_every_fourth_pose_and_the_last", "[unit]") {
   CHECK(two_rows.height == 2 * (96 + 18 + 6) + 6);
   CHECK_THROWS_AS(draw_insert3d_camera_frames(scene, rollout, 0), InvalidArgument);
   CHECK_THROWS_AS(draw_insert3d_camera_frames(scene, insert3d::Rollout{}), InvalidArgument);
+}
+
+TEST_CASE("image_settings_make_the_camera_the_model_records_and_gets_back", "[unit]") {
+  Insert3dImageSettings settings;
+  settings.width = 48;
+  settings.height = 36;
+  settings.fov_deg = 50.0;
+  settings.encoder = "8,16/1";
+  settings.features = policy::ImageFeatures::spatial_softmax;
+  policy::PolicyConfig config;
+  config.task = policy::kTaskInsert3d;
+  const auto camera = settings.apply(config);
+  CHECK(camera->shape() == policy::ImageShape{3, 36, 48});  // the default channels: normals
+  CHECK(config.observation == policy::ObservationKind::image);
+  CHECK((config.image_width == 48 && config.image_height == 36 && config.image_fov_deg == 50.0));
+  CHECK((config.encoder == "8,16/1" &&
+         config.image_features == policy::ImageFeatures::spatial_softmax));
+  // The camera a loaded model gets back is the one it was trained with, field of view too: the
+  // same pixels. Planted fault: the default 70 deg camera of that size sees another image.
+  const auto rebuilt = insert3d_camera_of(config);
+  CHECK(rebuilt->options().camera.horizontal_fov_deg == 50.0);
+  const Scene observation = task_observation(1);
+  CHECK(image_of(*rebuilt, observation) == image_of(*camera, observation));
+  Insert3dHandCameraOptions seventy;
+  seventy.channels = Insert3dImageChannels::normals;
+  seventy.camera.width = 48;
+  seventy.camera.height = 36;
+  CHECK(image_of(Insert3dHandCamera(seventy), observation) != image_of(*camera, observation));
+  // A narrower camera is still only a function of the hand-frame points.
+  CHECK(largest_change_under_g(*camera, 7) == 0.0);
+}
+
+TEST_CASE("image_sizes_and_fields_of_view_are_checked_with_the_value_and_the_fix", "[unit]") {
+  CHECK(parse_image_size("64x48") == std::pair<int, int>{64, 48});
+  for (const char* bad : {"64", "64x", "x48", "64x48x2", "0x48", "64x-1", "64 x 48", "5000x48"}) {
+    INFO(bad);
+    CHECK_THROWS_WITH(parse_image_size(bad), Catch::Contains(std::string("'") + bad + "'") &&
+                                                 Catch::Contains("e.g. 64x48"));
+  }
+  Insert3dImageSettings settings;
+  settings.fov_deg = 175.0;
+  policy::PolicyConfig config;
+  CHECK_THROWS_AS(settings.apply(config), InvalidArgument);
+}
+
+TEST_CASE("normals_from_depth_are_exact_on_a_plane_and_invariant_under_g", "[unit]") {
+  // A floor tilted 20 deg about the camera's x and 10 about its y, 30 cm in front of it: every
+  // pixel that sees it gets its normal from the depths alone, to rounding.
+  PinholeCamera camera{32, 24, 70.0, 200.0};
+  const Rotation tilt = Rotation::exp(Eigen::Vector3d(20.0, 10.0, 0.0) * std::numbers::pi / 180.0);
+  // The plane's +z faces the camera (which looks along +z): turned half a turn about x.
+  const Rotation facing = tilt * Rotation::exp(Eigen::Vector3d(std::numbers::pi, 0.0, 0.0));
+  const RigidTransform camera_T_plane(facing, Eigen::Vector3d(0.0, 0.0, 30.0));
+  const CameraImage picture = render({Solid::plane(camera_T_plane, Eigen::Vector3d(0.5, 0.5, 0.5))},
+                                     camera, RigidTransform::identity());
+  const Eigen::Vector3d truth = facing.matrix().col(2);
+  REQUIRE(truth.z() < 0.0);  // toward the camera
+  const auto worst_error = [&](const PinholeCamera& assumed) {
+    double worst = 0.0;
+    int seen = 0;
+    const std::vector<Eigen::Vector3d> normals = normals_from_depth(picture, assumed);
+    for (std::size_t p = 0; p < normals.size(); ++p) {
+      if (picture.depth[p] >= camera.max_range) continue;
+      ++seen;
+      worst = std::max(worst, (normals[p] - truth).norm());
+    }
+    CHECK(seen > 300);
+    return worst;
+  };
+  CHECK(worst_error(camera) < 1e-9);
+  // Planted fault: the rays of another camera (60 deg) bend the plane's points.
+  PinholeCamera other = camera;
+  other.horizontal_fov_deg = 60.0;
+  CHECK(worst_error(other) > 1e-2);
+  // The task's normals image is a function of hand-frame points: the same under every g.
+  Insert3dHandCameraOptions options;
+  options.channels = Insert3dImageChannels::normals;
+  const Insert3dHandCamera normals(options);
+  CHECK(normals.shape() == policy::ImageShape{3, 24, 32});
+  CHECK(largest_change_under_g(normals, 5) == 0.0);
+  // Its last channel is the depth image; its first two the normals' x and y, unit or 0.
+  const Scene observation = task_observation(3);
+  const Eigen::VectorXd image = image_of(normals, observation);
+  CHECK(image.tail(24 * 32) == image_of(Insert3dHandCamera(), observation));
+  CHECK(image.head(2 * 24 * 32).cwiseAbs().maxCoeff() <= 1.0);
+  CHECK(image.head(2 * 24 * 32).cwiseAbs().maxCoeff() > 0.05);
+  CHECK(parse_insert3d_image_channels("normals") == Insert3dImageChannels::normals);
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <vector>
 
 #include "fixtures.hpp"
 #include "handcentric/core/errors.hpp"
@@ -121,4 +122,74 @@ TEST_CASE("image_configs_out_of_range_are_typed_errors", "[unit]") {
   const PolicyConfig trained = image_policy(2).config();
   CHECK(PolicyConfig::from_text(trained.to_text()).to_text() == trained.to_text());
   CHECK(PolicyConfig().to_text().find("encoder") == std::string::npos);
+}
+
+TEST_CASE("spatial_softmax_image_policies_train_and_reload", "[unit]") {
+  // encoder 4,6/1 on the 8 x 10 blob image: 4 x 5 x 4, then 4 x 5 x 6 at stride 1, then one
+  // (x, y) per channel: 12 features in the MLP's input instead of 120.
+  const auto train = [](int steps) {
+    PolicyConfig config = test::small_image_config("hand_centric", steps);
+    config.encoder = "4,6/1";
+    config.image_features = ImageFeatures::spatial_softmax;
+    return train_policy(config, test::small_scenes(32, 2), 3, {}, 100,
+                        std::make_shared<const test::BlobCamera>());
+  };
+  const LearnedPolicy one = train(1), many = train(30);
+  const ConvEncoder* encoder = image_encoder(many.head());
+  REQUIRE(encoder != nullptr);
+  CHECK(encoder->layers()[1].stride() == 1);
+  CHECK(encoder->output_shape() == ImageShape{6, 4, 5});
+  // The loss reaches the encoder through the soft-argmax (planted fault: a training against
+  // itself shows no change).
+  CHECK(encoder_change(one, many) > 1e-4f);
+  CHECK(encoder_change(many, many) == 0.0f);
+  const LearnedPolicy loaded = deserialize_model(serialize_model(many), "keypoints.model");
+  CHECK(loaded.config().image_features == ImageFeatures::spatial_softmax);
+  const Scene scene = test::small_scenes(1, 9).front();
+  const LearnedPolicy seeing = loaded.with_camera(std::make_shared<const test::BlobCamera>());
+  CHECK(seeing.action_vector(scene, 4) == many.action_vector(scene, 4));
+  // The same weights read as flattened features are another network: the key decides.
+  std::string bytes = serialize_model(many);
+  const std::size_t at = bytes.find("image_features=spatial_softmax");
+  REQUIRE(at != std::string::npos);
+  bytes.replace(at, std::strlen("image_features=spatial_softmax"), "image_features=flatten");
+  CHECK_THROWS_AS(deserialize_model(rechecksummed(bytes), "flat.model"), InvalidModelFile);
+}
+
+TEST_CASE("image_model_files_from_before_the_feature_and_fov_keys_read_as_they_were_trained",
+          "[unit]") {
+  // A file written before image_features and image_fov_deg existed has neither line: it reads
+  // as flattened features and the 70 deg camera, what every such model was trained with.
+  const std::string text = image_policy(2).config().to_text();
+  REQUIRE(text.find("image_features=flatten\n") != std::string::npos);
+  REQUIRE(text.find("image_fov_deg=70\n") != std::string::npos);
+  std::string old = text;
+  for (const std::string line : {"image_features=flatten\n", "image_fov_deg=70\n"})
+    old.erase(old.find(line), line.size());
+  const PolicyConfig read = PolicyConfig::from_text(old);
+  CHECK(read.image_features == ImageFeatures::flatten);
+  CHECK(read.image_fov_deg == 70.0);
+  CHECK(read.to_text() == text);
+  // Planted fault: a file that says otherwise is read as it says.
+  std::string other = text;
+  other.replace(other.find("image_fov_deg=70"), std::strlen("image_fov_deg=70"),
+                "image_fov_deg=45");
+  CHECK(PolicyConfig::from_text(other).image_fov_deg == 45.0);
+  // A key-point config still writes none of them.
+  CHECK(PolicyConfig().to_text().find("image_") == std::string::npos);
+}
+
+TEST_CASE("encoder_strides_and_image_features_are_parsed_or_refused_by_name", "[unit]") {
+  const std::vector<EncoderLayerSetting> layers = parse_encoder("8,16/1,32");
+  REQUIRE(layers.size() == 3);
+  CHECK((layers[0].channels == 8 && layers[0].stride == 2));
+  CHECK((layers[1].channels == 16 && layers[1].stride == 1));
+  CHECK((layers[2].channels == 32 && layers[2].stride == 2));
+  HC_CHECK_THROWS(parse_encoder("8,16/2"), InvalidArgument, Catch::Contains("'16/2'"));
+  HC_CHECK_THROWS(parse_encoder("8,/1"), InvalidArgument, Catch::Contains("'/1'"));
+  HC_CHECK_THROWS(parse_image_features("softmax"), InvalidArgument,
+                  Catch::Contains("flatten or spatial_softmax"));
+  PolicyConfig config = test::small_image_config("hand_centric", 2);
+  config.image_fov_deg = 180.0;
+  HC_CHECK_THROWS(config.validate(), InvalidArgument, Catch::Contains("image_fov_deg"));
 }

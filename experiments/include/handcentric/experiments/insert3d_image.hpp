@@ -17,6 +17,8 @@
 // lose those groups: Theorem 1 needs every pixel to move with the scene.
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "handcentric/core/chunk_policy.hpp"
 #include "handcentric/policy/image_source.hpp"
@@ -26,12 +28,23 @@
 namespace handcentric::experiments {
 
 /// depth: 1 channel, the camera's depth (cm). rgbd: red, green, blue in [0, 1], then depth.
-enum class Insert3dImageChannels { depth, rgbd };
+/// normals: the seen surface's unit normal in the camera frame, its x and y (z follows: a seen
+/// surface faces the camera), then depth. The normals come from the depth image alone (the
+/// cross product of neighbouring pixels' points, on the side where the depth changes least), so
+/// they are exact on a plane up to its edges: a tilt of 1 deg moves them by 0.017, where depth
+/// changes by millimetres against a range of 60 cm (docs/SIM.md, "Image policies").
+enum class Insert3dImageChannels { depth, rgbd, normals };
 
-/// "depth", "rgbd".
+/// "depth", "rgbd", "normals".
 std::string to_string(Insert3dImageChannels channels);
 /// Throws InvalidArgument naming the value and the valid names.
 Insert3dImageChannels parse_insert3d_image_channels(const std::string& name);
+
+/// Each pixel's unit surface normal in the frame of `camera` (which rendered `picture`), from
+/// the depth alone (Insert3dImageChannels::normals), row-major; 0 where the pixel sees nothing or
+/// has no seen neighbour along a row or a column.
+std::vector<Eigen::Vector3d> normals_from_depth(const CameraImage& picture,
+                                                const PinholeCamera& camera);
 
 struct Insert3dHandCameraOptions {
   sim::insert3d::DepthCamera camera;  ///< 32 x 24, 70 deg, 60 cm, the task's mount
@@ -56,7 +69,30 @@ class Insert3dHandCamera final : public policy::ImageSource {
   Insert3dHandCameraOptions options_;
 };
 
-/// The hand camera an image config was trained with (its channels and size, no floor).
+/// An image policy of the 3D task before training: its hand camera's channels, size and field
+/// of view, and the encoder (PolicyConfig::encoder, image_features). The defaults are those of
+/// `train --observation image` and `table2 --observation image` (docs/SIM.md, "Image policies").
+struct Insert3dImageSettings {
+  /// normals: on the tuning seeds (8000 steps) the hand-centric image policy inserts 14 of 30
+  /// with them and 2 of 30 with depth alone, 20 of 30 at the automatic budget (docs/SIM.md,
+  /// "Image policies").
+  Insert3dImageChannels channels = Insert3dImageChannels::normals;
+  int width = 32;
+  int height = 24;
+  /// 50 deg scored the same within 30 trials (19 against 20 of 30 at 16000 steps).
+  double fov_deg = 70.0;
+  std::string encoder = "8,16,16";
+  policy::ImageFeatures features = policy::ImageFeatures::flatten;
+  /// Makes `config` an image config of these settings (observation, image size, field of view,
+  /// encoder, features), and returns the camera. Throws InvalidArgument for a bad camera.
+  std::shared_ptr<const Insert3dHandCamera> apply(policy::PolicyConfig& config) const;
+};
+
+/// "WxH" (e.g. 64x48) as width and height. Throws InvalidArgument naming the value and the form.
+std::pair<int, int> parse_image_size(const std::string& text);
+
+/// The hand camera an image config was trained with (its channels, size and field of view, no
+/// floor).
 /// Throws InvalidArgument for a config that is not an image model of the 3D task.
 std::shared_ptr<const Insert3dHandCamera> insert3d_camera_of(const policy::PolicyConfig& config,
                                                              bool floor = false);

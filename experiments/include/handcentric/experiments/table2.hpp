@@ -22,6 +22,7 @@
 
 #include "handcentric/core/chunk_policy.hpp"
 #include "handcentric/experiments/chart.hpp"
+#include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/policy/config.hpp"
 #include "handcentric/sim/draw.hpp"
 #include "handcentric/sim/insert3d/demos.hpp"
@@ -90,6 +91,8 @@ struct Table2Options {
   /// What the policies see, one set of rows each: the key points (insert3d_key_points.hpp)
   /// and/or the hand camera's depth image through a CNN trained end to end (insert3d_image.hpp).
   std::vector<policy::ObservationKind> observations = {policy::ObservationKind::key_points};
+  /// The image rows' camera and encoder.
+  Insert3dImageSettings image;
   /// Two noise-injected copies by default: on the tuning seeds relative learns the train scenes
   /// with them (0.10 -> 0.66) and hand-centric goes 0.98 -> 1.00 (docs/EXPERIMENTS.md).
   Perturbation perturbation{2, 0.15, 1.0};
@@ -97,13 +100,14 @@ struct Table2Options {
 
   /// Throws InvalidArgument naming the bad value and the fix (demos outside 1..1000, trials
   /// outside 1..100000, jobs < 0, steps < 0, no method or an unknown representation, no
-  /// observation).
+  /// observation, image settings that make no camera or encoder).
   void validate() const;
 };
 
 struct Table2Row {
   std::string method;  ///< the representation: hand_centric, relative or absolute
   policy::ObservationKind observation = policy::ObservationKind::key_points;
+  std::string image;  ///< image rows: the camera and encoder, e.g. "depth, 32 x 24, 70 deg, ..."
   int demos = 0;
   std::uint64_t seed = 0;
   int steps = 0;               ///< Adam steps run

@@ -54,9 +54,23 @@ DdpmPrediction parse_ddpm_prediction(const std::string& name);
 std::string to_string(ObservationKind kind);
 /// Throws InvalidArgument naming the value and the valid names.
 ObservationKind parse_observation(const std::string& name);
-/// PolicyConfig::encoder's channel counts ("8,16" -> {8, 16}). Throws InvalidArgument naming
-/// the bad entry unless it is 1 to 6 counts of 1..256.
-std::vector<int> parse_encoder_channels(const std::string& text);
+/// What an image policy's encoder hands the MLP (image_flow_head.hpp): its last map flattened
+/// (flatten), or one soft-argmax point per channel of it (spatial_softmax, spatial_softmax.hpp).
+enum class ImageFeatures { flatten, spatial_softmax };
+/// "flatten", "spatial_softmax".
+std::string to_string(ImageFeatures features);
+/// Throws InvalidArgument naming the value and the valid names.
+ImageFeatures parse_image_features(const std::string& name);
+
+/// One layer of PolicyConfig::encoder: a 3 x 3 convolution with `channels` filters and `stride`.
+struct EncoderLayerSetting {
+  int channels = 0;
+  int stride = 2;
+};
+/// PolicyConfig::encoder's layers: comma-separated out_channels, each of stride 2 unless it ends
+/// in "/1" ("8,16/1" -> {8, stride 2}, {16, stride 1}). Throws InvalidArgument naming the bad
+/// entry unless it is 1 to 6 layers of 1..256 channels.
+std::vector<EncoderLayerSetting> parse_encoder(const std::string& text);
 
 /// The tasks a model can be trained for: the 2D peg-in-hole ("peg2d", Sec. 4.2) and the 3D blade
 /// insertion ("insert3d", Table 2's analogue). Observations of the two differ in shape and
@@ -138,16 +152,25 @@ struct PolicyConfig {
   /// only, so key-point model files (and Table 1's hashes) are unchanged and a file without
   /// them reads as key_points. Image models: head flow only.
   ObservationKind observation = ObservationKind::key_points;
-  /// The camera's image, set by the trainer from the ImageSource: 1 channel (depth) or 4
-  /// (red, green, blue, depth), height x width pixels.
+  /// The camera's image, set by the trainer from the ImageSource: 1 channel (depth), 3 (the
+  /// surface normal's x and y, then depth) or 4 (red, green, blue, depth), height x width pixels.
   int image_channels = 0;
   int image_height = 0;
   int image_width = 0;
   /// The encoder's layers: their out_channels, comma-separated, each a 3 x 3 convolution of
-  /// stride 2 and padding 1 (conv_encoder.hpp). Three layers of 8, 16 and 16 turn a 32 x 24
-  /// depth image into 16 x 4 x 3 = 192 features in ~3.6k weights: the MLP's first layer then
-  /// costs about what the key points' does (768 features after two layers would quadruple it).
+  /// stride 2 (or 1, written "16/1") and padding 1 (conv_encoder.hpp). Three layers of 8, 16 and 16
+  /// turn a 32 x 24 depth image into 16 x 4 x 3 = 192 features in ~3.6k weights: the MLP's first
+  /// layer then costs about what the key points' does (768 features after two layers would
+  /// quadruple it).
   std::string encoder = "8,16,16";
+  /// What the MLP gets from the encoder's last map. An image model file without the key (every
+  /// one written before it existed) reads as this default, flatten, what it was trained with: the
+  /// default stays (a task's image defaults live with the task, experiments/insert3d_image.hpp).
+  ImageFeatures image_features = ImageFeatures::flatten;
+  /// The hand camera's horizontal field of view (deg), for the task to rebuild the camera the
+  /// model was trained with (a model file holds no camera). A file without the key reads as this
+  /// default, 70, the only camera there was; it stays for that reason.
+  double image_fov_deg = 70.0;
 
   /// The image's shape (image_channels, image_height, image_width).
   int image_size() const { return image_channels * image_height * image_width; }
