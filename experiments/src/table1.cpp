@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -68,19 +69,36 @@ bool cell_done(const Cell& cell, const EvalSettings& eval, const fs::path& dir) 
   return eval.audit_cases == 0 || fs::exists(dir / cell.audit_path(eval));
 }
 
-// Trains (or loads) the cell's model and writes each missing result file.
-void run_cell(const Cell& cell, const EvalSettings& eval, const sim::Difficulty& difficulty,
-              const fs::path& dir, const std::vector<sim::Demo>& demos) {
+// The hash of the training a cell runs: its own, with its head replaced by the one it trains
+// as (policy::trained_as), so cells that train the same bits share it.
+std::string training_hash(const Cell& cell) {
+  Cell trained = cell;
+  trained.config.head = policy::trained_as(cell.config.head);
+  trained.head = policy::to_string(trained.config.head);
+  return cell_hash(trained);
+}
+
+// Loads the cell's model, or makes it from `same_training` (the model of a cell with the same
+// training_hash: its weights under this cell's head), or trains it; a new model is saved.
+policy::LearnedPolicy cell_model(const Cell& cell, const sim::Difficulty& difficulty,
+                                 const fs::path& dir, const std::vector<sim::Demo>& demos,
+                                 const policy::LearnedPolicy* same_training) {
   const fs::path model_path = dir / cell.model_path();
-  const policy::LearnedPolicy trained = [&] {
-    if (fs::exists(model_path)) return policy::load_model(model_path.string());
+  if (fs::exists(model_path)) return policy::load_model(model_path.string());
+  policy::LearnedPolicy model = [&] {
+    if (same_training) return policy::with_head_kind(*same_training, cell.config.head);
     const auto scenes =
         sim::training_scenes(demos, cell.config.history_length, cell.config.chunk_length,
                              cell.demos, cell.data, difficulty.geometry());
-    policy::LearnedPolicy model = policy::train_policy(cell.config, scenes, cell.train_seed);
-    policy::save_model(model, model_path.string());
-    return model;
+    return policy::train_policy(cell.config, scenes, cell.train_seed);
   }();
+  policy::save_model(model, model_path.string());
+  return model;
+}
+
+// Writes each missing result file of the cell (and its audit) with the cell's `trained` model.
+void evaluate_cell(const Cell& cell, const policy::LearnedPolicy& trained, const EvalSettings& eval,
+                   const sim::Difficulty& difficulty, const fs::path& dir) {
   const sim::RolloutOptions rollout_options =
       sim::RolloutOptions::for_policy(trained.config().history_length, trained.config().execute);
   // one per thread: it counts its queries
@@ -354,19 +372,26 @@ Table1Grid prepare_table1(const Table1Options& options) {
 void run_table1(const Table1Options& options, const Table1Grid& grid) {
   const fs::path dir = grid.dir;
   const std::vector<sim::Demo> demos = sim::load_demos((dir / grid.demo_file).string());
-  // Largest cells first, so the last ones to finish are short and both cores stay busy.
-  std::vector<const Cell*> order;
+  // One job per training: the cells that train the same bits (training_hash; c8_averaged and
+  // c8_centre) run in one worker, the first trains and the others take its weights.
+  std::vector<std::vector<const Cell*>> order;
+  std::map<std::string, std::size_t> job_of_training;
   double total_work = 0.0;
   for (const Cell& cell : grid.cells) {
-    order.push_back(&cell);
-    total_work += cell_work(cell, options.eval);
+    const auto [job, added] = job_of_training.emplace(training_hash(cell), order.size());
+    if (added) order.emplace_back();
+    order[job->second].push_back(&cell);
+    total_work += cell_work(cell, options.eval) - (added ? 0.0 : cell.config.steps);
   }
+  // Largest trainings first, so the last ones to finish are short and both cores stay busy.
   std::stable_sort(order.begin(), order.end(),
-                   [](const Cell* a, const Cell* b) { return a->config.steps > b->config.steps; });
+                   [](const std::vector<const Cell*>& a, const std::vector<const Cell*>& b) {
+                     return a.front()->config.steps > b.front()->config.steps;
+                   });
   const int jobs = options.jobs > 0
                        ? options.jobs
                        : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  Progress progress(static_cast<int>(order.size()), total_work, stderr, options.quiet);
+  Progress progress(static_cast<int>(grid.cells.size()), total_work, stderr, options.quiet);
   std::atomic<std::size_t> next{0};
   std::atomic<bool> failed{false};
   std::mutex error_mutex;
@@ -375,18 +400,36 @@ void run_table1(const Table1Options& options, const Table1Grid& grid) {
     while (!failed) {
       const std::size_t i = next++;
       if (i >= order.size()) return;
-      const Cell& cell = *order[i];
-      progress.start(id, cell.describe());
-      const bool skipped = cell_done(cell, options.eval, dir);
-      try {
-        if (!skipped) run_cell(cell, options.eval, grid.difficulty, dir, demos);
-      } catch (const std::exception& e) {
-        const std::lock_guard lock(error_mutex);
-        if (!failed.exchange(true))
-          error = "Table 1 cell " + cell.describe() + " failed: " + e.what();
-        return;
+      std::optional<policy::LearnedPolicy> trained;  // the job's first model, once made
+      for (const Cell* cell : order[i]) {
+        progress.start(id, cell->describe());
+        const bool skipped = cell_done(*cell, options.eval, dir);
+        try {
+          if (!skipped) {
+            const policy::LearnedPolicy* same_training = nullptr;
+            if (cell != order[i].front()) {
+              // The first cell's model: made above, or on file when that cell was done.
+              if (!trained)
+                trained.emplace(
+                    cell_model(*order[i].front(), grid.difficulty, dir, demos, nullptr));
+              same_training = &*trained;
+            }
+            const policy::LearnedPolicy model =
+                cell_model(*cell, grid.difficulty, dir, demos, same_training);
+            if (!trained) trained.emplace(model);
+            evaluate_cell(*cell, model, options.eval, grid.difficulty, dir);
+          }
+        } catch (const std::exception& e) {
+          const std::lock_guard lock(error_mutex);
+          if (!failed.exchange(true))
+            error = "Table 1 cell " + cell->describe() + " failed: " + e.what();
+          return;
+        }
+        progress.finish(
+            id,
+            cell_work(*cell, options.eval) - (cell == order[i].front() ? 0.0 : cell->config.steps),
+            skipped);
       }
-      progress.finish(id, cell_work(cell, options.eval), skipped);
     }
   };
   std::vector<std::thread> threads;

@@ -47,6 +47,10 @@ bool is_c8_planar(HeadKind kind) {
          kind == HeadKind::c8ddpm_avg;
 }
 
+HeadKind trained_as(HeadKind kind) {
+  return kind == HeadKind::c8ddpm_avg ? HeadKind::c8ddpm : kind;
+}
+
 std::string to_string(Activation activation) {
   return activation == Activation::silu ? "silu" : "relu";
 }

@@ -3,6 +3,7 @@
 #include <random>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/policy/binary_io.hpp"
 
 namespace handcentric::policy {
 
@@ -33,6 +34,25 @@ LearnedPolicy::LearnedPolicy(PolicyConfig config,
           std::to_string(config_.image_width) + ": give it a camera of its training shape");
     }
   }
+}
+
+LearnedPolicy with_head_kind(const LearnedPolicy& trained, HeadKind kind) {
+  const HeadKind from = trained.config().head;
+  if (trained_as(kind) != trained_as(from)) {
+    throw InvalidArgument("a " + to_string(from) + " model cannot be given head " +
+                          to_string(kind) + ": it trains other weights (train --head " +
+                          to_string(kind) + " instead)");
+  }
+  PolicyConfig config = trained.config();
+  config.head = kind;
+  std::shared_ptr<Head> head = make_head(config);
+  // The head's own serialization carries every trained number (the model file's payload).
+  ByteWriter weights;
+  trained.head().write(weights);
+  ByteReader reader(weights.bytes(), to_string(from) + " weights");
+  head->read(reader);
+  return LearnedPolicy(std::move(config), trained.shared_representation(), std::move(head),
+                       trained.camera());
 }
 
 LearnedPolicy LearnedPolicy::with_camera(std::shared_ptr<const ImageSource> camera) const {

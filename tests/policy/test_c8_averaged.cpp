@@ -189,6 +189,22 @@ TEST_CASE("c8ddpm_avg_trains_the_weights_and_budget_of_c8ddpm", "[unit]") {
       averaged.representation().encode_observation(planar_training_scenes(1, 8)[0]);
   std::mt19937_64 rng_a(3), rng_b(3);
   CHECK(c8::averaged_sample(augmented.head(), o, rng_a) == averaged.head().sample_double(o, rng_b));
+  // So Table 1 trains c8_centre once and gives c8_averaged its weights: the model file is the
+  // one training c8ddpm_avg writes, byte for byte.
+  CHECK(trained_as(HeadKind::c8ddpm_avg) == HeadKind::c8ddpm);
+  CHECK(serialize_model(with_head_kind(augmented, HeadKind::c8ddpm_avg)) ==
+        serialize_model(averaged));
+  CHECK(serialize_model(with_head_kind(averaged, HeadKind::c8ddpm)) == serialize_model(augmented));
+  // The comparison can fail: another training seed is another model.
+  PolicyConfig config = test::small_config(HeadKind::c8ddpm, "absolute", 60);
+  config.noise_scale = 1.0;
+  const LearnedPolicy reseeded = train_policy(config, planar_training_scenes(6, 11), 6);
+  CHECK(serialize_model(with_head_kind(reseeded, HeadKind::c8ddpm_avg)) !=
+        serialize_model(averaged));
+  // A head that trains other weights is refused, naming both.
+  CHECK(trained_as(HeadKind::c8flow_planar) == HeadKind::c8flow_planar);
+  HC_CHECK_THROWS(with_head_kind(augmented, HeadKind::c8flow_planar), InvalidArgument,
+                  Catch::Contains("a c8ddpm model cannot be given head c8flow_planar"));
 }
 
 TEST_CASE("the_averaged_sampler_refuses_other_heads_and_bad_elements", "[unit]") {

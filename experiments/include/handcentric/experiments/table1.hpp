@@ -83,12 +83,17 @@ struct Table1Grid {
 Table1Grid prepare_table1(const Table1Options& options);
 
 /// Trains and scores every cell whose files are missing, options.jobs at a time, with a progress
-/// display on stderr. A failed cell stops the run (the running cells finish) and is rethrown
-/// naming the cell.
+/// display on stderr. Cells that train the same bits (their heads have one policy::trained_as:
+/// c8_averaged and c8_centre) are one training: the first trains, the others take its weights
+/// (policy::with_head_kind), which is a third of the C8 rows' time. A failed cell stops the run
+/// (the running cells finish) and is rethrown naming the cell.
 void run_table1(const Table1Options& options, const Table1Grid& grid);
 
 /// Writes DIR/jobs.txt: one line per cell with a missing result, `cli` train (unless its model
 /// exists) then eval of each missing set, outputs renamed into place. Returns the line count.
+/// Every line trains its own cell, so the lines stay independent: a c8_averaged line trains
+/// c8_centre's network again, to the same bits (tests/experiments: the plan's models equal the
+/// in-process ones).
 int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::string& cli);
 
 /// The rows from DIR/cells.json and whatever result files exist; writes DIR/table1.json,

@@ -40,6 +40,11 @@ HeadKind parse_head(const std::string& name);
 /// c8ddpm, c8flow_planar or c8ddpm_avg: the heads on the planar C8 encoding, which read
 /// c8_centre_*.
 bool is_c8_planar(HeadKind kind);
+/// The head whose training `kind` runs, bit for bit: c8ddpm for c8ddpm_avg (the same network,
+/// loss, data and random draws; only the sampler differs, c8_averaged.hpp), else `kind`. Two
+/// configs that differ only in heads with one trained_as train the same weights, so Table 1
+/// trains them once (with_head_kind in learned_policy.hpp).
+HeadKind trained_as(HeadKind kind);
 std::string to_string(Activation activation);
 Activation parse_activation(const std::string& name);
 /// "constant", "cosine".

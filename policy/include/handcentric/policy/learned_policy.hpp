@@ -61,4 +61,11 @@ class LearnedPolicy final : public ChunkPolicy {
   std::shared_ptr<const ImageSource> camera_;
 };
 
+/// `trained` with head `kind`, which trains the same weights (trained_as, config.hpp): its
+/// config with `kind`, its normalization, weights, representation and camera, `kind`'s sampler.
+/// Bit for bit the policy that training `kind` on the same data and seed returns (a test checks
+/// it), at no training cost: Table 1's c8_averaged row is c8_centre's network, sampled averaged.
+/// Throws InvalidArgument naming both heads when `kind` trains differently.
+LearnedPolicy with_head_kind(const LearnedPolicy& trained, HeadKind kind);
+
 }  // namespace handcentric::policy

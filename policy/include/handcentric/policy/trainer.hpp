@@ -39,8 +39,9 @@ inline constexpr int kBudgetMaxSteps = 30000;
 /// c8flow_planar, c8ddpm_avg) train on every sample's C8 orbit, so their budget counts the 8x
 /// augmented data, training_budget(8 * samples), but at most kC8BudgetMaxSteps: on the tuning seeds
 /// both C8 rows inserted 0.00 in distribution at 10, 40 and 100 demos after 30000 steps and
-/// 0.00-0.21 after 10000 (docs/EXPERIMENTS.md, "The C8 baseline"), so the longer training only
-/// overfits and costs the full Table 1 a third of its time. Every other head:
+/// 0.00-0.21 after 10000 under the success test of then, so the longer training cost the full
+/// Table 1 a third of its time for nothing; under today's test they insert 0.00 after 5000 and
+/// after 10000 alike (docs/EXPERIMENTS.md, "The C8 baseline"). Every other head:
 /// training_budget(samples).
 int training_budget(HeadKind head, long long samples);
 inline constexpr int kC8BudgetMaxSteps = 10000;
