@@ -85,10 +85,12 @@ void add_table1_command(CLI::App& app, int& exit_code) {
                   "0: no audit)")
       ->capture_default_str();
   cmd->add_option("--methods", options->methods,
-                  "hand_centric, relative, absolute, c8_centre, c8_base, c8_averaged")
+                  "hand_centric, relative, absolute, c8_centre, c8_base, c8_averaged (the "
+                  "default); also c8flow_centre, c8flow_averaged")
       ->capture_default_str();
   cmd->add_option("--heads", options->heads,
-                  "flow, ddpm, cvae (c8_centre and c8_base use c8ddpm, c8_averaged c8ddpm_avg)")
+                  "flow, ddpm, cvae (c8_centre and c8_base use c8ddpm, c8_averaged c8ddpm_avg, "
+                  "c8flow_centre c8flow_planar, c8flow_averaged c8flow_avg)")
       ->capture_default_str();
   cmd->add_option("--seed", t.demo_seed, "seed of the demos")->capture_default_str();
   cmd->add_option("--train-seeds", options->train_seeds, "training seeds, one row each")

@@ -182,14 +182,15 @@ void add_train_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--repr", config.representation, "absolute|relative|relative_diff|hand_centric")
       ->capture_default_str();
   cmd->add_option("--head", options->head,
-                  "flow|ddpm|cvae|c8flow|c8ddpm|c8flow_planar|c8ddpm_avg (the c8 heads need --repr "
+                  "flow|ddpm|cvae|c8flow|c8ddpm|c8flow_planar|c8ddpm_avg|c8flow_avg (the c8 heads "
+                  "need --repr "
                   "absolute)")
       ->capture_default_str();
   cmd->add_option("--c8-centre-x", config.c8_centre_x,
-                  "c8ddpm, c8flow_planar, c8ddpm_avg: x of the C8 centre (cm)")
+                  "c8ddpm, c8flow_planar, c8ddpm_avg, c8flow_avg: x of the C8 centre (cm)")
       ->capture_default_str();
   cmd->add_option("--c8-centre-y", config.c8_centre_y,
-                  "c8ddpm, c8flow_planar, c8ddpm_avg: y of the C8 centre (cm)")
+                  "c8ddpm, c8flow_planar, c8ddpm_avg, c8flow_avg: y of the C8 centre (cm)")
       ->capture_default_str();
   cmd->add_option("--steps", config.steps,
                   "Adam steps (0: the automatic budget for the number of training samples)")

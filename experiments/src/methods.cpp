@@ -9,7 +9,8 @@ namespace handcentric::experiments {
 namespace {
 
 constexpr const char* kMethodNames =
-    "hand_centric, relative, absolute, c8_centre, c8_base, c8_averaged";
+    "hand_centric, relative, absolute, c8_centre, c8_base, c8_averaged, c8flow_centre, "
+    "c8flow_averaged";
 
 std::vector<std::string> split(const std::string& list) {
   std::vector<std::string> items;
@@ -34,6 +35,13 @@ const std::vector<Method>& table1_methods() {
       {"c8_averaged", "absolute", "c8ddpm_avg",
        "C8 DDPM about the workspace centre (0, 0), each denoising step averaged over C8: "
        "equivariant by construction (stand-in for Equivariant-DiffPo [7])",
+       kWorkspaceCentre},
+      {"c8flow_centre", "absolute", "c8flow_planar",
+       "C8 flow about the workspace centre (0, 0) (the rectified flow in place of the DDPM)",
+       kWorkspaceCentre},
+      {"c8flow_averaged", "absolute", "c8flow_avg",
+       "C8 flow about the workspace centre (0, 0), each Euler step averaged over C8: "
+       "equivariant by construction",
        kWorkspaceCentre},
   };
   return methods;
@@ -86,7 +94,8 @@ std::optional<PaperRow> paper_row(const std::string& method, const std::string& 
   if (method == "absolute" && head == "flow") {
     return PaperRow{"Absolute-Action-Flow", {0.00, 0.00, 0.01, 0.06, 0.08, 0.12, 0.14}, 0.02};
   }
-  if (method == "c8_centre" || method == "c8_base" || method == "c8_averaged") {
+  if (method == "c8_centre" || method == "c8_base" || method == "c8_averaged" ||
+      method == "c8flow_centre" || method == "c8flow_averaged") {
     return PaperRow{"Equivariant-DiffPo [7]", {0.00, 0.01, 0.03, 0.07, 0.12, 0.18, 0.27}, 0.12};
   }
   return std::nullopt;

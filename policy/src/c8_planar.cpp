@@ -124,7 +124,7 @@ PolicyConfig inner_config(const PolicyConfig& config) {
   check_size(config.observation_dimension, observation_layout(config).absolute_size(),
              "the observation dimension");
   PolicyConfig inner = config;
-  inner.head = config.head == HeadKind::c8flow_planar ? HeadKind::flow : HeadKind::ddpm;
+  inner.head = trained_as(config.head) == HeadKind::c8flow_planar ? HeadKind::flow : HeadKind::ddpm;
   // Epsilon, as [7] (on Diffusion Policy's default). On the tuning seeds c8_base scored 0.00 at
   // 40 demos with either prediction (docs/EXPERIMENTS.md), so faithfulness to [7] decides.
   inner.ddpm_prediction = DdpmPrediction::epsilon;

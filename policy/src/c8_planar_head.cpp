@@ -1,6 +1,6 @@
 // Heads c8ddpm (the C8 baseline of Table 1, a stand-in for the 2D variant of Equivariant
-// Diffusion Policy [7]), c8flow_planar and c8ddpm_avg; c8_planar.hpp has the encoding and the
-// group action, c8_averaged.hpp the averaged sampler of c8ddpm_avg.
+// Diffusion Policy [7]), c8flow_planar, c8ddpm_avg and c8flow_avg; c8_planar.hpp has the
+// encoding and the group action, c8_averaged.hpp the averaged sampler of the last two.
 //
 //   encoding : absolute actions and observations -> planar ones (x, y, z, cos, sin per pose;
 //              eye-in-hand points as they are), decoded back with theta = atan2(sin, cos);
@@ -21,13 +21,16 @@
 // So the trained c8ddpm model is equivariant only as far as the network learned it; [7]'s
 // layers are equivariant exactly (docs/EXPERIMENTS.md, "The C8 baseline": not [7] itself).
 // c8ddpm_avg trains the same network the same way and averages each DDIM step over the group
-// instead (c8_averaged.hpp): exactly equivariant, with the modes of the unaveraged sampler.
+// instead (c8_averaged.hpp): exactly equivariant, with the modes of the unaveraged sampler;
+// c8flow_avg does the same to c8flow_planar's Euler steps.
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <numbers>
 #include <string>
 
 #include "ddpm_head.hpp"
+#include "flow_head.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/policy/c8_averaged.hpp"
 #include "handcentric/policy/c8_planar.hpp"
@@ -74,7 +77,7 @@ class C8PlanarHead final : public Head {
 
   Eigen::MatrixXd sample_double(const Eigen::MatrixXd& observations,
                                 std::mt19937_64& rng) const override {
-    if (kind_ == HeadKind::c8ddpm_avg) return c8::averaged_sample(*this, observations, rng);
+    if (averaged()) return c8::averaged_sample(*this, observations, rng);
     return sample(observations.cast<float>(), rng).cast<double>();
   }
 
@@ -84,7 +87,7 @@ class C8PlanarHead final : public Head {
   void finish_training() override { inner_->finish_training(); }
 
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override {
-    if (kind_ == HeadKind::c8ddpm_avg)
+    if (averaged())
       return c8::averaged_sample(*this, observations.cast<double>(), rng).cast<float>();
     Eigen::MatrixXf o(observations_.planar_size(), observations.cols());
     for (Eigen::Index j = 0; j < observations.cols(); ++j)
@@ -103,6 +106,10 @@ class C8PlanarHead final : public Head {
 
   /// The inner DDPM (c8ddpm, c8ddpm_avg), else null.
   const DdpmHead* ddpm() const { return dynamic_cast<const DdpmHead*>(inner_.get()); }
+  /// The inner rectified flow (c8flow_planar, c8flow_avg), else null.
+  const FlowHead* flow() const { return dynamic_cast<const FlowHead*>(inner_.get()); }
+  /// Whether sampling averages every step over C8 (c8ddpm_avg, c8flow_avg).
+  bool averaged() const { return kind_ != trained_as(kind_); }
   const c8::Layout& action_layout() const { return actions_; }
   const c8::Layout& observation_layout() const { return observations_; }
   const Eigen::Vector2d& centre() const { return centre_; }
@@ -121,6 +128,27 @@ class C8PlanarHead final : public Head {
   std::unique_ptr<Head> inner_;
   Eigen::MatrixXf a_, o_;  // minibatch buffers
 };
+
+// The sampler inside a planar C8 head as steps on normalized planar chunks: DDIM for the DDPM,
+// Euler for the flow. The averaged sampler moves each step's input by the group.
+struct StepSampler {
+  const NetworkHead* network;  // its normalizers
+  int steps;
+  std::function<Eigen::MatrixXf(Eigen::Index, std::mt19937_64&)> initial_noise;
+  std::function<void(Eigen::MatrixXf&, const Eigen::MatrixXf&, int)> step;
+};
+
+template <typename Inner>
+StepSampler step_sampler(const Inner* inner, int steps,
+                         void (Inner::*step)(Eigen::MatrixXf&, const Eigen::MatrixXf&, int) const) {
+  return {inner, steps,
+          [inner](Eigen::Index batch, std::mt19937_64& rng) {
+            return inner->initial_noise(batch, rng);
+          },
+          [inner, step](Eigen::MatrixXf& x, const Eigen::MatrixXf& o, int i) {
+            (inner->*step)(x, o, i);
+          }};
+}
 
 }  // namespace
 
@@ -146,10 +174,14 @@ Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observa
                                 std::mt19937_64& rng, const std::vector<int>& elements) {
   const auto* planar = dynamic_cast<const C8PlanarHead*>(&head);
   const DdpmHead* ddpm = planar != nullptr ? planar->ddpm() : nullptr;
-  if (ddpm == nullptr) {
-    throw InvalidArgument("the C8-averaged sampler needs a c8ddpm or c8ddpm_avg head, got " +
-                          to_string(head.kind()) + ": train with --head c8ddpm_avg");
+  const FlowHead* flow = planar != nullptr ? planar->flow() : nullptr;
+  if (ddpm == nullptr && flow == nullptr) {
+    throw InvalidArgument("the C8-averaged sampler needs a planar C8 head, got " +
+                          to_string(head.kind()) + ": train with --head c8ddpm_avg or c8flow_avg");
   }
+  const StepSampler inner = ddpm != nullptr
+                                ? step_sampler(ddpm, ddpm->ddim_steps(), &DdpmHead::ddim_step)
+                                : step_sampler(flow, flow->euler_steps(), &FlowHead::euler_step);
   if (elements.empty()) {
     throw InvalidArgument("the C8-averaged sampler needs at least one group element, got none");
   }
@@ -160,7 +192,7 @@ Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observa
   const Layout& A = planar->action_layout();
   const Layout& O = planar->observation_layout();
   const Eigen::Vector2d& c = planar->centre();
-  const Normalizer& action_normalizer = ddpm->action_normalizer();
+  const Normalizer& action_normalizer = inner.network->action_normalizer();
   const auto n = static_cast<Eigen::Index>(elements.size());
   const Eigen::Index batch = observations.cols();
 
@@ -172,7 +204,7 @@ Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observa
     mode.segment<2>(kPlanarPoseSize * i) = c;
     mode.segment<2>(kPlanarPoseSize * i + 3).setZero();
   }
-  const Eigen::MatrixXf noise = ddpm->initial_noise(batch, rng);  // normalized, drawn once
+  const Eigen::MatrixXf noise = inner.initial_noise(batch, rng);  // normalized, drawn once
   std::vector<Eigen::VectorXd> x(static_cast<std::size_t>(batch));
   Eigen::MatrixXf o_images(O.planar_size(), batch * n);
   for (Eigen::Index j = 0; j < batch; ++j) {
@@ -184,12 +216,13 @@ Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observa
       o_images.col(j * n + e) =
           act_planar(elements[static_cast<std::size_t>(e)], c, o, O).cast<float>();
   }
-  ddpm->observation_normalizer().normalize(o_images);
+  inner.network->observation_normalizer().normalize(o_images);
 
-  // Every DDIM step on all images at once (one network call), each image's result moved back
-  // by its element's inverse and averaged: Phi(x, o) = 1/8 sum_k g_k^-1 phi(g_k x, g_k o).
+  // Every step (DDIM or Euler) on all images at once (one network call), each image's result
+  // moved back by its element's inverse and averaged: Phi(x, o) = 1/8 sum_k g_k^-1 phi(g_k x, g_k
+  // o).
   Eigen::MatrixXf x_images(A.planar_size(), batch * n);
-  for (int step = 0; step < ddpm->ddim_steps(); ++step) {
+  for (int i = 0; i < inner.steps; ++i) {
     for (Eigen::Index j = 0; j < batch; ++j) {
       for (Eigen::Index e = 0; e < n; ++e) {
         x_images.col(j * n + e) =
@@ -198,7 +231,7 @@ Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observa
       }
     }
     action_normalizer.normalize(x_images);
-    ddpm->ddim_step(x_images, o_images, step);
+    inner.step(x_images, o_images, i);
     action_normalizer.denormalize(x_images);
     for (Eigen::Index j = 0; j < batch; ++j) {
       Eigen::VectorXd sum = Eigen::VectorXd::Zero(A.planar_size());

@@ -28,27 +28,32 @@ std::string to_string(HeadKind kind) {
       return "c8flow_planar";
     case HeadKind::c8ddpm_avg:
       return "c8ddpm_avg";
+    case HeadKind::c8flow_avg:
+      return "c8flow_avg";
   }
   return "?";
 }
 
 HeadKind parse_head(const std::string& name) {
-  for (HeadKind kind : {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow,
-                        HeadKind::c8ddpm, HeadKind::c8flow_planar, HeadKind::c8ddpm_avg}) {
+  for (HeadKind kind :
+       {HeadKind::flow, HeadKind::ddpm, HeadKind::cvae, HeadKind::c8flow, HeadKind::c8ddpm,
+        HeadKind::c8flow_planar, HeadKind::c8ddpm_avg, HeadKind::c8flow_avg}) {
     if (to_string(kind) == name) return kind;
   }
   throw InvalidArgument(
       "unknown head '" + name +
-      "': use one of flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar, c8ddpm_avg");
+      "': use one of flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar, c8ddpm_avg, c8flow_avg");
 }
 
 bool is_c8_planar(HeadKind kind) {
   return kind == HeadKind::c8ddpm || kind == HeadKind::c8flow_planar ||
-         kind == HeadKind::c8ddpm_avg;
+         kind == HeadKind::c8ddpm_avg || kind == HeadKind::c8flow_avg;
 }
 
 HeadKind trained_as(HeadKind kind) {
-  return kind == HeadKind::c8ddpm_avg ? HeadKind::c8ddpm : kind;
+  if (kind == HeadKind::c8ddpm_avg) return HeadKind::c8ddpm;
+  if (kind == HeadKind::c8flow_avg) return HeadKind::c8flow_planar;
+  return kind;
 }
 
 std::string to_string(Activation activation) {

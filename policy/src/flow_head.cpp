@@ -50,6 +50,21 @@ Eigen::MatrixXf FlowHead::normalized_velocity(const Eigen::MatrixXf& x, double t
   return output;
 }
 
+Eigen::MatrixXf FlowHead::initial_noise(Eigen::Index batch, std::mt19937_64& rng) const {
+  Eigen::MatrixXf x(config_.action_dimension, batch);
+  fill_standard_normal(rng, x);
+  x.array().colwise() *=
+      action_normalizer_.active_float().array() * static_cast<float>(config_.noise_scale);
+  return x;
+}
+
+void FlowHead::euler_step(Eigen::MatrixXf& x, const Eigen::MatrixXf& o, int n) const {
+  const int steps = config_.euler_steps;
+  Eigen::MatrixXf velocity = normalized_velocity(x, static_cast<double>(n) / steps, o);
+  velocity.array().colwise() *= action_normalizer_.active_float().array();
+  x += velocity * (1.0f / static_cast<float>(steps));
+}
+
 Eigen::MatrixXf FlowHead::sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const {
   Eigen::MatrixXf o = observations;
   observation_normalizer_.normalize(o);

@@ -17,6 +17,14 @@ class FlowHead : public NetworkHead {
   Eigen::MatrixXf normalized_velocity(const Eigen::MatrixXf& x, double t,
                                       const Eigen::MatrixXf& o) const;
 
+  /// The sampler's start in normalized units: noise_scale times standard normals, on the
+  /// active action rows (sample_normalized's first draw).
+  Eigen::MatrixXf initial_noise(Eigen::Index batch, std::mt19937_64& rng) const;
+  /// Euler step n (0 .. euler_steps - 1) in place on normalized x for normalized o:
+  /// x += f_theta(x, n / N, o) / N on the active rows, as sample_normalized steps.
+  void euler_step(Eigen::MatrixXf& x, const Eigen::MatrixXf& o, int n) const;
+  int euler_steps() const { return config_.euler_steps; }
+
  protected:
   /// The Euler sampler on normalized network observations (the MLP's observation rows).
   Eigen::MatrixXf sample_normalized(const Eigen::MatrixXf& o, std::mt19937_64& rng) const;

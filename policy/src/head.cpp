@@ -56,6 +56,7 @@ std::unique_ptr<Head> make_head(const PolicyConfig& config) {
     case HeadKind::c8ddpm:
     case HeadKind::c8flow_planar:
     case HeadKind::c8ddpm_avg:
+    case HeadKind::c8flow_avg:
       return make_c8_planar_head(config);
   }
   throw InvalidArgument("make_head: unknown head");

@@ -25,7 +25,8 @@ int training_budget(long long samples) {
 int training_budget(HeadKind head, long long samples) {
   const int copies = c8::augmentation_copies(head);
   if (copies == 1) return training_budget(samples);
-  return std::min(training_budget(copies * samples), kC8BudgetMaxSteps);
+  const int budget = training_budget(copies * samples);
+  return trained_as(head) == HeadKind::c8ddpm ? std::min(budget, kC8BudgetMaxSteps) : budget;
 }
 
 double learning_rate_at(const PolicyConfig& config, int step) {

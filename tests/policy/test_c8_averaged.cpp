@@ -108,10 +108,13 @@ class FaultyAveraging final : public ChunkPolicy {
 
 }  // namespace
 
-TEST_CASE("c8ddpm_avg_is_c8_equivariant_pointwise_and_not_se2_equivariant", "[unit][property]") {
-  for (const double noise_scale : {0.0, 1.0}) {
-    INFO("noise_scale " << noise_scale);
-    auto model = std::make_shared<LearnedPolicy>(trained(HeadKind::c8ddpm_avg, noise_scale));
+TEST_CASE("c8ddpm_avg_and_c8flow_avg_are_c8_equivariant_pointwise_and_not_se2_equivariant",
+          "[unit][property]") {
+  for (const auto& [head, noise_scale] :
+       {std::pair{HeadKind::c8ddpm_avg, 0.0}, std::pair{HeadKind::c8ddpm_avg, 1.0},
+        std::pair{HeadKind::c8flow_avg, 0.0}, std::pair{HeadKind::c8flow_avg, 1.0}}) {
+    INFO(to_string(head) << ", noise_scale " << noise_scale);
+    auto model = std::make_shared<LearnedPolicy>(trained(head, noise_scale));
     const auto verdicts = audit(model);
     INFO(props::to_string(verdicts[0].group) << ": " << verdicts[0].max_error);
     CHECK(verdicts[0].group == props::Group::c8);
@@ -125,8 +128,8 @@ TEST_CASE("c8ddpm_avg_is_c8_equivariant_pointwise_and_not_se2_equivariant", "[un
     CHECK_FALSE(verdicts[1].invariant);
     CHECK(verdicts[1].max_error > 1e-3);
     // The model file keeps it: the same sampler after a round trip.
-    const LearnedPolicy loaded = deserialize_model(serialize_model(*model), "c8ddpm_avg");
-    CHECK(loaded.head().kind() == HeadKind::c8ddpm_avg);
+    const LearnedPolicy loaded = deserialize_model(serialize_model(*model), to_string(head));
+    CHECK(loaded.head().kind() == head);
     const Scene scene = planar_training_scenes(1, 99)[0];
     CHECK(loaded.action_vector(scene, 3) == model->action_vector(scene, 3));
   }
@@ -154,19 +157,26 @@ TEST_CASE("c8ddpm_avg_profile_is_zero_on_c8_and_not_between", "[unit][property]"
   }
 }
 
-TEST_CASE("c8ddpm_trained_alike_is_c8_equivariant_only_as_far_as_it_learned", "[unit][property]") {
-  // The same network and training without the averaged sampler: the audit tells them apart.
-  const auto verdicts = audit(std::make_shared<LearnedPolicy>(trained(HeadKind::c8ddpm, 0.0)), 30);
-  CHECK_FALSE(verdicts[0].invariant);
+TEST_CASE("c8ddpm_and_c8flow_planar_trained_alike_are_c8_equivariant_only_as_far_as_they_learned",
+          "[unit][property]") {
+  // The same networks and training without the averaged sampler: the audit tells them apart.
+  for (const HeadKind head : {HeadKind::c8ddpm, HeadKind::c8flow_planar}) {
+    INFO(to_string(head));
+    const auto verdicts = audit(std::make_shared<LearnedPolicy>(trained(head, 0.0)), 30);
+    CHECK_FALSE(verdicts[0].invariant);
+  }
 }
 
 TEST_CASE("the_audit_catches_an_average_over_seven_of_the_eight_elements", "[unit][property]") {
-  auto model = std::make_shared<LearnedPolicy>(trained(HeadKind::c8ddpm_avg, 0.0));
-  const auto verdicts =
-      audit(std::make_shared<FaultyAveraging>(model, FaultyAveraging::Fault::seven_elements), 30);
-  CHECK_FALSE(verdicts[0].invariant);
-  REQUIRE(verdicts[0].witness);
-  CHECK(verdicts[0].witness->error > 1e-6);
+  for (const HeadKind head : {HeadKind::c8ddpm_avg, HeadKind::c8flow_avg}) {
+    INFO(to_string(head));
+    auto model = std::make_shared<LearnedPolicy>(trained(head, 0.0));
+    const auto verdicts =
+        audit(std::make_shared<FaultyAveraging>(model, FaultyAveraging::Fault::seven_elements), 30);
+    CHECK_FALSE(verdicts[0].invariant);
+    REQUIRE(verdicts[0].witness);
+    CHECK(verdicts[0].witness->error > 1e-6);
+  }
 }
 
 TEST_CASE("the_audit_catches_chunks_averaged_after_sampling_with_a_noise_per_element",
@@ -205,6 +215,21 @@ TEST_CASE("c8ddpm_avg_trains_the_weights_and_budget_of_c8ddpm", "[unit]") {
   CHECK(trained_as(HeadKind::c8flow_planar) == HeadKind::c8flow_planar);
   HC_CHECK_THROWS(with_head_kind(augmented, HeadKind::c8flow_planar), InvalidArgument,
                   Catch::Contains("a c8ddpm model cannot be given head c8flow_planar"));
+}
+
+TEST_CASE("c8flow_avg_trains_the_weights_and_budget_of_c8flow_planar", "[unit]") {
+  CHECK(trained_as(HeadKind::c8flow_avg) == HeadKind::c8flow_planar);
+  CHECK(training_budget(HeadKind::c8flow_avg, 500) ==
+        training_budget(HeadKind::c8flow_planar, 500));
+  // The flow inside keeps the 8x budget up to the general cap; the DDPM stops at the C8 cap.
+  CHECK(training_budget(HeadKind::c8flow_avg, 5000) == kBudgetMaxSteps);
+  CHECK(training_budget(HeadKind::c8ddpm_avg, 5000) == kC8BudgetMaxSteps);
+  const LearnedPolicy averaged = trained(HeadKind::c8flow_avg, 1.0);
+  const LearnedPolicy augmented = trained(HeadKind::c8flow_planar, 1.0);
+  CHECK(serialize_model(with_head_kind(augmented, HeadKind::c8flow_avg)) ==
+        serialize_model(averaged));
+  HC_CHECK_THROWS(with_head_kind(augmented, HeadKind::c8ddpm_avg), InvalidArgument,
+                  Catch::Contains("a c8flow_planar model cannot be given head c8ddpm_avg"));
 }
 
 TEST_CASE("the_averaged_sampler_refuses_other_heads_and_bad_elements", "[unit]") {

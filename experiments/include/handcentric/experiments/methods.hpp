@@ -7,7 +7,9 @@
 // same network with each denoising step averaged over C8 about the workspace centre, exactly
 // equivariant whatever it learned (policy/c8_averaged.hpp). c8_centre and c8_averaged train the
 // same weights, so the two rows differ by the sampler alone: learned against constructed
-// symmetry. The others take the head from --heads.
+// symmetry. c8flow_centre and c8flow_averaged are the same pair with the rectified flow inside
+// (c8flow_planar, c8flow_avg), which the default grid leaves out (--methods adds them): they
+// train 30000 steps where the DDPM rows stop at 10000. The others take the head from --heads.
 #include <array>
 #include <optional>
 #include <string>
@@ -29,7 +31,7 @@ struct Method {
 inline constexpr std::array<double, 2> kWorkspaceCentre = {0.0, 0.0};
 inline constexpr std::array<double, 2> kRobotBase = {0.0, -60.0};
 
-/// The methods of Table 1, in the paper's row order (the three C8 rows last).
+/// The methods of Table 1, in the paper's row order (the C8 rows last).
 const std::vector<Method>& table1_methods();
 
 /// A comma-separated list of method names, e.g. "hand_centric,absolute". Throws InvalidArgument

@@ -1,6 +1,8 @@
 #pragma once
-// The sampler of head c8ddpm_avg: the C8 stand-in for Equivariant Diffusion Policy [7] that is
-// C8-equivariant by construction, not only as far as its network learned it (c8ddpm).
+// The sampler of heads c8ddpm_avg and c8flow_avg: the C8 stand-ins for Equivariant Diffusion
+// Policy [7] that are C8-equivariant by construction, not only as far as their network learned
+// it (c8ddpm, c8flow_planar). What follows says DDIM step; for c8flow_avg read Euler step
+// x + f(x, t, o) / N, whose average is the averaged velocity field itself.
 //
 // Its network is c8ddpm's (c8_planar.hpp: DDPM with epsilon prediction on planar poses
 // (x, y, z, cos, sin), trained on the C8 orbit of its data about config.c8_centre_*; eye-in-hand
@@ -39,12 +41,12 @@ namespace handcentric::policy::c8 {
 /// The elements 0..7 of C8 (all of them: the equivariant average).
 const std::vector<int>& all_elements();
 
-/// c8ddpm_avg's sampler on raw absolute observation columns (in double: they are moved by the
-/// group before they are rounded to float32), averaging each DDIM step over
+/// c8ddpm_avg's (c8flow_avg's) sampler on raw absolute observation columns (in double: they are
+/// moved by the group before they are rounded to float32), averaging each DDIM (Euler) step over
 /// `elements` (all_elements(): what the head does; fewer elements are not a group and break
 /// equivariance, a planted fault for tests). Returns raw absolute chunks, one per column, in
 /// double (rounded to float32 they would no longer move exactly with g).
-/// Throws InvalidArgument if `head` is not a c8ddpm or c8ddpm_avg head, or for an element
+/// Throws InvalidArgument if `head` is not a planar C8 head (c8_planar.hpp), or for an element
 /// list that is empty or names an element outside 0..7.
 Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observations,
                                 std::mt19937_64& rng,

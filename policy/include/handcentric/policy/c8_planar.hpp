@@ -66,11 +66,11 @@ Eigen::Vector2d centre_of(const PolicyConfig& config);
 /// budget counts the augmented data (training_budget(HeadKind, samples), trainer.hpp).
 int augmentation_copies(HeadKind head);
 
-/// The config of the network inside a c8ddpm or c8ddpm_avg (c8flow_planar) head: a DDPM (flow)
-/// head on the planar dimensions, with every other setting of config (network, training,
-/// noise_scale); the DDPM predicts epsilon whatever config.ddpm_prediction says.
-/// Throws InvalidArgument if config's action or observation dimension does not fit its layout
-/// (an observation with extra poses or scalars, which the C8 baseline does not transform).
+/// The config of the network inside a c8ddpm or c8ddpm_avg (c8flow_planar, c8flow_avg) head: a
+/// DDPM (flow) head on the planar dimensions, with every other setting of config (network,
+/// training, noise_scale); the DDPM predicts epsilon whatever config.ddpm_prediction says. Throws
+/// InvalidArgument if config's action or observation dimension does not fit its layout (an
+/// observation with extra poses or scalars, which the C8 baseline does not transform).
 PolicyConfig inner_config(const PolicyConfig& config);
 
 }  // namespace handcentric::policy::c8

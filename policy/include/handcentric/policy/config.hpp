@@ -12,8 +12,9 @@ namespace handcentric::policy {
 /// planar poses, trained on the C8 orbit of its data (stand-ins for Equivariant-DiffPo [7]),
 /// or the same with the rectified flow (c8flow_planar, a control for the DDPM), or c8ddpm with
 /// its denoising step averaged over C8 at every DDIM step, C8-equivariant by construction
-/// (c8ddpm_avg, c8_averaged.hpp).
-enum class HeadKind { flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar, c8ddpm_avg };
+/// (c8ddpm_avg, c8_averaged.hpp), or c8flow_planar with its Euler step averaged so
+/// (c8flow_avg).
+enum class HeadKind { flow, ddpm, cvae, c8flow, c8ddpm, c8flow_planar, c8ddpm_avg, c8flow_avg };
 
 enum class Activation { silu, relu };
 
@@ -33,15 +34,16 @@ enum class DdpmPrediction { epsilon, sample };
 /// of the observation vector and only drive the camera (image_source.hpp).
 enum class ObservationKind { key_points, image };
 
-/// "flow", "ddpm", "cvae", "c8flow", "c8ddpm", "c8flow_planar", "c8ddpm_avg".
+/// "flow", "ddpm", "cvae", "c8flow", "c8ddpm", "c8flow_planar", "c8ddpm_avg", "c8flow_avg".
 std::string to_string(HeadKind kind);
 /// Throws InvalidArgument naming the value and the valid names.
 HeadKind parse_head(const std::string& name);
-/// c8ddpm, c8flow_planar or c8ddpm_avg: the heads on the planar C8 encoding, which read
-/// c8_centre_*.
+/// c8ddpm, c8flow_planar, c8ddpm_avg or c8flow_avg: the heads on the planar C8 encoding, which
+/// read c8_centre_*.
 bool is_c8_planar(HeadKind kind);
-/// The head whose training `kind` runs, bit for bit: c8ddpm for c8ddpm_avg (the same network,
-/// loss, data and random draws; only the sampler differs, c8_averaged.hpp), else `kind`. Two
+/// The head whose training `kind` runs, bit for bit: c8ddpm for c8ddpm_avg and c8flow_planar for
+/// c8flow_avg (the same network, loss, data and random draws; only the sampler differs,
+/// c8_averaged.hpp), else `kind`. Two
 /// configs that differ only in heads with one trained_as train the same weights, so Table 1
 /// trains them once (with_head_kind in learned_policy.hpp).
 HeadKind trained_as(HeadKind kind);

@@ -13,6 +13,7 @@
 //            config.c8_centre_*: Table 1's stand-in for [7] (c8_planar.hpp)
 //   c8ddpm_avg : c8ddpm's network, trained the same way, whose DDIM step is averaged over C8
 //            at every step: exactly C8-equivariant whatever the weights (c8_averaged.hpp)
+//   c8flow_planar, c8flow_avg : the same two with the rectified flow in place of the DDPM
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>

@@ -35,14 +35,16 @@ inline constexpr double kBudgetStepsPerSample = 6.0;
 inline constexpr int kBudgetMinSteps = 3000;
 inline constexpr int kBudgetMaxSteps = 30000;
 
-/// The automatic budget of `head` for `samples` demo samples. The C8 heads (c8ddpm,
-/// c8flow_planar, c8ddpm_avg) train on every sample's C8 orbit, so their budget counts the 8x
-/// augmented data, training_budget(8 * samples), but at most kC8BudgetMaxSteps: on the tuning seeds
-/// both C8 rows inserted 0.00 in distribution at 10, 40 and 100 demos after 30000 steps and
+/// The automatic budget of `head` for `samples` demo samples. The planar C8 heads train on every
+/// sample's C8 orbit, so their budget counts the 8x augmented data, training_budget(8 * samples).
+/// Those with a DDPM inside (c8ddpm, c8ddpm_avg) stop at kC8BudgetMaxSteps: on the tuning seeds
+/// both DDPM rows inserted 0.00 in distribution at 10, 40 and 100 demos after 30000 steps and
 /// 0.00-0.21 after 10000 under the success test of then, so the longer training cost the full
 /// Table 1 a third of its time for nothing; under today's test they insert 0.00 after 5000 and
-/// after 10000 alike (docs/EXPERIMENTS.md, "The C8 baseline"). Every other head:
-/// training_budget(samples).
+/// after 10000 alike. Those with the flow inside (c8flow_planar, c8flow_avg) keep the 8x budget
+/// up to kBudgetMaxSteps: at 10 cm / 0.3 cm (sim/difficulty.hpp) c8flow_planar inserted 0.09
+/// of the tuning scenes after 10000 steps and 0.31 after 30000 (docs/EXPERIMENTS.md, "The C8
+/// baseline"). Every other head: training_budget(samples).
 int training_budget(HeadKind head, long long samples);
 inline constexpr int kC8BudgetMaxSteps = 10000;
 
