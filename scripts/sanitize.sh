@@ -54,7 +54,7 @@ built=$(date +%s)
 export HANDCENTRIC_NUMERIC_CASES=10000
 end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_gates_exit_1|'\
 '^table1_cli_in_process_plan|^policy_cli_train_defaults_to_the_automatic_budget|'\
-'^table1_c8_cell_from_its_plan_line|^table1_plan_evaluates_in_the_runs|'\
+'^table1_c8_cell_from_its_plan_line|^table1_plan_evaluates_in_the_runs|^table1_c8_averaged_shares|'\
 '^audit_model_finds_a_trained|^protocol_v2_plugin_gets|'\
 '^python_plugin_audit_matches|^main_report_opens_with|^outputs_are_whole_or_absent_after_sigkill|'\
 '^report_page_writes_markdown_and_html|^report_page_check_in_chromium|'\

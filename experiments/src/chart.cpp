@@ -565,7 +565,7 @@ Box frame_box(const Geometry& g) {
 std::array<unsigned char, 3> chart_colour(int index) {
   static constexpr std::array<unsigned char, 3> kOkabeIto[] = {
       {0, 114, 178}, {213, 94, 0},   {0, 158, 115}, {204, 121, 167},
-      {230, 159, 0}, {86, 180, 233}, {0, 0, 0}};
+      {230, 159, 0}, {86, 180, 233}, {0, 0, 0},     {240, 228, 66}};
   const int n = static_cast<int>(std::size(kOkabeIto));
   return kOkabeIto[((index % n) + n) % n];
 }

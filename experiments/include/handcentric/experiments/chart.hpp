@@ -27,7 +27,7 @@ struct ChartValue {
 };
 
 /// Okabe-Ito colour `index` (wrapping), as 0-255 RGB: blue, vermillion, green, purple, orange,
-/// sky blue, black.
+/// sky blue, black, yellow (all eight, so that Table 1 with both C8 flow rows has no repeat).
 std::array<unsigned char, 3> chart_colour(int index);
 
 enum class Marker { dot, square, triangle };
