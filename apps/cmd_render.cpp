@@ -58,6 +58,7 @@ int run_insert3d_render(const RenderOptions& options) {
       sim::insert3d::sample_scene(distribution, options.seed, options.index);
   sim::insert3d::Rollout rollout;
   sim::insert3d::DepthCamera camera;
+  bool normals = false;
   std::string what = "scene";
   if (options.scene) {
     rollout.world_T_hand = {scene.world_T_hand_start};
@@ -65,6 +66,7 @@ int run_insert3d_render(const RenderOptions& options) {
     const LoadedInsert3dPolicy loaded = load_insert3d_policy(options.model);
     const ChunkPolicy& policy = *loaded.policy;
     camera = loaded.camera;
+    normals = loaded.normals;
     const sim::insert3d::CollisionChecker checker;
     rollout = sim::insert3d::rollout(policy, scene, sim::stream_seed(options.seed, options.index),
                                      checker, loaded.rollout_options);
@@ -78,9 +80,10 @@ int run_insert3d_render(const RenderOptions& options) {
   sim::write_png(options.out, experiments::draw_insert3d_rollout(scene, rollout, caption));
   std::cout << "wrote " << what << " to " << options.out << "\n";
   if (!options.camera_frames.empty()) {
-    sim::write_png(options.camera_frames,
-                   experiments::draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, camera));
-    std::cout << "wrote the hand camera's images of " << rollout.world_T_hand.size()
+    sim::write_png(options.camera_frames, experiments::draw_insert3d_camera_frames(
+                                              scene, rollout, 4, 8, {}, camera, normals));
+    std::cout << "wrote the hand camera's " << (normals ? "depth and normals" : "depth")
+              << " images of " << rollout.world_T_hand.size()
               << " poses (every 4th and the last) to " << options.camera_frames << "\n";
   }
   return 0;

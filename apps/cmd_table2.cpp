@@ -34,7 +34,8 @@ void add_table2_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--jobs", options->jobs, "trainings at once (0: one per hardware thread)")
       ->capture_default_str();
   cmd->add_option("--steps", options->steps,
-                  "Adam steps per policy (0: the library's automatic budget)")
+                  "Adam steps per policy (0: automatic: the library's budget for the key-point "
+                  "rows, the image rows' own)")
       ->capture_default_str();
   cmd->add_option("--methods", options->methods, "representations, one row each (comma-separated)")
       ->delimiter(',')
@@ -56,6 +57,9 @@ void add_table2_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   auto image = std::make_shared<ImageFlags>();
   add_image_options(cmd, image);
+  cmd->add_flag("--save-models", options->save_models,
+                "also write each row's trained model to --out (METHOD.hcm, METHOD_image.hcm), "
+                "for eval, render --rollout and audit --model");
   cmd->add_flag("--quiet", options->quiet, "no progress lines on stderr");
   cmd->callback([options, observations, image, &exit_code] {
     options->image = image->resolve();

@@ -193,7 +193,8 @@ void add_train_command(CLI::App& app, int& exit_code) {
                   "c8ddpm, c8flow_planar, c8ddpm_avg, c8flow_avg: y of the C8 centre (cm)")
       ->capture_default_str();
   cmd->add_option("--steps", config.steps,
-                  "Adam steps (0: the automatic budget for the number of training samples)")
+                  "Adam steps (0: the automatic budget for the number of training samples; "
+                  "--observation image: the image policies' own)")
       ->capture_default_str();
   cmd->add_option("--seed", options->seed,
                   "seed of initialization, minibatches, noise and the perturbed copies")

@@ -34,8 +34,12 @@ LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
   auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(model_path, overrides));
   policy::require_task(*model, policy::kTaskInsert3d, model_path);
   loaded.rollout_options = experiments::insert3d_rollout_options(model->config());
-  if (model->config().observation == policy::ObservationKind::image)
-    loaded.camera = experiments::insert3d_camera_of(model->config())->options().camera;
+  if (model->config().observation == policy::ObservationKind::image) {
+    const experiments::Insert3dHandCameraOptions& camera =
+        experiments::insert3d_camera_of(model->config())->options();
+    loaded.camera = camera.camera;
+    loaded.normals = camera.channels == experiments::Insert3dImageChannels::normals;
+  }
   // Each 3D model with the input it was trained on: the hand camera's image, or the corners and
   // the slot points computed from them (cmd_train).
   loaded.policy = experiments::insert3d_model_policy(std::move(model));

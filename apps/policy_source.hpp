@@ -35,6 +35,8 @@ struct LoadedInsert3dPolicy {
   /// The camera the frames of a rollout are drawn with: an image model's own (its size and
   /// field of view), else the task's.
   sim::insert3d::DepthCamera camera;
+  /// An image model that sees surface normals: the frames show them beside the depth.
+  bool normals = false;
 };
 LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
                                           const policy::SamplingOverrides& overrides = {});

@@ -9,6 +9,7 @@
 
 #include "drawing.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/experiments/insert3d_image.hpp"
 
 namespace handcentric::experiments {
 namespace {
@@ -69,6 +70,23 @@ cv::Mat depth_panel(const CameraImage& image, double max_range, int scale = kDep
       const double shade = 255.0 * std::clamp(1.0 - image.depth_at(row, col) / max_range, 0.0, 1.0);
       const cv::Scalar grey(shade, shade, shade);
       cv::rectangle(panel, cv::Rect(col * scale, row * scale, scale, scale), grey, cv::FILLED);
+    }
+  }
+  return panel;
+}
+
+// The normals channels of `image` (normals_from_depth): red (1 + x) / 2, green (1 + y) / 2 of the
+// normal in the camera frame, blue a constant half, black where no normal is seen.
+cv::Mat normals_panel(const CameraImage& image, const PinholeCamera& camera, int scale) {
+  const std::vector<Eigen::Vector3d> normals = normals_from_depth(image, camera);
+  cv::Mat panel(image.height * scale, image.width * scale, CV_8UC3, cv::Scalar(0, 0, 0));
+  for (int row = 0; row < image.height; ++row) {
+    for (int col = 0; col < image.width; ++col) {
+      const Eigen::Vector3d& n = normals[static_cast<std::size_t>(row) * image.width + col];
+      if (n.isZero()) continue;
+      const cv::Scalar colour = rgb(static_cast<int>(std::lround(127.5 * (1.0 + n.x()))),
+                                    static_cast<int>(std::lround(127.5 * (1.0 + n.y()))), 128);
+      cv::rectangle(panel, cv::Rect(col * scale, row * scale, scale, scale), colour, cv::FILLED);
     }
   }
   return panel;
@@ -141,7 +159,7 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
 sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
                                        const insert3d::Rollout& rollout, int every, int columns,
                                        const insert3d::BladeSlotGeometry& geometry,
-                                       const insert3d::DepthCamera& camera) {
+                                       const insert3d::DepthCamera& camera, bool normals) {
   using drawing::text;
   if (rollout.world_T_hand.empty())
     throw InvalidArgument("draw_insert3d_camera_frames: the rollout has no pose");
@@ -155,7 +173,8 @@ sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
   if (steps.back() + 1 != rollout.world_T_hand.size())
     steps.push_back(rollout.world_T_hand.size() - 1);
   constexpr int kScale = 4, kLabel = 18, kGap = 6;
-  const int panel_w = camera.width * kScale, panel_h = camera.height * kScale;
+  const int image_w = camera.width * kScale, panel_h = camera.height * kScale;
+  const int panel_w = normals ? 2 * image_w + kGap : image_w;
   const int cols = std::min<int>(columns, static_cast<int>(steps.size()));
   const int rows = (static_cast<int>(steps.size()) + cols - 1) / cols;
   cv::Mat canvas(rows * (panel_h + kLabel + kGap) + kGap, cols * (panel_w + kGap) + kGap, CV_8UC3,
@@ -164,11 +183,14 @@ sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
     const int x = kGap + static_cast<int>(i % static_cast<std::size_t>(cols)) * (panel_w + kGap);
     const int y =
         kGap + static_cast<int>(i / static_cast<std::size_t>(cols)) * (panel_h + kLabel + kGap);
-    const cv::Mat panel =
-        depth_panel(insert3d::render_depth(geometry, camera, rollout.world_T_hand[steps[i]],
-                                           scene.world_T_slot),
-                    camera.max_range, kScale);
-    panel.copyTo(canvas(cv::Rect(x, y + kLabel, panel_w, panel_h)));
+    const CameraImage image = insert3d::render_depth(
+        geometry, camera, rollout.world_T_hand[steps[i]], scene.world_T_slot);
+    depth_panel(image, camera.max_range, kScale)
+        .copyTo(canvas(cv::Rect(x, y + kLabel, image_w, panel_h)));
+    if (normals) {
+      normals_panel(image, camera, kScale)
+          .copyTo(canvas(cv::Rect(x + image_w + kGap, y + kLabel, image_w, panel_h)));
+    }
     text(canvas, "step " + std::to_string(steps[i]), {x, y + kLabel - 5}, 0.4);
   }
   return drawing::to_image(canvas);

@@ -185,6 +185,10 @@ std::shared_ptr<const Insert3dHandCamera> insert3d_camera_of(const policy::Polic
 
 std::shared_ptr<const Insert3dHandCamera> Insert3dImageSettings::apply(
     policy::PolicyConfig& config) const {
+  if (steps < 0) {
+    throw InvalidArgument("image policies' steps " + std::to_string(steps) +
+                          " is negative: use 0 (the library's automatic budget) or more");
+  }
   Insert3dHandCameraOptions options;
   options.channels = channels;
   options.camera.width = width;
@@ -199,6 +203,7 @@ std::shared_ptr<const Insert3dHandCamera> Insert3dImageSettings::apply(
   config.image_fov_deg = fov_deg;
   config.encoder = encoder;
   config.image_features = features;
+  if (config.steps == 0) config.steps = steps;
   return camera;
 }
 

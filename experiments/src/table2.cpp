@@ -22,6 +22,7 @@
 #include "handcentric/experiments/insert3d_key_points.hpp"
 #include "handcentric/experiments/results_page.hpp"
 #include "handcentric/experiments/wilson.hpp"
+#include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/insert3d/camera.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
@@ -190,6 +191,11 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
             : policy::train_policy(config, with_slot_key_points(scenes), options.seed));
   const double train_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (options.save_models) {
+    policy::save_model(
+        *model,
+        (std::filesystem::path(options.out) / table2_model_file(method, observation)).string());
+  }
   const std::shared_ptr<const ChunkPolicy> policy = insert3d_model_policy(model);
   const ChunkPolicy& trained = *policy;
   const insert3d::RolloutOptions rollout_options = insert3d_rollout_options(model->config());
@@ -227,6 +233,10 @@ std::string rate_with_interval(const Insert3dCounts& counts) {
 }
 
 }  // namespace
+
+std::string table2_model_file(const std::string& method, policy::ObservationKind observation) {
+  return observation == policy::ObservationKind::image ? method + "_image.hcm" : method + ".hcm";
+}
 
 std::vector<Table2Row> run_table2(const Table2Options& options) {
   options.validate();

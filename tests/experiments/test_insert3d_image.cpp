@@ -4,6 +4,7 @@
 // Theorem 1), and a table fixed in the world, in view, breaks that for every g that tilts it.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <numbers>
 #include <utility>
 
@@ -113,6 +114,36 @@ TEST_CASE("the_camera_frames_show_every_fourth_pose_and_the_last", "[unit]") {
   CHECK_THROWS_AS(draw_insert3d_camera_frames(scene, insert3d::Rollout{}), InvalidArgument);
 }
 
+// A planted fault (the normals panel left black, or x and y swapped) fails the pixel checks.
+TEST_CASE("the_camera_frames_show_the_normals_the_policy_sees_beside_the_depth", "[unit]") {
+  const insert3d::TaskScene scene =
+      insert3d::sample_scene(insert3d::SceneDistribution::train(), 11, 2);
+  insert3d::Rollout rollout;
+  rollout.world_T_hand = {scene.world_T_hand_start};
+  const insert3d::DepthCamera camera;
+  const sim::Image sheet = draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, camera, true);
+  // One panel: depth 128 x 96, 6 pixels, normals 128 x 96; 6 pixels around, 18 for the label.
+  REQUIRE(sheet.width == 2 * 128 + 6 + 2 * 6);
+  REQUIRE(sheet.height == 96 + 18 + 2 * 6);
+  const CameraImage picture =
+      insert3d::render_depth({}, camera, scene.world_T_hand_start, scene.world_T_slot);
+  const std::vector<Eigen::Vector3d> normals = normals_from_depth(picture, camera);
+  int tilted = 0;
+  for (int row = 0; row < camera.height; ++row) {
+    for (int col = 0; col < camera.width; ++col) {
+      const Eigen::Vector3d& n = normals[static_cast<std::size_t>(row * camera.width + col)];
+      const int x = 6 + 128 + 6 + 4 * col + 2, y = 6 + 18 + 4 * row + 2;
+      const std::uint8_t* pixel = &sheet.rgb[static_cast<std::size_t>(3 * (y * sheet.width + x))];
+      const int red = n.isZero() ? 0 : static_cast<int>(std::lround(127.5 * (1.0 + n.x())));
+      const int green = n.isZero() ? 0 : static_cast<int>(std::lround(127.5 * (1.0 + n.y())));
+      CHECK(pixel[0] == red);
+      CHECK(pixel[1] == green);
+      if (std::abs(n.x()) > 0.1 || std::abs(n.y()) > 0.1) ++tilted;
+    }
+  }
+  CHECK(tilted > 0);  // the block's faces are seen at an angle, so the check sees colours
+}
+
 TEST_CASE("image_settings_make_the_camera_the_model_records_and_gets_back", "[unit]") {
   Insert3dImageSettings settings;
   settings.width = 48;
@@ -141,6 +172,18 @@ TEST_CASE("image_settings_make_the_camera_the_model_records_and_gets_back", "[un
   CHECK(image_of(Insert3dHandCamera(seventy), observation) != image_of(*camera, observation));
   // A narrower camera is still only a function of the hand-frame points.
   CHECK(largest_change_under_g(*camera, 7) == 0.0);
+  // The image policies' own budget fills in steps the command left automatic (0), and only those.
+  // Planted fault: apply() leaving config.steps alone keeps 0, the library's 30000-step budget.
+  settings.steps = 1234;
+  config.steps = 0;
+  settings.apply(config);
+  CHECK(config.steps == 1234);
+  config.steps = 500;
+  settings.apply(config);
+  CHECK(config.steps == 500);
+  CHECK(Insert3dImageSettings{}.steps > 0);
+  settings.steps = -1;
+  CHECK_THROWS_WITH(settings.apply(config), Catch::Contains("-1") && Catch::Contains("use 0"));
 }
 
 TEST_CASE("image_sizes_and_fields_of_view_are_checked_with_the_value_and_the_fix", "[unit]") {

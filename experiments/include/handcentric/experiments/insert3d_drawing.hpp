@@ -27,11 +27,15 @@ sim::Image draw_insert3d_rollout(const sim::insert3d::TaskScene& scene,
 
 /// The hand camera's depth images along `rollout`, every `every`-th pose and the last, in rows of
 /// `columns` panels (4x enlarged, near bright, each labelled with its step): what an image
-/// policy saw. Throws InvalidArgument for an empty rollout, every < 1 or columns < 1.
+/// policy saw. With `normals`, each depth panel has the surface normals beside it, as the
+/// normals channels see them (normals_from_depth): red = (1 + x) / 2, green = (1 + y) / 2 of the
+/// normal in the camera frame, black where nothing is seen. Throws InvalidArgument for an empty
+/// rollout, every < 1 or columns < 1.
 sim::Image draw_insert3d_camera_frames(const sim::insert3d::TaskScene& scene,
                                        const sim::insert3d::Rollout& rollout, int every = 4,
                                        int columns = 8,
                                        const sim::insert3d::BladeSlotGeometry& geometry = {},
-                                       const sim::insert3d::DepthCamera& camera = {});
+                                       const sim::insert3d::DepthCamera& camera = {},
+                                       bool normals = false);
 
 }  // namespace handcentric::experiments

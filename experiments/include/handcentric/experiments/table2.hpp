@@ -15,6 +15,8 @@
 //                     "random_se3_success", "<set>_wilson95": [lo, hi], ...}], ...}
 //   DIR/table2.md    the table beside the paper's Table 2
 //   DIR/table2.png, table2.svg   success per method and scene set, Wilson 95% bars
+//   DIR/<method>.hcm, DIR/<method>_image.hcm   with save_models: each row's trained model, for
+//                     `eval`, `render --rollout` and `audit --model` on the very policy of the row
 // Every file is written atomically (write_file_atomically, write_png).
 #include <cstdint>
 #include <string>
@@ -86,7 +88,8 @@ struct Table2Options {
   std::string out = "table2";
   std::uint64_t seed = 1;
   int jobs = 0;   ///< trainings at once; 0: one per hardware thread
-  int steps = 0;  ///< Adam steps per policy; 0: the library's automatic budget
+  int steps = 0;  ///< Adam steps per policy; 0: automatic (the key-point rows: the library's
+                  ///< budget; the image rows: Insert3dImageSettings::steps)
   std::vector<std::string> methods = {"hand_centric", "relative", "absolute"};
   /// What the policies see, one set of rows each: the key points (insert3d_key_points.hpp)
   /// and/or the hand camera's depth image through a CNN trained end to end (insert3d_image.hpp).
@@ -97,6 +100,8 @@ struct Table2Options {
   /// with them (0.10 -> 0.66) and hand-centric goes 0.98 -> 1.00 (docs/EXPERIMENTS.md).
   Perturbation perturbation{2, 0.15, 1.0};
   bool quiet = false;
+  /// Also write each row's model (table2_model_file).
+  bool save_models = false;
 
   /// Throws InvalidArgument naming the bad value and the fix (demos outside 1..1000, trials
   /// outside 1..100000, jobs < 0, steps < 0, no method or an unknown representation, no
@@ -114,6 +119,10 @@ struct Table2Row {
   double train_seconds = 0.0;  ///< wall-clock time of the training
   Insert3dCounts train, ood, random_se3;
 };
+
+/// The file name of a row's model in DIR with Table2Options::save_models: "<method>.hcm" for
+/// the key-point rows, "<method>_image.hcm" for the image rows.
+std::string table2_model_file(const std::string& method, policy::ObservationKind observation);
 
 /// Trains and evaluates every method for every observation (options.jobs at a time), writes
 /// DIR/table2.json, .md, .png and .svg (DIR created when missing) and returns the rows in method
