@@ -77,7 +77,9 @@ int run_insert3d_render(const RenderOptions& options) {
   const std::string caption = "insert3d '" + distribution.name() + "' scene " +
                               std::to_string(options.index) + " (seed " +
                               std::to_string(options.seed) + "): " + what;
-  sim::write_png(options.out, experiments::draw_insert3d_rollout(scene, rollout, caption));
+  // The side panels show the camera the policy looked through (an image model's own).
+  sim::write_png(options.out,
+                 experiments::draw_insert3d_rollout(scene, rollout, caption, {}, camera));
   std::cout << "wrote " << what << " to " << options.out << "\n";
   if (!options.camera_frames.empty()) {
     sim::write_png(options.camera_frames, experiments::draw_insert3d_camera_frames(

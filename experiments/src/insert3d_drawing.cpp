@@ -102,9 +102,14 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
     throw InvalidArgument("draw_insert3d_rollout: the rollout has no pose");
   geometry.validate();
   camera.validate();
-  const int panel_width = camera.width * kDepthScale;
+  // Both panels fit the view's height whatever the camera: 8x a 32 x 24 image (the task's
+  // camera), 4x a 64 x 48 one.
+  const int scale = std::max(1, std::min(kDepthScale, (kViewHeight - 180) / (2 * camera.height)));
+  const int panel_width = camera.width * scale;
   const int width = kViewWidth + panel_width + 40;
-  cv::Mat canvas(kViewHeight, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  // Taller than the view only for a camera of more than 230 rows.
+  const int height = std::max(kViewHeight, 180 + 2 * camera.height * scale);
+  cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   // Aimed between the slot's opening and the hand's start, so both are in view at any placement.
   const Eigen::Vector3d target =
       0.5 * (scene.world_T_slot.translation() + scene.world_T_hand_start.translation());
@@ -143,14 +148,14 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
   const auto paste = [&](const RigidTransform& world_T_hand, int y, const std::string& label) {
     const cv::Mat panel =
         depth_panel(insert3d::render_depth(geometry, camera, world_T_hand, scene.world_T_slot),
-                    camera.max_range);
+                    camera.max_range, scale);
     panel.copyTo(canvas(cv::Rect(x0, y, panel.cols, panel.rows)));
     cv::rectangle(canvas, cv::Rect(x0, y, panel.cols, panel.rows), rgb(20, 20, 20), 1);
     text(canvas, label, {x0, y - 8}, 0.5);
   };
   paste(rollout.world_T_hand.front(), 60, "hand camera depth, first pose");
   if (n > 1) {
-    paste(rollout.world_T_hand.back(), 60 + camera.height * kDepthScale + 60,
+    paste(rollout.world_T_hand.back(), 60 + camera.height * scale + 60,
           "hand camera depth, last pose");
   }
   return drawing::to_image(canvas);

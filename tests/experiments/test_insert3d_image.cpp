@@ -114,6 +114,33 @@ TEST_CASE("the_camera_frames_show_every_fourth_pose_and_the_last", "[unit]") {
   CHECK_THROWS_AS(draw_insert3d_camera_frames(scene, insert3d::Rollout{}), InvalidArgument);
 }
 
+// The rollout picture's two camera panels fit beside the view for the image models' camera
+// (64 x 48, the default since session 14) as for the task's 32 x 24: 8x the smaller, 4x the
+// larger. At 8x, the 64 x 48 panels ran off the canvas (OpenCV's region check threw).
+TEST_CASE("the_rollout_picture_fits_the_camera_panels_of_any_image_size", "[unit]") {
+  const insert3d::TaskScene scene =
+      insert3d::sample_scene(insert3d::SceneDistribution::train(), 11, 2);
+  insert3d::Rollout rollout;
+  for (int t = 0; t < 3; ++t) {
+    rollout.world_T_hand.push_back(
+        scene.world_T_hand_start *
+        RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -0.5 * t)));
+  }
+  insert3d::DepthCamera small;
+  const sim::Image with_small = draw_insert3d_rollout(scene, rollout, "32 x 24", {}, small);
+  insert3d::DepthCamera large = small;
+  large.width = 64;
+  large.height = 48;
+  const sim::Image with_large = draw_insert3d_rollout(scene, rollout, "64 x 48", {}, large);
+  CHECK(with_large.width == with_small.width);  // 64 x 4 = 32 x 8 pixels of panel
+  CHECK(with_large.height == with_small.height);
+  insert3d::DepthCamera tall = small;
+  tall.width = 320;
+  tall.height = 240;
+  const sim::Image with_tall = draw_insert3d_rollout(scene, rollout, "320 x 240", {}, tall);
+  CHECK(with_tall.height == 180 + 2 * 240);  // 1x, on a taller canvas
+}
+
 // A planted fault (the normals panel left black, or x and y swapped) fails the pixel checks.
 TEST_CASE("the_camera_frames_show_the_normals_the_policy_sees_beside_the_depth", "[unit]") {
   const insert3d::TaskScene scene =
