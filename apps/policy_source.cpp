@@ -35,10 +35,10 @@ LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
   policy::require_task(*model, policy::kTaskInsert3d, model_path);
   loaded.rollout_options = experiments::insert3d_rollout_options(model->config());
   if (model->config().observation == policy::ObservationKind::image) {
-    const experiments::Insert3dHandCameraOptions& camera =
-        experiments::insert3d_camera_of(model->config())->options();
-    loaded.camera = camera.camera;
-    loaded.normals = camera.channels == experiments::Insert3dImageChannels::normals;
+    // Held, not a temporary: options() refers into the camera object.
+    const auto camera = experiments::insert3d_camera_of(model->config());
+    loaded.camera = camera->options().camera;
+    loaded.normals = camera->options().channels == experiments::Insert3dImageChannels::normals;
   }
   // Each 3D model with the input it was trained on: the hand camera's image, or the corners and
   // the slot points computed from them (cmd_train).
