@@ -183,8 +183,7 @@ void add_train_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--head", options->head,
                   "flow|ddpm|cvae|c8flow|c8ddpm|c8flow_planar|c8ddpm_avg|c8flow_avg (the c8 heads "
-                  "need --repr "
-                  "absolute)")
+                  "need --repr absolute)")
       ->capture_default_str();
   cmd->add_option("--c8-centre-x", config.c8_centre_x,
                   "c8ddpm, c8flow_planar, c8ddpm_avg, c8flow_avg: x of the C8 centre (cm)")

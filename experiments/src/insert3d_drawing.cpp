@@ -102,13 +102,15 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
     throw InvalidArgument("draw_insert3d_rollout: the rollout has no pose");
   geometry.validate();
   camera.validate();
-  // Both panels fit the view's height whatever the camera: 8x a 32 x 24 image (the task's
-  // camera), 4x a 64 x 48 one.
-  const int scale = std::max(1, std::min(kDepthScale, (kViewHeight - 180) / (2 * camera.height)));
+  // Both panels, with 60 pixels above each and below the last, fit the view's height whatever
+  // the camera: 8x a 32 x 24 image (the task's camera), 4x a 64 x 48 one.
+  constexpr int kMargins = 3 * 60;
+  const int scale =
+      std::max(1, std::min(kDepthScale, (kViewHeight - kMargins) / (2 * camera.height)));
   const int panel_width = camera.width * scale;
   const int width = kViewWidth + panel_width + 40;
   // Taller than the view only for a camera of more than 230 rows.
-  const int height = std::max(kViewHeight, 180 + 2 * camera.height * scale);
+  const int height = std::max(kViewHeight, kMargins + 2 * camera.height * scale);
   cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
   // Aimed between the slot's opening and the hand's start, so both are in view at any placement.
   const Eigen::Vector3d target =

@@ -400,24 +400,23 @@ void run_table1(const Table1Options& options, const Table1Grid& grid) {
     while (!failed) {
       const std::size_t i = next++;
       if (i >= order.size()) return;
-      std::optional<policy::LearnedPolicy> trained;  // the job's first model, once made
+      const Cell& first = *order[i].front();
+      // The job's trained model, made (or loaded, when its cell was done) once when needed.
+      std::optional<policy::LearnedPolicy> trained;
+      const auto first_model = [&]() -> const policy::LearnedPolicy& {
+        if (!trained) trained.emplace(cell_model(first, grid.difficulty, dir, demos, nullptr));
+        return *trained;
+      };
       for (const Cell* cell : order[i]) {
         progress.start(id, cell->describe());
         const bool skipped = cell_done(*cell, options.eval, dir);
         try {
           if (!skipped) {
-            const policy::LearnedPolicy* same_training = nullptr;
-            if (cell != order[i].front()) {
-              // The first cell's model: made above, or on file when that cell was done.
-              if (!trained)
-                trained.emplace(
-                    cell_model(*order[i].front(), grid.difficulty, dir, demos, nullptr));
-              same_training = &*trained;
-            }
-            const policy::LearnedPolicy model =
-                cell_model(*cell, grid.difficulty, dir, demos, same_training);
-            if (!trained) trained.emplace(model);
-            evaluate_cell(*cell, model, options.eval, grid.difficulty, dir);
+            evaluate_cell(*cell,
+                          cell == &first
+                              ? first_model()
+                              : cell_model(*cell, grid.difficulty, dir, demos, &first_model()),
+                          options.eval, grid.difficulty, dir);
           }
         } catch (const std::exception& e) {
           const std::lock_guard lock(error_mutex);
@@ -426,8 +425,7 @@ void run_table1(const Table1Options& options, const Table1Grid& grid) {
           return;
         }
         progress.finish(
-            id,
-            cell_work(*cell, options.eval) - (cell == order[i].front() ? 0.0 : cell->config.steps),
+            id, cell_work(*cell, options.eval) - (cell == &first ? 0.0 : cell->config.steps),
             skipped);
       }
     }

@@ -219,8 +219,8 @@ Eigen::MatrixXd averaged_sample(const Head& head, const Eigen::MatrixXd& observa
   inner.network->observation_normalizer().normalize(o_images);
 
   // Every step (DDIM or Euler) on all images at once (one network call), each image's result
-  // moved back by its element's inverse and averaged: Phi(x, o) = 1/8 sum_k g_k^-1 phi(g_k x, g_k
-  // o).
+  // moved back by its element's inverse and averaged:
+  //   Phi(x, o) = 1/8 sum_k g_k^-1 phi(g_k x, g_k o).
   Eigen::MatrixXf x_images(A.planar_size(), batch * n);
   for (int i = 0; i < inner.steps; ++i) {
     for (Eigen::Index j = 0; j < batch; ++j) {

@@ -73,10 +73,8 @@ Eigen::MatrixXf FlowHead::sample(const Eigen::MatrixXf& observations, std::mt199
 
 Eigen::MatrixXf FlowHead::sample_normalized(const Eigen::MatrixXf& o, std::mt19937_64& rng) const {
   const Eigen::Index batch = o.cols();
-  Eigen::MatrixXf x(config_.action_dimension, batch);
-  fill_standard_normal(rng, x);
+  Eigen::MatrixXf x = initial_noise(batch, rng);
   const Eigen::VectorXf& active = action_normalizer_.active_float();
-  x.array().colwise() *= active.array() * static_cast<float>(config_.noise_scale);
   Eigen::MatrixXf input, velocity, scratch[2];
   const Eigen::VectorXd t0 = Eigen::VectorXd::Zero(batch);
   assemble(x, t0, o, input);  // sizes the input once; per step only x and the time rows change

@@ -47,6 +47,17 @@ double largest_change_under_g(const Insert3dHandCamera& camera, std::uint64_t se
   return largest;
 }
 
+// `poses` poses of the hand going straight down from its start, 0.5 cm a step.
+insert3d::Rollout straight_descent(const insert3d::TaskScene& scene, int poses) {
+  insert3d::Rollout rollout;
+  for (int t = 0; t < poses; ++t) {
+    rollout.world_T_hand.push_back(
+        scene.world_T_hand_start *
+        RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -0.5 * t)));
+  }
+  return rollout;
+}
+
 }  // namespace
 
 TEST_CASE("the_image_policy_reads_the_sims_hand_camera", "[unit]") {
@@ -97,12 +108,7 @@ TEST_CASE("the_hand_camera_renders_any_four_points_and_refuses_other_counts", "[
 TEST_CASE("the_camera_frames_show_every_fourth_pose_and_the_last", "[unit]") {
   const insert3d::TaskScene scene =
       insert3d::sample_scene(insert3d::SceneDistribution::train(), 11, 2);
-  insert3d::Rollout rollout;
-  for (int t = 0; t < 10; ++t) {
-    rollout.world_T_hand.push_back(
-        scene.world_T_hand_start *
-        RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -0.5 * t)));
-  }
+  const insert3d::Rollout rollout = straight_descent(scene, 10);
   // Steps 0, 4, 8 and 9: four panels of 128 x 96 in one row, 6 pixels apart, 18 for the label.
   const sim::Image sheet = draw_insert3d_camera_frames(scene, rollout);
   CHECK(sheet.width == 4 * (128 + 6) + 6);
@@ -120,12 +126,7 @@ TEST_CASE("the_camera_frames_show_every_fourth_pose_and_the_last", "[unit]") {
 TEST_CASE("the_rollout_picture_fits_the_camera_panels_of_any_image_size", "[unit]") {
   const insert3d::TaskScene scene =
       insert3d::sample_scene(insert3d::SceneDistribution::train(), 11, 2);
-  insert3d::Rollout rollout;
-  for (int t = 0; t < 3; ++t) {
-    rollout.world_T_hand.push_back(
-        scene.world_T_hand_start *
-        RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, -0.5 * t)));
-  }
+  const insert3d::Rollout rollout = straight_descent(scene, 3);
   insert3d::DepthCamera small;
   const sim::Image with_small = draw_insert3d_rollout(scene, rollout, "32 x 24", {}, small);
   insert3d::DepthCamera large = small;
