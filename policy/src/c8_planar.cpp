@@ -1,5 +1,6 @@
 #include "handcentric/policy/c8_planar.hpp"
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -25,12 +26,19 @@ void check_size(Eigen::Index size, int expected, const char* what) {
 }
 
 // cos and sin of k * 45 deg, exact at multiples of 90 deg, so that 4 quarter turns are the
-// identity to the last bit.
-Eigen::Vector2d cos_sin(int k) {
-  const int m = ((k % 8) + 8) % 8;
-  const double angle = m * std::numbers::pi / 4.0;
-  if (m % 2 == 0) return {std::round(std::cos(angle)), std::round(std::sin(angle))};
-  return {std::cos(angle), std::sin(angle)};
+// identity to the last bit. A table: the training step moves every minibatch column.
+const Eigen::Vector2d& cos_sin(int k) {
+  static const std::array<Eigen::Vector2d, 8> table = [] {
+    std::array<Eigen::Vector2d, 8> out;
+    for (int m = 0; m < 8; ++m) {
+      const double angle = m * std::numbers::pi / 4.0;
+      out[static_cast<std::size_t>(m)] =
+          m % 2 == 0 ? Eigen::Vector2d(std::round(std::cos(angle)), std::round(std::sin(angle)))
+                     : Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    }
+    return out;
+  }();
+  return table[static_cast<std::size_t>(((k % 8) + 8) % 8)];
 }
 
 Eigen::Vector2d rotate(const Eigen::Vector2d& cs, const Eigen::Vector2d& v) {
@@ -80,25 +88,52 @@ Eigen::VectorXd decode_planar(const Eigen::VectorXd& planar, const Layout& layou
   return out;
 }
 
-Eigen::VectorXd act_planar(int k, const Eigen::Vector2d& centre, const Eigen::VectorXd& planar,
-                           const Layout& layout) {
-  check_size(planar.size(), layout.planar_size(), "a planar vector");
-  Eigen::VectorXd out = planar;
+namespace {
+
+// g_k on a planar vector (the header's formula), each moved number rounded to `Scalar` as it is
+// written into `out`, which holds `planar` (rounded alike) on entry. The one copy of the group's
+// arithmetic: act_planar and act_planar_float round the same doubles, so the float32 training
+// columns are act_planar's, rounded.
+template <typename Scalar>
+void move_planar(int k, const Eigen::Vector2d& centre,
+                 const Eigen::Ref<const Eigen::VectorXd>& planar, const Layout& layout,
+                 Eigen::Ref<Eigen::Matrix<Scalar, Eigen::Dynamic, 1>> out) {
   // The identity exactly: c + (x - c) need not round back to x.
-  if (k % 8 == 0) return out;
+  if (k % 8 == 0) return;
   const Eigen::Vector2d cs = cos_sin(k);
   for (int i = 0; i < layout.poses; ++i) {
     const Eigen::Index at = kPlanarPoseSize * i;
-    out.segment<2>(at) = centre + rotate(cs, planar.segment<2>(at) - centre);
-    out.segment<2>(at + 3) = rotate(cs, planar.segment<2>(at + 3));  // the heading
+    out.template segment<2>(at) =
+        (centre + rotate(cs, planar.segment<2>(at) - centre)).template cast<Scalar>();
+    // The heading.
+    out.template segment<2>(at + 3) = rotate(cs, planar.segment<2>(at + 3)).template cast<Scalar>();
   }
   // Eye-in-hand points stay; world points move like positions.
   const Eigen::Index world = kPlanarPoseSize * layout.poses + 3 * layout.hand_points;
   for (int i = 0; i < layout.world_points; ++i) {
     const Eigen::Index at = world + 3 * i;
-    out.segment<2>(at) = centre + rotate(cs, planar.segment<2>(at) - centre);
+    out.template segment<2>(at) =
+        (centre + rotate(cs, planar.segment<2>(at) - centre)).template cast<Scalar>();
   }
+}
+
+}  // namespace
+
+Eigen::VectorXd act_planar(int k, const Eigen::Vector2d& centre, const Eigen::VectorXd& planar,
+                           const Layout& layout) {
+  check_size(planar.size(), layout.planar_size(), "a planar vector");
+  Eigen::VectorXd out = planar;
+  move_planar<double>(k, centre, planar, layout, out);
   return out;
+}
+
+void act_planar_float(int k, const Eigen::Vector2d& centre,
+                      const Eigen::Ref<const Eigen::VectorXd>& planar, const Layout& layout,
+                      Eigen::Ref<Eigen::VectorXf> out) {
+  check_size(planar.size(), layout.planar_size(), "a planar vector");
+  check_size(out.size(), layout.planar_size(), "the output vector");
+  out = planar.cast<float>();
+  move_planar<float>(k, centre, planar, layout, out);
 }
 
 Eigen::MatrixXd orbit(const Eigen::MatrixXd& planar, const Eigen::Vector2d& centre,

@@ -54,7 +54,12 @@ std::vector<double> cosine_alpha_bar(int T) {
 DdpmHead::DdpmHead(const PolicyConfig& config)
     : NetworkHead(config),
       alpha_bar_(cosine_alpha_bar(config.ddpm_train_steps)),
-      initial_noise_(static_cast<float>(config.noise_scale)) {}
+      time_features_(time_rows(), config.ddpm_train_steps),
+      initial_noise_(static_cast<float>(config.noise_scale)) {
+  const int T = config.ddpm_train_steps;
+  for (int k = 0; k < T; ++k)
+    time_features(static_cast<double>(k + 1) / T, config.time_embedding, time_features_.col(k));
+}
 
 void DdpmHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixXd& observations,
                        std::mt19937_64& rng) {
@@ -87,15 +92,15 @@ double DdpmHead::train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixX
   noise_.resize(a_.rows(), batch);
   fill_standard_normal(rng, noise_);
   noise_.array().colwise() *= action_normalizer_.active_float().array();  // constant dims: no noise
-  t_.resize(batch);
+  steps_.resize(static_cast<std::size_t>(batch));
   x_.resize(a_.rows(), batch);
   for (Eigen::Index j = 0; j < batch; ++j) {
     const int k = static_cast<int>(rng() % static_cast<std::uint64_t>(T));
-    t_[j] = static_cast<double>(k + 1) / T;
+    steps_[static_cast<std::size_t>(j)] = k;
     x_.col(j) = static_cast<float>(std::sqrt(alpha_bar_[k])) * a_.col(j) +
                 static_cast<float>(std::sqrt(1.0 - alpha_bar_[k])) * noise_.col(j);
   }
-  assemble(x_, t_, o_, input_);
+  assemble(x_, time_features_, steps_, o_, input_);
   return regress(network_.forward(input_),
                  config_.ddpm_prediction == DdpmPrediction::sample ? a_ : noise_);
 }
@@ -116,7 +121,7 @@ void DdpmHead::ddim_step(Eigen::MatrixXf& x, const Eigen::MatrixXf& o, int i) co
   const float signal = static_cast<float>(std::sqrt(abar));
   const float noise = static_cast<float>(std::sqrt(1.0 - abar));
   Eigen::MatrixXf input, output, x0, eps_hat, scratch[2];
-  assemble(x, Eigen::VectorXd::Constant(batch, static_cast<double>(k + 1) / T), o, input);
+  assemble(x, time_features_, std::vector<int>(static_cast<std::size_t>(batch), k), o, input);
   network_.infer(input, output, scratch);
   output.array().colwise() *= action_normalizer_.active_float().array();
   if (config_.ddpm_prediction == DdpmPrediction::sample) {

@@ -31,6 +31,9 @@ class DdpmHead final : public NetworkHead {
 
  private:
   std::vector<double> alpha_bar_;
+  /// Column k: the time features of step k, of t = (k + 1) / T.
+  Eigen::MatrixXf time_features_;
+  std::vector<int> steps_;      ///< the minibatch's steps k
   float clip_ = 1.0f;           ///< max |normalized training action|, at least 1
   float initial_noise_ = 1.0f;  ///< scale of x_T; 0 starts DDIM at the prior's mode
 };

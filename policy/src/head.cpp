@@ -152,6 +152,17 @@ void NetworkHead::assemble(const Eigen::MatrixXf& x, const Eigen::VectorXd& t,
   }
 }
 
+void NetworkHead::assemble(const Eigen::MatrixXf& x, const Eigen::MatrixXf& features,
+                           std::span<const int> times, const Eigen::MatrixXf& o,
+                           Eigen::MatrixXf& input) const {
+  const Eigen::Index da = x.rows(), dt = time_rows(), batch = x.cols();
+  input.resize(da + dt + o.rows(), batch);
+  input.topRows(da) = x;
+  input.bottomRows(o.rows()) = o;
+  for (Eigen::Index j = 0; j < batch; ++j)
+    input.block(da, j, dt, 1) = features.col(times[static_cast<std::size_t>(j)]);
+}
+
 double NetworkHead::regress(const Eigen::MatrixXf& output, const Eigen::MatrixXf& target) {
   const double loss = mse_loss<float>(output, target, d_output_);  // eq. (5), averaged
   network_.backward_parameters(d_output_);

@@ -3,6 +3,7 @@
 // the two normalizers, Adam, and the minibatch buffers (allocated once, reused every step).
 #include <Eigen/Core>
 #include <random>
+#include <span>
 
 #include "handcentric/policy/adam.hpp"
 #include "handcentric/policy/head.hpp"
@@ -35,6 +36,10 @@ class NetworkHead : public Head {
   /// Writes [x; features(t_j); o] into `input` (columns j); resizes it once per batch size.
   void assemble(const Eigen::MatrixXf& x, const Eigen::VectorXd& t, const Eigen::MatrixXf& o,
                 Eigen::MatrixXf& input) const;
+  /// The same with column j's time features given as features.col(times[j]) (the DDPM's
+  /// discrete times, whose features are computed once, not once per draw).
+  void assemble(const Eigen::MatrixXf& x, const Eigen::MatrixXf& features,
+                std::span<const int> times, const Eigen::MatrixXf& o, Eigen::MatrixXf& input) const;
   /// Mean squared error of the last network_.forward() output against `target`, its backward
   /// pass, clipping and the Adam step. Returns the loss.
   double regress(const Eigen::MatrixXf& output, const Eigen::MatrixXf& target);

@@ -6,6 +6,7 @@
 #include <string>
 #include <numbers>
 #include <random>
+#include <vector>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
@@ -110,6 +111,8 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
   }
   Eigen::MatrixXf batch_actions(actions.rows(), config.batch_size);
   Eigen::MatrixXf batch_observations(observations.rows(), config.batch_size);
+  std::vector<Eigen::Index> columns(static_cast<std::size_t>(config.batch_size));
+  const Minibatch batch{actions, observations, columns, batch_actions, batch_observations};
 
   const auto start = std::chrono::steady_clock::now();
   double loss_sum = 0.0;
@@ -118,12 +121,13 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
   for (int step = 1; step <= config.steps; ++step) {
     for (int j = 0; j < config.batch_size; ++j) {
       const auto i = static_cast<Eigen::Index>(rng() % n);
+      columns[static_cast<std::size_t>(j)] = i;
       batch_actions.col(j) = actions.col(i);
       batch_observations.col(j) = observations.col(i);
     }
     const double learning_rate = learning_rate_at(config, step);
     head->set_learning_rate(learning_rate);
-    const double loss = head->train_step(batch_actions, batch_observations, rng);
+    const double loss = head->train_step_on(batch, rng);
     if (!std::isfinite(loss)) {
       throw InvalidArgument("training diverged at step " + std::to_string(step) + " (loss " +
                             std::to_string(loss) + ", learning rate " +

@@ -5,13 +5,19 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/Geometry>
+#include <cmath>
 #include <functional>
+#include <memory>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "fixtures.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/policy/binary_io.hpp"
 #include "handcentric/policy/c8_planar.hpp"
+#include "handcentric/policy/head.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "throws.hpp"
 
@@ -242,4 +248,89 @@ TEST_CASE("c8ddpm_trains_on_8x_the_budget_and_refuses_what_it_cannot_encode", "[
                   Catch::Contains("not a rotation about z"));
   config.c8_centre_x = 1e7;
   HC_CHECK_THROWS(config.validate(), InvalidArgument, Catch::Contains("c8_centre_x"));
+}
+
+TEST_CASE("act_planar_float_is_act_planar_rounded_to_the_last_bit", "[unit]") {
+  const AbsoluteRepresentation absolute;
+  const Eigen::Vector2d centre(13.25, -60.0);
+  for (std::uint64_t seed = 0; seed < 10; ++seed) {
+    const Eigen::VectorXd x =
+        c8::encode_planar(absolute.encode_observation(planar_scene(seed)), kObservations);
+    for (int k = -1; k < 9; ++k) {
+      Eigen::VectorXf out(kObservations.planar_size());
+      c8::act_planar_float(k, centre, x, kObservations, out);
+      CHECK(out == c8::act_planar(k, centre, x, kObservations).cast<float>());
+    }
+  }
+  Eigen::VectorXf short_out(3);
+  HC_CHECK_THROWS(
+      c8::act_planar_float(1, centre, Eigen::VectorXd::Zero(kObservations.planar_size()),
+                           kObservations, short_out),
+      InvalidArgument, Catch::Contains("the output vector of length 3"));
+}
+
+namespace {
+
+// The bytes of a planar C8 head trained 5 steps on minibatches of the set's columns: through
+// train_step on the copied columns, or through train_step_on with `observations_for_lookup` as
+// the set's observations (the trainer's call, answered from the head's encoding of the set).
+std::string c8_head_bytes_after_steps(HeadKind kind, const Eigen::MatrixXd& actions,
+                                      const Eigen::MatrixXd& observations, bool through_the_set,
+                                      const Eigen::MatrixXf& observations_for_lookup) {
+  PolicyConfig config = test::small_config(kind, "absolute", 0);
+  config.hand_points = 2;
+  config.world_points = 1;
+  config.history_length = 2;
+  config.chunk_length = 4;
+  config.action_dimension = static_cast<int>(actions.rows());
+  config.observation_dimension = static_cast<int>(observations.rows());
+  config.batch_size = 8;
+  const std::unique_ptr<Head> head = make_head(config);
+  std::mt19937_64 rng(11);
+  head->prepare(actions, observations, rng);
+  const Eigen::MatrixXf set_actions = actions.cast<float>();
+  const Eigen::MatrixXf set_observations = observations.cast<float>();
+  Eigen::MatrixXf batch_actions(actions.rows(), 8), batch_observations(observations.rows(), 8);
+  std::vector<Eigen::Index> columns(8);
+  for (int step = 0; step < 5; ++step) {
+    for (int j = 0; j < 8; ++j) {
+      columns[static_cast<std::size_t>(j)] = static_cast<Eigen::Index>(rng() % actions.cols());
+      batch_actions.col(j) = set_actions.col(columns[static_cast<std::size_t>(j)]);
+      batch_observations.col(j) = set_observations.col(columns[static_cast<std::size_t>(j)]);
+    }
+    if (through_the_set) {
+      head->train_step_on(Minibatch{set_actions, observations_for_lookup, columns, batch_actions,
+                                    batch_observations},
+                          rng);
+    } else {
+      head->train_step(batch_actions, batch_observations, rng);
+    }
+  }
+  ByteWriter out;
+  head->write(out);
+  return out.bytes();
+}
+
+}  // namespace
+
+TEST_CASE("planar_c8_heads_train_the_same_bits_from_their_encoded_set", "[unit]") {
+  const AbsoluteRepresentation absolute;
+  Eigen::MatrixXd actions(24, 12), observations(3 * 6 + 9, 12);
+  for (int j = 0; j < 12; ++j) {
+    const Scene scene = planar_scene(static_cast<std::uint64_t>(j));
+    actions.col(j) = absolute.encode_actions(scene);
+    observations.col(j) = absolute.encode_observation(scene);
+  }
+  const Eigen::MatrixXf set_observations = observations.cast<float>();
+  for (const HeadKind kind : {HeadKind::c8ddpm, HeadKind::c8flow_planar}) {
+    INFO(to_string(kind));
+    const std::string copied =
+        c8_head_bytes_after_steps(kind, actions, observations, false, set_observations);
+    CHECK(c8_head_bytes_after_steps(kind, actions, observations, true, set_observations) == copied);
+    // Planted fault: a set whose column 3 differs in one float's last bit from the columns
+    // copied out. The head reads its encoding of the set, so its weights move away.
+    Eigen::MatrixXf nudged = set_observations;
+    nudged(0, 3) = std::nextafter(nudged(0, 3), 1e9f);
+    CHECK(c8_head_bytes_after_steps(kind, actions, observations, true, nudged) != copied);
+  }
 }

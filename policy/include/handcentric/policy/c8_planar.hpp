@@ -52,6 +52,13 @@ Eigen::VectorXd decode_planar(const Eigen::VectorXd& planar, const Layout& layou
 Eigen::VectorXd act_planar(int k, const Eigen::Vector2d& centre, const Eigen::VectorXd& planar,
                            const Layout& layout);
 
+/// act_planar(k, centre, planar, layout).cast<float>(), written into `out` without allocating
+/// (the planar C8 heads' training step, once per minibatch column). The same bits. Throws
+/// InvalidArgument for a `planar` or `out` whose length does not fit `layout`.
+void act_planar_float(int k, const Eigen::Vector2d& centre,
+                      const Eigen::Ref<const Eigen::VectorXd>& planar, const Layout& layout,
+                      Eigen::Ref<Eigen::VectorXf> out);
+
 /// The 8x augmented data: column 8 j + k is g_k applied to column j of `planar` (each column
 /// a planar vector of `layout`). A set that C8 maps onto itself, so the loss on it is the
 /// orbit-averaged loss. Throws as act_planar.

@@ -18,11 +18,23 @@
 #include <cstdint>
 #include <memory>
 #include <random>
+#include <span>
 
 #include "handcentric/policy/binary_io.hpp"
 #include "handcentric/policy/config.hpp"
 
 namespace handcentric::policy {
+
+/// A minibatch as the trainer draws it: the columns `columns` of the whole training set
+/// (`set_actions`, `set_observations`: float32, the trainer's copy of what prepare() saw), and
+/// those columns copied out, in that order (`actions`, `observations`).
+struct Minibatch {
+  const Eigen::MatrixXf& set_actions;
+  const Eigen::MatrixXf& set_observations;
+  std::span<const Eigen::Index> columns;
+  const Eigen::MatrixXf& actions;
+  const Eigen::MatrixXf& observations;
+};
 
 class Head {
  public:
@@ -38,6 +50,12 @@ class Head {
   virtual double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
                             std::mt19937_64& rng) = 0;
 
+  /// train_step on a minibatch the trainer drew (what the trainer calls). A head that applies a
+  /// fixed transform to each raw column (the planar C8 heads' encoding) overrides it to compute
+  /// the transform once per column of the training set rather than once per draw.
+  virtual double train_step_on(const Minibatch& batch, std::mt19937_64& rng) {
+    return train_step(batch.actions, batch.observations, rng);
+  }
   /// The optimizer's learning rate for the next train_step calls (the trainer's schedule).
   virtual void set_learning_rate(double learning_rate) = 0;
 
