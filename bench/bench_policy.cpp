@@ -1,6 +1,7 @@
 // Policy speed: training throughput of the flow head on the anchor network of
 // bench/vs_pytorch.sh, 57 inputs (24 noisy action + 1 time + 32 observation) -> 256 -> 256 -> 256
-// -> 24, SiLU, Adam, batch 256; and sampling latency at batch 1 (10 Euler steps). Numbers are
+// -> 24, SiLU, Adam, batch 256; the C8 baseline's training step (c8ddpm) with and without its
+// encoded set; and sampling latency at batch 1 (10 Euler steps). Numbers are
 // recorded in docs/BENCHMARKS.md ("## Policy") with the commands that produced them.
 #include <benchmark/benchmark.h>
 #if defined(__x86_64__)
@@ -8,9 +9,11 @@
 #endif
 
 #include <random>
+#include <vector>
 
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/head.hpp"
 #include "handcentric/policy/mlp.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -60,6 +63,61 @@ void BM_flow_train_step_batch256(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 256);  // items/s = training samples/s
 }
 BENCHMARK(BM_flow_train_step_batch256)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// The planar C8 head of Table 1's c8_centre row (c8ddpm, the library's defaults: K = 16, one
+// observed pose and 2 eye-in-hand points), one training step at batch 256 as the trainer makes
+// it (train_step_on: the columns' encoding looked up) and as it was made before (train_step on
+// the copied columns: each column encoded again at every draw).
+void c8ddpm_train_step(benchmark::State& state, bool on_the_set) {
+  PolicyConfig config;
+  config.head = HeadKind::c8ddpm;
+  config.representation = "absolute";
+  config.hand_points = 2;
+  const c8::Layout actions_layout = c8::action_layout(config);
+  const c8::Layout observations_layout = c8::observation_layout(config);
+  config.action_dimension = actions_layout.absolute_size();
+  config.observation_dimension = observations_layout.absolute_size();
+  std::mt19937_64 rng(3);
+  // Planar absolute columns: every pose block (x, y, z, 0, 0, theta).
+  const auto planar_columns = [&rng](const c8::Layout& layout, Eigen::Index n) {
+    Eigen::MatrixXd m(layout.absolute_size(), n);
+    for (Eigen::Index i = 0; i < m.size(); ++i) m(i) = standard_normal(rng);
+    for (int p = 0; p < layout.poses; ++p) m.middleRows(6 * p + 3, 2).setZero();
+    return m;
+  };
+  const Eigen::MatrixXd actions = planar_columns(actions_layout, 4096);
+  const Eigen::MatrixXd observations = planar_columns(observations_layout, 4096);
+  auto head = make_head(config);
+  head->prepare(actions, observations, rng);
+  const Eigen::MatrixXf set_actions = actions.cast<float>();
+  const Eigen::MatrixXf set_observations = observations.cast<float>();
+  std::vector<Eigen::Index> columns(256);
+  Eigen::MatrixXf batch_actions(set_actions.rows(), 256);
+  Eigen::MatrixXf batch_observations(set_observations.rows(), 256);
+  for (auto _ : state) {
+    for (std::size_t j = 0; j < columns.size(); ++j) {
+      columns[j] = static_cast<Eigen::Index>(rng() % 4096);
+      batch_actions.col(static_cast<Eigen::Index>(j)) = set_actions.col(columns[j]);
+      batch_observations.col(static_cast<Eigen::Index>(j)) = set_observations.col(columns[j]);
+    }
+    benchmark::DoNotOptimize(
+        on_the_set ? head->train_step_on(Minibatch{set_actions, set_observations, columns,
+                                                   batch_actions, batch_observations},
+                                         rng)
+                   : head->train_step(batch_actions, batch_observations, rng));
+  }
+  state.SetItemsProcessed(state.iterations() * 256);
+}
+void BM_c8ddpm_train_step_batch256(benchmark::State& state) {
+  c8ddpm_train_step(state, true);
+}
+void BM_c8ddpm_train_step_reencoding_every_draw_batch256(benchmark::State& state) {
+  c8ddpm_train_step(state, false);
+}
+BENCHMARK(BM_c8ddpm_train_step_batch256)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK(BM_c8ddpm_train_step_reencoding_every_draw_batch256)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 void sample_batch1(benchmark::State& state, HeadKind kind) {
   const PolicyConfig config = anchor_config(kind);
