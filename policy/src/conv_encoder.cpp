@@ -222,17 +222,15 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     const Matrix& delta = delta_[l];
     float* d_weights = gradient_.data() + offsets_[l];
     float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
-    // dW (out x K) = delta patches^T (the first layer stores patches^T, N x K); db = delta 1.
-    if (l == 0) {
-      set.gemm({Op::none, Op::none, out, k, n, delta.data(), out, patches_[0].data(), n, nullptr,
-                d_weights, out});
-    } else {
-      set.gemm({Op::none, Op::transpose, out, k, n, delta.data(), out, patches_[l].data(), k,
-                nullptr, d_weights, out});
-    }
-    if (ones_.size() < n) ones_ = Vector::Ones(n);
-    set.gemm(
-        {Op::none, Op::none, out, 1, n, delta.data(), out, ones_.data(), n, nullptr, d_bias, out});
+    // dW (out x K) = delta patches^T (the first layer stores patches^T, N x K); db = delta 1,
+    // the row sums of the product's A, added up while it packs delta.
+    kernels::Gemm d_product =
+        l == 0 ? kernels::Gemm{Op::none, Op::none,           out, k,       n,         delta.data(),
+                               out,      patches_[0].data(), n,   nullptr, d_weights, out}
+               : kernels::Gemm{Op::none, Op::transpose,      out, k,       n,         delta.data(),
+                               out,      patches_[l].data(), k,   nullptr, d_weights, out};
+    d_product.a_row_sums = d_bias;
+    set.gemm(d_product);
     if (l == 0 && !input_gradient) break;
     // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from: a
     // chunk of samples at a time, so that col2im reads the patches from L2. A chunk's pixels

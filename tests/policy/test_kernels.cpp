@@ -193,6 +193,60 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
   }
 }
 
+// Gemm::a_row_sums (db = delta 1 beside dW = delta x^T): the worst |sum_i - ref_i| / bound over
+// op(A)'s rows, ref in double; `skip_last_term` plants a fault in the reference (the last k term
+// left out), which the check must catch.
+double row_sums_error(const GemmProblem& problem, const std::vector<float>& sums,
+                      bool skip_last_term = false) {
+  double worst = 0.0;
+  for (int i = 0; i < problem.m; ++i) {
+    double sum = 0.0, magnitude = 0.0;
+    for (int p = 0; p < (skip_last_term ? problem.k - 1 : problem.k); ++p) {
+      sum += problem.A(i, p);
+      magnitude += std::abs(problem.A(i, p));
+    }
+    const double bound = 4.0 * std::max(problem.k, 1) * 6e-8 * magnitude + 1e-30;
+    worst = std::max(worst, std::abs(sums[i] - sum) / bound);
+  }
+  return worst;
+}
+
+TEST_CASE("row_sums_of_a_are_the_narrow_products_bits_on_every_path", "[unit]") {
+  // The blocked nest adds A's rows up while it packs A; every other path in a pass of its own.
+  // On every target and shape the sums match the double reference, C is still the product, and
+  // with op(A) = A (the bias gradients') the sums have the bits of the narrow product A 1, which
+  // computed the bias gradients before, so trained weights keep their bits.
+  std::mt19937_64 rng(17);
+  for (const auto& [name, set] : every_target()) {
+    INFO("target " << name);
+    for (const Shape& shape : kShapes) {
+      for (Op op_a : {Op::none, Op::transpose}) {
+        for (Op op_b : {Op::none, Op::transpose}) {
+          GemmProblem problem(op_a, op_b, shape.m, shape.n, shape.k, 3, false, rng);
+          std::vector<float> sums(static_cast<std::size_t>(shape.m), 1e30f);
+          kernels::Gemm gemm = problem.gemm();
+          gemm.a_row_sums = sums.data();
+          set->gemm(gemm);
+          INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a)
+                    << " op_b " << int(op_b));
+          CHECK(gemm_error(problem) <= 1.0);
+          CHECK(row_sums_error(problem, sums) <= 1.0);
+          if (op_a == Op::none) {  // against the narrow product by ones, a call of its own
+            const std::vector<float> ones(static_cast<std::size_t>(std::max(shape.k, 1)), 1.0f);
+            std::vector<float> narrow(static_cast<std::size_t>(shape.m), -1e30f);
+            set->gemm({Op::none, Op::none, shape.m, 1, shape.k, problem.a.data(), problem.lda,
+                       ones.data(), std::max(shape.k, 1), nullptr, narrow.data(), shape.m});
+            CHECK(sums == narrow);
+          }
+          if (shape.k >= 2) {  // planted fault: a reference that leaves out the last term
+            CHECK(row_sums_error(problem, sums, /*skip_last_term=*/true) > 1.0);
+          }
+        }
+      }
+    }
+  }
+}
+
 // The epilogues on every path of the product (blocked, narrow, k = 0): C against the double
 // reference Z followed by SiLU, or by the product with SiLU'(z) = s + a (1 - s) from given s and
 // a (leading dimension lds, unlike C's). Returns the worst error over C in units of the bound;

@@ -28,6 +28,10 @@ enum class Epilogue { none, silu, silu_derivative };
 /// gets sigmoid(Z) (kept for the backward pass).
 /// With Epilogue::silu_derivative, C = Z * SiLU'(z) elementwise, SiLU'(z) = s + a (1 - s), from
 /// the forward pass's s = `sigmoid` and a = `activation` = SiLU(z) (both m x n, lds, read only).
+/// `a_row_sums` (m floats), when not null, gets the sums of op(A)'s rows, sum_p op(A)(i, p), each
+/// added from 0 in the order p = 0, 1, ..., k - 1: the bits of the product op(A) 1 on the narrow
+/// kernel (db = delta 1, a bias gradient). With op(A) = A the blocked product adds them up while
+/// it packs A (a weight gradient delta x^T reads delta once for both).
 struct Gemm {
   Op op_a = Op::none, op_b = Op::none;
   int m = 0, n = 0, k = 0;
@@ -42,6 +46,7 @@ struct Gemm {
   float* sigmoid = nullptr;
   int lds = 0;
   const float* activation = nullptr;
+  float* a_row_sums = nullptr;
 };
 
 /// Handles the degenerate shapes (m, n or k <= 0; k = 0 writes C = bias 1^T) and returns

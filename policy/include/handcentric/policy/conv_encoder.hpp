@@ -100,7 +100,6 @@ class ConvEncoder {
   std::vector<Matrix> activation_;  ///< SiLU(z) of each layer; the last one is the features
   std::vector<Matrix> delta_;  ///< d loss / d (each layer's output), kept: no reallocation per step
   Vector d_patches_;
-  Vector ones_;
   Matrix d_images_;
   long input_sample_stride_ = 0;  ///< of the images of the last forward()
 };
