@@ -99,7 +99,7 @@ enum class BLayout { packed, rows, columns };
 ///   (640 KB of the 1 MB).
 struct Blocking {
   static constexpr std::size_t kL1Bytes = 32 * 1024, kL2Bytes = 1024 * 1024;
-  static constexpr int KC = 256, MC = 256, NC = 384;
+  static constexpr int KC = kProductKBlock, MC = 256, NC = 384;
   static_assert((MC + NC) * KC * sizeof(float) <= kL2Bytes, "the A block and the B block share L2");
 };
 
@@ -127,13 +127,13 @@ void blocked_gemm(const Gemm& g) {
   alignas(64) float bias_tile[MR];
   // The row sums of A, added up by the packing of the first column block (which packs every
   // (i0, p0) block once, p0 ascending).
-  if (g.a_row_sums != nullptr) std::fill(g.a_row_sums, g.a_row_sums + g.m, 0.0f);
+  if (g.a_row_sums != nullptr && !g.accumulate) std::fill(g.a_row_sums, g.a_row_sums + g.m, 0.0f);
   for (int j0 = 0; j0 < g.n; j0 += NC) {
     const int nc = std::min(NC, g.n - j0);
     const int full = nc / NR * NR;  // columns in full panels, read in place
     for (int p0 = 0; p0 < g.k; p0 += KC) {
       const int kc = std::min(KC, g.k - p0);
-      const bool accumulate = p0 > 0;
+      const bool accumulate = p0 > 0 || g.accumulate;
       if (full < nc) pack_b<NR>(g.op_b, g.b, g.ldb, p0, kc, j0 + full, nc - full, buffers.b.data());
       for (int i0 = 0; i0 < g.m; i0 += MC) {
         const int mc = std::min(MC, g.m - i0);
@@ -257,7 +257,7 @@ void narrow_gemm(const Gemm& g) {
 /// Gemm::a_row_sums where the blocked nest does not add them up while packing: a pass of its own,
 /// in the same order.
 inline void sum_rows_of_a(const Gemm& g) {
-  for (int i = 0; i < g.m; ++i) g.a_row_sums[i] = 0.0f;
+  if (!g.accumulate) std::fill(g.a_row_sums, g.a_row_sums + g.m, 0.0f);
   for (int p = 0; p < g.k; ++p) {
     for (int i = 0; i < g.m; ++i) {
       g.a_row_sums[i] += g.op_a == Op::none ? g.a[i + static_cast<long>(p) * g.lda]
@@ -278,9 +278,11 @@ void vector_gemm(const Gemm& g) {
     Gemm rest = g;
     rest.a_row_sums = nullptr;
     vector_gemm<Kernel, ShortKernel>(rest);
+  } else if (g.accumulate && (g.m <= 0 || g.n <= 0 || g.k <= 0)) {
+    // nothing to add
   } else if (trivial_gemm(g)) {
     apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
-  } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
+  } else if (g.n <= kNarrowMax && g.op_a == Op::none && !g.accumulate) {
     narrow_gemm<Kernel>(g);
     apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
   } else if (g.m <= ShortKernel::MR) {
