@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <string>
 
 #include "handcentric/core/errors.hpp"
@@ -76,12 +77,17 @@ kernels::ConvPatches map_patches(const Conv2d& layer, int batch) {
 
 // Samples per chunk of the batch whose patch matrix (K x pixels each) fills about half of a
 // 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and the product reads it back from
-// there, and backward's col2im reads its gradient from there; at least one sample.
-int samples_per_chunk(const Conv2d& layer) {
+// there, and backward's col2im reads its gradient from there. Below the first layer, a chunk's
+// pixels are a multiple of the products' k block, so that the weight gradient summed chunk by
+// chunk adds the same terms in the same order as one product over the batch.
+int samples_per_chunk(const Conv2d& layer, bool first) {
   constexpr Eigen::Index kChunkFloats = Eigen::Index{1} << 17;  // 512 KB
-  const Eigen::Index per_sample =
-      static_cast<Eigen::Index>(layer.patch_size()) * layer.output().height * layer.output().width;
-  return static_cast<int>(std::max<Eigen::Index>(1, kChunkFloats / per_sample));
+  const int pixels = layer.output().height * layer.output().width;
+  const Eigen::Index per_sample = static_cast<Eigen::Index>(layer.patch_size()) * pixels;
+  const int fill = static_cast<int>(std::max<Eigen::Index>(1, kChunkFloats / per_sample));
+  if (first) return fill;
+  const int unit = kernels::kProductKBlock / std::gcd(pixels, kernels::kProductKBlock);
+  return std::max(unit, fill / unit * unit);
 }
 
 }  // namespace
@@ -151,10 +157,12 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
     const int pixels = layer.output().height * layer.output().width;
     const int k = layer.patch_size(), out = layer.out_channels();
     const Eigen::Index per_sample = static_cast<Eigen::Index>(k) * pixels;
-    patches_[l].resize(per_sample * batch_);
+    const int chunk = samples_per_chunk(layer, l == 0);
+    // The first layer's patches are kept for backward (which does not see the images); a hidden
+    // layer's are one chunk's, made again by backward from the map below.
+    patches_[l].resize(per_sample * (l == 0 ? batch_ : std::min(chunk, batch_)));
     activation_[l].resize(layer.output().size(), batch);
     sigmoid_[l].resize(layer.output().size(), batch);
-    const int chunk = samples_per_chunk(layer);
     for (int b0 = 0; b0 < batch_; b0 += chunk) {
       const int count = std::min(chunk, batch_ - b0);
       // The first layer reads the input, (channels, height, width): its patches are stored
@@ -185,7 +193,7 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
         product.b = rows;
         product.ldb = static_cast<int>(ld);
       } else {
-        float* columns = patches_[l].data() + b0 * per_sample;
+        float* columns = patches_[l].data();
         set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
                    columns);
         product.b = columns;
@@ -222,38 +230,48 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     const Matrix& delta = delta_[l];
     float* d_weights = gradient_.data() + offsets_[l];
     float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
-    // dW (out x K) = delta patches^T (the first layer stores patches^T, N x K); db = delta 1.
-    if (l == 0) {
-      set.gemm({Op::none, Op::none, out, k, n, delta.data(), out, patches_[0].data(), n, nullptr,
-                d_weights, out});
-    } else {
-      set.gemm({Op::none, Op::transpose, out, k, n, delta.data(), out, patches_[l].data(), k,
-                nullptr, d_weights, out});
-    }
-    if (ones_.size() < n) ones_ = Vector::Ones(n);
-    set.gemm(
-        {Op::none, Op::none, out, 1, n, delta.data(), out, ones_.data(), n, nullptr, d_bias, out});
-    if (l == 0 && !input_gradient) break;
-    // d patches (K x N) = W^T delta, then each entry back to the pixel it was read from: a
-    // chunk of samples at a time, so that col2im reads the patches from L2. A chunk's pixels
-    // receive only its own patches, so after its col2im they are complete: the chunk is
-    // zeroed just before (in cache, not a pass over the whole map) and, below the first layer,
-    // multiplied by the layer below's SiLU' just after.
+    const int pixels = layer.output().height * layer.output().width;
+    const int chunk = samples_per_chunk(layer, l == 0);
+    const bool d_input = l > 0 || input_gradient;
     const Eigen::Index below = layer.input().size();
     float* target = nullptr;
-    if (l == 0) {
-      d_images_.resize(below, batch_);
-      target = d_images_.data();
-    } else {
-      delta_[l - 1].resize(below, batch_);
-      target = delta_[l - 1].data();
+    if (d_input) {
+      Matrix& d_below = l == 0 ? d_images_ : delta_[l - 1];
+      d_below.resize(below, batch_);
+      target = d_below.data();
+      d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
     }
-    const int pixels = layer.output().height * layer.output().width;
-    const int chunk = samples_per_chunk(layer);
-    d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
+    // dW (out x K) = delta patches^T and db = delta 1, the row sums of the product's A, added up
+    // while it packs delta: for the first layer from the patches^T (N x K) forward() kept, in one
+    // product; below, chunk by chunk (in the loop).
+    if (l == 0) {
+      kernels::Gemm d_product{Op::none, Op::none,           out, k,       n,         delta.data(),
+                              out,      patches_[0].data(), n,   nullptr, d_weights, out};
+      d_product.a_row_sums = d_bias;
+      set.gemm(d_product);
+      if (!d_input) break;
+    }
+    // A chunk of samples at a time, so that the patches and their gradient are read from L2:
+    // below the first layer, the chunk's patches again from the map below, dW += delta
+    // patches^T and db += delta 1 (a chunk's pixels are a multiple of the products' k block, so
+    // these are the sums of one product over the batch, bit for bit); then d patches (K x N) =
+    // W^T delta, each entry back to the pixel it was read from. A chunk's pixels receive only its
+    // own patches, so after its col2im they are complete: the chunk is zeroed just before (in
+    // cache, not a pass over the whole map) and, below the first layer, multiplied by the layer
+    // below's SiLU' just after.
     for (int b0 = 0; b0 < batch_; b0 += chunk) {
       const int count = std::min(chunk, batch_ - b0);
       const float* delta_chunk = delta.data() + b0 * layer.output().size();
+      if (l > 0) {
+        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * below,
+                   patches_[l].data());
+        kernels::Gemm d_product{
+            Op::none, Op::transpose,      out, k,       count * pixels, delta_chunk,
+            out,      patches_[l].data(), k,   nullptr, d_weights,      out};
+        d_product.a_row_sums = d_bias;
+        d_product.accumulate = b0 > 0;
+        set.gemm(d_product);
+      }
       const Eigen::Index first = b0 * below, size = count * below;
       if (l == 0) {
         // d patches^T (N x K) = delta^T W, back onto the image rows by row2im.

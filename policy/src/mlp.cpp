@@ -111,16 +111,27 @@ void affine(const W& weights, const B& bias, const In& in, Out& out, bool silu =
   }
 }
 
-// dW (out x in) = delta a^T.
-template <typename Scalar, typename Delta, typename A, typename DW>
-void outer(const Delta& delta, const A& a, DW& dW) {
+// dW (out x in) = delta a^T and db = delta 1.
+template <typename Scalar, typename Delta, typename A, typename DW, typename DB>
+void outer(const Delta& delta, const A& a, DW& dW, DB& db) {
   if constexpr (std::is_same_v<Scalar, float>) {
-    kernels::active().gemm(
-        {Op::none, Op::transpose, static_cast<int>(delta.rows()), static_cast<int>(a.rows()),
-         static_cast<int>(delta.cols()), delta.data(), static_cast<int>(delta.rows()), a.data(),
-         static_cast<int>(a.rows()), nullptr, dW.data(), static_cast<int>(dW.rows())});
+    kernels::Gemm product{Op::none,
+                          Op::transpose,
+                          static_cast<int>(delta.rows()),
+                          static_cast<int>(a.rows()),
+                          static_cast<int>(delta.cols()),
+                          delta.data(),
+                          static_cast<int>(delta.rows()),
+                          a.data(),
+                          static_cast<int>(a.rows()),
+                          nullptr,
+                          dW.data(),
+                          static_cast<int>(dW.rows())};
+    product.a_row_sums = db.data();  // added up while the product packs delta
+    kernels::active().gemm(product);
   } else {
     dW.noalias() = delta * a.transpose();
+    db.noalias() = delta.rowwise().sum();
   }
 }
 
@@ -237,17 +248,7 @@ void MlpT<Scalar>::propagate(const Eigen::Ref<const Matrix>& d_output, bool inpu
     const Eigen::Index n = static_cast<Eigen::Index>(widths_[l + 1]) * widths_[l];
     Eigen::Map<Matrix> dW(gradient_.data() + offsets_[l], widths_[l + 1], widths_[l]);
     Eigen::Map<Vector> db(gradient_.data() + offsets_[l] + n, widths_[l + 1]);
-    outer<Scalar>(delta, a_[l], dW);
-    if constexpr (std::is_same_v<Scalar, float>) {
-      // db = delta 1: the batch-1 kernel (GEMV) against a vector of ones.
-      if (ones_.size() != delta.cols()) ones_ = Vector::Ones(delta.cols());
-      kernels::active().gemm(
-          {Op::none, Op::none, static_cast<int>(delta.rows()), 1, static_cast<int>(delta.cols()),
-           delta.data(), static_cast<int>(delta.rows()), ones_.data(),
-           static_cast<int>(delta.cols()), nullptr, db.data(), static_cast<int>(delta.rows())});
-    } else {
-      db.noalias() = delta.rowwise().sum();
-    }
+    outer<Scalar>(delta, a_[l], dW, db);
     if (l == 0 && !input_gradient) break;
     if (fused_derivative && l > 0) {
       transposed<Scalar>(W(l), delta, delta_[l], a_[l].data(), sigmoid_[l - 1].data());

@@ -193,6 +193,108 @@ TEST_CASE("the_gemm_check_catches_a_product_that_misses_a_term", "[unit]") {
   }
 }
 
+// Gemm::a_row_sums (db = delta 1 beside dW = delta x^T): the worst |sum_i - ref_i| / bound over
+// op(A)'s rows, ref in double; `skip_last_term` plants a fault in the reference (the last k term
+// left out), which the check must catch.
+double row_sums_error(const GemmProblem& problem, const std::vector<float>& sums,
+                      bool skip_last_term = false) {
+  double worst = 0.0;
+  for (int i = 0; i < problem.m; ++i) {
+    double sum = 0.0, magnitude = 0.0;
+    for (int p = 0; p < (skip_last_term ? problem.k - 1 : problem.k); ++p) {
+      sum += problem.A(i, p);
+      magnitude += std::abs(problem.A(i, p));
+    }
+    const double bound = 4.0 * std::max(problem.k, 1) * 6e-8 * magnitude + 1e-30;
+    worst = std::max(worst, std::abs(sums[i] - sum) / bound);
+  }
+  return worst;
+}
+
+TEST_CASE("row_sums_of_a_are_the_narrow_products_bits_on_every_path", "[unit]") {
+  // The blocked nest adds A's rows up while it packs A; every other path in a pass of its own.
+  // On every target and shape the sums match the double reference, C is still the product, and
+  // with op(A) = A (the bias gradients') the sums have the bits of the narrow product A 1, which
+  // computed the bias gradients before, so trained weights keep their bits.
+  std::mt19937_64 rng(17);
+  for (const auto& [name, set] : every_target()) {
+    INFO("target " << name);
+    for (const Shape& shape : kShapes) {
+      for (Op op_a : {Op::none, Op::transpose}) {
+        for (Op op_b : {Op::none, Op::transpose}) {
+          GemmProblem problem(op_a, op_b, shape.m, shape.n, shape.k, 3, false, rng);
+          std::vector<float> sums(static_cast<std::size_t>(shape.m), 1e30f);
+          kernels::Gemm gemm = problem.gemm();
+          gemm.a_row_sums = sums.data();
+          set->gemm(gemm);
+          INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a)
+                    << " op_b " << int(op_b));
+          CHECK(gemm_error(problem) <= 1.0);
+          CHECK(row_sums_error(problem, sums) <= 1.0);
+          if (op_a == Op::none) {  // against the narrow product by ones, a call of its own
+            const std::vector<float> ones(static_cast<std::size_t>(std::max(shape.k, 1)), 1.0f);
+            std::vector<float> narrow(static_cast<std::size_t>(shape.m), -1e30f);
+            set->gemm({Op::none, Op::none, shape.m, 1, shape.k, problem.a.data(), problem.lda,
+                       ones.data(), std::max(shape.k, 1), nullptr, narrow.data(), shape.m});
+            CHECK(sums == narrow);
+          }
+          if (shape.k >= 2) {  // planted fault: a reference that leaves out the last term
+            CHECK(row_sums_error(problem, sums, /*skip_last_term=*/true) > 1.0);
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("a_product_split_over_k_into_accumulating_calls_is_one_product_bit_for_bit", "[unit]") {
+  // ConvEncoder sums a weight gradient chunk by chunk (Gemm::accumulate, each chunk a multiple
+  // of the k block): C and the row sums must be the bits of one call over the whole k, and
+  // C_before + the product to within the double reference's bound. Shapes of the encoder's
+  // weight gradients (B = patches^T or patches), and edge tiles; n > 16 (a single narrow call,
+  // n <= 16, sums all of k in one pass: splitting it rounds differently).
+  std::mt19937_64 rng(18);
+  constexpr int kBlock = kernels::kProductKBlock;
+  for (const auto& [name, set] : every_target()) {
+    INFO("target " << name);
+    for (const Shape& shape : {Shape{32, 144, 3 * kBlock + 40}, Shape{16, 36, 2 * kBlock},
+                               Shape{33, 17, kBlock + 1}, Shape{7, 25, 2 * kBlock + 9}}) {
+      for (Op op_b : {Op::none, Op::transpose}) {
+        GemmProblem problem(Op::none, op_b, shape.m, shape.n, shape.k, 3, false, rng);
+        std::vector<float> sums(static_cast<std::size_t>(shape.m), 1e30f);
+        kernels::Gemm whole = problem.gemm();
+        whole.a_row_sums = sums.data();
+        set->gemm(whole);
+        const std::vector<float> c_whole = problem.c, sums_whole = sums;
+        // The same product in calls of one k block each, the last one shorter; `plant`: the last
+        // call writes C instead of adding to it (a planted fault the reference check must catch).
+        const auto split = [&](bool plant) {
+          std::fill(problem.c.begin(), problem.c.end(), 1e30f);
+          std::fill(sums.begin(), sums.end(), 1e30f);
+          for (int p0 = 0; p0 < shape.k; p0 += kBlock) {
+            kernels::Gemm part = problem.gemm();
+            part.k = std::min(kBlock, shape.k - p0);
+            part.a = problem.a.data() + static_cast<long>(p0) * problem.lda;
+            part.b =
+                problem.b.data() + (op_b == Op::none ? p0 : static_cast<long>(p0) * problem.ldb);
+            part.a_row_sums = sums.data();
+            part.accumulate = p0 > 0 && !(plant && p0 + kBlock >= shape.k);
+            set->gemm(part);
+          }
+        };
+        split(false);
+        INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_b " << int(op_b));
+        CHECK(problem.c == c_whole);
+        CHECK(sums == sums_whole);
+        CHECK(gemm_error(problem) <= 1.0);
+        CHECK(row_sums_error(problem, sums) <= 1.0);
+        split(true);
+        CHECK(gemm_error(problem) > 1.0);
+      }
+    }
+  }
+}
+
 // The epilogues on every path of the product (blocked, narrow, k = 0): C against the double
 // reference Z followed by SiLU, or by the product with SiLU'(z) = s + a (1 - s) from given s and
 // a (leading dimension lds, unlike C's). Returns the worst error over C in units of the bound;

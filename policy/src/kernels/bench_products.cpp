@@ -19,8 +19,10 @@ namespace {
 
 constexpr int kBatch = 256;
 
-// C (m x n) = op(A) op(B) (+ bias, for op(B) = B, the forward products) with the epilogue.
-void product(benchmark::State& state, Op op_a, Op op_b, int m, int n, int k, Epilogue epilogue) {
+// C (m x n) = op(A) op(B) (+ bias, for op(B) = B, the forward products) with the epilogue, and
+// with `row_sums` the sums of A's rows too (Gemm::a_row_sums, a weight gradient's bias gradient).
+void product(benchmark::State& state, Op op_a, Op op_b, int m, int n, int k, Epilogue epilogue,
+             bool row_sums = false) {
   std::mt19937 rng(1);
   std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
   const auto random = [&](std::size_t size) {
@@ -42,6 +44,8 @@ void product(benchmark::State& state, Op op_a, Op op_b, int m, int n, int k, Epi
   gemm.sigmoid = sigmoid.data();
   gemm.lds = m;
   gemm.activation = activation.data();
+  std::vector<float> sums(static_cast<std::size_t>(m));
+  if (row_sums) gemm.a_row_sums = sums.data();
   const auto& kernels = handcentric::policy::kernels::active();
   for (auto _ : state) {
     kernels.gemm(gemm);
@@ -69,6 +73,30 @@ BENCHMARK_CAPTURE(product, dw_hidden_layer, Op::none, Op::transpose, 256, 256, k
 BENCHMARK_CAPTURE(product, dx_hidden_layer_silu_derivative, Op::transpose, Op::none, 256, kBatch,
                   256, Epilogue::silu_derivative);
 BENCHMARK_CAPTURE(product, dw_first_layer, Op::none, Op::transpose, 256, 57, kBatch,
+                  Epilogue::none);
+
+// The image encoder's products (bench/bench_conv.cpp: 4 x 48 x 64 -> 16, 32, 32 filters of 3 x 3,
+// stride 2), at the sizes ConvEncoder runs them at batch 256: forward and W^T delta one chunk of
+// samples at a time (4, 4 and 9 samples: patches of about 512 KB), the weight gradients over the
+// whole batch. Layer 1 reads its patches transposed (im2row: op(B) = B^T); the weight gradients
+// also add up delta's rows (the bias gradients).
+constexpr int kPixels1 = 24 * 32, kPixels2 = 12 * 16, kPixels3 = 6 * 8;
+constexpr int kColumns1 = kBatch * kPixels1, kColumns2 = kBatch * kPixels2,
+              kColumns3 = kBatch * kPixels3;  // a weight gradient's k
+BENCHMARK_CAPTURE(product, conv1_forward_silu, Op::none, Op::transpose, 16, 4 * kPixels1, 36,
+                  Epilogue::silu);
+BENCHMARK_CAPTURE(product, conv2_forward_silu, Op::none, Op::none, 32, 4 * kPixels2, 144,
+                  Epilogue::silu);
+BENCHMARK_CAPTURE(product, conv3_forward_silu, Op::none, Op::none, 32, 9 * kPixels3, 288,
+                  Epilogue::silu);
+BENCHMARK_CAPTURE(product, conv1_dw, Op::none, Op::none, 16, 36, kColumns1, Epilogue::none, true);
+BENCHMARK_CAPTURE(product, conv2_dw, Op::none, Op::transpose, 32, 144, kColumns2, Epilogue::none,
+                  true);
+BENCHMARK_CAPTURE(product, conv3_dw, Op::none, Op::transpose, 32, 288, kColumns3, Epilogue::none,
+                  true);
+BENCHMARK_CAPTURE(product, conv2_d_patches, Op::transpose, Op::none, 144, 4 * kPixels2, 32,
+                  Epilogue::none);
+BENCHMARK_CAPTURE(product, conv3_d_patches, Op::transpose, Op::none, 288, 9 * kPixels3, 32,
                   Epilogue::none);
 
 }  // namespace

@@ -91,9 +91,11 @@ struct GemmKernelOf {
   static constexpr auto narrow_block = &NarrowProduct<N, W>;
   static constexpr SiluFunctions kSilu{SiluForward, SiluInPlace, SiluBackward};
 
-  // pack_a<MR> with vector moves: op(A) = A copies V (partial) vectors per k; op(A) = A^T
-  // gathers each row panel's k-th column (kLanes rows at stride lda) from rows that stay in L1.
-  static void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out) {
+  // pack_a<MR> with vector moves: op(A) = A copies V (partial) vectors per k, and adds them to
+  // `row_sums` when it is not null (gemm.hpp, blocked_gemm); op(A) = A^T gathers each row
+  // panel's k-th column (kLanes rows at stride lda) from rows that stay in L1.
+  static void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out,
+                     float* row_sums) {
     // Gather offsets are int32 byte offsets: beyond them, the scalar packing.
     if (op == Op::transpose && static_cast<long>(lda) * kLanes >= (1L << 29)) {
       kernels::pack_a<MR>(op, a, lda, i0, mc, p0, kc, out);
@@ -107,7 +109,26 @@ struct GemmKernelOf {
       int part[V];  // the rows in each vector of the panel
 #pragma GCC unroll 2
       for (int v = 0; v < V; ++v) part[v] = std::clamp(rows - v * kLanes, 0, kLanes);
-      if (op == Op::none) {
+      if (op == Op::none && row_sums != nullptr) {
+        // The same additions as the narrow product op(A) 1 (whose FMAs by 1 are exact
+        // products): each row's sum, in the order of k.
+        const float* column = a + (i0 + panel) + static_cast<long>(p0) * lda;
+        hn::Vec<FloatTag> sum[V];
+#pragma GCC unroll 2
+        for (int v = 0; v < V; ++v) sum[v] = LoadPart(d, row_sums + panel + v * kLanes, part[v]);
+        for (int p = 0; p < kc; ++p, column += lda) {
+#pragma GCC unroll 2
+          for (int v = 0; v < V; ++v) {
+            const auto x = LoadPart(d, column + v * kLanes, part[v]);
+            hn::Store(x, d, out + p * MR + v * kLanes);
+            sum[v] = hn::Add(sum[v], x);
+          }
+        }
+#pragma GCC unroll 2
+        for (int v = 0; v < V; ++v) {
+          if (part[v] > 0) StorePart(d, sum[v], row_sums + panel + v * kLanes, part[v]);
+        }
+      } else if (op == Op::none) {
         const float* column = a + (i0 + panel) + static_cast<long>(p0) * lda;
         for (int p = 0; p < kc; ++p, column += lda) {
 #pragma GCC unroll 2

@@ -99,7 +99,7 @@ enum class BLayout { packed, rows, columns };
 ///   (640 KB of the 1 MB).
 struct Blocking {
   static constexpr std::size_t kL1Bytes = 32 * 1024, kL2Bytes = 1024 * 1024;
-  static constexpr int KC = 256, MC = 256, NC = 384;
+  static constexpr int KC = kProductKBlock, MC = 256, NC = 384;
   static_assert((MC + NC) * KC * sizeof(float) <= kL2Bytes, "the A block and the B block share L2");
 };
 
@@ -108,7 +108,9 @@ struct Blocking {
 /// op(B) is read in place, NR columns at a time (a k x NR block is reused from L1 by every row
 /// panel), except a last partial panel, which is packed with zero padding.
 /// Kernel::kSilu (SiluFunctions) applies Gemm::epilogue to each finished block.
-/// Kernel::pack_a has pack_a<MR>'s contract (it may be a faster vector version).
+/// Kernel::pack_a has pack_a<MR>'s contract (it may be a faster vector version) and one more
+/// argument, `row_sums` (null, or with op(A) = A the mc sums of the block's rows, to which it adds
+/// the block's kc entries of each row in order).
 /// Kernel::tile<BLayout>(kc, a_panel, b, ldb, c, ldc, accumulate, bias) writes a full MR x NR
 /// tile of C: C = A B (+ bias, an MR-float pointer or null) or, when accumulate, C += A B.
 /// The first k block writes C (plus the bias), later ones add to it.
@@ -123,16 +125,20 @@ void blocked_gemm(const Gemm& g) {
   buffers.b.resize(static_cast<std::size_t>(NR) * KC);
   alignas(64) float tile[MR * NR];
   alignas(64) float bias_tile[MR];
+  // The row sums of A, added up by the packing of the first column block (which packs every
+  // (i0, p0) block once, p0 ascending).
+  if (g.a_row_sums != nullptr && !g.accumulate) std::fill(g.a_row_sums, g.a_row_sums + g.m, 0.0f);
   for (int j0 = 0; j0 < g.n; j0 += NC) {
     const int nc = std::min(NC, g.n - j0);
     const int full = nc / NR * NR;  // columns in full panels, read in place
     for (int p0 = 0; p0 < g.k; p0 += KC) {
       const int kc = std::min(KC, g.k - p0);
-      const bool accumulate = p0 > 0;
+      const bool accumulate = p0 > 0 || g.accumulate;
       if (full < nc) pack_b<NR>(g.op_b, g.b, g.ldb, p0, kc, j0 + full, nc - full, buffers.b.data());
       for (int i0 = 0; i0 < g.m; i0 += MC) {
         const int mc = std::min(MC, g.m - i0);
-        Kernel::pack_a(g.op_a, g.a, g.lda, i0, mc, p0, kc, buffers.a.data());
+        float* row_sums = j0 == 0 && g.a_row_sums != nullptr ? g.a_row_sums + i0 : nullptr;
+        Kernel::pack_a(g.op_a, g.a, g.lda, i0, mc, p0, kc, buffers.a.data(), row_sums);
         for (int jr = 0; jr < nc; jr += NR) {
           const int cols = std::min(NR, nc - jr);
           const long j = j0 + jr;
@@ -248,6 +254,18 @@ void narrow_gemm(const Gemm& g) {
   }
 }
 
+/// Gemm::a_row_sums where the blocked nest does not add them up while packing: a pass of its own,
+/// in the same order.
+inline void sum_rows_of_a(const Gemm& g) {
+  if (!g.accumulate) std::fill(g.a_row_sums, g.a_row_sums + g.m, 0.0f);
+  for (int p = 0; p < g.k; ++p) {
+    for (int i = 0; i < g.m; ++i) {
+      g.a_row_sums[i] += g.op_a == Op::none ? g.a[i + static_cast<long>(p) * g.lda]
+                                            : g.a[p + static_cast<long>(i) * g.lda];
+    }
+  }
+}
+
 /// KernelSet::gemm of a vector set: the degenerate shapes, the narrow products, or the blocked
 /// product, then the epilogue where the blocked nest has not applied it. The blocked product runs
 /// on ShortKernel, a tile of fewer rows (ShortKernel::MR < Kernel::MR), when op(A) has no more
@@ -255,9 +273,16 @@ void narrow_gemm(const Gemm& g) {
 template <typename Kernel, typename ShortKernel>
 void vector_gemm(const Gemm& g) {
   static_assert(ShortKernel::MR < Kernel::MR, "the short tile has fewer rows");
-  if (trivial_gemm(g)) {
+  if (g.a_row_sums != nullptr && g.m > 0 && (g.n <= kNarrowMax || g.k <= 0 || g.op_a != Op::none)) {
+    sum_rows_of_a(g);  // the blocked nest's packing does not run on op(A) = A
+    Gemm rest = g;
+    rest.a_row_sums = nullptr;
+    vector_gemm<Kernel, ShortKernel>(rest);
+  } else if (g.accumulate && (g.m <= 0 || g.n <= 0 || g.k <= 0)) {
+    // nothing to add
+  } else if (trivial_gemm(g)) {
     apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
-  } else if (g.n <= kNarrowMax && g.op_a == Op::none) {
+  } else if (g.n <= kNarrowMax && g.op_a == Op::none && !g.accumulate) {
     narrow_gemm<Kernel>(g);
     apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
   } else if (g.m <= ShortKernel::MR) {

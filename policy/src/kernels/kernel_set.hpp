@@ -28,6 +28,14 @@ enum class Epilogue { none, silu, silu_derivative };
 /// gets sigmoid(Z) (kept for the backward pass).
 /// With Epilogue::silu_derivative, C = Z * SiLU'(z) elementwise, SiLU'(z) = s + a (1 - s), from
 /// the forward pass's s = `sigmoid` and a = `activation` = SiLU(z) (both m x n, lds, read only).
+/// `a_row_sums` (m floats), when not null, gets the sums of op(A)'s rows, sum_p op(A)(i, p), each
+/// added from 0 in the order p = 0, 1, ..., k - 1: the bits of the product op(A) 1 on the narrow
+/// kernel (db = delta 1, a bias gradient). With op(A) = A the blocked product adds them up while
+/// it packs A (a weight gradient delta x^T reads delta once for both).
+/// `accumulate` (no bias, Epilogue::none): C += op(A) op(B) instead, and the row sums are added
+/// to too: a product over k split into calls, k0 .. k1 then k1 .. k2, gives the bits of one call
+/// over k0 .. k2 when k1 - k0 is a multiple of the blocked nest's k block (kProductKBlock) and
+/// n > 16 (one narrow product, n <= 16, sums the whole k in one pass).
 struct Gemm {
   Op op_a = Op::none, op_b = Op::none;
   int m = 0, n = 0, k = 0;
@@ -42,7 +50,12 @@ struct Gemm {
   float* sigmoid = nullptr;
   int lds = 0;
   const float* activation = nullptr;
+  float* a_row_sums = nullptr;
+  bool accumulate = false;
 };
+
+/// The k block of the blocked products (gemm.hpp, Blocking::KC).
+constexpr int kProductKBlock = 256;
 
 /// Handles the degenerate shapes (m, n or k <= 0; k = 0 writes C = bias 1^T) and returns
 /// true; false for a real product. Every set's gemm starts with it.

@@ -13,6 +13,8 @@
 // float32 on the run-time dispatched kernels (kernels.hpp): im2col (the first layer, which reads
 // the (channels, height, width) input: im2row, its transpose), then one product per layer with
 // the bias and SiLU in its epilogue; backward the two products of the gradients and col2im.
+// Below the first layer, patches live only one L2-sized chunk of samples at a time: backward
+// makes them again from the map below rather than reading a whole batch's back from memory.
 #include <Eigen/Core>
 #include <random>
 #include <vector>
@@ -94,13 +96,13 @@ class ConvEncoder {
   Vector parameters_;
   Vector gradient_;
   int batch_ = 0;  ///< of the last forward()
-  /// each layer's patch matrix of the last forward(): K x N, the first layer's N x K (im2row)
+  /// the first layer's patch matrix of the last forward(), N x K (im2row), kept for backward();
+  /// a hidden layer's, K x N, for one chunk of samples at a time (forward and backward make it)
   std::vector<Vector> patches_;
   std::vector<Matrix> sigmoid_;     ///< sigmoid(z) of each layer (out size x B)
   std::vector<Matrix> activation_;  ///< SiLU(z) of each layer; the last one is the features
   std::vector<Matrix> delta_;  ///< d loss / d (each layer's output), kept: no reallocation per step
   Vector d_patches_;
-  Vector ones_;
   Matrix d_images_;
   long input_sample_stride_ = 0;  ///< of the images of the last forward()
 };

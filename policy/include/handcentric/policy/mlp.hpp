@@ -75,7 +75,6 @@ class MlpT {
   /// One buffer per layer boundary, each of one size: no reallocation from step to step
   /// (delta_[0] is d loss / d input, delta_[l + 1] d loss / d z_l).
   std::vector<Matrix> delta_;
-  Vector ones_;  ///< float: batch ones, for db = delta 1
 };
 
 using Mlp = MlpT<float>;
