@@ -58,6 +58,7 @@ int run_insert3d_render(const RenderOptions& options) {
       sim::insert3d::sample_scene(distribution, options.seed, options.index);
   sim::insert3d::Rollout rollout;
   sim::insert3d::DepthCamera camera;
+  std::vector<sim::insert3d::DepthCamera> rig{camera};
   bool normals = false;
   std::string what = "scene";
   if (options.scene) {
@@ -66,6 +67,7 @@ int run_insert3d_render(const RenderOptions& options) {
     const LoadedInsert3dPolicy loaded = load_insert3d_policy(options.model);
     const ChunkPolicy& policy = *loaded.policy;
     camera = loaded.camera;
+    rig = loaded.rig;
     normals = loaded.normals;
     const sim::insert3d::CollisionChecker checker;
     rollout = sim::insert3d::rollout(policy, scene, sim::stream_seed(options.seed, options.index),
@@ -83,10 +85,11 @@ int run_insert3d_render(const RenderOptions& options) {
   std::cout << "wrote " << what << " to " << options.out << "\n";
   if (!options.camera_frames.empty()) {
     sim::write_png(options.camera_frames, experiments::draw_insert3d_camera_frames(
-                                              scene, rollout, 4, 8, {}, camera, normals));
-    std::cout << "wrote the hand camera's " << (normals ? "depth and normals" : "depth")
-              << " images of " << rollout.world_T_hand.size()
-              << " poses (every 4th and the last) to " << options.camera_frames << "\n";
+                                              scene, rollout, 4, 8, {}, rig, normals));
+    std::cout << "wrote the hand " << (rig.size() == 2 ? "cameras' " : "camera's ")
+              << (normals ? "depth and normals" : "depth") << " images of "
+              << rollout.world_T_hand.size() << " poses (every 4th and the last) to "
+              << options.camera_frames << "\n";
   }
   return 0;
 }

@@ -1,7 +1,7 @@
 #pragma once
 // The image policy's options that `train` and `table2` share (--observation image): the hand
-// camera's channels, size and field of view, the encoder and its features; one place for their
-// flags, help and defaults (experiments::Insert3dImageSettings).
+// cameras' channels, size, field of view and number, the encoder and its features; one place for
+// their flags, help and defaults (experiments::Insert3dImageSettings).
 #include <CLI/CLI.hpp>
 #include <memory>
 #include <tuple>
@@ -41,6 +41,11 @@ inline void add_image_options(CLI::App* cmd, const std::shared_ptr<ImageFlags>& 
       ->capture_default_str();
   cmd->add_option("--image-fov", s.fov_deg,
                   "--observation image: the hand camera's horizontal field of view (deg)")
+      ->capture_default_str();
+  cmd->add_option("--image-cameras", s.cameras,
+                  "--observation image: hand cameras, 1 or 2 (the second the first's mirror about "
+                  "the blade, seeing what the blade hides; their images stacked as channels)")
+      ->check(CLI::IsMember({1, 2}))
       ->capture_default_str();
   cmd->add_option("--encoder", s.encoder,
                   "--observation image: out channels of each 3x3 convolution, comma-separated, "

@@ -38,6 +38,7 @@ LoadedInsert3dPolicy load_insert3d_policy(const std::string& model_path,
     // Held, not a temporary: options() refers into the camera object.
     const auto camera = experiments::insert3d_camera_of(model->config());
     loaded.camera = camera->options().camera;
+    loaded.rig = camera->rig();
     loaded.normals = camera->options().channels == experiments::Insert3dImageChannels::normals;
   }
   // Each 3D model with the input it was trained on: the hand camera's image, or the corners and

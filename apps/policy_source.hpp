@@ -3,6 +3,7 @@
 // scripted policy of the sim by name (--policy expert|straight|hold).
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "handcentric/core/chunk_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -35,6 +36,9 @@ struct LoadedInsert3dPolicy {
   /// The camera the frames of a rollout are drawn with: an image model's own (its size and
   /// field of view), else the task's.
   sim::insert3d::DepthCamera camera;
+  /// The cameras an image model sees through (its rig: `camera`, and its mirror for a
+  /// two-camera model), else the task's one.
+  std::vector<sim::insert3d::DepthCamera> rig{sim::insert3d::DepthCamera{}};
   /// An image model that sees surface normals: the frames show them beside the depth.
   bool normals = false;
 };

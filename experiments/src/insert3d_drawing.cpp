@@ -166,7 +166,8 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
 sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
                                        const insert3d::Rollout& rollout, int every, int columns,
                                        const insert3d::BladeSlotGeometry& geometry,
-                                       const insert3d::DepthCamera& camera, bool normals) {
+                                       const std::vector<insert3d::DepthCamera>& rig,
+                                       bool normals) {
   using drawing::text;
   if (rollout.world_T_hand.empty())
     throw InvalidArgument("draw_insert3d_camera_frames: the rollout has no pose");
@@ -174,13 +175,18 @@ sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
     throw InvalidArgument("draw_insert3d_camera_frames: every " + std::to_string(every) +
                           " and columns " + std::to_string(columns) + " must be >= 1");
   }
+  if (rig.empty()) throw InvalidArgument("draw_insert3d_camera_frames: the rig has no camera");
+  for (const insert3d::DepthCamera& camera : rig) camera.validate();
   std::vector<std::size_t> steps;
   for (std::size_t t = 0; t < rollout.world_T_hand.size(); t += static_cast<std::size_t>(every))
     steps.push_back(t);
   if (steps.back() + 1 != rollout.world_T_hand.size())
     steps.push_back(rollout.world_T_hand.size() - 1);
   constexpr int kScale = 4, kLabel = 18, kGap = 6;
-  const int image_w = camera.width * kScale, panel_h = camera.height * kScale;
+  const insert3d::DepthCamera& camera = rig.front();  // every camera of a rig has one size
+  const int image_w = camera.width * kScale, image_h = camera.height * kScale;
+  const int cameras = static_cast<int>(rig.size());
+  const int panel_h = cameras * image_h + (cameras - 1) * kGap;
   const int panel_w = normals ? 2 * image_w + kGap : image_w;
   const int cols = std::min<int>(columns, static_cast<int>(steps.size()));
   const int rows = (static_cast<int>(steps.size()) + cols - 1) / cols;
@@ -190,13 +196,16 @@ sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
     const int x = kGap + static_cast<int>(i % static_cast<std::size_t>(cols)) * (panel_w + kGap);
     const int y =
         kGap + static_cast<int>(i / static_cast<std::size_t>(cols)) * (panel_h + kLabel + kGap);
-    const CameraImage image = insert3d::render_depth(
-        geometry, camera, rollout.world_T_hand[steps[i]], scene.world_T_slot);
-    depth_panel(image, camera.max_range, kScale)
-        .copyTo(canvas(cv::Rect(x, y + kLabel, image_w, panel_h)));
-    if (normals) {
-      normals_panel(image, camera, kScale)
-          .copyTo(canvas(cv::Rect(x + image_w + kGap, y + kLabel, image_w, panel_h)));
+    for (int k = 0; k < cameras; ++k) {
+      const insert3d::DepthCamera& eye = rig[static_cast<std::size_t>(k)];
+      const int top = y + kLabel + k * (image_h + kGap);
+      const CameraImage image =
+          insert3d::render_depth(geometry, eye, rollout.world_T_hand[steps[i]], scene.world_T_slot);
+      depth_panel(image, eye.max_range, kScale).copyTo(canvas(cv::Rect(x, top, image_w, image_h)));
+      if (normals) {
+        normals_panel(image, eye, kScale)
+            .copyTo(canvas(cv::Rect(x + image_w + kGap, top, image_w, image_h)));
+      }
     }
     text(canvas, "step " + std::to_string(steps[i]), {x, y + kLabel - 5}, 0.4);
   }

@@ -1,6 +1,7 @@
 #include "handcentric/experiments/insert3d_image.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 
@@ -105,14 +106,20 @@ std::vector<Eigen::Vector3d> normals_from_depth(const CameraImage& picture,
 }
 
 Insert3dHandCamera::Insert3dHandCamera(Insert3dHandCameraOptions options)
-    : options_(std::move(options)) {
-  options_.camera.validate();
+    : options_(std::move(options)),
+      rig_(sim::insert3d::hand_camera_rig(options_.camera, options_.cameras)) {
   if (!std::isfinite(options_.table_z)) throw InvalidArgument("the table's height must be finite");
+  if (options_.second_camera_in_world && options_.cameras != 2) {
+    throw InvalidArgument("a second camera fixed in the world needs cameras = 2, got " +
+                          std::to_string(options_.cameras));
+  }
 }
 
 std::string Insert3dHandCamera::name() const {
   return "insert3d hand camera (" + to_string(options_.channels) + ", " +
          std::to_string(options_.camera.width) + " x " + std::to_string(options_.camera.height) +
+         (options_.cameras == 2 ? ", 2 cameras" : "") +
+         (options_.second_camera_in_world ? ", the second fixed in the world" : "") +
          (options_.floor ? ", with the table" : "") + ")";
 }
 
@@ -120,10 +127,15 @@ policy::ImageShape Insert3dHandCamera::shape() const {
   const int channels = options_.channels == Insert3dImageChannels::rgbd      ? 4
                        : options_.channels == Insert3dImageChannels::normals ? 3
                                                                              : 1;
-  return policy::ImageShape{channels, options_.camera.height, options_.camera.width};
+  return policy::ImageShape{channels * options_.cameras, options_.camera.height,
+                            options_.camera.width};
 }
 
 CameraImage Insert3dHandCamera::render_image(const Scene& observation) const {
+  return render_images(observation).front();
+}
+
+std::vector<CameraImage> Insert3dHandCamera::render_images(const Scene& observation) const {
   observation.validate_observation();
   const RigidTransform hand_T_slot = hand_T_slot_of(observation.hand_points);
   const sim::insert3d::BladeSlotGeometry geometry;
@@ -135,7 +147,16 @@ CameraImage Insert3dHandCamera::render_image(const Scene& observation) const {
     solids.push_back(Solid::plane(observation.world_T_hand0().inverse_compose(world_T_table),
                                   Eigen::Vector3d(0.5, 0.4, 0.3)));
   }
-  return handcentric::render(solids, options_.camera, options_.camera.hand_T_camera);
+  std::vector<CameraImage> pictures;
+  for (std::size_t k = 0; k < rig_.size(); ++k) {
+    RigidTransform hand_T_camera = rig_[k].hand_T_camera;
+    if (k == 1 && options_.second_camera_in_world) {
+      // Where the camera would be with the hand at the identity, seen from the hand at T_0.
+      hand_T_camera = observation.world_T_hand0().inverse_compose(hand_T_camera);
+    }
+    pictures.push_back(handcentric::render(solids, rig_[k], hand_T_camera));
+  }
+  return pictures;
 }
 
 void Insert3dHandCamera::render(const Scene& observation, Eigen::Ref<Eigen::VectorXd> image) const {
@@ -144,24 +165,26 @@ void Insert3dHandCamera::render(const Scene& observation, Eigen::Ref<Eigen::Vect
     throw InvalidArgument(name() + ": an image of " + std::to_string(image_shape.size()) +
                           " values, got room for " + std::to_string(image.size()));
   }
-  const CameraImage picture = render_image(observation);
-  const Eigen::Index pixels = static_cast<Eigen::Index>(picture.width) * picture.height;
   Eigen::Index channel = 0;
-  if (options_.channels == Insert3dImageChannels::rgbd) {
-    for (int c = 0; c < 3; ++c, ++channel) {
-      for (Eigen::Index p = 0; p < pixels; ++p)
-        image[channel * pixels + p] = picture.rgb[static_cast<std::size_t>(3 * p + c)];
+  for (const CameraImage& picture : render_images(observation)) {
+    const Eigen::Index pixels = static_cast<Eigen::Index>(picture.width) * picture.height;
+    if (options_.channels == Insert3dImageChannels::rgbd) {
+      for (int c = 0; c < 3; ++c, ++channel) {
+        for (Eigen::Index p = 0; p < pixels; ++p)
+          image[channel * pixels + p] = picture.rgb[static_cast<std::size_t>(3 * p + c)];
+      }
     }
-  }
-  if (options_.channels == Insert3dImageChannels::normals) {
-    const std::vector<Eigen::Vector3d> normals = normals_from_depth(picture, options_.camera);
-    for (int c = 0; c < 2; ++c, ++channel) {
-      for (Eigen::Index p = 0; p < pixels; ++p)
-        image[channel * pixels + p] = normals[static_cast<std::size_t>(p)][c];
+    if (options_.channels == Insert3dImageChannels::normals) {
+      const std::vector<Eigen::Vector3d> normals = normals_from_depth(picture, options_.camera);
+      for (int c = 0; c < 2; ++c, ++channel) {
+        for (Eigen::Index p = 0; p < pixels; ++p)
+          image[channel * pixels + p] = normals[static_cast<std::size_t>(p)][c];
+      }
     }
+    for (Eigen::Index p = 0; p < pixels; ++p)
+      image[channel * pixels + p] = picture.depth[static_cast<std::size_t>(p)];
+    ++channel;
   }
-  for (Eigen::Index p = 0; p < pixels; ++p)
-    image[channel * pixels + p] = picture.depth[static_cast<std::size_t>(p)];
 }
 
 std::shared_ptr<const Insert3dHandCamera> insert3d_camera_of(const policy::PolicyConfig& config,
@@ -173,9 +196,11 @@ std::shared_ptr<const Insert3dHandCamera> insert3d_camera_of(const policy::Polic
                           " has no hand camera: give an image model of the 3D task (insert3d)");
   }
   Insert3dHandCameraOptions options;
-  options.channels = config.image_channels == 4   ? Insert3dImageChannels::rgbd
-                     : config.image_channels == 3 ? Insert3dImageChannels::normals
-                                                  : Insert3dImageChannels::depth;
+  options.cameras = config.image_cameras;
+  const int per_camera = config.image_channels / std::max(1, config.image_cameras);
+  options.channels = per_camera == 4   ? Insert3dImageChannels::rgbd
+                     : per_camera == 3 ? Insert3dImageChannels::normals
+                                       : Insert3dImageChannels::depth;
   options.camera.width = config.image_width;
   options.camera.height = config.image_height;
   options.camera.horizontal_fov_deg = config.image_fov_deg;
@@ -194,6 +219,7 @@ std::shared_ptr<const Insert3dHandCamera> Insert3dImageSettings::apply(
   options.camera.width = width;
   options.camera.height = height;
   options.camera.horizontal_fov_deg = fov_deg;
+  options.cameras = cameras;
   auto camera = std::make_shared<const Insert3dHandCamera>(options);  // checks the camera
   config.observation = policy::ObservationKind::image;
   const policy::ImageShape shape = camera->shape();
@@ -201,6 +227,7 @@ std::shared_ptr<const Insert3dHandCamera> Insert3dImageSettings::apply(
   config.image_height = shape.height;
   config.image_width = shape.width;
   config.image_fov_deg = fov_deg;
+  config.image_cameras = cameras;
   config.encoder = encoder;
   config.image_features = features;
   if (config.steps == 0) config.steps = steps;

@@ -171,7 +171,8 @@ std::string image_summary(const policy::PolicyConfig& config) {
            : channels == Insert3dImageChannels::rgbd  ? "colour and depth"
                                                       : "depth")
        << ", " << config.image_width << " x " << config.image_height << ", " << config.image_fov_deg
-       << " deg, encoder " << config.encoder << ", " << policy::to_string(config.image_features);
+       << " deg" << (config.image_cameras == 2 ? ", 2 cameras" : "") << ", encoder "
+       << config.encoder << ", " << policy::to_string(config.image_features);
   return text.str();
 }
 

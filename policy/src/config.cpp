@@ -202,6 +202,7 @@ const std::vector<Field>& fields() {
               c.image_features = parse_image_features(v);
             }},
       HC_DOUBLE_FIELD(image_fov_deg),
+      HC_INT_FIELD(image_cameras),
   };
   return all;
 }
@@ -263,10 +264,14 @@ void PolicyConfig::validate() const {
   if (observation == ObservationKind::image) {
     require(head == HeadKind::flow, "head", to_string(head),
             "flow (the only head with an image encoder; or use observation key_points)");
-    require(
-        image_channels == 0 || image_channels == 1 || image_channels == 3 || image_channels == 4,
-        "image_channels", s(image_channels),
-        "1 (depth), 3 (depth with normals) or 4 (rgbd), 0 before training");
+    require(image_cameras == 1 || image_cameras == 2, "image_cameras", s(image_cameras),
+            "1 or 2 (the hand camera and its mirror about the blade)");
+    const int per_camera = image_channels / image_cameras;
+    require(image_channels == 0 || (image_channels % image_cameras == 0 &&
+                                    (per_camera == 1 || per_camera == 3 || per_camera == 4)),
+            "image_channels", s(image_channels),
+            "per camera 1 (depth), 3 (depth with normals) or 4 (rgbd), times image_cameras (" +
+                s(image_cameras) + "), 0 before training");
     require(image_height >= 0 && image_height <= 4096, "image_height", s(image_height), "0..4096");
     require(image_width >= 0 && image_width <= 4096, "image_width", s(image_width), "0..4096");
     parse_encoder(encoder);  // names the bad entry

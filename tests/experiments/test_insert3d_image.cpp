@@ -4,6 +4,7 @@
 // Theorem 1), and a table fixed in the world, in view, breaks that for every g that tilts it.
 #include <catch2/catch.hpp>
 
+#include <Eigen/LU>
 #include <cmath>
 #include <numbers>
 #include <utility>
@@ -94,6 +95,70 @@ TEST_CASE("the_hand_cameras_image_is_se3_invariant_and_the_table_breaks_it", "[u
   CHECK(largest_change_under_g(Insert3dHandCamera(with_table), 5) > 1.0);
 }
 
+TEST_CASE("the_two_camera_rigs_images_are_se3_invariant_and_a_world_fixed_second_breaks_it",
+          "[unit]") {
+  Insert3dHandCameraOptions two;
+  two.channels = Insert3dImageChannels::normals;
+  two.cameras = 2;
+  const Insert3dHandCamera rig(two);
+  CHECK(rig.shape() == policy::ImageShape{6, 24, 32});
+  CHECK(largest_change_under_g(rig, 5) == 0.0);
+  // The first camera's three channels are the one-camera image; the second's are another view
+  // (the mirror's: the same blade, the block from the other side).
+  Insert3dHandCameraOptions one = two;
+  one.cameras = 1;
+  const Scene observation = task_observation(2);
+  const Eigen::VectorXd both = image_of(rig, observation);
+  const Eigen::Index half = 3 * 24 * 32;
+  CHECK(both.head(half) == image_of(Insert3dHandCamera(one), observation));
+  CHECK((both.tail(half) - both.head(half)).cwiseAbs().maxCoeff() > 1.0);
+  // The second camera is the first's mirror about the blade's plane (hand x -> -x), turned
+  // half a turn about the hand's z to stay right-handed: it sits 3 cm off the blade's other face.
+  const std::vector<insert3d::DepthCamera>& cameras = rig.rig();
+  REQUIRE(cameras.size() == 2);
+  const Eigen::Vector3d first = cameras[0].hand_T_camera.translation();
+  const Eigen::Vector3d second = cameras[1].hand_T_camera.translation();
+  CHECK((second - Eigen::Vector3d(-first.x(), -first.y(), first.z())).norm() < 1e-12);
+  CHECK(cameras[1].hand_T_camera.rotation().matrix().determinant() == Approx(1.0));
+  // The planted fault: the second camera fixed in the world sees g * scene elsewhere.
+  Insert3dHandCameraOptions world = two;
+  world.second_camera_in_world = true;
+  CHECK(largest_change_under_g(Insert3dHandCamera(world), 5) > 1.0);
+  // A rig of another size is refused with the value and the fix.
+  two.cameras = 3;
+  CHECK_THROWS_WITH(Insert3dHandCamera(two),
+                    Catch::Contains("3 cameras") && Catch::Contains("use 1"));
+  one.second_camera_in_world = true;
+  CHECK_THROWS_WITH(Insert3dHandCamera(one), Catch::Contains("needs cameras = 2"));
+}
+
+TEST_CASE("a_two_camera_model_records_its_rig_and_gets_it_back", "[unit]") {
+  Insert3dImageSettings settings;
+  settings.width = 32;
+  settings.height = 24;
+  settings.cameras = 2;
+  policy::PolicyConfig config;
+  config.task = policy::kTaskInsert3d;
+  const auto camera = settings.apply(config);
+  CHECK(camera->shape() == policy::ImageShape{6, 24, 32});
+  CHECK((config.image_cameras == 2 && config.image_channels == 6));
+  config.validate();
+  const auto rebuilt = insert3d_camera_of(config);
+  CHECK(rebuilt->rig().size() == 2);
+  CHECK(rebuilt->options().channels == Insert3dImageChannels::normals);
+  const Scene observation = task_observation(4);
+  CHECK(image_of(*rebuilt, observation) == image_of(*camera, observation));
+  // Planted fault: the config without its cameras key reads as one camera, which no six-channel
+  // image fits: refused, not rebuilt as another camera.
+  policy::PolicyConfig forgotten = config;
+  forgotten.image_cameras = 1;
+  CHECK_THROWS_AS(forgotten.validate(), InvalidArgument);
+  // A one-camera config (every model file before the key) rebuilds one camera.
+  settings.cameras = 1;
+  settings.apply(config);
+  CHECK(insert3d_camera_of(config)->rig().size() == 1);
+}
+
 TEST_CASE("the_hand_camera_renders_any_four_points_and_refuses_other_counts", "[unit]") {
   const Insert3dHandCamera camera;
   Scene observation = task_observation(0);
@@ -142,6 +207,33 @@ TEST_CASE("the_rollout_picture_fits_the_camera_panels_of_any_image_size", "[unit
   CHECK(with_tall.height == 180 + 2 * 240);  // 1x, on a taller canvas
 }
 
+// Each panel stacks the rig's cameras, the first on top: the second camera's depth is drawn
+// below the first's (planted fault: drawing the first camera twice fails the pixel check).
+TEST_CASE("the_camera_frames_draw_both_cameras_of_a_two_camera_rig", "[unit]") {
+  const insert3d::TaskScene scene =
+      insert3d::sample_scene(insert3d::SceneDistribution::train(), 11, 2);
+  insert3d::Rollout rollout;
+  rollout.world_T_hand = {scene.world_T_hand_start};
+  const std::vector<insert3d::DepthCamera> rig = insert3d::hand_camera_rig({}, 2);
+  const sim::Image one = draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, {rig[0]});
+  const sim::Image two = draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, rig);
+  CHECK(one.height == 96 + 18 + 2 * 6);
+  REQUIRE(two.height == 2 * 96 + 6 + 18 + 2 * 6);
+  REQUIRE(two.width == one.width);
+  // The top image is the first camera's, bit for bit; the one below differs from it.
+  const auto row_bytes = [](const sim::Image& image, int y) {
+    const auto begin = image.rgb.begin() + 3 * y * image.width;
+    return std::vector<std::uint8_t>(begin, begin + 3 * image.width);
+  };
+  int differing_rows = 0;
+  for (int y = 6 + 18; y < 6 + 18 + 96; ++y) {
+    REQUIRE(row_bytes(two, y) == row_bytes(one, y));
+    if (row_bytes(two, y + 96 + 6) != row_bytes(two, y)) ++differing_rows;
+  }
+  CHECK(differing_rows > 10);
+  CHECK_THROWS_AS(draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, {}), InvalidArgument);
+}
+
 // A planted fault (the normals panel left black, or x and y swapped) fails the pixel checks.
 TEST_CASE("the_camera_frames_show_the_normals_the_policy_sees_beside_the_depth", "[unit]") {
   const insert3d::TaskScene scene =
@@ -149,7 +241,7 @@ TEST_CASE("the_camera_frames_show_the_normals_the_policy_sees_beside_the_depth",
   insert3d::Rollout rollout;
   rollout.world_T_hand = {scene.world_T_hand_start};
   const insert3d::DepthCamera camera;
-  const sim::Image sheet = draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, camera, true);
+  const sim::Image sheet = draw_insert3d_camera_frames(scene, rollout, 4, 8, {}, {camera}, true);
   // One panel: depth 128 x 96, 6 pixels, normals 128 x 96; 6 pixels around, 18 for the label.
   REQUIRE(sheet.width == 2 * 128 + 6 + 2 * 6);
   REQUIRE(sheet.height == 96 + 18 + 2 * 6);

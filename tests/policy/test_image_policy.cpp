@@ -40,6 +40,22 @@ std::string rechecksummed(std::string bytes) {
   return bytes;
 }
 
+// A model file's bytes with one line of its config text taken out, as a file written before
+// the line's key existed: the payload's and the text's lengths (the u64s at bytes 12 and 20,
+// model_file.cpp) shrink with it, and the checksum is recomputed.
+std::string without_config_line(std::string bytes, const std::string& line) {
+  const std::size_t at = bytes.find(line);
+  REQUIRE(at != std::string::npos);
+  bytes.erase(at, line.size());
+  for (const std::size_t length_at : {std::size_t{12}, std::size_t{20}}) {
+    std::uint64_t length = 0;
+    std::memcpy(&length, bytes.data() + length_at, 8);
+    length -= line.size();
+    std::memcpy(bytes.data() + length_at, &length, 8);
+  }
+  return rechecksummed(bytes);
+}
+
 }  // namespace
 
 TEST_CASE("image_policies_train_their_encoder_end_to_end", "[unit]") {
@@ -177,6 +193,45 @@ TEST_CASE("image_model_files_from_before_the_feature_and_fov_keys_read_as_they_w
   CHECK(PolicyConfig::from_text(other).image_fov_deg == 45.0);
   // A key-point config still writes none of them.
   CHECK(PolicyConfig().to_text().find("image_") == std::string::npos);
+}
+
+TEST_CASE("one_camera_model_files_from_before_the_cameras_key_load_and_act_the_same", "[unit]") {
+  // A file written before image_cameras existed has no such line: it reads as one camera, the
+  // only rig there was, and its policy gives the same actions bit for bit.
+  const LearnedPolicy model = image_policy(2);
+  CHECK(model.config().image_cameras == 1);
+  const std::string bytes = serialize_model(model);
+  const std::string old = without_config_line(bytes, "image_cameras=1\n");
+  REQUIRE(old.size() + std::strlen("image_cameras=1\n") == bytes.size());
+  const LearnedPolicy loaded = deserialize_model(old, "one_camera.model");
+  CHECK(loaded.config().image_cameras == 1);
+  CHECK(loaded.config().to_text() == model.config().to_text());
+  const Scene scene = test::small_scenes(1, 9).front();
+  const LearnedPolicy seeing = loaded.with_camera(std::make_shared<const test::BlobCamera>());
+  CHECK(seeing.action_vector(scene, 4) == model.action_vector(scene, 4));
+  // Planted fault: the same file claiming two cameras describes an image it cannot hold (one
+  // channel for two cameras): a typed error naming the file, not a model.
+  std::string two = bytes;
+  two.replace(two.find("image_cameras=1"), std::strlen("image_cameras=1"), "image_cameras=2");
+  HC_CHECK_THROWS(deserialize_model(rechecksummed(two), "two.model"), InvalidModelFile,
+                  Catch::Contains("two.model") && Catch::Contains("image_cameras"));
+}
+
+TEST_CASE("image_cameras_and_their_channels_are_checked_with_the_value_and_the_fix", "[unit]") {
+  PolicyConfig config = test::small_image_config("hand_centric", 2);
+  config.image_cameras = 2;
+  config.image_channels = 6;  // normals from each of two cameras
+  CHECK_NOTHROW(config.validate());
+  config.image_channels = 3;
+  HC_CHECK_THROWS(
+      config.validate(), InvalidArgument,
+      Catch::Contains("image_channels = 3") && Catch::Contains("times image_cameras (2)"));
+  config.image_channels = 0;
+  config.image_cameras = 3;
+  HC_CHECK_THROWS(config.validate(), InvalidArgument,
+                  Catch::Contains("image_cameras") && Catch::Contains("1 or 2"));
+  config.image_cameras = 0;
+  HC_CHECK_THROWS(config.validate(), InvalidArgument, Catch::Contains("image_cameras"));
 }
 
 TEST_CASE("encoder_strides_and_image_features_are_parsed_or_refused_by_name", "[unit]") {

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
+
+#include "handcentric/core/errors.hpp"
 
 namespace handcentric::sim::insert3d {
 
@@ -13,6 +16,26 @@ RigidTransform DepthCamera::default_mount() {
   hand_R_camera.col(1) = Eigen::Vector3d(std::cos(a), 0.0, -std::sin(a));
   hand_R_camera.col(2) = Eigen::Vector3d(-std::sin(a), 0.0, -std::cos(a));
   return RigidTransform(Rotation::from_matrix(hand_R_camera), Eigen::Vector3d(3.0, 0.0, -1.0));
+}
+
+std::vector<DepthCamera> hand_camera_rig(const DepthCamera& first, int count) {
+  first.validate();
+  if (count != 1 && count != 2) {
+    throw InvalidArgument("a hand camera rig of " + std::to_string(count) +
+                          " cameras: use 1 (the task's camera) or 2 (and its mirror about the "
+                          "blade)");
+  }
+  std::vector<DepthCamera> rig{first};
+  if (count == 2) {
+    DepthCamera second = first;
+    // Half a turn about the hand's z: (x, y, z) -> (-x, -y, z); the blade is symmetric under it.
+    const RigidTransform hand_T_turned(
+        Rotation::from_matrix(Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal().toDenseMatrix()),
+        Eigen::Vector3d::Zero());
+    second.hand_T_camera = hand_T_turned * first.hand_T_camera;
+    rig.push_back(second);
+  }
+  return rig;
 }
 
 std::vector<Solid> task_solids_in_hand(const BladeSlotGeometry& geometry,

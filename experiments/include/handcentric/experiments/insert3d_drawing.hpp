@@ -10,6 +10,7 @@
 // The viewpoint looks from the world direction (1, -1.5, 1), 55 cm from the midpoint of the slot
 // and the hand's start, world +z up on the page, so a rotated scene looks rotated.
 #include <string>
+#include <vector>
 
 #include "handcentric/sim/draw.hpp"
 #include "handcentric/sim/insert3d/camera.hpp"
@@ -25,17 +26,17 @@ sim::Image draw_insert3d_rollout(const sim::insert3d::TaskScene& scene,
                                  const sim::insert3d::BladeSlotGeometry& geometry = {},
                                  const sim::insert3d::DepthCamera& camera = {});
 
-/// The hand camera's depth images along `rollout`, every `every`-th pose and the last, in rows of
+/// The hand cameras' depth images along `rollout`, every `every`-th pose and the last, in rows of
 /// `columns` panels (4x enlarged, near bright, each labelled with its step): what an image
-/// policy saw. With `normals`, each depth panel has the surface normals beside it, as the
-/// normals channels see them (normals_from_depth): red = (1 + x) / 2, green = (1 + y) / 2 of the
-/// normal in the camera frame, black where nothing is seen. Throws InvalidArgument for an empty
-/// rollout, every < 1 or columns < 1.
-sim::Image draw_insert3d_camera_frames(const sim::insert3d::TaskScene& scene,
-                                       const sim::insert3d::Rollout& rollout, int every = 4,
-                                       int columns = 8,
-                                       const sim::insert3d::BladeSlotGeometry& geometry = {},
-                                       const sim::insert3d::DepthCamera& camera = {},
-                                       bool normals = false);
+/// policy saw. Each panel holds one image per camera of `rig`, the first on top. With `normals`,
+/// each depth panel has the surface normals beside it, as the normals channels see them
+/// (normals_from_depth): red = (1 + x) / 2, green = (1 + y) / 2 of the normal in the camera frame,
+/// black where nothing is seen. Throws InvalidArgument for an empty rollout, every < 1, columns < 1
+/// or an empty rig.
+sim::Image draw_insert3d_camera_frames(
+    const sim::insert3d::TaskScene& scene, const sim::insert3d::Rollout& rollout, int every = 4,
+    int columns = 8, const sim::insert3d::BladeSlotGeometry& geometry = {},
+    const std::vector<sim::insert3d::DepthCamera>& rig = {sim::insert3d::DepthCamera{}},
+    bool normals = false);
 
 }  // namespace handcentric::experiments

@@ -49,6 +49,13 @@ std::vector<Eigen::Vector3d> normals_from_depth(const CameraImage& picture,
 struct Insert3dHandCameraOptions {
   sim::insert3d::DepthCamera camera;  ///< 32 x 24, 70 deg, 60 cm, the task's mount
   Insert3dImageChannels channels = Insert3dImageChannels::depth;
+  /// The hand camera rig (sim::insert3d::hand_camera_rig): 1, `camera`; 2, also its mirror about
+  /// the blade. The image stacks each camera's channels in turn (camera 1's, then camera 2's).
+  int cameras = 1;
+  /// The second camera fixed in the world instead of on the hand (at T_0 times its mount, where
+  /// the hand was at the identity): a third-person camera, which g moves relative to the scene.
+  /// Theorem 1 does not cover it; the rig's invariance test plants it as its fault.
+  bool second_camera_in_world = false;
   bool floor = false;
   double table_z = 0.0;  ///< the table's top in the world (cm)
 };
@@ -61,12 +68,17 @@ class Insert3dHandCamera final : public policy::ImageSource {
   policy::ImageShape shape() const override;
   /// Throws InvalidScene unless the observation has exactly four eye-in-hand points.
   void render(const Scene& observation, Eigen::Ref<Eigen::VectorXd> image) const override;
-  /// The camera image itself (depth and colour) of an observation, for pictures.
+  /// The first camera's image itself (depth and colour) of an observation, for pictures.
   CameraImage render_image(const Scene& observation) const;
+  /// Every camera's image of the rig, in the order the observation stacks them.
+  std::vector<CameraImage> render_images(const Scene& observation) const;
+  /// The rig's cameras (intrinsics and mounts on the hand).
+  const std::vector<sim::insert3d::DepthCamera>& rig() const { return rig_; }
   const Insert3dHandCameraOptions& options() const { return options_; }
 
  private:
   Insert3dHandCameraOptions options_;
+  std::vector<sim::insert3d::DepthCamera> rig_;
 };
 
 /// An image policy of the 3D task before training: its hand camera's channels, size and field
@@ -86,6 +98,9 @@ struct Insert3dImageSettings {
   /// the image's edge (failed rollouts of the 70 deg policy): 26 of 30 against 25 at 12000 steps
   /// (a narrower 50 deg camera scored the same as 70 at 32 x 24).
   double fov_deg = 90.0;
+  /// The hand cameras (Insert3dHandCameraOptions::cameras): 1, or 2 with the mirror about the
+  /// blade.
+  int cameras = 1;
   std::string encoder = "8,16,16,16";
   policy::ImageFeatures features = policy::ImageFeatures::flatten;
   /// The image policies' own automatic budget: the Adam steps when the command gives none
@@ -102,8 +117,8 @@ struct Insert3dImageSettings {
 /// "WxH" (e.g. 64x48) as width and height. Throws InvalidArgument naming the value and the form.
 std::pair<int, int> parse_image_size(const std::string& text);
 
-/// The hand camera an image config was trained with (its channels, size and field of view, no
-/// floor).
+/// The hand camera an image config was trained with (its channels, size, field of view and
+/// cameras, no floor).
 /// Throws InvalidArgument for a config that is not an image model of the 3D task.
 std::shared_ptr<const Insert3dHandCamera> insert3d_camera_of(const policy::PolicyConfig& config,
                                                              bool floor = false);

@@ -159,8 +159,9 @@ struct PolicyConfig {
   /// only, so key-point model files (and Table 1's hashes) are unchanged and a file without
   /// them reads as key_points. Image models: head flow only.
   ObservationKind observation = ObservationKind::key_points;
-  /// The camera's image, set by the trainer from the ImageSource: 1 channel (depth), 3 (the
-  /// surface normal's x and y, then depth) or 4 (red, green, blue, depth), height x width pixels.
+  /// The camera's image, set by the trainer from the ImageSource: per camera 1 channel (depth), 3
+  /// (the surface normal's x and y, then depth) or 4 (red, green, blue, depth), height x width
+  /// pixels.
   int image_channels = 0;
   int image_height = 0;
   int image_width = 0;
@@ -178,6 +179,10 @@ struct PolicyConfig {
   /// model was trained with (a model file holds no camera). A file without the key reads as this
   /// default, 70, the only camera there was; it stays for that reason.
   double image_fov_deg = 70.0;
+  /// The hand cameras whose images are stacked along the channels (image_channels counts them
+  /// all: per camera 1, 3 or 4): 1, or 2 (the task's camera and its mirror about the blade). A
+  /// file without the key reads as 1, the only rig there was.
+  int image_cameras = 1;
 
   /// The image's shape (image_channels, image_height, image_width).
   int image_size() const { return image_channels * image_height * image_width; }

@@ -9,6 +9,7 @@
 // The rendered objects are the block's five boxes and the blade (which the camera sees at the
 // same place in every image); a ray that hits nothing within max_range (cm) reads max_range.
 #include <array>
+#include <vector>
 
 #include "handcentric/core/camera.hpp"
 #include "handcentric/core/rigid_transform.hpp"
@@ -31,6 +32,15 @@ struct DepthCamera : PinholeCamera {
   /// Throws InvalidArgument naming the value and the fix (PinholeCamera::validate).
   void validate() const { PinholeCamera::validate("depth camera"); }
 };
+
+/// The hand camera rig: `count` cameras of `first`'s intrinsics, all fixed to the hand. The first
+/// is `first`; a second (count 2) is its mirror about the blade's plane (the hand's y-z plane),
+/// turned half a turn about the hand's z axis so that it stays a right-handed camera: 3 cm off
+/// the blade on the hand's -x side, it sees the block where the blade hides it from the first
+/// (docs/SIM.md, "Image policies"). Both depend on hand-frame points only, so the rig's images
+/// are SE(3)-invariant as one camera's are. Throws InvalidArgument for a count other than 1 or 2
+/// or a bad camera.
+std::vector<DepthCamera> hand_camera_rig(const DepthCamera& first, int count);
 
 /// The block's walls (in the slot frame) and the blade (in the hand frame) as solids in the hand
 /// frame, for the hand at hand_T_slot relative to the slot.
