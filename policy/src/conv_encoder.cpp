@@ -92,6 +92,21 @@ int samples_per_chunk(const Conv2d& layer, bool first) {
 
 }  // namespace
 
+ConvEncoder::ConvEncoder(const ConvEncoder& other)
+    : layers_(other.layers_),
+      offsets_(other.offsets_),
+      parameters_(other.parameters_),
+      gradient_(other.gradient_),
+      patches_(other.layers_.size()),
+      sigmoid_(other.layers_.size()),
+      activation_(other.layers_.size()),
+      delta_(other.layers_.size()) {}
+
+ConvEncoder& ConvEncoder::operator=(const ConvEncoder& other) {
+  if (this != &other) *this = ConvEncoder(other);
+  return *this;
+}
+
 ConvEncoder::ConvEncoder(ImageShape input, const std::vector<ConvLayerSpec>& layers)
     : layers_(stack(input, layers)) {
   Eigen::Index count = 0;

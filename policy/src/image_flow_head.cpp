@@ -101,10 +101,11 @@ Eigen::MatrixXf ImageFlowHead::sample(const Eigen::MatrixXf& observations,
                                       std::mt19937_64& rng) const {
   Eigen::MatrixXf o = observations;
   observation_normalizer_.normalize(o);
-  // forward() keeps its activations, so a const sampler runs a copy (a few thousand weights):
-  // one policy may act from several threads.
+  // forward() keeps its activations, so a const sampler runs a copy: one policy may act from
+  // several threads. The copy is the weights alone (a few thousand), not the last training
+  // batch's activations; the spatial softmax has no weights.
   ConvEncoder encoder = encoder_;
-  SpatialSoftmax softmax = spatial_softmax_;
+  SpatialSoftmax softmax(spatial_softmax_.map_shape());
   const Eigen::MatrixXf network_o = network_observation(encoder, softmax, o);
   return sample_normalized(network_o, rng);
 }

@@ -574,3 +574,29 @@ TEST_CASE("bad_conv_encoder_records_are_invalid_model_files", "[unit]") {
   HC_CHECK_THROWS(read_record(with_u32(good, 16 + 16, 6)), InvalidModelFile,
                   Contains("encoder.bin"));
 }
+
+TEST_CASE("a_copy_of_an_encoder_is_its_weights_not_its_last_batch", "[unit]") {
+  std::mt19937_64 rng(61);
+  const Case& c = kCases[0];
+  ConvEncoder trained = encoder_of(c, 62);
+  const Eigen::MatrixXf images = random_matrix(c.input.size(), c.batch, rng).cast<float>();
+  const Eigen::MatrixXf d_features =
+      random_matrix(trained.output_size(), c.batch, rng).cast<float>();
+  const Eigen::MatrixXf features = trained.forward(images);
+  // The sampler's copy: the same network, without the batch that training kept for backward()
+  // (a copy that carried it cost a copy of the training batch's patches per sampled chunk).
+  ConvEncoder copy = trained;
+  CHECK(copy.parameters() == trained.parameters());
+  HC_CHECK_THROWS(copy.backward_parameters(d_features), InvalidArgument,
+                  Catch::Contains("call forward() first"));
+  CHECK(copy.forward(images) == features);
+  copy.backward_parameters(d_features);
+  trained.backward_parameters(d_features);
+  CHECK(copy.gradient() == trained.gradient());
+  // Assignment likewise.
+  ConvEncoder assigned = encoder_of(kCases[1], 63);
+  assigned = trained;
+  HC_CHECK_THROWS(assigned.backward_parameters(d_features), InvalidArgument,
+                  Catch::Contains("call forward() first"));
+  CHECK(assigned.forward(images) == features);
+}

@@ -47,6 +47,15 @@ class ConvEncoder {
   /// layer). Parameters start at zero: call initialize().
   ConvEncoder(ImageShape input, const std::vector<ConvLayerSpec>& layers);
 
+  /// A copy is the network (architecture, parameters, gradient), not the activations of the
+  /// last forward(): those are a training batch's (hundreds of MB at 64 x 48 and batch 256), and
+  /// a sampler copies the encoder on every call. A copy's backward() needs its own forward().
+  ConvEncoder(const ConvEncoder& other);
+  ConvEncoder& operator=(const ConvEncoder& other);
+  ConvEncoder(ConvEncoder&&) noexcept = default;
+  ConvEncoder& operator=(ConvEncoder&&) noexcept = default;
+  ~ConvEncoder() = default;
+
   /// PyTorch's default for Conv2d: W, b uniform in +-1/sqrt(K), from `rng` (same seed, same bits).
   void initialize(std::mt19937_64& rng);
 
