@@ -274,7 +274,8 @@ TEST_CASE("image_settings_make_the_camera_the_model_records_and_gets_back", "[un
   policy::PolicyConfig config;
   config.task = policy::kTaskInsert3d;
   const auto camera = settings.apply(config);
-  CHECK(camera->shape() == policy::ImageShape{3, 36, 48});  // the default channels: normals
+  // The default channels (normals, 3) of each of the default two cameras.
+  CHECK(camera->shape() == policy::ImageShape{6, 36, 48});
   CHECK(config.observation == policy::ObservationKind::image);
   CHECK((config.image_width == 48 && config.image_height == 36 && config.image_fov_deg == 50.0));
   CHECK((config.encoder == "8,16/1" &&
