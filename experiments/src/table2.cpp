@@ -335,8 +335,9 @@ std::string table2_markdown(const std::vector<Table2Row>& rows) {
   for (const Table2Row& row : rows) {
     if (row.observation != policy::ObservationKind::image) continue;
     md << "Rows marked (image) see no key points: "
-       << (row.image.find("2 cameras") != std::string::npos ? "the images of two cameras on the hand ("
-                                                             : "the hand camera's image (")
+       << (row.image.find("2 cameras") != std::string::npos
+               ? "the images of two cameras on the hand ("
+               : "the hand camera's image (")
        << row.image
        << ") through a small CNN trained end to end with the flow head "
           "(experiments/insert3d_image.hpp).\n\n";
