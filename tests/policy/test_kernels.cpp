@@ -255,8 +255,10 @@ TEST_CASE("a_product_split_over_k_into_accumulating_calls_is_one_product_bit_for
   // n <= 16, sums all of k in one pass: splitting it rounds differently).
   std::mt19937_64 rng(18);
   constexpr int kBlock = kernels::kProductKBlock;
-  for (const auto& [name, set] : every_target()) {
+  for (const auto& [name, set_pointer] : every_target()) {
     INFO("target " << name);
+    // A plain pointer for the lambda below: clang 14 cannot capture a structured binding.
+    const kernels::KernelSet* set = set_pointer;
     for (const Shape& shape : {Shape{32, 144, 3 * kBlock + 40}, Shape{16, 36, 2 * kBlock},
                                Shape{33, 17, kBlock + 1}, Shape{7, 25, 2 * kBlock + 9}}) {
       for (Op op_b : {Op::none, Op::transpose}) {
