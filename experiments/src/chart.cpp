@@ -208,6 +208,36 @@ struct BarGeometry {
   double py(double y) const { return frame.y1 - y / y_hi * (frame.y1 - frame.y0); }
 };
 
+// The value written above bar (group, series): its text and its box. It sits 4 px above the
+// bar or its interval; a reference line through that box would hide the number, so then it
+// sits above the line instead. One function for the drawing and for chart_layout.
+struct ValueLabel {
+  std::string text;
+  Box box;
+};
+constexpr double kValueText = 9.0;  // px
+
+ValueLabel value_label(const BarGeometry& g, const BarChart& chart, std::size_t group,
+                       std::size_t series) {
+  const ChartValue& v = *chart.values[group][series];
+  double top = g.py(v.value);
+  if (v.interval) top = std::min(top, g.py(v.interval->hi));
+  const std::optional<double> reference =
+      chart.reference.empty() ? std::nullopt : chart.reference[group][series];
+  if (reference) {
+    const double r = g.py(*reference);
+    // The label's box spans top - 4 - 9 .. top - 4, the line r +- 1.25.
+    if (r > top - 18.0 && r < top + 2.0) top = r - 2.0;
+  }
+  char text[16];
+  std::snprintf(text, sizeof text, "%.2f", v.value);
+  const double centre = g.bar_x0(group, series, chart.series.size()) + 0.5 * g.bar_width;
+  const double half = 0.5 * text_width(text, kValueText);
+  return {text,
+          {centre - half, top - 4.0 - kValueText, centre + half, top - 4.0,
+           chart.groups[group] + " " + chart.series[series] + " (value)"}};
+}
+
 BarGeometry bar_geometry(const BarChart& chart, int width, int height) {
   BarGeometry g{};
   g.frame = frame_of(width, height, legend_labels(chart), chart.notes);
@@ -429,10 +459,8 @@ void draw(cairo_t* cr, const BarChart& chart, int width, int height) {
       set_colour(cr, static_cast<int>(s));
       cairo_rectangle(cr, x0 + 1.0, g.py(v->value), g.bar_width - 2.0, g.frame.y1 - g.py(v->value));
       cairo_fill(cr);
-      double top = g.py(v->value);
       if (v->interval) {  // black (the palette's last colour), whatever the bar's colour
         error_bar(cr, 0.5 * (x0 + x1), g.py(v->interval->lo), g.py(v->interval->hi), 6);
-        top = std::min(top, g.py(v->interval->hi));
       }
       if (!chart.reference.empty() && chart.reference[gi][s]) {
         const double r = g.py(*chart.reference[gi][s]);
@@ -443,9 +471,8 @@ void draw(cairo_t* cr, const BarChart& chart, int width, int height) {
         cairo_stroke(cr);
       }
       set_grey(cr, 0.1);
-      char label[16];
-      std::snprintf(label, sizeof label, "%.2f", v->value);
-      text(cr, label, 0.5 * (x0 + x1), top - 4.0, 9.0, Align::centre);
+      const ValueLabel label = value_label(g, chart, gi, s);
+      text(cr, label.text, 0.5 * (x0 + x1), label.box.y1, kValueText, Align::centre);
     }
     set_grey(cr, 0.1);
     const std::vector<std::string> lines = lines_of(chart.groups[gi]);
@@ -609,9 +636,29 @@ ChartLayout chart_layout(const BarChart& chart, int width, int height) {
         layout.marks.push_back({x0, g.py(v->interval->hi), x0 + g.bar_width, g.py(v->interval->lo),
                                 what + " (interval)"});
       }
+      layout.labels.push_back(value_label(g, chart, gi, s).box);
+      if (!chart.reference.empty() && chart.reference[gi][s]) {
+        const double r = g.py(*chart.reference[gi][s]);
+        layout.lines.push_back(
+            {x0 - 1.0, r - 1.25, x0 + g.bar_width + 1.0, r + 1.25, what + " (reference)"});
+      }
     }
   }
   return layout;
+}
+
+std::string label_under_line(const ChartLayout& layout) {
+  for (const Box& label : layout.labels) {
+    for (const Box& line : layout.lines) {
+      if (label.x1 <= line.x0 || line.x1 <= label.x0 || label.y1 <= line.y0 || line.y1 <= label.y0)
+        continue;
+      char text[160];
+      std::snprintf(text, sizeof text, " at (%.1f, %.1f)-(%.1f, %.1f) is crossed by ", label.x0,
+                    label.y0, label.x1, label.y1);
+      return label.what + text + line.what;
+    }
+  }
+  return "";
 }
 
 std::string mark_outside_axes(const ChartLayout& layout) {

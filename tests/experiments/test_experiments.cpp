@@ -363,6 +363,38 @@ TEST_CASE("the_figure_draws_grouped_bars_for_one_demo_count_with_the_papers_tick
   CHECK(image.count_pixels(213, 94, 0, 10) > 500);   // the OOD bars
 }
 
+TEST_CASE("a_reference_line_never_crosses_a_bars_value", "[unit]") {
+  // The paper's number drawn as a line across a bar just below it (0.84 against 0.87, as in
+  // Table 2's image rows) used to run through the written value. Every bar height around its
+  // reference, with and without an interval.
+  for (const double value : {0.80, 0.83, 0.84, 0.85, 0.86, 0.87, 0.88, 0.90, 0.95}) {
+    for (const bool interval : {false, true}) {
+      BarChart chart;
+      chart.title = "t";
+      chart.groups = {"a", "b"};
+      chart.series = {"train", "ood"};
+      const std::optional<ChartValue> v =
+          interval ? ChartValue{value, Interval{value - 0.08, std::min(1.0, value + 0.06)}}
+                   : ChartValue{value};
+      chart.values = {{v, v}, {v, ChartValue{0.0}}};
+      chart.reference = {{0.87, 0.87}, {0.87, std::nullopt}};
+      const ChartLayout layout = chart_layout(chart, 900, 520);
+      INFO("value " << value << " interval " << interval);
+      REQUIRE(layout.labels.size() == 4);
+      REQUIRE(layout.lines.size() == 3);
+      CHECK(label_under_line(layout).empty());
+      CHECK(mark_outside_axes(layout).empty());
+      // Planted fault: the first label moved onto its line must be caught.
+      ChartLayout planted = layout;
+      const double line_y = 0.5 * (layout.lines[0].y0 + layout.lines[0].y1);
+      const double height = planted.labels[0].y1 - planted.labels[0].y0;
+      planted.labels[0].y0 = line_y - 0.5 * height;
+      planted.labels[0].y1 = line_y + 0.5 * height;
+      CHECK_THAT(label_under_line(planted), Contains("a train (value)") && Contains("(reference)"));
+    }
+  }
+}
+
 TEST_CASE("a_chart_is_written_as_png_and_svg_and_refuses_bad_input_naming_it", "[unit]") {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() /
                                     ("handcentric_test_chart_" + std::to_string(::getpid()));

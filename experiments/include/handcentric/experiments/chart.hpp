@@ -4,7 +4,8 @@
 // and an SVG (vector, with the DejaVu Sans font), so a page shows the SVG and a reader who wants
 // pixels has the PNG beside it. Colours are Okabe-Ito's colour-blind-safe palette; every mark
 // lies inside its axes (the y range is padded, the x range too), which chart_layout reports and
-// mark_outside_axes checks.
+// mark_outside_axes checks, and no reference line runs through a bar's written value
+// (label_under_line checks).
 //
 //   LineChart chart;
 //   chart.x_label = "number of demos";
@@ -85,6 +86,8 @@ struct ChartLayout {
   };
   Box frame;
   std::vector<Box> marks;
+  std::vector<Box> labels;  ///< the values written above bars
+  std::vector<Box> lines;   ///< the reference lines (the paper's numbers), 2.5 px thick
 };
 
 ChartLayout chart_layout(const LineChart& chart, int width, int height);
@@ -93,6 +96,10 @@ ChartLayout chart_layout(const BarChart& chart, int width, int height);
 /// The first mark not strictly inside the frame, as "<what> at (x0, y0)-(x1, y1) outside the
 /// axes ..."; empty when every mark is inside.
 std::string mark_outside_axes(const ChartLayout& layout);
+
+/// The first value label that a reference line crosses (the line would hide the number), as
+/// "<what> (value) at (x0, y0)-(x1, y1) is crossed by <what> (reference)"; empty when none is.
+std::string label_under_line(const ChartLayout& layout);
 
 /// The chart as an RGB image (tests read its pixels). Throws InvalidArgument for a chart with
 /// nothing to draw, a curve whose x and y differ in length, a bar row of the wrong width, a
