@@ -47,8 +47,18 @@ HWY_INLINE hn::Vec<D> GlibcLogf(D d, hn::Vec<D> u1, const LibmFloatConstants& c)
   const auto index = hn::And(hn::ShiftRight<19>(tmp), hn::Set(di, 15));
   const auto k = hn::ShiftRight<23>(tmp);  // arithmetic: tmp < 0 for u1 < 0.7
   const auto z = hn::BitCast(d, hn::Sub(bits, hn::ShiftLeft<52>(k)));
+#if HWY_TARGET == HWY_AVX3
+  // The 16-entry tables in two registers each, one two-table permute per lookup instead of a
+  // gather (Highway 1.0 has no two-table lookup): exact copies either way.
+  const auto lookup = [&](const double* table) HWY_ATTR {
+    return hn::Vec<D>{
+        _mm512_permutex2var_pd(hn::LoadU(d, table).raw, index.raw, hn::LoadU(d, table + 8).raw)};
+  };
+  const auto invc = lookup(c.log_invc), logc = lookup(c.log_logc);
+#else
   const auto invc = hn::GatherIndex(d, c.log_invc, index);
   const auto logc = hn::GatherIndex(d, c.log_logc, index);
+#endif
   // k as a double: k + 1.5 2^52 has k in its low bits, for |k| < 2^51.
   const auto kd =
       hn::Sub(hn::BitCast(d, hn::Add(k, hn::Set(di, 0x4338000000000000ll))), hn::Set(d, 0x1.8p52));
