@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "box_muller.hpp"
 #include "handcentric/policy/kernels.hpp"
 
 namespace handcentric::policy::kernels {
@@ -139,6 +140,14 @@ struct KernelSet {
   /// row2im, im2row's adjoint: adds each entry of the N x K `rows` (ld) to the pixel it was read
   /// from (padding dropped); `image` is accumulated into.
   void (*row2im)(const ConvPatches& shape, const float* rows, long ld, float* image);
+  /// Box-Muller's pairs (box_muller.hpp) with glibc's logf, cosf and sinf transcribed in double
+  /// lanes (box_muller-inl.h) on AVX2 and AVX-512; libm itself (box_muller_pairs_libm) on the
+  /// targets without FMA, whose rounding could not follow glibc's FMA variants.
+  void (*box_muller)(std::ptrdiff_t pairs, const std::uint64_t* bits, float* out,
+                     const LibmFloatConstants& constants);
+  /// The parts of the same pairs, for the checks against libm (box_muller_parts_libm).
+  void (*box_muller_parts)(std::ptrdiff_t pairs, const std::uint64_t* bits, float* radius,
+                           float* cosine, float* sine, const LibmFloatConstants& constants);
   /// The Highway target (HWY_AVX3, HWY_AVX2, ...) the functions are compiled for.
   std::int64_t target;
 };

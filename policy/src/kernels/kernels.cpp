@@ -18,9 +18,24 @@
 #include "kernels/adam-inl.h"
 #include "kernels/gemm-inl.h"
 #include "kernels/conv-inl.h"
+#include "kernels/box_muller-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace handcentric::policy::kernels::HWY_NAMESPACE {
+
+// Box-Muller: the vector transform on the targets with FMA, libm itself on the others
+// (box_muller-inl.h).
+#if HWY_TARGET == HWY_AVX2 || HWY_TARGET == HWY_AVX3
+constexpr auto* kBoxMullerPairs = &BoxMullerPairs;
+constexpr auto* kBoxMullerParts = &BoxMullerParts;
+#else
+inline void LibmBoxMullerPairs(std::ptrdiff_t pairs, const std::uint64_t* bits, float* out,
+                               const LibmFloatConstants&) {
+  box_muller_pairs_libm(pairs, bits, out);
+}
+constexpr auto* kBoxMullerPairs = &LibmBoxMullerPairs;
+constexpr auto* kBoxMullerParts = &box_muller_parts_libm;
+#endif
 
 const KernelSet* TargetKernels() {
   static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel>,
@@ -33,6 +48,8 @@ const KernelSet* TargetKernels() {
                                   Col2im,
                                   Im2row,
                                   Row2im,
+                                  kBoxMullerPairs,
+                                  kBoxMullerParts,
                                   HWY_TARGET};
   return &kSet;
 }
