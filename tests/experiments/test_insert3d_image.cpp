@@ -286,11 +286,13 @@ TEST_CASE("image_settings_make_the_camera_the_model_records_and_gets_back", "[un
   CHECK(rebuilt->options().camera.horizontal_fov_deg == 50.0);
   const Scene observation = task_observation(1);
   CHECK(image_of(*rebuilt, observation) == image_of(*camera, observation));
-  Insert3dHandCameraOptions seventy;
-  seventy.channels = Insert3dImageChannels::normals;
-  seventy.camera.width = 48;
-  seventy.camera.height = 36;
-  CHECK(image_of(Insert3dHandCamera(seventy), observation) != image_of(*camera, observation));
+  // The same rig (both cameras, the same channels and size), only the field of view changed, so
+  // the two images have one shape and differ in their pixels.
+  Insert3dHandCameraOptions seventy = camera->options();
+  seventy.camera.horizontal_fov_deg = 70.0;
+  const Eigen::VectorXd seventy_image = image_of(Insert3dHandCamera(seventy), observation);
+  REQUIRE(seventy_image.size() == image_of(*camera, observation).size());
+  CHECK(seventy_image != image_of(*camera, observation));
   // A narrower camera is still only a function of the hand-frame points.
   CHECK(largest_change_under_g(*camera, 7) == 0.0);
   // The image policies' own budget fills in steps the command left automatic (0), and only those.
