@@ -41,13 +41,25 @@ void add_table2_command(CLI::App& app, int& exit_code) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--perturb-copies", options->perturbation.copies,
-                  "noise-injected copies of every training scene (DART; 0: the demos only)")
+                  "the key-point rows' noise-injected copies of every training scene (DART; 0: the "
+                  "demos only)")
       ->capture_default_str();
-  cmd->add_option("--perturb-cm", options->perturbation.max_cm,
-                  "largest move of a copy's hand, per axis, in the hand frame (cm)")
+  cmd->add_option(
+         "--perturb-cm", options->perturbation.max_cm,
+         "the key-point rows' largest move of a copy's hand, per axis, in the hand frame (cm)")
       ->capture_default_str();
-  cmd->add_option("--perturb-deg", options->perturbation.max_deg,
-                  "largest turn of a copy's hand, per rotation-vector axis (deg)")
+  cmd->add_option(
+         "--perturb-deg", options->perturbation.max_deg,
+         "the key-point rows' largest turn of a copy's hand, per rotation-vector axis (deg)")
+      ->capture_default_str();
+  cmd->add_option("--image-perturb-copies", options->image_perturbation.copies,
+                  "the image rows' noise-injected copies of every training scene")
+      ->capture_default_str();
+  cmd->add_option("--image-perturb-cm", options->image_perturbation.max_cm,
+                  "the image rows' largest move of a copy's hand, per axis (cm)")
+      ->capture_default_str();
+  cmd->add_option("--image-perturb-deg", options->image_perturbation.max_deg,
+                  "the image rows' largest turn of a copy's hand, per axis (deg)")
       ->capture_default_str();
   cmd->add_option("--observation", *observations,
                   "key_points and/or image (the hand camera's image through a CNN), one "

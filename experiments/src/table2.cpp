@@ -87,16 +87,20 @@ std::vector<insert3d::Demo> insert3d_train_demos(int count, std::uint64_t seed) 
   return std::move(run.demos);
 }
 
-void Perturbation::validate() const {
+void Perturbation::validate(const std::string& flag) const {
   if (copies < 0 || copies > 100) {
-    throw InvalidArgument("--perturb-copies " + std::to_string(copies) +
+    throw InvalidArgument(flag + "-copies " + std::to_string(copies) +
                           " is out of range: use 0..100");
   }
   if (!(max_cm >= 0.0 && max_cm < 1e3) || !(max_deg >= 0.0 && max_deg <= 180.0)) {
-    throw InvalidArgument("perturbation sizes " + std::to_string(max_cm) + " cm, " +
+    throw InvalidArgument(flag + "-cm " + std::to_string(max_cm) + ", " + flag + "-deg " +
                           std::to_string(max_deg) +
-                          " deg are out of range: use [0, 1000) cm and [0, 180] deg");
+                          ": out of range: use [0, 1000) cm and [0, 180] deg");
   }
+}
+
+Perturbation insert3d_default_perturbation(policy::ObservationKind observation) {
+  return {2, 0.15, observation == policy::ObservationKind::image ? 5.0 : 1.0};
 }
 
 std::vector<Scene> insert3d_training_data(const std::vector<insert3d::Demo>& demos, int H, int K,
@@ -146,6 +150,7 @@ void Table2Options::validate() const {
     throw InvalidArgument("table2: no observation: give key_points, image or both");
   for (const std::string& method : methods) make_representation(method);  // names the valid ones
   perturbation.validate();
+  image_perturbation.validate("--image-perturb");
   if (std::find(observations.begin(), observations.end(), policy::ObservationKind::image) !=
       observations.end()) {
     policy::PolicyConfig config;
@@ -208,6 +213,7 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
   row.demos = options.demos;
   row.seed = options.seed;
   row.steps = model->config().steps;
+  row.perturbation = options.perturbation_for(observation);
   const std::uint64_t eval_seed = options.seed + 1;
   row.train = evaluate_insert3d(trained, insert3d::SceneDistribution::train(), options.trials,
                                 eval_seed, rollout_options);
@@ -239,17 +245,27 @@ std::string table2_model_file(const std::string& method, policy::ObservationKind
   return observation == policy::ObservationKind::image ? method + "_image.hcm" : method + ".hcm";
 }
 
+std::vector<Scene> table2_training_data(const Table2Options& options,
+                                        const std::vector<insert3d::Demo>& demos,
+                                        policy::ObservationKind observation) {
+  const policy::PolicyConfig defaults;
+  return insert3d_training_data(demos, defaults.history_length, defaults.chunk_length,
+                                options.perturbation_for(observation), options.seed);
+}
+
 std::vector<Table2Row> run_table2(const Table2Options& options) {
   options.validate();
   std::filesystem::create_directories(options.out);
-  const policy::PolicyConfig defaults;
   const std::vector<insert3d::Demo> demos = insert3d_train_demos(options.demos, options.seed);
-  const std::vector<Scene> scenes = insert3d_training_data(
-      demos, defaults.history_length, defaults.chunk_length, options.perturbation, options.seed);
+  // One set of training scenes per observation (their noise injections differ).
+  std::vector<std::vector<Scene>> scenes;
+  for (const policy::ObservationKind observation : options.observations)
+    scenes.push_back(table2_training_data(options, demos, observation));
   if (!options.quiet) {
-    std::cerr << "table2: " << demos.size() << " demos (" << scenes.size() << " training samples), "
-              << options.methods.size() << " methods x " << options.observations.size()
-              << " observations, " << options.trials << " trials per scene set\n";
+    std::cerr << "table2: " << demos.size() << " demos (" << scenes.front().size()
+              << " training samples), " << options.methods.size() << " methods x "
+              << options.observations.size() << " observations, " << options.trials
+              << " trials per scene set\n";
   }
   // Rows in order: every method for the first observation, then for the next.
   const std::size_t count = options.methods.size() * options.observations.size();
@@ -260,8 +276,9 @@ std::vector<Table2Row> run_table2(const Table2Options& options) {
   const auto worker = [&] {
     for (std::size_t m = next++; m < count; m = next++) {
       try {
+        const std::size_t o = m / options.methods.size();
         rows[m] = run_method(options, options.methods[m % options.methods.size()],
-                             options.observations[m / options.methods.size()], scenes);
+                             options.observations[o], scenes[o]);
         if (!options.quiet) {
           const std::lock_guard<std::mutex> lock(print);
           std::cerr << "table2: " << row_label(rows[m]) << " (trained in "
@@ -302,7 +319,11 @@ std::string table2_json(const std::vector<Table2Row>& rows) {
                         {"seed", row.seed},
                         {"eval_seed", row.seed + 1},
                         {"steps", row.steps},
-                        {"train_seconds", row.train_seconds}};
+                        {"train_seconds", row.train_seconds},
+                        {"perturbation",
+                         {{"copies", row.perturbation.copies},
+                          {"max_cm", row.perturbation.max_cm},
+                          {"max_deg", row.perturbation.max_deg}}}};
     if (!row.image.empty()) r["image"] = row.image;
     for (int set = 0; set < 3; ++set) {
       const Insert3dCounts& c = set_counts(row, set);
@@ -331,6 +352,22 @@ std::string table2_markdown(const std::vector<Table2Row>& rows) {
        << rows.front().seed + 1
        << "; ood and random-se3 scene i is a global transform of train scene i). Success rate "
           "[Wilson 95%].\n\n";
+  }
+  // The noise injection of each kind of row, once per kind.
+  for (const policy::ObservationKind kind :
+       {policy::ObservationKind::key_points, policy::ObservationKind::image}) {
+    const auto row = std::find_if(rows.begin(), rows.end(),
+                                  [kind](const Table2Row& r) { return r.observation == kind; });
+    if (row == rows.end()) continue;
+    md << (kind == policy::ObservationKind::image ? "Image rows" : "Key-point rows")
+       << " train on the demos' scenes";
+    if (row->perturbation.copies > 0) {
+      md << " and " << row->perturbation.copies
+         << " noise-injected copies of each (the hand moved by up to " << row->perturbation.max_cm
+         << " cm and turned by up to " << row->perturbation.max_deg
+         << " deg per axis, in its own frame)";
+    }
+    md << ".\n\n";
   }
   for (const Table2Row& row : rows) {
     if (row.observation != policy::ObservationKind::image) continue;

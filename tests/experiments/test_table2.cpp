@@ -3,7 +3,10 @@
 // paper's numbers, the figure, and the options' errors. The end-to-end run is a CLI test.
 #include <catch2/catch.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -50,6 +53,7 @@ Table2Row sample_row(const std::string& method, int train, int ood, int random_s
   row.demos = 10;
   row.seed = 1;
   row.steps = 3000;
+  row.perturbation = {2, 0.15, 1.0};
   row.train = {20, train, 20 - train, 0, 0, 0};
   row.ood = {20, ood, 0, 0, 20 - ood, 0};  // invalid
   row.random_se3 = {20, random_se3, 0, 20 - random_se3, 0, 0};
@@ -68,6 +72,7 @@ TEST_CASE("table2_json_has_the_issue_schema", "[unit]") {
   CHECK(doc["rows"][1]["train_success"] == Approx(0.9));
   CHECK(doc["rows"][1]["random_se3_counts"]["timeout"] == 19);
   CHECK(doc["rows"][1]["ood_counts"]["invalid"] == 20);
+  CHECK(doc["rows"][1]["perturbation"]["max_deg"] == 1.0);
 }
 
 TEST_CASE("mutant_table2_schema_check_fails_on_a_row_without_random_se3_success", "[unit]") {
@@ -84,6 +89,8 @@ TEST_CASE("table2_markdown_sits_beside_the_papers_real_robot_numbers", "[unit]")
   CHECK_THAT(md, Contains("| flow / hand_centric | 10 | 3000 | 0.95 ["));
   CHECK_THAT(md, Contains("| hand-centric (paper) | 26/30 (0.87) | 5/5 (1.00) |"));
   CHECK_THAT(md, Contains("real robot"));
+  CHECK_THAT(md, Contains("Key-point rows train on the demos' scenes and 2 noise-injected copies "
+                          "of each (the hand moved by up to 0.15 cm and turned by up to 1 deg"));
 }
 
 TEST_CASE("table2_figure_draws_one_bar_per_method_and_set", "[unit]") {
@@ -138,4 +145,41 @@ TEST_CASE("table2_noise_injected_copies_move_the_hand_and_keep_the_demos_chunk",
   }
   CHECK_THROWS_WITH(insert3d_training_data(demos, 0, 16, Perturbation{101, 0.1, 1.0}, 3),
                     Contains("--perturb-copies 101"));
+}
+
+TEST_CASE("table2_image_rows_train_on_copies_turned_further_than_the_key_point_rows", "[unit]") {
+  // The image policies need copies turned by up to 5 deg per axis (the start yaw they must undo
+  // before the mouth), the key-point rows keep 1 deg: each kind of row gets its own data.
+  const std::vector<sim::insert3d::Demo> demos = insert3d_train_demos(2, 5);
+  const std::size_t first = demos[0].world_T_hand.size();
+  // The largest turn of a first copy of the first demo's scenes away from its own scene (deg).
+  const auto largest_turn = [first](const std::vector<Scene>& scenes) {
+    double deg = 0.0;
+    for (std::size_t t = 0; t < first; ++t) {
+      const RigidTransform delta =
+          scenes[t].world_T_hand0().inverse_compose(scenes[first + t].world_T_hand0());
+      deg = std::max(deg, delta.rotation().angle() * 180.0 / std::numbers::pi);
+    }
+    return deg;
+  };
+  Table2Options options;
+  options.seed = 3;
+  const std::vector<Scene> key_points =
+      table2_training_data(options, demos, policy::ObservationKind::key_points);
+  const std::vector<Scene> images =
+      table2_training_data(options, demos, policy::ObservationKind::image);
+  REQUIRE(key_points.size() == images.size());
+  REQUIRE(images.size() == 3 * (first + demos[1].world_T_hand.size()));
+  const double per_axis_to_angle = std::sqrt(3.0);  // a rotation vector in [-d, d]^3
+  CHECK(largest_turn(key_points) <= 1.0 * per_axis_to_angle + 1e-9);
+  CHECK(largest_turn(images) > 2.0 * per_axis_to_angle);
+  CHECK(largest_turn(images) <= 5.0 * per_axis_to_angle + 1e-9);
+  // Planted fault: the image rows handed the key-point rows' recipe turn no further than they do.
+  Table2Options shared = options;
+  shared.image_perturbation = shared.perturbation;
+  CHECK_FALSE(largest_turn(table2_training_data(shared, demos, policy::ObservationKind::image)) >
+              2.0 * per_axis_to_angle);
+  // A bad image recipe is named by its own flag.
+  options.image_perturbation.copies = 101;
+  CHECK_THROWS_WITH(options.validate(), Contains("--image-perturb-copies 101"));
 }
