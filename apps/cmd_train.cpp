@@ -24,10 +24,12 @@
 #include "image_options.hpp"
 #include "task_of_files.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/cell.hpp"
 #include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/experiments/insert3d_key_points.hpp"
+#include "handcentric/experiments/table2.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
@@ -97,7 +99,8 @@ int run_train(const TrainOptions& options) {
         "--observation image: the 2D task (peg2d) has no camera; train on a 3D "
         "demo file (task insert3d) or leave --observation key_points");
   }
-  // The 2D task's recipe (mirror images, perturbed copies); the 3D task trains on its demos.
+  // The 2D task's recipe (mirror images, perturbed copies); the 3D task's is Table 2's
+  // (experiments::insert3d_default_perturbation: noise-injected copies in the hand frame).
   sim::TrainingData data = options.data;
   data.mirror = planar && options.data.mirror;
   data.perturbed_copies = planar ? options.data.perturbed_copies : 0;
@@ -105,6 +108,7 @@ int run_train(const TrainOptions& options) {
   std::size_t demo_count = 0;
   long long demo_samples = 0;  // one scene per pose of each demo trained on
   std::vector<Scene> scenes;
+  experiments::Perturbation recipe_3d;  // the 3D task's noise injection
   if (planar) {
     const std::vector<sim::Demo> demos = sim::load_demos(options.demos);
     demo_count = demos.size();
@@ -120,8 +124,13 @@ int run_train(const TrainOptions& options) {
     const std::vector<sim::insert3d::Demo> demos = sim::insert3d::load_demos(options.demos);
     demo_count = demos.size();
     check_max_demos(options, demo_count);
-    scenes = sim::insert3d::training_scenes(demos, config.history_length, config.chunk_length,
-                                            options.max_demos);
+    const std::size_t kept =
+        options.max_demos == 0 ? demos.size() : static_cast<std::size_t>(options.max_demos);
+    recipe_3d = experiments::insert3d_default_perturbation(config.observation);
+    scenes = experiments::insert3d_training_data(
+        std::vector<sim::insert3d::Demo>(demos.begin(),
+                                         demos.begin() + static_cast<std::ptrdiff_t>(kept)),
+        config.history_length, config.chunk_length, recipe_3d, options.seed);
     // The key-point policy input of the 3D task: the corners and the slot points computed from
     // them. An image policy sees the hand camera's image of the corners' slot instead.
     if (!image) scenes = experiments::with_slot_key_points(scenes);
@@ -155,6 +164,10 @@ int run_train(const TrainOptions& options) {
             << (data.perturbed_copies > 0
                     ? " (" + std::to_string(data.perturbed_copies) + " perturbed copies each)"
                     : "")
+            << (recipe_3d.copies > 0 ? " (" + std::to_string(recipe_3d.copies) +
+                                           " noise-injected copies each, turned up to " +
+                                           format_number(recipe_3d.max_deg) + " deg)"
+                                     : "")
             << " (task " << config.task
             << (image ? ", " + camera->name() + ", encoder " + config.encoder + " " +
                             policy::to_string(config.image_features)
