@@ -151,7 +151,12 @@ const std::vector<Shape> kShapes = {
     {9, 37, 20},
     {8, 400, 31},
     {4, 30, 5},
-    {1, 25, 9}};
+    {1, 25, 9},
+    // the half-width tile (m <= 8 on AVX-512): a first layer of 8 filters, forward (K = 54,
+    // 6 channels of 3 x 3) and its weight gradient (k = the batch's pixels)
+    {8, 300, 54},
+    {8, 54, 600},
+    {6, 20, 13}};
 
 }  // namespace
 
@@ -259,8 +264,9 @@ TEST_CASE("a_product_split_over_k_into_accumulating_calls_is_one_product_bit_for
     INFO("target " << name);
     // A plain pointer for the lambda below: clang 14 cannot capture a structured binding.
     const kernels::KernelSet* set = set_pointer;
-    for (const Shape& shape : {Shape{32, 144, 3 * kBlock + 40}, Shape{16, 36, 2 * kBlock},
-                               Shape{33, 17, kBlock + 1}, Shape{7, 25, 2 * kBlock + 9}}) {
+    for (const Shape& shape :
+         {Shape{32, 144, 3 * kBlock + 40}, Shape{16, 36, 2 * kBlock}, Shape{33, 17, kBlock + 1},
+          Shape{7, 25, 2 * kBlock + 9}, Shape{8, 54, 3 * kBlock}}) {
       for (Op op_b : {Op::none, Op::transpose}) {
         GemmProblem problem(Op::none, op_b, shape.m, shape.n, shape.k, 3, false, rng);
         std::vector<float> sums(static_cast<std::size_t>(shape.m), 1e30f);
@@ -292,6 +298,46 @@ TEST_CASE("a_product_split_over_k_into_accumulating_calls_is_one_product_bit_for
         CHECK(row_sums_error(problem, sums) <= 1.0);
         split(true);
         CHECK(gemm_error(problem) > 1.0);
+      }
+    }
+  }
+}
+
+TEST_CASE("a_products_rows_have_the_same_bits_whichever_tile_computes_them", "[unit]") {
+  // vector_gemm picks the tile by op(A)'s rows (the half-width one up to 8 on AVX-512, the
+  // one-vector one up to a vector, the two-vector one beyond); each row of C is the same sum in
+  // the same order on all of them, so trained weights do not depend on the choice. A product of
+  // m rows against the same product with one row more (the next tile up): the first m rows of C
+  // must be equal bit for bit. Planted fault: one entry of A changed in the larger product.
+  std::mt19937_64 rng(19);
+  for (const auto& [name, set] : every_target()) {
+    INFO("target " << name);
+    for (const int m : {4, 8, 16, 32}) {
+      for (Op op_b : {Op::none, Op::transpose}) {
+        const int n = 40, k = 300;
+        GemmProblem large(Op::none, op_b, m + 1, n, k, 0, true, rng);
+        set->gemm(large.gemm());
+        // The first m rows of A, the same B and bias.
+        GemmProblem small(Op::none, op_b, m, n, k, 0, true, rng);
+        for (int p = 0; p < k; ++p) {
+          for (int i = 0; i < m; ++i) small.a[i + p * small.lda] = large.a[i + p * large.lda];
+        }
+        small.b = large.b;
+        std::copy(large.row_bias.begin(), large.row_bias.begin() + m, small.row_bias.begin());
+        set->gemm(small.gemm());
+        INFO("m " << m << " op_b " << int(op_b));
+        const auto first_rows_equal = [&] {
+          for (int j = 0; j < n; ++j) {
+            for (int i = 0; i < m; ++i) {
+              if (small.c[i + j * small.ldc] != large.c[i + j * large.ldc]) return false;
+            }
+          }
+          return true;
+        };
+        CHECK(first_rows_equal());
+        large.a[m / 2 + 7 * large.lda] += 0.5f;  // planted fault
+        set->gemm(large.gemm());
+        CHECK_FALSE(first_rows_equal());
       }
     }
   }

@@ -77,11 +77,15 @@ void NarrowProduct(int shift, int rows, int k, const float* a, long lda, const f
 /// of B, V NR FMAs. V = 2 is the product's tile; V = 1 serves products of at most one vector of
 /// rows (a layer of 16 filters on AVX-512), which the two-vector tile would compute half of in
 /// zero padding. Each entry of C is the same sum in the same order whatever V, so both tiles give
-/// the same bits.
-template <int V>
+/// the same bits. `Tag` sets the vectors' width: the full one, or half of AVX-512's (8 floats) for
+/// products of at most 8 rows (a layer of 8 filters), whose 16-lane tile would spend half of
+/// every FMA on padding (and AMD's cores run a 512-bit FMA as two 256-bit halves).
+template <int V, class Tag = FloatTag>
 struct GemmKernelOf {
   static_assert(V == 1 || V == 2, "one or two vectors of rows");
-  static constexpr int MR = V * kLanes, NR = kRegisters == 32 ? 12 : 6;
+  /// Floats per vector of this tile.
+  static constexpr int kTagLanes = static_cast<int>(hn::MaxLanes(Tag()));
+  static constexpr int MR = V * kTagLanes, NR = kRegisters == 32 ? 12 : 6;
   static constexpr int kNarrowLanes = kLanes, kNarrowAccumulators = kRegisters == 32 ? 24 : 12;
   static constexpr int kNarrowGroup = kRegisters == 32 ? 8 : 4;
   /// Whether the narrow products start a shifted, masked head at a vector boundary: only where
@@ -93,47 +97,48 @@ struct GemmKernelOf {
 
   // pack_a<MR> with vector moves: op(A) = A copies V (partial) vectors per k, and adds them to
   // `row_sums` when it is not null (gemm.hpp, blocked_gemm); op(A) = A^T gathers each row
-  // panel's k-th column (kLanes rows at stride lda) from rows that stay in L1.
+  // panel's k-th column (kTagLanes rows at stride lda) from rows that stay in L1.
   static void pack_a(Op op, const float* a, int lda, int i0, int mc, int p0, int kc, float* out,
                      float* row_sums) {
     // Gather offsets are int32 byte offsets: beyond them, the scalar packing.
-    if (op == Op::transpose && static_cast<long>(lda) * kLanes >= (1L << 29)) {
+    if (op == Op::transpose && static_cast<long>(lda) * kTagLanes >= (1L << 29)) {
       kernels::pack_a<MR>(op, a, lda, i0, mc, p0, kc, out);
       return;
     }
-    const FloatTag d;
-    const hn::RebindToSigned<FloatTag> di;
+    const Tag d;
+    const hn::RebindToSigned<Tag> di;
     const auto row_offsets = hn::Mul(hn::Iota(di, 0), hn::Set(di, lda));
     for (int panel = 0; panel < mc; panel += MR) {
       const int rows = std::min(MR, mc - panel);
       int part[V];  // the rows in each vector of the panel
 #pragma GCC unroll 2
-      for (int v = 0; v < V; ++v) part[v] = std::clamp(rows - v * kLanes, 0, kLanes);
+      for (int v = 0; v < V; ++v) part[v] = std::clamp(rows - v * kTagLanes, 0, kTagLanes);
       if (op == Op::none && row_sums != nullptr) {
         // The same additions as the narrow product op(A) 1 (whose FMAs by 1 are exact
         // products): each row's sum, in the order of k.
         const float* column = a + (i0 + panel) + static_cast<long>(p0) * lda;
-        hn::Vec<FloatTag> sum[V];
+        hn::Vec<Tag> sum[V];
 #pragma GCC unroll 2
-        for (int v = 0; v < V; ++v) sum[v] = LoadPart(d, row_sums + panel + v * kLanes, part[v]);
+        for (int v = 0; v < V; ++v) sum[v] = LoadPart(d, row_sums + panel + v * kTagLanes, part[v]);
         for (int p = 0; p < kc; ++p, column += lda) {
 #pragma GCC unroll 2
           for (int v = 0; v < V; ++v) {
-            const auto x = LoadPart(d, column + v * kLanes, part[v]);
-            hn::Store(x, d, out + p * MR + v * kLanes);
+            const auto x = LoadPart(d, column + v * kTagLanes, part[v]);
+            hn::Store(x, d, out + p * MR + v * kTagLanes);
             sum[v] = hn::Add(sum[v], x);
           }
         }
 #pragma GCC unroll 2
         for (int v = 0; v < V; ++v) {
-          if (part[v] > 0) StorePart(d, sum[v], row_sums + panel + v * kLanes, part[v]);
+          if (part[v] > 0) StorePart(d, sum[v], row_sums + panel + v * kTagLanes, part[v]);
         }
       } else if (op == Op::none) {
         const float* column = a + (i0 + panel) + static_cast<long>(p0) * lda;
         for (int p = 0; p < kc; ++p, column += lda) {
 #pragma GCC unroll 2
           for (int v = 0; v < V; ++v)
-            hn::Store(LoadPart(d, column + v * kLanes, part[v]), d, out + p * MR + v * kLanes);
+            hn::Store(LoadPart(d, column + v * kTagLanes, part[v]), d,
+                      out + p * MR + v * kTagLanes);
         }
       } else {
         // op(A)(i, p) = a[p + i lda]; a vector without rows gathers the first row again, masked.
@@ -141,9 +146,10 @@ struct GemmKernelOf {
 #pragma GCC unroll 2
         for (int v = 0; v < V; ++v) {
           const auto lanes = FirstLanes(d, part[v]);
-          const float* rows_v = part[v] > 0 ? row0 + static_cast<long>(v) * kLanes * lda : row0;
+          const float* rows_v = part[v] > 0 ? row0 + static_cast<long>(v) * kTagLanes * lda : row0;
           for (int p = 0; p < kc; ++p)
-            hn::Store(GatherRows(d, rows_v + p, row_offsets, lanes), d, out + p * MR + v * kLanes);
+            hn::Store(GatherRows(d, rows_v + p, row_offsets, lanes), d,
+                      out + p * MR + v * kTagLanes);
         }
       }
       out += static_cast<long>(kc) * MR;
@@ -154,17 +160,17 @@ struct GemmKernelOf {
   template <BLayout layout>
   static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc,
                    bool accumulate, const float* bias) {
-    const FloatTag d;
-    hn::Vec<FloatTag> acc[NR][V];
+    const Tag d;
+    hn::Vec<Tag> acc[NR][V];
 #pragma GCC unroll 32
     for (int j = 0; j < NR; ++j) {
 #pragma GCC unroll 2
       for (int v = 0; v < V; ++v) acc[j][v] = hn::Zero(d);
     }
     for (int p = 0; p < kc; ++p) {
-      hn::Vec<FloatTag> a_v[V];
+      hn::Vec<Tag> a_v[V];
 #pragma GCC unroll 2
-      for (int v = 0; v < V; ++v) a_v[v] = hn::Load(d, a + v * kLanes);
+      for (int v = 0; v < V; ++v) a_v[v] = hn::Load(d, a + v * kTagLanes);
       hwy::Prefetch(a + 8 * MR);
 #pragma GCC unroll 32
       for (int j = 0; j < NR; ++j) {
@@ -176,18 +182,18 @@ struct GemmKernelOf {
       a += MR;
       b += layout == BLayout::packed ? NR : layout == BLayout::rows ? ldb : 1;
     }
-    hn::Vec<FloatTag> add[V];
+    hn::Vec<Tag> add[V];
 #pragma GCC unroll 2
     for (int v = 0; v < V; ++v) {
-      add[v] = !accumulate && bias != nullptr ? hn::LoadU(d, bias + v * kLanes) : hn::Zero(d);
+      add[v] = !accumulate && bias != nullptr ? hn::LoadU(d, bias + v * kTagLanes) : hn::Zero(d);
     }
 #pragma GCC unroll 32
     for (int j = 0; j < NR; ++j) {
       float* cj = c + static_cast<long>(j) * ldc;
 #pragma GCC unroll 2
       for (int v = 0; v < V; ++v) {
-        if (accumulate) add[v] = hn::LoadU(d, cj + v * kLanes);
-        hn::StoreU(hn::Add(acc[j][v], add[v]), d, cj + v * kLanes);
+        if (accumulate) add[v] = hn::LoadU(d, cj + v * kTagLanes);
+        hn::StoreU(hn::Add(acc[j][v], add[v]), d, cj + v * kTagLanes);
       }
     }
   }
@@ -196,6 +202,9 @@ struct GemmKernelOf {
 /// The product's register tile (two vectors of rows) and the one for short products.
 using GemmKernel = GemmKernelOf<2>;
 using ShortGemmKernel = GemmKernelOf<1>;
+/// The tile of at most 8 rows in 8-float vectors: on AVX-512 half of ShortGemmKernel's rows; on
+/// AVX2 and narrower targets the same MR as it, and then never chosen (vector_gemm).
+using HalfGemmKernel = GemmKernelOf<1, hn::CappedTag<float, 8>>;
 
 }  // namespace handcentric::policy::kernels::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();

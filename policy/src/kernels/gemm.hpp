@@ -269,15 +269,18 @@ inline void sum_rows_of_a(const Gemm& g) {
 /// KernelSet::gemm of a vector set: the degenerate shapes, the narrow products, or the blocked
 /// product, then the epilogue where the blocked nest has not applied it. The blocked product runs
 /// on ShortKernel, a tile of fewer rows (ShortKernel::MR < Kernel::MR), when op(A) has no more
-/// rows than it: Kernel's tile would spend the rest of its rows on zero padding.
-template <typename Kernel, typename ShortKernel>
+/// rows than it: Kernel's tile would spend the rest of its rows on zero padding; and on
+/// HalfKernel, narrower still, when it has fewer rows than ShortKernel and op(A) fits it. Each
+/// entry of C is the same sum in the same order on every tile, so the choice changes no bit.
+template <typename Kernel, typename ShortKernel, typename HalfKernel = ShortKernel>
 void vector_gemm(const Gemm& g) {
   static_assert(ShortKernel::MR < Kernel::MR, "the short tile has fewer rows");
+  static_assert(HalfKernel::MR <= ShortKernel::MR, "the half tile has no more rows");
   if (g.a_row_sums != nullptr && g.m > 0 && (g.n <= kNarrowMax || g.k <= 0 || g.op_a != Op::none)) {
     sum_rows_of_a(g);  // the blocked nest's packing does not run on op(A) = A
     Gemm rest = g;
     rest.a_row_sums = nullptr;
-    vector_gemm<Kernel, ShortKernel>(rest);
+    vector_gemm<Kernel, ShortKernel, HalfKernel>(rest);
   } else if (g.accumulate && (g.m <= 0 || g.n <= 0 || g.k <= 0)) {
     // nothing to add
   } else if (trivial_gemm(g)) {
@@ -285,6 +288,8 @@ void vector_gemm(const Gemm& g) {
   } else if (g.n <= kNarrowMax && g.op_a == Op::none && !g.accumulate) {
     narrow_gemm<Kernel>(g);
     apply_epilogue(g, 0, g.m, 0, g.n, Kernel::kSilu);
+  } else if (HalfKernel::MR < ShortKernel::MR && g.m <= HalfKernel::MR) {
+    blocked_gemm<HalfKernel>(g);
   } else if (g.m <= ShortKernel::MR) {
     blocked_gemm<ShortKernel>(g);
   } else {

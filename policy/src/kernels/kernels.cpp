@@ -38,7 +38,7 @@ constexpr auto* kBoxMullerParts = &box_muller_parts_libm;
 #endif
 
 const KernelSet* TargetKernels() {
-  static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel>,
+  static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>,
                                   SiluForward,
                                   SiluBackward,
                                   SiluInPlace,
