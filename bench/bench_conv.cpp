@@ -4,6 +4,10 @@
 //   SiLU after each -> flatten (32 x 6 x 8 = 1536) -> 256 -> 256 -> 24 (SiLU), MSE to a target,
 //   Adam (lr 1e-3) on the encoder's and the MLP's parameters;
 // at batch 64 and 256 (items/s = training samples/s), and the encoder's forward alone.
+// BM_default_encoder_train_step: the same step on the image policies' default encoder
+// (experiments::Insert3dImageSettings: two cameras' normals and depth, 6 x 48 x 64 -> conv 8,
+// 16, 16, 16, the same 3 x 3 stride-2 layers -> 16 x 3 x 4 = 192 -> 256 -> 256 -> 24), whose
+// first layer has 8 filters.
 // Numbers and commands: docs/BENCHMARKS.md, "Image encoder".
 #include <benchmark/benchmark.h>
 
@@ -21,6 +25,9 @@ namespace {
 
 const ImageShape kImage{4, 48, 64};
 const std::vector<ConvLayerSpec> kLayers = {{16, 3, 2, 1}, {32, 3, 2, 1}, {32, 3, 2, 1}};
+const ImageShape kDefaultImage{6, 48, 64};
+const std::vector<ConvLayerSpec> kDefaultLayers = {
+    {8, 3, 2, 1}, {16, 3, 2, 1}, {16, 3, 2, 1}, {16, 3, 2, 1}};
 
 Eigen::MatrixXf random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937_64& rng) {
   Eigen::MatrixXf m(rows, cols);
@@ -28,15 +35,16 @@ Eigen::MatrixXf random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937
   return m;
 }
 
-void BM_conv_train_step(benchmark::State& state) {
+void train_steps(benchmark::State& state, const ImageShape& image,
+                 const std::vector<ConvLayerSpec>& layers) {
   const int batch = static_cast<int>(state.range(0));
   std::mt19937_64 rng(1);
-  ConvEncoder encoder(kImage, kLayers);
+  ConvEncoder encoder(image, layers);
   encoder.initialize(rng);
   Mlp mlp({static_cast<int>(encoder.output_size()), 256, 256, 24}, Activation::silu);
   mlp.initialize(rng);
   Adam encoder_adam(encoder.parameter_count(), {}), mlp_adam(mlp.parameter_count(), {});
-  const Eigen::MatrixXf images = random_matrix(kImage.size(), batch, rng);
+  const Eigen::MatrixXf images = random_matrix(image.size(), batch, rng);
   const Eigen::MatrixXf target = random_matrix(24, batch, rng);
   Eigen::MatrixXf d_output(24, batch);
   for (auto _ : state) {
@@ -49,9 +57,22 @@ void BM_conv_train_step(benchmark::State& state) {
   }
   state.SetItemsProcessed(state.iterations() * batch);
 }
+
+void BM_conv_train_step(benchmark::State& state) {
+  train_steps(state, kImage, kLayers);
+}
+void BM_default_encoder_train_step(benchmark::State& state) {
+  train_steps(state, kDefaultImage, kDefaultLayers);
+}
 // Wall time (UseRealTime), as PyTorch's side measures: on a shared machine the CPU time would
 // leave out the waits for a core that PyTorch's rate includes.
 BENCHMARK(BM_conv_train_step)
+    ->Arg(64)
+    ->Arg(256)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_default_encoder_train_step)
     ->Arg(64)
     ->Arg(256)
     ->Unit(benchmark::kMillisecond)

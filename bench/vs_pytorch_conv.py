@@ -3,7 +3,9 @@
 
 RGB-D 4 x 48 x 64 -> Conv2d 16, 32, 32 (3x3, stride 2, padding 1), SiLU after each -> flatten
 (1536) -> 256 -> 256 -> 24 (SiLU), MSE to a fixed target, Adam (lr 1e-3), float32; one fixed
-batch of images, as bench_conv.cpp trains on. Prints one JSON line per batch size and memory
+batch of images, as bench_conv.cpp trains on. `--network default`: the image policies' default
+encoder instead (bench_conv.cpp's BM_default_encoder_train_step: 6 x 48 x 64 -> Conv2d 8, 16,
+16, 16 -> flatten (192) -> the same head). Prints one JSON line per batch size and memory
 format (contiguous NCHW, channels_last NHWC):
   {"threads": T, "batch": B, "format": F, "train_samples_per_s": best over repetitions,
    "train_samples_per_cpu_s": the same per second of process CPU time,
@@ -16,17 +18,22 @@ import time
 import torch
 
 
-def encoder():
-    return torch.nn.Sequential(
-        torch.nn.Conv2d(4, 16, 3, stride=2, padding=1), torch.nn.SiLU(),
-        torch.nn.Conv2d(16, 32, 3, stride=2, padding=1), torch.nn.SiLU(),
-        torch.nn.Conv2d(32, 32, 3, stride=2, padding=1), torch.nn.SiLU(),
-        torch.nn.Flatten())
+# (input channels, the layers' filters, features after flatten) of each network.
+NETWORKS = {"bench": (4, [16, 32, 32], 32 * 6 * 8), "default": (6, [8, 16, 16, 16], 16 * 3 * 4)}
 
 
-def head():
+def encoder(network):
+    channels, filters, _ = NETWORKS[network]
+    layers = []
+    for out in filters:
+        layers += [torch.nn.Conv2d(channels, out, 3, stride=2, padding=1), torch.nn.SiLU()]
+        channels = out
+    return torch.nn.Sequential(*layers, torch.nn.Flatten())
+
+
+def head(network):
     return torch.nn.Sequential(
-        torch.nn.Linear(32 * 6 * 8, 256), torch.nn.SiLU(),
+        torch.nn.Linear(NETWORKS[network][2], 256), torch.nn.SiLU(),
         torch.nn.Linear(256, 256), torch.nn.SiLU(),
         torch.nn.Linear(256, 24))
 
@@ -71,6 +78,7 @@ def main():
     parser.add_argument("--batch", type=int, nargs="+", default=[64, 256])
     parser.add_argument("--seconds", type=float, default=3.0)
     parser.add_argument("--repetitions", type=int, default=3)
+    parser.add_argument("--network", choices=sorted(NETWORKS), default="bench")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
     for batch in args.batch:
@@ -78,9 +86,9 @@ def main():
         # comparison is against PyTorch's best.
         for layout in ("contiguous", "channels_last"):
             torch.manual_seed(0)
-            cnn = encoder()
-            net = torch.nn.Sequential(cnn, head())
-            images = torch.randn(batch, 4, 48, 64)
+            cnn = encoder(args.network)
+            net = torch.nn.Sequential(cnn, head(args.network))
+            images = torch.randn(batch, NETWORKS[args.network][0], 48, 64)
             if layout == "channels_last":
                 net = net.to(memory_format=torch.channels_last)
                 images = images.contiguous(memory_format=torch.channels_last)
@@ -89,7 +97,8 @@ def main():
             train_rate(net, optimizer, images, target, 1.0)  # warm-up
             rates = [train_rate(net, optimizer, images, target, args.seconds)
                      for _ in range(args.repetitions)]
-            print(json.dumps({"threads": args.threads, "batch": batch, "format": layout,
+            print(json.dumps({"network": args.network, "threads": args.threads, "batch": batch,
+                              "format": layout,
                               "train_samples_per_s": max(wall for wall, _ in rates),
                               "train_samples_per_cpu_s": max(cpu for _, cpu in rates),
                               "forward_ms": forward_ms(cnn, images), "blas": blas_library()}),

@@ -6,7 +6,10 @@
 # memory format), Y = the same per second of CPU time, each on one thread (on a shared machine
 # the wall times include waits for a core, which differ between the two runs).
 #
-#   bench/vs_pytorch_conv.sh [BUILD_DIR]        (default: build)
+#   bench/vs_pytorch_conv.sh [BUILD_DIR] [NETWORK]   (defaults: build, bench)
+#
+# NETWORK: `bench`, the network above (bench_conv's BM_conv_train_step), or `default`, the image
+# policies' default encoder (BM_default_encoder_train_step: 6 x 48 x 64 -> 8, 16, 16, 16).
 #
 # As bench/vs_pytorch.sh: /usr/bin/python3 (Debian's torch imports only there), both sides
 # pinned with taskset when it exists, ours on core 0, PyTorch on core 0 (1 thread) and cores 0
@@ -17,6 +20,15 @@
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 build="${1:-$here/../build}"
+network="${2:-bench}"
+case "$network" in
+  bench) filter=BM_conv_train_step ;;
+  default) filter=BM_default_encoder_train_step ;;
+  *)
+    echo "vs_pytorch_conv.sh: unknown network '$network': use bench or default" >&2
+    exit 2
+    ;;
+esac
 bench="$build/bench/bench_conv"
 python=/usr/bin/python3
 
@@ -29,13 +41,13 @@ if ! "$python" -c "import torch" 2>/dev/null; then
   echo "vs_pytorch_conv.sh: PyTorch is missing: bench/vs_pytorch.sh installs it" >&2
   exit 1
 fi
-echo "handcentric's kernels: ${HANDCENTRIC_KERNELS:-best for this CPU}"
+echo "handcentric's kernels: ${HANDCENTRIC_KERNELS:-best for this CPU}; network: $network"
 pin() { if command -v taskset >/dev/null; then taskset -c "$1" "${@:2}"; else "${@:2}"; fi; }
 
-ours_json="$(pin 0 "$bench" --benchmark_filter='BM_conv_train_step' \
+ours_json="$(pin 0 "$bench" --benchmark_filter="$filter" \
   --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"
-torch_lines="$(pin 0 "$python" "$here/vs_pytorch_conv.py" --threads 1
-               pin 0,1 "$python" "$here/vs_pytorch_conv.py" --threads 2)"
+torch_lines="$(pin 0 "$python" "$here/vs_pytorch_conv.py" --threads 1 --network "$network"
+               pin 0,1 "$python" "$here/vs_pytorch_conv.py" --threads 2 --network "$network")"
 echo "$torch_lines" | sed 's/^/pytorch: /'
 "$python" -c '
 import json, sys
