@@ -390,11 +390,14 @@ TEST_CASE("every_kernel_set_applies_the_silu_epilogues_on_every_path", "[unit]")
       for (Op op_a : {Op::none, Op::transpose}) {
         for (kernels::Epilogue epilogue :
              {kernels::Epilogue::silu, kernels::Epilogue::silu_derivative}) {
-          for (bool keep_sigmoid : {false, true}) {
+          // pad 0: C and the maps packed (ldc = lds = m), where a block's columns are one run
+          // of values and the epilogue takes them in one call; pad 3: column by column.
+          for (const auto& [keep_sigmoid, pad] :
+               {std::pair{false, 3}, std::pair{true, 3}, std::pair{false, 0}, std::pair{true, 0}}) {
             if (epilogue == kernels::Epilogue::silu_derivative && !keep_sigmoid) continue;
-            GemmProblem problem(op_a, Op::none, shape.m, shape.n, shape.k, 3, true, rng);
+            GemmProblem problem(op_a, Op::none, shape.m, shape.n, shape.k, pad, true, rng);
             for (float& x : problem.a) x *= 3.0f;  // z spans both tails of the sigmoid
-            const int lds = problem.ldc + 5;
+            const int lds = pad == 0 ? problem.ldc : problem.ldc + 5;
             const std::size_t size = static_cast<std::size_t>(lds) * std::max(shape.n, 1);
             std::vector<float> s_in = random_floats(size, rng), a_in = random_floats(size, rng);
             for (float& x : s_in) x = 0.5f + 0.5f * x;  // a sigmoid is in (0, 1)
@@ -412,7 +415,8 @@ TEST_CASE("every_kernel_set_applies_the_silu_epilogues_on_every_path", "[unit]")
             const std::vector<float>& kept =
                 epilogue == kernels::Epilogue::silu && keep_sigmoid ? s_out : std::vector<float>{};
             INFO("m " << shape.m << " n " << shape.n << " k " << shape.k << " op_a " << int(op_a)
-                      << " epilogue " << int(epilogue) << " keep_sigmoid " << keep_sigmoid);
+                      << " epilogue " << int(epilogue) << " keep_sigmoid " << keep_sigmoid
+                      << " pad " << pad);
             CHECK(epilogue_error(problem, epilogue, lds, s_in, a_in, kept) <= 1.0);
             if (shape.m * shape.n >= 4) {  // planted fault: a reference without the epilogue
               CHECK(epilogue_error(problem, epilogue, lds, s_in, a_in, kept,
