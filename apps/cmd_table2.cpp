@@ -14,6 +14,24 @@
 #include "handcentric/experiments/table2.hpp"
 
 namespace handcentric::apps {
+namespace {
+
+// PREFIX-copies, PREFIX-cm and PREFIX-deg for one Perturbation (experiments/table2.hpp).
+void add_perturbation_options(CLI::App* cmd, const std::string& prefix, const std::string& rows,
+                              experiments::Perturbation& perturbation) {
+  cmd->add_option(prefix + "-copies", perturbation.copies,
+                  rows + " noise-injected copies of every training scene (0: the demos only)")
+      ->capture_default_str();
+  cmd->add_option(prefix + "-cm", perturbation.max_cm,
+                  rows + " largest move of a copy's hand, per axis, in the hand frame (cm)")
+      ->capture_default_str();
+  cmd->add_option(prefix + "-deg", perturbation.max_deg,
+                  rows + " largest turn of a copy's hand, per rotation-vector axis (deg)")
+      ->capture_default_str();
+}
+
+}  // namespace
+
 void add_table2_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<experiments::Table2Options>();
   auto observations = std::make_shared<std::vector<std::string>>(
@@ -40,27 +58,9 @@ void add_table2_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--methods", options->methods, "representations, one row each (comma-separated)")
       ->delimiter(',')
       ->capture_default_str();
-  cmd->add_option("--perturb-copies", options->perturbation.copies,
-                  "the key-point rows' noise-injected copies of every training scene (DART; 0: the "
-                  "demos only)")
-      ->capture_default_str();
-  cmd->add_option(
-         "--perturb-cm", options->perturbation.max_cm,
-         "the key-point rows' largest move of a copy's hand, per axis, in the hand frame (cm)")
-      ->capture_default_str();
-  cmd->add_option(
-         "--perturb-deg", options->perturbation.max_deg,
-         "the key-point rows' largest turn of a copy's hand, per rotation-vector axis (deg)")
-      ->capture_default_str();
-  cmd->add_option("--image-perturb-copies", options->image_perturbation.copies,
-                  "the image rows' noise-injected copies of every training scene")
-      ->capture_default_str();
-  cmd->add_option("--image-perturb-cm", options->image_perturbation.max_cm,
-                  "the image rows' largest move of a copy's hand, per axis (cm)")
-      ->capture_default_str();
-  cmd->add_option("--image-perturb-deg", options->image_perturbation.max_deg,
-                  "the image rows' largest turn of a copy's hand, per axis (deg)")
-      ->capture_default_str();
+  // The key-point rows' and the image rows' noise injection (DART), one set of flags each.
+  add_perturbation_options(cmd, "--perturb", "the key-point rows'", options->perturbation);
+  add_perturbation_options(cmd, "--image-perturb", "the image rows'", options->image_perturbation);
   cmd->add_option("--observation", *observations,
                   "key_points and/or image (the hand camera's image through a CNN), one "
                   "set of rows each (comma-separated)")

@@ -62,12 +62,14 @@ std::string clock_text(double seconds) {
   return text;
 }
 
-void check_max_demos(const TrainOptions& options, std::size_t held) {
+// The number of demos trained on: --max-demos of the `held` in the file, 0 meaning all.
+std::size_t demos_used(const TrainOptions& options, std::size_t held) {
   if (options.max_demos < 0 || options.max_demos > static_cast<int>(held)) {
     throw InvalidArgument("--max-demos " + std::to_string(options.max_demos) + " but '" +
                           options.demos + "' holds " + std::to_string(held) +
                           " demos: give 0 (all) up to " + std::to_string(held));
   }
+  return options.max_demos == 0 ? held : static_cast<std::size_t>(options.max_demos);
 }
 
 int run_train(const TrainOptions& options) {
@@ -105,39 +107,32 @@ int run_train(const TrainOptions& options) {
   data.mirror = planar && options.data.mirror;
   data.perturbed_copies = planar ? options.data.perturbed_copies : 0;
   data.perturbation_seed = options.seed;  // one seed names the whole training run
-  std::size_t demo_count = 0;
-  long long demo_samples = 0;  // one scene per pose of each demo trained on
+  std::size_t used = 0;                   // demos trained on
+  long long demo_samples = 0;             // the samples the automatic budget counts
   std::vector<Scene> scenes;
   experiments::Perturbation recipe_3d;  // the 3D task's noise injection
   if (planar) {
     const std::vector<sim::Demo> demos = sim::load_demos(options.demos);
-    demo_count = demos.size();
-    check_max_demos(options, demo_count);
+    used = demos_used(options, demos.size());
     // Recovery copies must clear the hole the demos were made with.
     scenes = sim::training_scenes(demos, config.history_length, config.chunk_length,
                                   options.max_demos, data, sim::demo_file_geometry(options.demos));
-    const std::size_t used =
-        options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
-    for (std::size_t i = 0; i < used; ++i)
+    for (std::size_t i = 0; i < used; ++i)  // one per pose of each demo
       demo_samples += static_cast<long long>(demos[i].world_T_hand.size());
   } else {
     const std::vector<sim::insert3d::Demo> demos = sim::insert3d::load_demos(options.demos);
-    demo_count = demos.size();
-    check_max_demos(options, demo_count);
-    const std::size_t kept =
-        options.max_demos == 0 ? demos.size() : static_cast<std::size_t>(options.max_demos);
+    used = demos_used(options, demos.size());
     recipe_3d = experiments::insert3d_default_perturbation(config.observation);
     scenes = experiments::insert3d_training_data(
         std::vector<sim::insert3d::Demo>(demos.begin(),
-                                         demos.begin() + static_cast<std::ptrdiff_t>(kept)),
+                                         demos.begin() + static_cast<std::ptrdiff_t>(used)),
         config.history_length, config.chunk_length, recipe_3d, options.seed);
     // The key-point policy input of the 3D task: the corners and the slot points computed from
     // them. An image policy sees the hand camera's image of the corners' slot instead.
     if (!image) scenes = experiments::with_slot_key_points(scenes);
+    // The copies counted too, as Table 2's budget (policy::training_budget of its data) does.
     demo_samples = static_cast<long long>(scenes.size());
   }
-  const std::size_t used =
-      options.max_demos == 0 ? demo_count : static_cast<std::size_t>(options.max_demos);
   if (config.steps == 0)
     config.steps = experiments::automatic_steps(data, config.head, demo_samples);
 
@@ -166,7 +161,7 @@ int run_train(const TrainOptions& options) {
                     : "")
             << (recipe_3d.copies > 0 ? " (" + std::to_string(recipe_3d.copies) +
                                            " noise-injected copies each, turned up to " +
-                                           format_number(recipe_3d.max_deg) + " deg)"
+                                           format_shortest(recipe_3d.max_deg) + " deg)"
                                      : "")
             << " (task " << config.task
             << (image ? ", " + camera->name() + ", encoder " + config.encoder + " " +

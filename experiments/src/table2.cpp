@@ -17,6 +17,7 @@
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/experiments/insert3d_key_points.hpp"
@@ -93,8 +94,8 @@ void Perturbation::validate(const std::string& flag) const {
                           " is out of range: use 0..100");
   }
   if (!(max_cm >= 0.0 && max_cm < 1e3) || !(max_deg >= 0.0 && max_deg <= 180.0)) {
-    throw InvalidArgument(flag + "-cm " + std::to_string(max_cm) + ", " + flag + "-deg " +
-                          std::to_string(max_deg) +
+    throw InvalidArgument(flag + "-cm " + format_shortest(max_cm) + ", " + flag + "-deg " +
+                          format_shortest(max_deg) +
                           ": out of range: use [0, 1000) cm and [0, 180] deg");
   }
 }
