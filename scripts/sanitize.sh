@@ -48,6 +48,10 @@ built=$(date +%s)
 #    decoder that forgets R0, Theorem 1 pointwise and in law): 134 s under ASan; the same code
 #    paths run in shorter tests of the run (the energy test's detectable shift, the world-delta
 #    mode, the outer policy of any random network);
+#  - the batched policy audits' comparisons with the unbatched ones, in process and through the
+#    --exec pipe (whole audits each way, and planted batch-dependent maps): 240 s under ASan,
+#    20 s in the Release tree; the batching code runs here in the batched representation
+#    audit's comparison, the batched maps' refusals and the pipe's shorter batch tests;
 #  - three simulations of the in-distribution tests' power (the tabulated detectable shift, the
 #    scale test on curved world noise and without the exact split): 196 s under ASan; the same
 #    code paths run in the shorter anisotropic-noise and scale-test-level tests.
@@ -63,7 +67,9 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^the_tabulated_detectable_shift_is_the_simulated_one|'\
 '^anisotropic_world_noise_through_a_curve|^without_the_exact_split_and_the_scale_test|'\
 '^conventions_committed_table_is_up_to_date|^mutant_conventions_a_changed_formula|'\
-'^policy_exec_audits_a_plugin_on_recorded_observations'
+'^policy_exec_audits_a_plugin_on_recorded_observations|'\
+'^a_batched_policy_audit_is_the_unbatched_one_bit|^a_map_whose_answer_depends_on_its_batch|'\
+'^a_batched_exec_audit_gives_the_unbatched_json|^a_batched_policy_exec_audit_gives_the_unbatched'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 
