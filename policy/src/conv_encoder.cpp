@@ -76,10 +76,11 @@ kernels::ConvPatches map_patches(const Conv2d& layer, int batch) {
 }
 
 // Samples per chunk of the batch whose patch matrix (K x pixels each) fills about half of a
-// 1 MB L2 (kernels/gemm.hpp assumes it): im2col writes it and the product reads it back from
-// there, and backward's col2im reads its gradient from there. Below the first layer, a chunk's
-// pixels are a multiple of the products' k block, so that the weight gradient summed chunk by
-// chunk adds the same terms in the same order as one product over the batch.
+// 1 MB L2 (kernels/gemm.hpp assumes it): backward's col2im reads the patches' gradient from
+// there (and the chunk's padded map, a ninth of it at kernel 3, is read in place). Below the
+// first layer, a chunk's pixels are a multiple of the products' k block, so that the weight
+// gradient summed chunk by chunk adds the same terms in the same order as one product over the
+// batch.
 int samples_per_chunk(const Conv2d& layer, bool first) {
   constexpr Eigen::Index kChunkFloats = Eigen::Index{1} << 17;  // 512 KB
   const int pixels = layer.output().height * layer.output().width;
@@ -90,6 +91,80 @@ int samples_per_chunk(const Conv2d& layer, bool first) {
   return std::max(unit, fill / unit * unit);
 }
 
+// How a layer's input lies in its padded copy, in the input's own layout: (channels, height,
+// width) for the encoder's input (channels_first), (height, width, channels) for a hidden map.
+// A plane is height + 2 padding rows of `run` values between two borders of `border` zeros:
+// channels_first, one plane per channel and a row of pixels; else one plane, a row of pixels'
+// channels.
+struct PaddedLayout {
+  int planes;
+  long run, border, row, plane, sample, channel_step, column_step;
+};
+
+PaddedLayout padded_layout(const Conv2d& layer, bool channels_first) {
+  const ImageShape& in = layer.input();
+  PaddedLayout l;
+  l.planes = channels_first ? in.channels : 1;
+  l.run = channels_first ? in.width : static_cast<long>(in.width) * in.channels;
+  l.border = static_cast<long>(layer.padding()) * (channels_first ? 1 : in.channels);
+  l.row = l.run + 2 * l.border;
+  l.plane = l.row * (in.height + 2L * layer.padding());
+  l.sample = l.plane * l.planes;
+  l.channel_step = channels_first ? l.plane : 1;
+  l.column_step = channels_first ? 1 : in.channels;
+  return l;
+}
+
+// Makes room for `count` padded samples, if padded holds fewer: the maps all zeros (the copies
+// below write only the interiors, so the borders stay zero from then on), and the offsets
+// through which the layer's product reads its patches in place (kernels::OffsetGemm): entry
+// (ky, kx, c) of output pixel (b, oy, ox) is maps[patch_offsets[(ky kernel + kx) channels + c] +
+// pixel_offsets[(b out_height + oy) out_width + ox]], the patch matrix im2col would write.
+void reserve_padded(const Conv2d& layer, bool channels_first, int count, PaddedInput& padded) {
+  if (count <= padded.samples) return;
+  const PaddedLayout l = padded_layout(layer, channels_first);
+  padded.maps = Eigen::VectorXf::Zero(l.sample * count);
+  padded.samples = count;
+  padded.patch_offsets.clear();
+  for (int ky = 0; ky < layer.kernel(); ++ky) {
+    for (int kx = 0; kx < layer.kernel(); ++kx) {
+      for (int c = 0; c < layer.input().channels; ++c) {
+        padded.patch_offsets.push_back(c * l.channel_step + ky * l.row + kx * l.column_step);
+      }
+    }
+  }
+  const ImageShape& out = layer.output();
+  padded.pixel_offsets.resize(static_cast<std::size_t>(count) * out.height * out.width);
+  std::size_t at = 0;
+  for (int b = 0; b < count; ++b) {
+    for (int oy = 0; oy < out.height; ++oy) {
+      for (int ox = 0; ox < out.width; ++ox) {
+        padded.pixel_offsets[at++] = b * l.sample + static_cast<long>(oy) * layer.stride() * l.row +
+                                     static_cast<long>(ox) * layer.stride() * l.column_step;
+      }
+    }
+  }
+}
+
+// Copies `count` samples of a layer's input (sample b at source + b source_stride) into padded
+// samples first, first + 1, ... (reserve_padded made room), interiors only.
+void pad(const Conv2d& layer, bool channels_first, const float* source, long source_stride,
+         int first, int count, PaddedInput& padded) {
+  const PaddedLayout l = padded_layout(layer, channels_first);
+  const int height = layer.input().height, pad = layer.padding();
+  for (int b = 0; b < count; ++b) {
+    for (int q = 0; q < l.planes; ++q) {
+      float* rows = padded.maps.data() + (first + b) * l.sample + q * l.plane + l.border;
+      for (int y = 0; y < height; ++y) {
+        const float* from =
+            source + b * source_stride + (static_cast<long>(q) * height + y) * l.run;
+        float* to = rows + (y + pad) * l.row;
+        for (long i = 0; i < l.run; ++i) to[i] = from[i];
+      }
+    }
+  }
+}
+
 }  // namespace
 
 ConvEncoder::ConvEncoder(const ConvEncoder& other)
@@ -97,7 +172,7 @@ ConvEncoder::ConvEncoder(const ConvEncoder& other)
       offsets_(other.offsets_),
       parameters_(other.parameters_),
       gradient_(other.gradient_),
-      patches_(other.layers_.size()),
+      padded_(other.layers_.size()),
       sigmoid_(other.layers_.size()),
       activation_(other.layers_.size()),
       delta_(other.layers_.size()) {}
@@ -116,7 +191,7 @@ ConvEncoder::ConvEncoder(ImageShape input, const std::vector<ConvLayerSpec>& lay
   }
   parameters_ = Vector::Zero(count);
   gradient_ = Vector::Zero(count);
-  patches_.resize(layers_.size());
+  padded_.resize(layers_.size());
   sigmoid_.resize(layers_.size());
   activation_.resize(layers_.size());
   delta_.resize(layers_.size());
@@ -166,27 +241,34 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
     }
   }
   batch_ = static_cast<int>(batch);
-  input_sample_stride_ = images.outerStride();
   for (std::size_t l = 0; l < layers_.size(); ++l) {
     const Conv2d& layer = layers_[l];
     const int pixels = layer.output().height * layer.output().width;
     const int k = layer.patch_size(), out = layer.out_channels();
-    const Eigen::Index per_sample = static_cast<Eigen::Index>(k) * pixels;
-    const int chunk = samples_per_chunk(layer, l == 0);
-    // The first layer's patches are kept for backward (which does not see the images); a hidden
-    // layer's are one chunk's, made again by backward from the map below.
-    patches_[l].resize(per_sample * (l == 0 ? batch_ : std::min(chunk, batch_)));
+    const float* weights = parameters_.data() + offsets_[l];
     activation_[l].resize(layer.output().size(), batch);
     sigmoid_[l].resize(layer.output().size(), batch);
+    // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), the patches read in
+    // place from the padded input, one chunk of samples at a time, padded and multiplied while
+    // it is in L2. The first layer keeps the whole batch's padded images for backward (which
+    // does not see the images); a hidden layer's chunk is padded again by backward from the map
+    // below.
+    const int chunk = samples_per_chunk(layer, l == 0);
+    PaddedInput& padded = padded_[l];
+    reserve_padded(layer, l == 0, l == 0 ? batch_ : std::min(chunk, batch_), padded);
     for (int b0 = 0; b0 < batch_; b0 += chunk) {
       const int count = std::min(chunk, batch_ - b0);
-      // The first layer reads the input, (channels, height, width): its patches are stored
-      // transposed (N x K, im2row), where a patch entry over a row of output pixels is one
-      // strided image row; the hidden maps' patches are runs of channels (K x N, im2col).
-      // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), while the
-      // chunk's patches are still in L2.
-      const float* weights = parameters_.data() + offsets_[l];
       const Eigen::Index first = b0 * layer.output().size();
+      // The first layer's chunk goes to its place in the whole batch's padded images; a hidden
+      // layer's to the start of its chunk's room.
+      const int at = l == 0 ? b0 : 0;
+      if (l == 0) {
+        pad(layer, true, images.data() + b0 * images.outerStride(), images.outerStride(), at, count,
+            padded);
+      } else {
+        pad(layer, false, activation_[l - 1].data() + b0 * layer.input().size(),
+            layer.input().size(), at, count, padded);
+      }
       kernels::Gemm product{Op::none,
                             Op::none,
                             out,
@@ -194,29 +276,16 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
                             k,
                             weights,
                             out,
-                            nullptr,  // the patches, below
+                            padded.maps.data(),
                             k,
                             weights + static_cast<Eigen::Index>(out) * k,
                             activation_[l].data() + first,
                             out};
-      if (l == 0) {
-        float* rows = patches_[0].data() + b0 * pixels;
-        const long ld = static_cast<long>(batch_) * pixels;
-        set.im2row(image_patches(layer, count, input_sample_stride_),
-                   images.data() + b0 * input_sample_stride_, rows, ld);
-        product.op_b = Op::transpose;
-        product.b = rows;
-        product.ldb = static_cast<int>(ld);
-      } else {
-        float* columns = patches_[l].data();
-        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * layer.input().size(),
-                   columns);
-        product.b = columns;
-      }
       product.epilogue = kernels::Epilogue::silu;
       product.sigmoid = sigmoid_[l].data() + first;
       product.lds = out;
-      set.gemm(product);
+      set.offset_gemm({product, padded.patch_offsets.data(),
+                       padded.pixel_offsets.data() + static_cast<long>(at) * pixels});
     }
   }
   return activation_.back();
@@ -257,13 +326,14 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
       d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
     }
     // dW (out x K) = delta patches^T and db = delta 1, the row sums of the product's A, added up
-    // while it packs delta: for the first layer from the patches^T (N x K) forward() kept, in one
-    // product; below, chunk by chunk (in the loop).
+    // while it packs delta: for the first layer in one product, its patches^T (N x K) read in
+    // place from the padded images forward() kept; below, chunk by chunk (in the loop).
     if (l == 0) {
+      const PaddedInput& padded = padded_[0];
       kernels::Gemm d_product{Op::none, Op::none,           out, k,       n,         delta.data(),
-                              out,      patches_[0].data(), n,   nullptr, d_weights, out};
+                              out,      padded.maps.data(), n,   nullptr, d_weights, out};
       d_product.a_row_sums = d_bias;
-      set.gemm(d_product);
+      set.offset_gemm({d_product, padded.pixel_offsets.data(), padded.patch_offsets.data()});
       if (!d_input) break;
     }
     // A chunk of samples at a time, so that the patches and their gradient are read from L2:
@@ -278,14 +348,14 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
       const int count = std::min(chunk, batch_ - b0);
       const float* delta_chunk = delta.data() + b0 * layer.output().size();
       if (l > 0) {
-        set.im2col(map_patches(layer, count), activation_[l - 1].data() + b0 * below,
-                   patches_[l].data());
+        PaddedInput& padded = padded_[l];
+        pad(layer, false, activation_[l - 1].data() + b0 * below, below, 0, count, padded);
         kernels::Gemm d_product{
-            Op::none, Op::transpose,      out, k,       count * pixels, delta_chunk,
-            out,      patches_[l].data(), k,   nullptr, d_weights,      out};
+            Op::none, Op::none,           out, k,       count * pixels, delta_chunk,
+            out,      padded.maps.data(), k,   nullptr, d_weights,      out};
         d_product.a_row_sums = d_bias;
         d_product.accumulate = b0 > 0;
-        set.gemm(d_product);
+        set.offset_gemm({d_product, padded.pixel_offsets.data(), padded.patch_offsets.data()});
       }
       const Eigen::Index first = b0 * below, size = count * below;
       if (l == 0) {

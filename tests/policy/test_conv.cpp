@@ -4,9 +4,9 @@
 // the weights, biases and input, with odd sizes, stride 1, 2 and 3, no padding, a kernel of 2 and
 // images with a column stride. The reference's backward is checked by central differences of
 // its forward, and the float encoder's by directional differences of its own. Each check is seen
-// failing on kernel sets with a planted fault (a mutant im2col, col2im, im2row, row2im, product
-// or SiLU'), on every target. Then the model-file record of the encoder and the typed errors of
-// bad shapes.
+// failing on kernel sets with a planted fault (a mutant product reading its patches in place,
+// col2im, row2im, input-gradient product or SiLU'), on every target. Then the model-file record of
+// the encoder and the typed errors of bad shapes.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -192,7 +192,7 @@ const std::vector<Case> kCases = {
     {"rgb-d 48 x 64", {4, 48, 64}, {{16, 3, 2, 1}, {32, 3, 2, 1}, {32, 3, 2, 1}}, 2},
     // Patches of more than half a megabyte per image: the encoder works one image at a time.
     {"chunks of one image", {4, 64, 64}, {{8, 3, 1, 1}, {8, 3, 2, 1}}, 3},
-    // A first layer of stride 3: im2row's strided copy (stride 1 copies, stride 2 deinterleaves).
+    // A first layer of stride 3 (the windows' offsets and row2im at a stride other than 1 and 2).
     {"stride 3", {2, 11, 10}, {{4, 3, 3, 1}, {5, 2, 1, 0}}, 2},
 };
 
@@ -232,14 +232,9 @@ constexpr double kTolerance = 1e-5;  // float against double, as for the Mlp (te
 // through this pointer (function pointers carry no state); the tests run on one thread.
 const kernels::KernelSet* g_base = nullptr;
 
-void im2col_stride_off_by_one(const kernels::ConvPatches& shape, const float* image, float* out) {
-  kernels::ConvPatches wrong = shape;
-  wrong.stride += 1;  // same output size: the windows walk one pixel too far per step
-  g_base->im2col(wrong, image, out);
-}
 void col2im_window_shifted(const kernels::ConvPatches& shape, const float* patches, float* image) {
   kernels::ConvPatches wrong = shape;
-  wrong.padding -= 1;  // every window one pixel down and right of where im2col read it
+  wrong.padding -= 1;  // every window one pixel down and right of where forward read it
   g_base->col2im(wrong, patches, image);
 }
 void gemm_short_k(const kernels::Gemm& problem) {
@@ -258,11 +253,23 @@ void gemm_untransposed_weights(const kernels::Gemm& problem) {
   }
   g_base->gemm(wrong);
 }
-void im2row_stride_off_by_one(const kernels::ConvPatches& shape, const float* image, float* rows,
-                              long ld) {
-  kernels::ConvPatches wrong = shape;
-  wrong.stride += 1;
-  g_base->im2row(wrong, image, rows, ld);
+void offset_gemm_patches_shifted(const kernels::OffsetGemm& problem) {
+  // Every window read one float early (one pixel, or one channel of a hidden map): B copied one
+  // float later (the reads stay inside the copy).
+  const kernels::Gemm& g = problem.product;
+  const long extent =
+      *std::max_element(problem.b_row_offsets, problem.b_row_offsets + std::max(g.k, 1)) +
+      *std::max_element(problem.b_column_offsets, problem.b_column_offsets + std::max(g.n, 1)) + 1;
+  std::vector<float> shifted(static_cast<std::size_t>(extent) + 1, 0.0f);
+  std::copy(g.b, g.b + extent, shifted.begin() + 1);
+  kernels::OffsetGemm wrong = problem;
+  wrong.product.b = shifted.data();
+  g_base->offset_gemm(wrong);
+}
+void offset_gemm_short_k(const kernels::OffsetGemm& problem) {
+  kernels::OffsetGemm wrong = problem;
+  if (wrong.product.k > 1) wrong.product.k -= 1;  // a patch entry (a pixel, for dW) left out
+  g_base->offset_gemm(wrong);
 }
 void row2im_window_shifted(const kernels::ConvPatches& shape, const float* rows, long ld,
                            float* image) {
@@ -286,13 +293,14 @@ std::vector<Mutant> mutants_of(const kernels::KernelSet& base) {
     return m;
   };
   return {
-      mutant("im2col stride off by one", true,
-             [](Set& set) { set.im2col = im2col_stride_off_by_one; }),
       mutant("col2im window shifted", false, [](Set& set) { set.col2im = col2im_window_shifted; }),
-      mutant("im2row stride off by one", true,
-             [](Set& set) { set.im2row = im2row_stride_off_by_one; }),
+      mutant("patches read one float early", true,
+             [](Set& set) { set.offset_gemm = offset_gemm_patches_shifted; }),
+      mutant("a layer's product one k term short", true,
+             [](Set& set) { set.offset_gemm = offset_gemm_short_k; }),
       mutant("row2im window shifted", false, [](Set& set) { set.row2im = row2im_window_shifted; }),
-      mutant("product one k term short", true, [](Set& set) { set.gemm = gemm_short_k; }),
+      mutant("input-gradient product one k term short", false,
+             [](Set& set) { set.gemm = gemm_short_k; }),
       mutant("input gradient through W, not W^T", false,
              [](Set& set) { set.gemm = gemm_untransposed_weights; }),
       // Last: the gradient check below takes it.

@@ -76,10 +76,11 @@ BENCHMARK_CAPTURE(product, dw_first_layer, Op::none, Op::transpose, 256, 57, kBa
                   Epilogue::none);
 
 // The image encoder's products (bench/bench_conv.cpp: 4 x 48 x 64 -> 16, 32, 32 filters of 3 x 3,
-// stride 2), at the sizes ConvEncoder runs them at batch 256: forward and W^T delta one chunk of
-// samples at a time (4, 4 and 9 samples: patches of about 512 KB), the weight gradients over the
-// whole batch. Layer 1 reads its patches transposed (im2row: op(B) = B^T); the weight gradients
-// also add up delta's rows (the bias gradients).
+// stride 2), at the sizes ConvEncoder runs them at batch 256, on stored patch matrices: forward
+// and W^T delta one chunk of samples at a time (4, 4 and 9 samples: patches of about 512 KB), the
+// weight gradients over the whole batch; the weight gradients also add up delta's rows (the bias
+// gradients). The encoder reads the patches of its forward products and weight gradients in
+// place (offset_gemm: the same tiles, broadcasts from the padded map instead of the matrix).
 constexpr int kPixels1 = 24 * 32, kPixels2 = 12 * 16, kPixels3 = 6 * 8;
 constexpr int kColumns1 = kBatch * kPixels1, kColumns2 = kBatch * kPixels2,
               kColumns3 = kBatch * kPixels3;  // a weight gradient's k

@@ -1,5 +1,7 @@
-// Private, per target: im2col and col2im, im2row and row2im (kernel_set.hpp, ConvPatches), the
-// data movement around the convolution's products; the products themselves are the GEMM driver's.
+// Private, per target: col2im and row2im (kernel_set.hpp, ConvPatches), which add a patch
+// matrix's gradient back onto the pixels its entries were read from (the input gradient of a
+// convolution). The forward products read their patches in place (OffsetGemm), so nothing
+// writes a patch matrix; the products themselves are the GEMM driver's.
 
 #include <algorithm>
 #include <cstddef>
@@ -45,31 +47,6 @@ HWY_INLINE void ForEachPatchRun(const ConvPatches& g, long sample, int oy, int o
       const long column = first + static_cast<long>(kx - kx_begin) * g.column_stride;
       for (int ch = 0; ch < c; ++ch)
         run(row_start + kx * c + ch, column + ch * g.channel_stride, 1);
-    }
-  }
-}
-
-inline void Im2col(const ConvPatches& g, const float* image, float* patches) {
-  const hn::ScalableTag<float> d;
-  const long k = static_cast<long>(g.kernel) * g.kernel * g.channels;
-  float* out = patches;
-  for (int b = 0; b < g.batch; ++b) {
-    const long sample = b * g.sample_stride;
-    for (int oy = 0; oy < g.out_height; ++oy) {
-      for (int ox = 0; ox < g.out_width; ++ox, out += k) {
-        ForEachPatchRun(
-            g, sample, oy, ox,
-            [&](int at, long pixel, int count) HWY_ATTR {
-              if (count == 1) {
-                out[at] = image[pixel];
-                return;
-              }
-              ForEachVector(d, count, [&](std::ptrdiff_t i, std::size_t n) HWY_ATTR {
-                StorePart(d, LoadPart(d, image + pixel + i, n), out + at + i, n);
-              });
-            },
-            [&](int at, int count) { std::fill(out + at, out + at + count, 0.0f); });
-      }
     }
   }
 }
@@ -135,47 +112,6 @@ HWY_INLINE void ForEachPatchLine(const ConvPatches& g, Run&& run, Pad&& padding)
       }
     }
   }
-}
-
-/// out[i] = in[2 i], i < n: the even lanes of two vectors of `in` (its last odd entry unread).
-inline void CopyEvens(const float* in, float* out, std::ptrdiff_t n) {
-#if HWY_TARGET == HWY_SCALAR
-  for (std::ptrdiff_t i = 0; i < n; ++i) out[i] = in[2 * i];
-#else
-  const hn::ScalableTag<float> d;
-  const std::ptrdiff_t lanes = static_cast<std::ptrdiff_t>(hn::Lanes(d));
-  ForEachVector(d, n, [&](std::ptrdiff_t i, std::size_t count) HWY_ATTR {
-    const std::ptrdiff_t needed = 2 * static_cast<std::ptrdiff_t>(count) - 1;  // in[2i .. )
-    const auto lo = LoadPart(d, in + 2 * i, static_cast<std::size_t>(std::min(needed, lanes)));
-    const auto hi = needed > lanes
-                        ? LoadPart(d, in + 2 * i + lanes, static_cast<std::size_t>(needed - lanes))
-                        : hn::Zero(d);
-    StorePart(d, hn::ConcatEven(d, hi, lo), out + i, count);
-  });
-#endif
-}
-
-inline void Im2row(const ConvPatches& g, const float* image, float* rows, long ld) {
-  const hn::ScalableTag<float> d;
-  const long step = g.stride * g.column_stride;
-  ForEachPatchLine(
-      g,
-      [&](long p, long j, long pixel, int count) HWY_ATTR {
-        const float* in = image + pixel;
-        float* out = rows + j + p * ld;
-        if (step == 1) {
-          ForEachVector(d, count, [&](std::ptrdiff_t i, std::size_t n) HWY_ATTR {
-            StorePart(d, LoadPart(d, in + i, n), out + i, n);
-          });
-        } else if (step == 2) {
-          CopyEvens(in, out, count);
-        } else {
-          for (int i = 0; i < count; ++i) out[i] = in[i * step];
-        }
-      },
-      [&](long p, long j, int count) {
-        std::fill(rows + j + p * ld, rows + j + p * ld + count, 0.0f);
-      });
 }
 
 // Only the input gradient of a first layer runs it (training does not): a plain loop.

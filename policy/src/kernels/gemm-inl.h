@@ -160,8 +160,33 @@ struct GemmKernelOf {
   template <BLayout layout>
   static void tile(int kc, const float* a, const float* b, int ldb, float* c, int ldc,
                    bool accumulate, const float* bias) {
-    const Tag d;
     hn::Vec<Tag> acc[NR][V];
+    multiply(kc, a, acc, [&](int p, int j) HWY_ATTR {
+      return layout == BLayout::columns ? b[p + j * static_cast<long>(ldb)]
+             : layout == BLayout::rows  ? b[static_cast<long>(p) * ldb + j]
+                                        : b[p * NR + j];
+    });
+    store_tile(acc, c, ldc, accumulate, bias);
+  }
+
+  // tile() on a block of op(B) read in place through offsets (gemm.hpp, offset_gemm):
+  // op(B)(p, j) = b[p_offsets[p] + j_offsets[j]], the same multiply-adds in the same order.
+  static void offset_tile(int kc, const float* a, const float* b, const long* p_offsets,
+                          const long* j_offsets, float* c, int ldc, bool accumulate,
+                          const float* bias) {
+    const float* column[NR];
+#pragma GCC unroll 32
+    for (int j = 0; j < NR; ++j) column[j] = b + j_offsets[j];
+    hn::Vec<Tag> acc[NR][V];
+    multiply(kc, a, acc, [&](int p, int j) HWY_ATTR { return column[j][p_offsets[p]]; });
+    store_tile(acc, c, ldc, accumulate, bias);
+  }
+
+  // acc = the packed A panel (MR x kc) times op(B)'s block, b_at(p, j) = op(B)(p, j) (kc x NR):
+  // each entry one chain of multiply-adds from zero, in the order of p.
+  template <class BAt>
+  static HWY_INLINE void multiply(int kc, const float* a, hn::Vec<Tag> (&acc)[NR][V], BAt&& b_at) {
+    const Tag d;
 #pragma GCC unroll 32
     for (int j = 0; j < NR; ++j) {
 #pragma GCC unroll 2
@@ -174,14 +199,18 @@ struct GemmKernelOf {
       hwy::Prefetch(a + 8 * MR);
 #pragma GCC unroll 32
       for (int j = 0; j < NR; ++j) {
-        const auto bj =
-            hn::Set(d, layout == BLayout::columns ? b[j * static_cast<long>(ldb)] : b[j]);
+        const auto bj = hn::Set(d, b_at(p, j));
 #pragma GCC unroll 2
         for (int v = 0; v < V; ++v) acc[j][v] = hn::MulAdd(a_v[v], bj, acc[j][v]);
       }
       a += MR;
-      b += layout == BLayout::packed ? NR : layout == BLayout::rows ? ldb : 1;
     }
+  }
+
+  // C = acc + bias (or + 0), or C += acc: the end of every tile.
+  static HWY_INLINE void store_tile(const hn::Vec<Tag> (&acc)[NR][V], float* c, int ldc,
+                                    bool accumulate, const float* bias) {
+    const Tag d;
     hn::Vec<Tag> add[V];
 #pragma GCC unroll 2
     for (int v = 0; v < V; ++v) {

@@ -14,6 +14,7 @@
 #include <memory>
 #include <new>
 #include <utility>
+#include <vector>
 
 #include "kernel_set.hpp"
 
@@ -103,19 +104,68 @@ struct Blocking {
   static_assert((MC + NC) * KC * sizeof(float) <= kL2Bytes, "the A block and the B block share L2");
 };
 
+/// op(B) as a matrix in memory (Gemm::b, ldb, op_b), for blocked_nest: a last partial panel
+/// packed by pack_b (`pack`, into `packed`, zero padded), a full one read in place by the
+/// kernel's tile.
+struct MatrixB {
+  const Gemm& g;
+  template <int NR>
+  void pack(int p0, int kc, int j, int cols, float* packed) const {
+    pack_b<NR>(g.op_b, g.b, g.ldb, p0, kc, j, cols, packed);
+  }
+  template <typename Kernel>
+  void tile(int kc, const float* a_panel, int p0, long j, int cols, const float* packed, float* c,
+            int ldc, bool accumulate, const float* bias) const {
+    if (cols < Kernel::NR) {
+      Kernel::template tile<BLayout::packed>(kc, a_panel, packed, Kernel::NR, c, ldc, accumulate,
+                                             bias);
+    } else if (g.op_b == Op::none) {
+      Kernel::template tile<BLayout::columns>(kc, a_panel, g.b + p0 + j * g.ldb, g.ldb, c, ldc,
+                                              accumulate, bias);
+    } else {
+      Kernel::template tile<BLayout::rows>(kc, a_panel, g.b + j + static_cast<long>(p0) * g.ldb,
+                                           g.ldb, c, ldc, accumulate, bias);
+    }
+  }
+};
+
+/// op(B) read through offsets (OffsetGemm), for blocked_nest: op(B)(p, j) =
+/// b[row_offsets[p] + column_offsets[j]], every panel in place; a partial one repeats its last
+/// column into the tile's spare columns (each column of C is its own sum, and the edge tile keeps
+/// only the valid ones), so nothing is packed.
+struct OffsetB {
+  const float* b;
+  const long* row_offsets;
+  const long* column_offsets;
+  template <int NR>
+  void pack(int, int, int, int, float*) const {}
+  template <typename Kernel>
+  void tile(int kc, const float* a_panel, int p0, long j, int cols, const float*, float* c, int ldc,
+            bool accumulate, const float* bias) const {
+    const long* columns = column_offsets + j;
+    long edge[Kernel::NR];
+    if (cols < Kernel::NR) {
+      for (int jj = 0; jj < Kernel::NR; ++jj) edge[jj] = columns[std::min(jj, cols - 1)];
+      columns = edge;
+    }
+    Kernel::offset_tile(kc, a_panel, b, row_offsets + p0, columns, c, ldc, accumulate, bias);
+  }
+};
+
 /// The blocked loop nest shared by the targets (the BLIS order: columns of C, then k, then rows).
 /// A block of MC x KC of op(A) is packed (it stays in L2 and streams through the micro-kernel);
-/// op(B) is read in place, NR columns at a time (a k x NR block is reused from L1 by every row
-/// panel), except a last partial panel, which is packed with zero padding.
+/// op(B) is read in place (`source`: MatrixB or OffsetB), NR columns at a time (a k x NR block is
+/// reused from L1 by every row panel); a last partial panel as the source says.
 /// Kernel::kSilu (SiluFunctions) applies Gemm::epilogue to each finished block.
 /// Kernel::pack_a has pack_a<MR>'s contract (it may be a faster vector version) and one more
 /// argument, `row_sums` (null, or with op(A) = A the mc sums of the block's rows, to which it adds
 /// the block's kc entries of each row in order).
 /// Kernel::tile<BLayout>(kc, a_panel, b, ldb, c, ldc, accumulate, bias) writes a full MR x NR
-/// tile of C: C = A B (+ bias, an MR-float pointer or null) or, when accumulate, C += A B.
+/// tile of C: C = A B (+ bias, an MR-float pointer or null) or, when accumulate, C += A B;
+/// Kernel::offset_tile the same from op(B) read through offsets.
 /// The first k block writes C (plus the bias), later ones add to it.
-template <typename Kernel>
-void blocked_gemm(const Gemm& g) {
+template <typename Kernel, typename Source>
+void blocked_nest(const Gemm& g, const Source& source) {
   constexpr int MR = Kernel::MR, NR = Kernel::NR;
   constexpr int KC = Blocking::KC, MC = Blocking::MC, NC = Blocking::NC;
   static_assert(static_cast<std::size_t>(KC) * (MR + NR) * sizeof(float) <= 2 * Blocking::kL1Bytes,
@@ -134,7 +184,9 @@ void blocked_gemm(const Gemm& g) {
     for (int p0 = 0; p0 < g.k; p0 += KC) {
       const int kc = std::min(KC, g.k - p0);
       const bool accumulate = p0 > 0 || g.accumulate;
-      if (full < nc) pack_b<NR>(g.op_b, g.b, g.ldb, p0, kc, j0 + full, nc - full, buffers.b.data());
+      if (full < nc) {
+        source.template pack<NR>(p0, kc, j0 + full, nc - full, buffers.b.data());
+      }
       for (int i0 = 0; i0 < g.m; i0 += MC) {
         const int mc = std::min(MC, g.m - i0);
         float* row_sums = j0 == 0 && g.a_row_sums != nullptr ? g.a_row_sums + i0 : nullptr;
@@ -142,8 +194,6 @@ void blocked_gemm(const Gemm& g) {
         for (int jr = 0; jr < nc; jr += NR) {
           const int cols = std::min(NR, nc - jr);
           const long j = j0 + jr;
-          const float* b_in_place =
-              g.op_b == Op::none ? g.b + p0 + j * g.ldb : g.b + j + static_cast<long>(p0) * g.ldb;
           for (int ir = 0; ir < mc; ir += MR) {
             const int rows = std::min(MR, mc - ir);
             const float* a_panel = buffers.a.data() + static_cast<long>(ir / MR) * kc * MR;
@@ -168,16 +218,8 @@ void blocked_gemm(const Gemm& g) {
                   std::copy(c + jj * g.ldc, c + jj * g.ldc + rows, tile + jj * MR);
               }
             }
-            if (cols < NR) {
-              Kernel::template tile<BLayout::packed>(kc, a_panel, buffers.b.data(), NR, target,
-                                                     ld_target, accumulate, bias);
-            } else if (g.op_b == Op::none) {
-              Kernel::template tile<BLayout::columns>(kc, a_panel, b_in_place, g.ldb, target,
-                                                      ld_target, accumulate, bias);
-            } else {
-              Kernel::template tile<BLayout::rows>(kc, a_panel, b_in_place, g.ldb, target,
-                                                   ld_target, accumulate, bias);
-            }
+            source.template tile<Kernel>(kc, a_panel, p0, j, cols, buffers.b.data(), target,
+                                         ld_target, accumulate, bias);
             if (target == tile) {
               for (int jj = 0; jj < cols; ++jj)
                 std::copy(tile + jj * MR, tile + jj * MR + rows, c + jj * g.ldc);
@@ -190,6 +232,12 @@ void blocked_gemm(const Gemm& g) {
       }
     }
   }
+}
+
+/// The blocked product of a matrix op(B).
+template <typename Kernel>
+void blocked_gemm(const Gemm& g) {
+  blocked_nest<Kernel>(g, MatrixB{g});
 }
 
 // Narrow products (n <= kNarrowMax columns: batch-1 sampling is n = 1, the C8 average n = 8).
@@ -295,6 +343,39 @@ void vector_gemm(const Gemm& g) {
   } else {
     blocked_gemm<Kernel>(g);
   }
+}
+
+/// KernelSet::offset_gemm of a vector set: the blocked nest reading op(B) through the offsets
+/// wherever vector_gemm would run the blocked nest on it (n > kNarrowMax, row sums only with
+/// op(A) = A); elsewhere (the narrow and degenerate products) op(B) gathered into a matrix for
+/// vector_gemm. Either way C has the bits vector_gemm gives on that matrix.
+template <typename Kernel, typename ShortKernel, typename HalfKernel = ShortKernel>
+void vector_offset_gemm(const OffsetGemm& problem) {
+  const Gemm& g = problem.product;
+  if (g.m > 0 && g.n > kNarrowMax && g.k > 0 && (g.a_row_sums == nullptr || g.op_a == Op::none)) {
+    const OffsetB source{g.b, problem.b_row_offsets, problem.b_column_offsets};
+    if (HalfKernel::MR < ShortKernel::MR && g.m <= HalfKernel::MR) {
+      blocked_nest<HalfKernel>(g, source);
+    } else if (g.m <= ShortKernel::MR) {
+      blocked_nest<ShortKernel>(g, source);
+    } else {
+      blocked_nest<Kernel>(g, source);
+    }
+    return;
+  }
+  const int k = std::max(g.k, 0), n = std::max(g.n, 0);
+  std::vector<float> matrix(static_cast<std::size_t>(k) * n);
+  for (int j = 0; j < n; ++j) {
+    for (int p = 0; p < k; ++p) {
+      matrix[p + static_cast<std::size_t>(j) * k] =
+          g.b[problem.b_row_offsets[p] + problem.b_column_offsets[j]];
+    }
+  }
+  Gemm gathered = g;
+  gathered.op_b = Op::none;
+  gathered.b = matrix.data();
+  gathered.ldb = std::max(k, 1);
+  vector_gemm<Kernel, ShortKernel, HalfKernel>(gathered);
 }
 
 }  // namespace handcentric::policy::kernels

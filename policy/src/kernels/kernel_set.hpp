@@ -55,6 +55,18 @@ struct Gemm {
   bool accumulate = false;
 };
 
+/// A product whose op(B) is read in place through offsets: op(B)(p, j) =
+/// product.b[b_row_offsets[p] + b_column_offsets[j]] (k row offsets, n column offsets;
+/// product.op_b and ldb are not used). A convolution's patch matrix is such an op(B) over a
+/// zero-padded image (an implicit im2col), so the layer needs no patch matrix. The rest is
+/// Gemm's contract, and C (with its epilogue and row sums) gets the bits gemm gives on that op(B)
+/// stored as a matrix.
+struct OffsetGemm {
+  Gemm product;
+  const long* b_row_offsets = nullptr;
+  const long* b_column_offsets = nullptr;
+};
+
 /// The k block of the blocked products (gemm.hpp, Blocking::KC).
 constexpr int kProductKBlock = 256;
 
@@ -116,6 +128,8 @@ struct ConvPatches {
 /// One target's kernels. SiLU(z) = z s with s = sigmoid(z) = 1 / (1 + exp(-z)).
 struct KernelSet {
   void (*gemm)(const Gemm& problem);
+  /// gemm with op(B) read through offsets (OffsetGemm), the same bits.
+  void (*offset_gemm)(const OffsetGemm& problem);
   /// s = sigmoid(z), a = z s over n values (training: s is kept for the backward pass); a may be z.
   void (*silu_forward)(std::ptrdiff_t n, const float* z, float* s, float* a);
   /// delta *= SiLU'(z) over n values, from s = sigmoid(z) and a = SiLU(z) = z s:
@@ -126,19 +140,13 @@ struct KernelSet {
   /// sum of g_i^2, in double.
   double (*squared_norm)(std::ptrdiff_t n, const float* g);
   void (*adam)(const AdamUpdate& update);
-  /// im2col: the K x N patch matrix (ConvPatches) of `image` into `patches` (ld K).
-  void (*im2col)(const ConvPatches& shape, const float* image, float* patches);
-  /// col2im, im2col's adjoint: adds each entry of the K x N `patches` to the pixel it was read
-  /// from (entries of the padding are dropped). `image` is accumulated into, not cleared.
+  /// col2im: adds each entry of the K x N patch matrix (ConvPatches) `patches` (ld K) to the pixel
+  /// it was read from (entries of the padding are dropped). `image` is accumulated into, not
+  /// cleared. The adjoint of reading the patches (an input gradient).
   void (*col2im)(const ConvPatches& shape, const float* patches, float* image);
-  /// im2row: the patch matrix transposed, N x K with leading dimension `ld` >= N: entry (pixel j,
-  /// patch entry p) at rows[j + p ld], for a product that reads it as op(B) = B^T. A patch entry
-  /// over a row of output pixels reads one image row at the stride, which vector moves copy
-  /// (stride 1) or deinterleave (stride 2) where the columns are contiguous (column_stride 1: the
-  /// encoder's (channels, height, width) input, whose im2col would copy one float at a time).
-  void (*im2row)(const ConvPatches& shape, const float* image, float* rows, long ld);
-  /// row2im, im2row's adjoint: adds each entry of the N x K `rows` (ld) to the pixel it was read
-  /// from (padding dropped); `image` is accumulated into.
+  /// row2im: the same for the patch matrix transposed, N x K with leading dimension `ld` >= N
+  /// (entry (pixel j, patch entry p) at rows[j + p ld]), as the first layer's input gradient
+  /// delta^T W comes out of its product.
   void (*row2im)(const ConvPatches& shape, const float* rows, long ld, float* image);
   /// Box-Muller's pairs (box_muller.hpp) with glibc's logf, cosf and sinf transcribed in double
   /// lanes (box_muller-inl.h) on AVX2 and AVX-512; libm itself (box_muller_pairs_libm) on the

@@ -39,14 +39,13 @@ constexpr auto* kBoxMullerParts = &box_muller_parts_libm;
 
 const KernelSet* TargetKernels() {
   static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>,
+                                  vector_offset_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>,
                                   SiluForward,
                                   SiluBackward,
                                   SiluInPlace,
                                   SquaredNorm,
                                   Adam,
-                                  Im2col,
                                   Col2im,
-                                  Im2row,
                                   Row2im,
                                   kBoxMullerPairs,
                                   kBoxMullerParts,

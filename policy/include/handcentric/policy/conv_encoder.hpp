@@ -10,11 +10,12 @@
 // (y out_width + x) out_channels + c.
 // All parameters live in one flat vector (W_1, b_1, W_2, b_2, ...), as the MLP keeps them
 // (conv2d.hpp gives a layer's layout), so that Adam, clipping and model files see one array.
-// float32 on the run-time dispatched kernels (kernels.hpp): im2col (the first layer, which reads
-// the (channels, height, width) input: im2row, its transpose), then one product per layer with
-// the bias and SiLU in its epilogue; backward the two products of the gradients and col2im.
-// Below the first layer, patches live only one L2-sized chunk of samples at a time: backward
-// makes them again from the map below rather than reading a whole batch's back from memory.
+// float32 on the run-time dispatched kernels (kernels.hpp): one product per layer with the bias
+// and SiLU in its epilogue, reading its patches in place from the zero-padded input (an
+// implicit im2col, kernels::OffsetGemm: no patch matrix is written); backward the two products
+// of the gradients and col2im (row2im for the first layer's input).
+// Below the first layer, the padded maps live only one L2-sized chunk of samples at a time:
+// backward pads them again from the map below rather than keeping a whole batch's.
 #include <Eigen/Core>
 #include <random>
 #include <vector>
@@ -28,6 +29,14 @@ class ByteWriter;
 namespace kernels {
 struct KernelSet;
 }
+
+/// A layer's input with its zero padding, and where each patch entry of each output pixel is
+/// in it: the patch matrix, read in place by the layer's products (kernels::OffsetGemm).
+struct PaddedInput {
+  Eigen::VectorXf maps;  ///< room for `samples` padded samples, whose borders are zero
+  int samples = 0;
+  std::vector<long> patch_offsets, pixel_offsets;
+};
 
 /// One layer of a ConvEncoder (the input channels come from the layer before).
 struct ConvLayerSpec {
@@ -105,15 +114,16 @@ class ConvEncoder {
   Vector parameters_;
   Vector gradient_;
   int batch_ = 0;  ///< of the last forward()
-  /// the first layer's patch matrix of the last forward(), N x K (im2row), kept for backward();
-  /// a hidden layer's, K x N, for one chunk of samples at a time (forward and backward make it)
-  std::vector<Vector> patches_;
+  /// Each layer's input with its zero padding and the offsets of its patches in it
+  /// (conv_encoder.cpp, reserve_padded and pad): the first layer's for the last forward()'s
+  /// whole batch, kept for backward(); a hidden layer's for one chunk of samples at a time
+  /// (forward and backward pad it). The buffers only grow, so their borders are zeroed once.
+  std::vector<PaddedInput> padded_;
   std::vector<Matrix> sigmoid_;     ///< sigmoid(z) of each layer (out size x B)
   std::vector<Matrix> activation_;  ///< SiLU(z) of each layer; the last one is the features
   std::vector<Matrix> delta_;  ///< d loss / d (each layer's output), kept: no reallocation per step
   Vector d_patches_;
   Matrix d_images_;
-  long input_sample_stride_ = 0;  ///< of the images of the last forward()
 };
 
 }  // namespace handcentric::policy
