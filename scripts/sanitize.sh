@@ -69,7 +69,8 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^conventions_committed_table_is_up_to_date|^mutant_conventions_a_changed_formula|'\
 '^policy_exec_audits_a_plugin_on_recorded_observations|'\
 '^a_batched_policy_audit_is_the_unbatched_one_bit|^a_map_whose_answer_depends_on_its_batch|'\
-'^a_batched_exec_audit_gives_the_unbatched_json|^a_batched_policy_exec_audit_gives_the_unbatched'
+'^a_batched_exec_audit_gives_the_unbatched_json|^a_batched_policy_exec_audit_gives_the_unbatched|'\
+'^table1_cli_writes_the_table_beside_the_papers|^table2_cli_image_rows_beside_the_key_point_rows'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 
