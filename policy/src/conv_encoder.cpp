@@ -165,22 +165,6 @@ void pad(const Conv2d& layer, bool channels_first, const float* source, long sou
   }
 }
 
-// Samples per pass of the depth-first forward and backward: a multiple of every layer's unit,
-// the samples whose pixels are a multiple of the products' k block (so that the weight gradients
-// summed pass by pass and chunk by chunk are one product's sums, bit for bit), about 64: the
-// default encoder's pass of 64 images keeps each layer's maps (1.5 MB at its first layer) in
-// cache for the next.
-int samples_per_pass(const std::vector<Conv2d>& layers) {
-  constexpr int kSamples = 64;
-  long unit = 1;
-  for (const Conv2d& layer : layers) {
-    const int pixels = layer.output().height * layer.output().width;
-    unit = std::lcm(unit, static_cast<long>(kernels::kProductKBlock /
-                                            std::gcd(pixels, kernels::kProductKBlock)));
-  }
-  return static_cast<int>(unit * std::max<long>(1, kSamples / unit));
-}
-
 }  // namespace
 
 ConvEncoder::ConvEncoder(const ConvEncoder& other)
@@ -259,65 +243,52 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
   batch_ = static_cast<int>(batch);
   for (std::size_t l = 0; l < layers_.size(); ++l) {
     const Conv2d& layer = layers_[l];
+    const int pixels = layer.output().height * layer.output().width;
+    const int k = layer.patch_size(), out = layer.out_channels();
+    const float* weights = parameters_.data() + offsets_[l];
     activation_[l].resize(layer.output().size(), batch);
     sigmoid_[l].resize(layer.output().size(), batch);
-    reserve_padded(layer, l == 0,
-                   l == 0 ? batch_ : std::min(samples_per_chunk(layer, false), batch_), padded_[l]);
-  }
-  // Depth first: every layer on one pass of samples before the next pass, so that a layer reads
-  // the map the layer above just wrote from cache.
-  const int pass = samples_per_pass(layers_);
-  for (int s0 = 0; s0 < batch_; s0 += pass) {
-    for (std::size_t l = 0; l < layers_.size(); ++l) {
-      forward_layer(static_cast<int>(l), s0, std::min(batch_, s0 + pass), images, set);
+    // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), the patches read in
+    // place from the padded input, one chunk of samples at a time, padded and multiplied while
+    // it is in L2. The first layer keeps the whole batch's padded images for backward (which
+    // does not see the images); a hidden layer's chunk is padded again by backward from the map
+    // below.
+    const int chunk = samples_per_chunk(layer, l == 0);
+    PaddedInput& padded = padded_[l];
+    reserve_padded(layer, l == 0, l == 0 ? batch_ : std::min(chunk, batch_), padded);
+    for (int b0 = 0; b0 < batch_; b0 += chunk) {
+      const int count = std::min(chunk, batch_ - b0);
+      const Eigen::Index first = b0 * layer.output().size();
+      // The first layer's chunk goes to its place in the whole batch's padded images; a hidden
+      // layer's to the start of its chunk's room.
+      const int at = l == 0 ? b0 : 0;
+      if (l == 0) {
+        pad(layer, true, images.data() + b0 * images.outerStride(), images.outerStride(), at, count,
+            padded);
+      } else {
+        pad(layer, false, activation_[l - 1].data() + b0 * layer.input().size(),
+            layer.input().size(), at, count, padded);
+      }
+      kernels::Gemm product{Op::none,
+                            Op::none,
+                            out,
+                            count * pixels,
+                            k,
+                            weights,
+                            out,
+                            padded.maps.data(),
+                            k,
+                            weights + static_cast<Eigen::Index>(out) * k,
+                            activation_[l].data() + first,
+                            out};
+      product.epilogue = kernels::Epilogue::silu;
+      product.sigmoid = sigmoid_[l].data() + first;
+      product.lds = out;
+      set.offset_gemm({product, padded.patch_offsets.data(),
+                       padded.pixel_offsets.data() + static_cast<long>(at) * pixels});
     }
   }
   return activation_.back();
-}
-
-void ConvEncoder::forward_layer(int l, int s0, int s1, const Eigen::Ref<const Matrix>& images,
-                                const kernels::KernelSet& set) {
-  const Conv2d& layer = layers_[l];
-  const int pixels = layer.output().height * layer.output().width;
-  const int k = layer.patch_size(), out = layer.out_channels();
-  const float* weights = parameters_.data() + offsets_[l];
-  // a (out x N) = SiLU(W patches + b 1^T), sigmoid(z) kept for backward(), the patches read in
-  // place from the padded input, one chunk of samples at a time, padded and multiplied while it
-  // is in L2. The first layer keeps the whole batch's padded images for backward (which does not
-  // see the images); a hidden layer's chunk is padded again by backward from the map below.
-  const int chunk = samples_per_chunk(layer, l == 0);
-  PaddedInput& padded = padded_[l];
-  for (int b0 = s0; b0 < s1; b0 += chunk) {
-    const int count = std::min(chunk, s1 - b0);
-    const Eigen::Index first = b0 * layer.output().size();
-    // The first layer's chunk goes to its place in the whole batch's padded images; a hidden
-    // layer's to the start of its chunk's room.
-    const int at = l == 0 ? b0 : 0;
-    if (l == 0) {
-      pad(layer, true, images.data() + b0 * images.outerStride(), images.outerStride(), at, count,
-          padded);
-    } else {
-      pad(layer, false, activation_[l - 1].data() + b0 * layer.input().size(), layer.input().size(),
-          at, count, padded);
-    }
-    kernels::Gemm product{Op::none,
-                          Op::none,
-                          out,
-                          count * pixels,
-                          k,
-                          weights,
-                          out,
-                          padded.maps.data(),
-                          k,
-                          weights + static_cast<Eigen::Index>(out) * k,
-                          activation_[l].data() + first,
-                          out};
-    product.epilogue = kernels::Epilogue::silu;
-    product.sigmoid = sigmoid_[l].data() + first;
-    product.lds = out;
-    set.offset_gemm({product, padded.patch_offsets.data(),
-                     padded.pixel_offsets.data() + static_cast<long>(at) * pixels});
-  }
 }
 
 const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>& d_features,
@@ -333,95 +304,79 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
   }
   delta_.back() = d_features;
   // Through the last layer's SiLU: delta *= SiLU'(z) = s + a (1 - s). The layers below get
-  // theirs chunk by chunk, right after col2im completes their delta (backward_layer).
+  // theirs chunk by chunk, right after col2im completes their delta (below).
   set.silu_backward(delta_.back().size(), activation_.back().data(), sigmoid_.back().data(),
                     delta_.back().data());
-  for (std::size_t l = 0; l < layers_.size(); ++l) {
-    if (l > 0 || input_gradient) {
-      (l == 0 ? d_images_ : delta_[l - 1]).resize(layers_[l].input().size(), batch_);
+  for (int l = static_cast<int>(layers_.size()) - 1; l >= 0; --l) {
+    const Conv2d& layer = layers_[l];
+    const int n = batch_ * layer.output().height * layer.output().width;
+    const int k = layer.patch_size(), out = layer.out_channels();
+    const Matrix& delta = delta_[l];
+    float* d_weights = gradient_.data() + offsets_[l];
+    float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
+    const int pixels = layer.output().height * layer.output().width;
+    const int chunk = samples_per_chunk(layer, l == 0);
+    const bool d_input = l > 0 || input_gradient;
+    const Eigen::Index below = layer.input().size();
+    float* target = nullptr;
+    if (d_input) {
+      Matrix& d_below = l == 0 ? d_images_ : delta_[l - 1];
+      d_below.resize(below, batch_);
+      target = d_below.data();
+      d_patches_.resize(static_cast<Eigen::Index>(k) * pixels * std::min(chunk, batch_));
     }
-  }
-  // Depth first, as forward(): each pass of samples through every layer, top down. The weight
-  // gradients add up the passes in order, each a multiple of the products' k block in every
-  // layer (samples_per_pass), so they are the sums of one product over the batch, bit for bit.
-  const int pass = samples_per_pass(layers_);
-  for (int s0 = 0; s0 < batch_; s0 += pass) {
-    for (int l = static_cast<int>(layers_.size()) - 1; l >= 0; --l) {
-      backward_layer(l, s0, std::min(batch_, s0 + pass), set, l > 0 || input_gradient);
+    // dW (out x K) = delta patches^T and db = delta 1, the row sums of the product's A, added up
+    // while it packs delta: for the first layer in one product, its patches^T (N x K) read in
+    // place from the padded images forward() kept; below, chunk by chunk (in the loop).
+    if (l == 0) {
+      const PaddedInput& padded = padded_[0];
+      kernels::Gemm d_product{Op::none, Op::none,           out, k,       n,         delta.data(),
+                              out,      padded.maps.data(), n,   nullptr, d_weights, out};
+      d_product.a_row_sums = d_bias;
+      set.offset_gemm({d_product, padded.pixel_offsets.data(), padded.patch_offsets.data()});
+      if (!d_input) break;
+    }
+    // A chunk of samples at a time, so that the patches and their gradient are read from L2:
+    // below the first layer, the chunk's patches again from the map below, dW += delta
+    // patches^T and db += delta 1 (a chunk's pixels are a multiple of the products' k block, so
+    // these are the sums of one product over the batch, bit for bit); then d patches (K x N) =
+    // W^T delta, each entry back to the pixel it was read from. A chunk's pixels receive only its
+    // own patches, so after its col2im they are complete: the chunk is zeroed just before (in
+    // cache, not a pass over the whole map) and, below the first layer, multiplied by the layer
+    // below's SiLU' just after.
+    for (int b0 = 0; b0 < batch_; b0 += chunk) {
+      const int count = std::min(chunk, batch_ - b0);
+      const float* delta_chunk = delta.data() + b0 * layer.output().size();
+      if (l > 0) {
+        PaddedInput& padded = padded_[l];
+        pad(layer, false, activation_[l - 1].data() + b0 * below, below, 0, count, padded);
+        kernels::Gemm d_product{
+            Op::none, Op::none,           out, k,       count * pixels, delta_chunk,
+            out,      padded.maps.data(), k,   nullptr, d_weights,      out};
+        d_product.a_row_sums = d_bias;
+        d_product.accumulate = b0 > 0;
+        set.offset_gemm({d_product, padded.pixel_offsets.data(), padded.patch_offsets.data()});
+      }
+      const Eigen::Index first = b0 * below, size = count * below;
+      if (l == 0) {
+        // d patches^T (N x K) = delta^T W, back onto the image rows by row2im.
+        set.gemm({Op::transpose, Op::none, count * pixels, k, out, delta_chunk, out,
+                  parameters_.data() + offsets_[l], out, nullptr, d_patches_.data(),
+                  count * pixels});
+        std::fill(target + first, target + first + size, 0.0f);
+        set.row2im(image_patches(layer, count, input_size()), d_patches_.data(), count * pixels,
+                   target + first);
+      } else {
+        set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
+                  out, delta_chunk, out, nullptr, d_patches_.data(), k});
+        std::fill(target + first, target + first + size, 0.0f);
+        set.col2im(map_patches(layer, count), d_patches_.data(), target + first);
+        set.silu_backward(size, activation_[l - 1].data() + first, sigmoid_[l - 1].data() + first,
+                          target + first);
+      }
     }
   }
   return d_images_;
-}
-
-void ConvEncoder::backward_layer(int l, int s0, int s1, const kernels::KernelSet& set,
-                                 bool d_input) {
-  const Conv2d& layer = layers_[l];
-  const int k = layer.patch_size(), out = layer.out_channels();
-  const Matrix& delta = delta_[l];
-  float* d_weights = gradient_.data() + offsets_[l];
-  float* d_bias = d_weights + static_cast<Eigen::Index>(out) * k;
-  const int pixels = layer.output().height * layer.output().width;
-  const int chunk = samples_per_chunk(layer, l == 0);
-  const Eigen::Index below = layer.input().size();
-  float* target = nullptr;
-  if (d_input) {
-    target = (l == 0 ? d_images_ : delta_[l - 1]).data();
-    d_patches_.resize(std::max<Eigen::Index>(
-        d_patches_.size(), static_cast<Eigen::Index>(k) * pixels * std::min(chunk, s1 - s0)));
-  }
-  // dW (out x K) = delta patches^T and db = delta 1, the row sums of the product's A, added up
-  // while it packs delta, the patches^T (N x K) read in place: for the first layer from the
-  // padded images forward() kept, the pass in one product; below, chunk by chunk (in the loop),
-  // padded again from the map below.
-  if (l == 0) {
-    const PaddedInput& padded = padded_[0];
-    kernels::Gemm d_product{Op::none, Op::none,           out,
-                            k,        (s1 - s0) * pixels, delta.data() + s0 * layer.output().size(),
-                            out,      padded.maps.data(), 0,
-                            nullptr,  d_weights,          out};
-    d_product.a_row_sums = d_bias;
-    d_product.accumulate = s0 > 0;
-    set.offset_gemm({d_product, padded.pixel_offsets.data() + static_cast<long>(s0) * pixels,
-                     padded.patch_offsets.data()});
-    if (!d_input) return;
-  }
-  // A chunk of samples at a time, so that the patches and their gradient are read from L2:
-  // below the first layer, dW += delta patches^T and db += delta 1 (a chunk's pixels are a
-  // multiple of the products' k block, so these too are the sums of one product over the
-  // batch); then d patches (K x N) = W^T delta, each entry back to the pixel it was read from. A
-  // chunk's pixels receive only its own patches, so after its col2im they are complete: the
-  // chunk is zeroed just before (in cache, not a pass over the whole map) and, below the first
-  // layer, multiplied by the layer below's SiLU' just after.
-  for (int b0 = s0; b0 < s1; b0 += chunk) {
-    const int count = std::min(chunk, s1 - b0);
-    const float* delta_chunk = delta.data() + b0 * layer.output().size();
-    if (l > 0) {
-      PaddedInput& padded = padded_[l];
-      pad(layer, false, activation_[l - 1].data() + b0 * below, below, 0, count, padded);
-      kernels::Gemm d_product{
-          Op::none, Op::none,           out, k,       count * pixels, delta_chunk,
-          out,      padded.maps.data(), 0,   nullptr, d_weights,      out};
-      d_product.a_row_sums = d_bias;
-      d_product.accumulate = b0 > 0;
-      set.offset_gemm({d_product, padded.pixel_offsets.data(), padded.patch_offsets.data()});
-    }
-    const Eigen::Index first = b0 * below, size = count * below;
-    if (l == 0) {
-      // d patches^T (N x K) = delta^T W, back onto the image rows by row2im.
-      set.gemm({Op::transpose, Op::none, count * pixels, k, out, delta_chunk, out,
-                parameters_.data() + offsets_[l], out, nullptr, d_patches_.data(), count * pixels});
-      std::fill(target + first, target + first + size, 0.0f);
-      set.row2im(image_patches(layer, count, input_size()), d_patches_.data(), count * pixels,
-                 target + first);
-    } else {
-      set.gemm({Op::transpose, Op::none, k, count * pixels, out, parameters_.data() + offsets_[l],
-                out, delta_chunk, out, nullptr, d_patches_.data(), k});
-      std::fill(target + first, target + first + size, 0.0f);
-      set.col2im(map_patches(layer, count), d_patches_.data(), target + first);
-      set.silu_backward(size, activation_[l - 1].data() + first, sigmoid_[l - 1].data() + first,
-                        target + first);
-    }
-  }
 }
 
 void ConvEncoder::write(ByteWriter& out) const {

@@ -194,9 +194,6 @@ const std::vector<Case> kCases = {
     {"chunks of one image", {4, 64, 64}, {{8, 3, 1, 1}, {8, 3, 2, 1}}, 3},
     // A first layer of stride 3 (the windows' offsets and row2im at a stride other than 1 and 2).
     {"stride 3", {2, 11, 10}, {{4, 3, 3, 1}, {5, 2, 1, 0}}, 2},
-    // 70 images: a pass of 64 (its second layer's 4 pixels make 256, the products' k block, in
-    // 64 images), then one of 6.
-    {"two passes of samples", {1, 8, 8}, {{4, 3, 2, 1}, {3, 3, 2, 1}}, 70},
 };
 
 // The results of one encoder run: features, parameter gradient, image gradient.

@@ -109,11 +109,6 @@ class ConvEncoder {
   static ConvEncoder read(ByteReader& in);
 
  private:
-  /// Layer l's forward (backward) on samples [s0, s1) of the batch (a pass, conv_encoder.cpp).
-  void forward_layer(int l, int s0, int s1, const Eigen::Ref<const Matrix>& images,
-                     const kernels::KernelSet& set);
-  void backward_layer(int l, int s0, int s1, const kernels::KernelSet& set, bool d_input);
-
   std::vector<Conv2d> layers_;
   std::vector<Eigen::Index> offsets_;
   Vector parameters_;
