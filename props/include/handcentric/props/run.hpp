@@ -33,7 +33,7 @@ struct PropertyOutcome {
   bool passed = false;
   std::uint64_t seed = 0;
   int cases = 0;               ///< test cases run (up to the first failure)
-  std::string counterexample;  ///< shrunk, printed; empty when passed
+  std::string counterexample;  ///< printed (shrunk when a pass was expected); empty when passed
   std::string message;         ///< RapidCheck's full message plus how to replay
 };
 
@@ -46,8 +46,9 @@ struct PropertyParams {
 /// RC_PARAMS's seed and max_success where it names them, else kDefaultSeed and kDefaultCases.
 PropertyParams property_params();
 
-/// Whether a failure is news (print RapidCheck's "to reproduce" line at exit) or the expected
-/// result of a planted fault (stay quiet: the outcome carries the counterexample).
+/// Whether a failure is news (print RapidCheck's "to reproduce" line at exit, shrink the
+/// counterexample) or the expected result of a planted fault (stay quiet and do not shrink: the
+/// outcome carries the first failing case as drawn).
 enum class Expect { pass, failure };
 
 /// Runs a property of no arguments (it draws its values with *gen and fails with RC_ASSERT).
