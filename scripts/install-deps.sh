@@ -51,5 +51,5 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 export DEBIAN_FRONTEND=noninteractive
 "${as_root[@]}" apt-get update -qq
-# --no-install-recommends keeps OpenCV to its -dev packages (we link core, imgproc, imgcodecs).
+# --no-install-recommends keeps OpenCV to its -dev packages (we link core and imgproc).
 "${as_root[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

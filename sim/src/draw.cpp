@@ -1,15 +1,15 @@
-// OpenCV drawings of scenes, demos and rollouts (draw.hpp).
+// OpenCV drawings of scenes, demos and rollouts (draw.hpp), written as PNG by png.hpp.
 #include "handcentric/sim/draw.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "handcentric/core/errors.hpp"
 #include "handcentric/core/atomic_file.hpp"
+#include "handcentric/core/errors.hpp"
+#include "png.hpp"
 
 namespace handcentric::sim {
 namespace {
@@ -220,12 +220,8 @@ void write_png(const std::string& path, const Image& image) {
       image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3) {
     throw InvalidArgument("write_png: the image is empty or its pixel buffer has the wrong size");
   }
-  cv::Mat rgb_mat(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.rgb.data()));
-  cv::Mat bgr;
-  cv::cvtColor(rgb_mat, bgr, cv::COLOR_RGB2BGR);
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", bgr, bytes)) throw Error("cannot encode a PNG for '" + path + "'");
-  write_file_atomically(path, std::string(bytes.begin(), bytes.end()));
+  write_file_atomically(path,
+                        encode_png(image.rgb.data(), image.rgb.size(), image.width, image.height));
 }
 
 }  // namespace handcentric::sim
