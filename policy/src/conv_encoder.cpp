@@ -93,25 +93,34 @@ int samples_per_chunk(const Conv2d& layer, bool first) {
 
 // How a layer's input lies in its padded copy, in the input's own layout: (channels, height,
 // width) for the encoder's input (channels_first), (height, width, channels) for a hidden map.
-// A plane is height + 2 padding rows of `run` values between two borders of `border` zeros:
-// channels_first, one plane per channel and a row of pixels; else one plane, a row of pixels'
-// channels.
+// Padded row Y of plane q starts at q plane + Y row. Channels first, there is a plane per channel
+// and a padded row stores its columns by phase: column X at (X mod stride) phase + X / stride,
+// so that the windows of consecutive output pixels of a row, stride columns apart, start at
+// consecutive floats (what PixelConv reads in vectors). Channels last, one plane, and column X's
+// channels at X channels.
 struct PaddedLayout {
-  int planes;
-  long run, border, row, plane, sample, channel_step, column_step;
+  bool channels_first;
+  int planes, stride;
+  long phase, row, plane, sample, channel_step, column_step;
+  // Where padded column x (of channel 0) lies in its row.
+  long column(long x) const {
+    return channels_first ? x % stride * phase + x / stride : x * column_step;
+  }
 };
 
 PaddedLayout padded_layout(const Conv2d& layer, bool channels_first) {
   const ImageShape& in = layer.input();
+  const long padded_width = in.width + 2L * layer.padding();
   PaddedLayout l;
+  l.channels_first = channels_first;
   l.planes = channels_first ? in.channels : 1;
-  l.run = channels_first ? in.width : static_cast<long>(in.width) * in.channels;
-  l.border = static_cast<long>(layer.padding()) * (channels_first ? 1 : in.channels);
-  l.row = l.run + 2 * l.border;
+  l.stride = layer.stride();
+  l.phase = (padded_width + l.stride - 1) / l.stride;
+  l.row = channels_first ? l.phase * l.stride : padded_width * in.channels;
   l.plane = l.row * (in.height + 2L * layer.padding());
   l.sample = l.plane * l.planes;
   l.channel_step = channels_first ? l.plane : 1;
-  l.column_step = channels_first ? 1 : in.channels;
+  l.column_step = in.channels;
   return l;
 }
 
@@ -119,7 +128,9 @@ PaddedLayout padded_layout(const Conv2d& layer, bool channels_first) {
 // below write only the interiors, so the borders stay zero from then on), and the offsets
 // through which the layer's product reads its patches in place (kernels::OffsetGemm): entry
 // (ky, kx, c) of output pixel (b, oy, ox) is maps[patch_offsets[(ky kernel + kx) channels + c] +
-// pixel_offsets[(b out_height + oy) out_width + ox]], the patch matrix im2col would write.
+// pixel_offsets[(b out_height + oy) out_width + ox]], the patch matrix im2col would write. Its
+// padded column ox stride + kx lies at column(kx) + column(ox stride) in either layout (channels
+// first, in phase kx mod stride at ox + kx / stride; column(ox stride) = ox).
 void reserve_padded(const Conv2d& layer, bool channels_first, int count, PaddedInput& padded) {
   if (count <= padded.samples) return;
   const PaddedLayout l = padded_layout(layer, channels_first);
@@ -129,7 +140,7 @@ void reserve_padded(const Conv2d& layer, bool channels_first, int count, PaddedI
   for (int ky = 0; ky < layer.kernel(); ++ky) {
     for (int kx = 0; kx < layer.kernel(); ++kx) {
       for (int c = 0; c < layer.input().channels; ++c) {
-        padded.patch_offsets.push_back(c * l.channel_step + ky * l.row + kx * l.column_step);
+        padded.patch_offsets.push_back(c * l.channel_step + ky * l.row + l.column(kx));
       }
     }
   }
@@ -140,7 +151,7 @@ void reserve_padded(const Conv2d& layer, bool channels_first, int count, PaddedI
     for (int oy = 0; oy < out.height; ++oy) {
       for (int ox = 0; ox < out.width; ++ox) {
         padded.pixel_offsets[at++] = b * l.sample + static_cast<long>(oy) * layer.stride() * l.row +
-                                     static_cast<long>(ox) * layer.stride() * l.column_step;
+                                     l.column(static_cast<long>(ox) * layer.stride());
       }
     }
   }
@@ -149,17 +160,38 @@ void reserve_padded(const Conv2d& layer, bool channels_first, int count, PaddedI
 // Copies `count` samples of a layer's input (sample b at source + b source_stride) into padded
 // samples first, first + 1, ... (reserve_padded made room), interiors only.
 void pad(const Conv2d& layer, bool channels_first, const float* source, long source_stride,
-         int first, int count, PaddedInput& padded) {
+         int first, int count, PaddedInput& padded, const kernels::KernelSet& set) {
   const PaddedLayout l = padded_layout(layer, channels_first);
-  const int height = layer.input().height, pad = layer.padding();
+  const ImageShape& in = layer.input();
+  const int pad = layer.padding();
   for (int b = 0; b < count; ++b) {
-    for (int q = 0; q < l.planes; ++q) {
-      float* rows = padded.maps.data() + (first + b) * l.sample + q * l.plane + l.border;
-      for (int y = 0; y < height; ++y) {
+    float* sample = padded.maps.data() + (first + b) * l.sample;
+    if (!channels_first) {
+      const long run = static_cast<long>(in.width) * in.channels;
+      for (int y = 0; y < in.height; ++y) {
+        const float* from = source + b * source_stride + y * run;
+        std::copy(from, from + run, sample + (y + pad) * l.row + l.column(pad));
+      }
+      continue;
+    }
+    for (int c = 0; c < in.channels; ++c) {
+      for (int y = 0; y < in.height; ++y) {
         const float* from =
-            source + b * source_stride + (static_cast<long>(q) * height + y) * l.run;
-        float* to = rows + (y + pad) * l.row;
-        for (long i = 0; i < l.run; ++i) to[i] = from[i];
+            source + b * source_stride + (static_cast<long>(c) * in.height + y) * in.width;
+        float* to = sample + c * l.plane + (y + pad) * l.row;
+        if (l.stride == 2) {
+          // x even: padded column x + pad in phase pad mod 2 at (x + pad) / 2 = x / 2 + pad / 2;
+          // x odd: in the other phase at (x - 1) / 2 + (pad + 1) / 2.
+          set.deinterleave(in.width, from, to + l.column(pad), to + l.column(pad + 1));
+          continue;
+        }
+        // Phase by phase: the columns x with (x + pad) mod stride = q go to phase q in order.
+        for (int q = 0; q < l.stride; ++q) {
+          const int x_first = ((q - pad) % l.stride + l.stride) % l.stride;
+          float* phase = to + q * l.phase + (x_first + pad) / l.stride;
+          const int columns = x_first < in.width ? (in.width - 1 - x_first) / l.stride + 1 : 0;
+          for (int i = 0; i < columns; ++i) phase[i] = from[x_first + i * l.stride];
+        }
       }
     }
   }
@@ -264,10 +296,20 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
       const int at = l == 0 ? b0 : 0;
       if (l == 0) {
         pad(layer, true, images.data() + b0 * images.outerStride(), images.outerStride(), at, count,
-            padded);
+            padded, set);
       } else {
         pad(layer, false, activation_[l - 1].data() + b0 * layer.input().size(),
-            layer.input().size(), at, count, padded);
+            layer.input().size(), at, count, padded, set);
+      }
+      if (l == 0 && out == kernels::kPixelConvFilters && count * pixels > kernels::kNarrowMax) {
+        // Eight filters fill half of an AVX-512 vector: the pixels go in the lanes instead (the
+        // same bits where offset_gemm would run its blocked nest).
+        set.pixel_conv({k, count * layer.output().height, layer.output().width, weights,
+                        weights + static_cast<Eigen::Index>(out) * k, padded.maps.data(),
+                        padded.patch_offsets.data(),
+                        padded.pixel_offsets.data() + static_cast<long>(at) * pixels,
+                        activation_[l].data() + first, sigmoid_[l].data() + first});
+        continue;
       }
       kernels::Gemm product{Op::none,
                             Op::none,
@@ -349,7 +391,7 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
       const float* delta_chunk = delta.data() + b0 * layer.output().size();
       if (l > 0) {
         PaddedInput& padded = padded_[l];
-        pad(layer, false, activation_[l - 1].data() + b0 * below, below, 0, count, padded);
+        pad(layer, false, activation_[l - 1].data() + b0 * below, below, 0, count, padded, set);
         kernels::Gemm d_product{
             Op::none, Op::none,           out, k,       count * pixels, delta_chunk,
             out,      padded.maps.data(), k,   nullptr, d_weights,      out};

@@ -5,7 +5,8 @@
 // images with a column stride. The reference's backward is checked by central differences of
 // its forward, and the float encoder's by directional differences of its own. Each check is seen
 // failing on kernel sets with a planted fault (a mutant product reading its patches in place,
-// col2im, row2im, input-gradient product or SiLU'), on every target. Then the model-file record of
+// col2im, row2im, input-gradient product or SiLU', the first layer's pixel product or its rows'
+// split by column phase), on every target. Then the model-file record of
 // the encoder and the typed errors of bad shapes.
 #include <catch2/catch.hpp>
 
@@ -278,17 +279,32 @@ void row2im_window_shifted(const kernels::ConvPatches& shape, const float* rows,
   g_base->row2im(wrong, rows, ld, image);
 }
 void silu_backward_left_out(std::ptrdiff_t, const float*, const float*, float*) {}
+void pixel_conv_short_k(const kernels::PixelConv& problem) {
+  kernels::PixelConv wrong = problem;
+  if (wrong.k > 1) wrong.k -= 1;  // the first layer's last patch entry left out
+  g_base->pixel_conv(wrong);
+}
+void deinterleave_swapped(std::ptrdiff_t n, const float* x, float* even, float* odd) {
+  // Each column phase gets the other's floats (a row of the first layer's padded copy misread).
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const std::ptrdiff_t other = (i ^ 1) < n ? (i ^ 1) : i;
+    (i % 2 == 0 ? even : odd)[i / 2] = x[other];
+  }
+}
 
 struct Mutant {
   std::string name;
   kernels::KernelSet set;
   bool forward_wrong;  // whether the features are wrong too, or only the gradients
+  // The cases whose encoder calls the mutated function (null: every case).
+  bool (*applies)(const Case& c) = nullptr;
 };
 
 std::vector<Mutant> mutants_of(const kernels::KernelSet& base) {
   using Set = kernels::KernelSet;
-  const auto mutant = [&](std::string name, bool forward_wrong, void (*plant)(Set&)) {
-    Mutant m{std::move(name), base, forward_wrong};
+  const auto mutant = [&](std::string name, bool forward_wrong, void (*plant)(Set&),
+                          bool (*applies)(const Case&) = nullptr) {
+    Mutant m{std::move(name), base, forward_wrong, applies};
     plant(m.set);
     return m;
   };
@@ -303,6 +319,14 @@ std::vector<Mutant> mutants_of(const kernels::KernelSet& base) {
              [](Set& set) { set.gemm = gemm_short_k; }),
       mutant("input gradient through W, not W^T", false,
              [](Set& set) { set.gemm = gemm_untransposed_weights; }),
+      mutant(
+          "the first layer's pixel product one k term short", true,
+          [](Set& set) { set.pixel_conv = pixel_conv_short_k; },
+          [](const Case& c) { return c.layers.front().out_channels == 8; }),
+      mutant(
+          "the first layer's rows split into the wrong column phases", true,
+          [](Set& set) { set.deinterleave = deinterleave_swapped; },
+          [](const Case& c) { return c.layers.front().stride == 2; }),
       // Last: the gradient check below takes it.
       mutant("SiLU' left out", false,
              [](Set& set) { set.silu_backward = silu_backward_left_out; })};
@@ -359,6 +383,7 @@ TEST_CASE("mutant_conv_kernel_sets_are_caught_on_every_target", "[unit]") {
     for (const auto& [name, set] : conv_targets()) {
       g_base = set;
       for (const Mutant& mutant : mutants_of(*set)) {
+        if (mutant.applies != nullptr && !mutant.applies(c)) continue;
         INFO(c.name << ", target " << name << ", mutant: " << mutant.name);
         const Errors e = expected.errors(mutant.set);
         CHECK(e.worst() > 100 * kTolerance);

@@ -3,9 +3,11 @@
 // the three orientations Mlp uses and the fourth, with biases, every edge of the blocking
 // (partial tiles, k beyond one k block, n beyond one column block, strides, k = 0), the narrow
 // products of sampling (n <= 16) with unaligned columns, the SiLU kernels, the squared norm
-// and Adam. Then the whole Mlp per named kernel set (kernels.hpp) against MlpT<double>. The checks
-// are seen failing on planted faults. Under ASan, the masked accesses ASan cannot see are checked
-// lane by lane (kernels/asan_lanes.hpp).
+// and Adam; the image encoder's first-layer product with the pixels in the lanes against the
+// offset product's bits, and the split of a row into its even and odd floats. Then the whole
+// Mlp per named kernel set (kernels.hpp) against MlpT<double>. The checks are seen failing on
+// planted faults. Under ASan, the masked accesses ASan cannot see are checked lane by lane
+// (kernels/asan_lanes.hpp).
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -368,6 +370,86 @@ TEST_CASE("offset_products_have_the_bits_of_the_product_on_their_matrix", "[unit
           }
         }
       }
+    }
+  }
+}
+
+// pixel_conv (the image encoder's first layer of 8 filters, with the pixels in the lanes) must
+// give offset_gemm's bits on the same product with the SiLU epilogue, wherever offset_gemm runs
+// the blocked nest (more than 16 pixels): C and the sigmoid, rows of every width against the
+// vectors (a partial tile, one pixel), k within one k block and beyond it (the blocked nest's
+// order of the sums), overlapping windows at random offsets.
+TEST_CASE("pixel_products_have_the_bits_of_the_offset_product", "[unit]") {
+  constexpr int kFilters = kernels::kPixelConvFilters;
+  std::mt19937_64 rng(23);
+  for (const auto& [name, set_pointer] : every_target()) {
+    INFO("target " << name);
+    const kernels::KernelSet* set = set_pointer;
+    for (int k : {1, 9, 54, 300}) {
+      // rows x width: n > 16, the products offset_gemm runs on the blocked nest.
+      for (const auto& [rows, width] : std::vector<std::pair<int, int>>{
+               {20, 1}, {4, 5}, {3, 16}, {3, 17}, {2, 32}, {3, 33}, {2, 47}}) {
+        const int n = rows * width;
+        const long span = 2L * k + 3L * width + 1;
+        const std::vector<float> input = random_floats(static_cast<std::size_t>(4 * span), rng);
+        const std::vector<float> weights =
+            random_floats(static_cast<std::size_t>(kFilters) * k, rng);
+        const std::vector<float> bias = random_floats(kFilters, rng);
+        std::vector<long> patches(static_cast<std::size_t>(k)), pixels(static_cast<std::size_t>(n));
+        for (long& offset : patches) offset = static_cast<long>(uniform01(rng) * span);
+        for (int r = 0; r < rows; ++r) {
+          const long start = static_cast<long>(uniform01(rng) * 2 * span);
+          for (int x = 0; x < width; ++x)
+            pixels[static_cast<std::size_t>(r * width + x)] = start + x;
+        }
+        const std::size_t size = static_cast<std::size_t>(kFilters) * n;
+        std::vector<float> c(size, 7.0f), sigmoid(size, 7.0f);
+        const auto expected_run = [&] {
+          kernels::Gemm product{Op::none, Op::none,       kFilters, n,
+                                k,        weights.data(), kFilters, input.data(),
+                                k,        bias.data(),    c.data(), kFilters};
+          product.epilogue = kernels::Epilogue::silu;
+          product.sigmoid = sigmoid.data();
+          product.lds = kFilters;
+          set->offset_gemm({product, patches.data(), pixels.data()});
+          return std::pair{c, sigmoid};
+        };
+        const auto pixel_run = [&](const long* patch_offsets, int terms) {
+          std::fill(c.begin(), c.end(), 7.0f);
+          std::fill(sigmoid.begin(), sigmoid.end(), 7.0f);
+          set->pixel_conv({terms, rows, width, weights.data(), bias.data(), input.data(),
+                           patch_offsets, pixels.data(), c.data(), sigmoid.data()});
+          return std::pair{c, sigmoid};
+        };
+        INFO("k " << k << " width " << width);
+        const auto expected = expected_run();
+        CHECK(pixel_run(patches.data(), k) == expected);
+        // Planted faults: the last patch entry read from the first one's place; a term short.
+        if (k >= 2) {
+          std::vector<long> wrong = patches;
+          wrong.back() = wrong.front() == wrong.back() ? wrong.back() + 1 : wrong.front();
+          CHECK(pixel_run(wrong.data(), k).first != expected.first);
+          CHECK(pixel_run(patches.data(), k - 1).first != expected.first);
+        }
+      }
+    }
+  }
+}
+
+// deinterleave splits a row into its even and odd floats (the first layer's padded rows by
+// column phase), every length around the vectors' widths.
+TEST_CASE("deinterleave_splits_a_row_into_its_even_and_odd_floats", "[unit]") {
+  std::mt19937_64 rng(29);
+  for (const auto& [name, set] : every_target()) {
+    for (int n = 0; n <= 70; ++n) {
+      INFO("target " << name << " n " << n);
+      const std::vector<float> x = random_floats(static_cast<std::size_t>(n), rng);
+      // One float of guard past each half: nothing may be written there.
+      std::vector<float> even((n + 1) / 2 + 1, 5.0f), odd(n / 2 + 1, 5.0f);
+      set->deinterleave(n, x.data(), even.data(), odd.data());
+      bool right = even.back() == 5.0f && odd.back() == 5.0f;
+      for (int i = 0; i < n; ++i) right = right && (i % 2 == 0 ? even : odd)[i / 2] == x[i];
+      CHECK(right);
     }
   }
 }

@@ -1,7 +1,8 @@
 // Private, per target: col2im and row2im (kernel_set.hpp, ConvPatches), which add a patch
 // matrix's gradient back onto the pixels its entries were read from (the input gradient of a
-// convolution). The forward products read their patches in place (OffsetGemm), so nothing
-// writes a patch matrix; the products themselves are the GEMM driver's.
+// convolution), and the first layer's forward product with the pixels in the lanes (PixelConv).
+// The other forward products read their patches in place (OffsetGemm), so nothing writes a patch
+// matrix; those products are the GEMM driver's.
 
 #include <algorithm>
 #include <cstddef>
@@ -112,6 +113,133 @@ HWY_INLINE void ForEachPatchLine(const ConvPatches& g, Run&& run, Pad&& padding)
       }
     }
   }
+}
+
+/// Transposes kPixelConvFilters vectors in place: v[f] holds filter f of the vector's pixels
+/// (lane i: pixel i), and after it v[q] holds the filters of pixels q L / F ... (q + 1) L / F,
+/// each pixel's F filters together (L lanes, F = kPixelConvFilters, both powers of two). Read as
+/// one array of F L floats, the element at index m = f L + i goes to n = i F + f: m's bits
+/// rotated right by log2(L). One round of ConcatEven and ConcatOdd over the vectors' pairs (the
+/// even elements of the whole array, then the odd ones) rotates every index right by one bit.
+template <class D>
+HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
+// One lane (HWY_SCALAR) is its own transpose, and that target has no ConcatEven.
+#if HWY_TARGET != HWY_SCALAR
+  constexpr int kVectorLanes = static_cast<int>(hn::MaxLanes(D()));
+  constexpr int kHalf = kPixelConvFilters / 2;
+#pragma GCC unroll 4
+  for (int round = 1; round < kVectorLanes; round *= 2) {
+    hn::Vec<D> next[kPixelConvFilters];
+#pragma GCC unroll 4
+    for (int t = 0; t < kHalf; ++t) {
+      next[t] = hn::ConcatEven(d, v[2 * t + 1], v[2 * t]);
+      next[kHalf + t] = hn::ConcatOdd(d, v[2 * t + 1], v[2 * t]);
+    }
+#pragma GCC unroll 8
+    for (int f = 0; f < kPixelConvFilters; ++f) v[f] = next[f];
+  }
+#else
+  (void)d;
+  (void)v;
+#endif
+}
+
+/// One tile of PixelConvForward: `pixels` <= V L consecutive pixels of one output row (`row`:
+/// the input at its first pixel) for filters 0..F-1, z = W P + b into z[f][pixel]. Full: every
+/// vector of pixels is whole (plain loads); else the loads are masked to the pixels.
+template <int V, bool kFull, class D>
+HWY_INLINE void PixelConvTile(D d, const PixelConv& g, const float* row, int pixels,
+                              float (&z)[kPixelConvFilters][V * hn::MaxLanes(D())]) {
+  constexpr int F = kPixelConvFilters, L = static_cast<int>(hn::MaxLanes(D()));
+  int part[V];
+#pragma GCC unroll 4
+  for (int v = 0; v < V; ++v) part[v] = std::clamp(pixels - v * L, 0, L);
+  // The blocked nest's order (gemm.hpp): each k block summed from zero, the first plus the bias,
+  // the later ones added to that.
+  for (int p0 = 0; p0 < g.k; p0 += kProductKBlock) {
+    const int p_end = std::min(g.k, p0 + kProductKBlock);
+    hn::Vec<D> acc[F][V];
+#pragma GCC unroll 8
+    for (int f = 0; f < F; ++f) {
+#pragma GCC unroll 4
+      for (int v = 0; v < V; ++v) acc[f][v] = hn::Zero(d);
+    }
+    for (int p = p0; p < p_end; ++p) {
+      const float* at = row + g.patch_offsets[p];
+      hn::Vec<D> x[V];
+#pragma GCC unroll 4
+      for (int v = 0; v < V; ++v) {
+        x[v] = kFull ? hn::LoadU(d, at + v * L) : LoadPart(d, at + v * L, part[v]);
+      }
+      const float* w = g.weights + static_cast<long>(p) * F;
+#pragma GCC unroll 8
+      for (int f = 0; f < F; ++f) {
+        const auto w_f = hn::Set(d, w[f]);
+#pragma GCC unroll 4
+        for (int v = 0; v < V; ++v) acc[f][v] = hn::MulAdd(x[v], w_f, acc[f][v]);
+      }
+    }
+#pragma GCC unroll 8
+    for (int f = 0; f < F; ++f) {
+#pragma GCC unroll 4
+      for (int v = 0; v < V; ++v) {
+        const auto before = p0 == 0 ? hn::Set(d, g.bias[f]) : hn::Load(d, z[f] + v * L);
+        hn::Store(hn::Add(acc[f][v], before), d, z[f] + v * L);
+      }
+    }
+  }
+}
+
+inline void PixelConvForward(const PixelConv& g) {
+  using D = hn::ScalableTag<float>;
+  const D d;
+  constexpr int F = kPixelConvFilters, L = static_cast<int>(hn::MaxLanes(D()));
+  // V F accumulators, V vectors of pixels and a broadcast: 19 of AVX-512's 32 registers, 10 of
+  // AVX2's 16.
+  constexpr int V = kRegisters == 32 ? 2 : 1;
+  alignas(64) float z[F][V * L];
+  for (long r = 0; r < g.rows; ++r) {
+    const float* row = g.input + g.pixel_offsets[r * g.width];
+    for (int x0 = 0; x0 < g.width; x0 += V * L) {
+      const int pixels = std::min(V * L, g.width - x0);
+      if (pixels == V * L) {
+        PixelConvTile<V, true>(d, g, row + x0, pixels, z);
+      } else {
+        PixelConvTile<V, false>(d, g, row + x0, pixels, z);
+      }
+      // The epilogue of each vector of pixels, transposed to each pixel's filters together:
+      // SiluForward's operations (silu-inl.h), so the same bits.
+      for (int v = 0; v * L < pixels; ++v) {
+        hn::Vec<D> t[F];
+#pragma GCC unroll 8
+        for (int f = 0; f < F; ++f) t[f] = hn::Load(d, z[f] + v * L);
+        TransposeFilters(d, t);
+        const long first = (r * g.width + x0 + v * L) * F;
+        const int floats = std::min(L, pixels - v * L) * F;
+#pragma GCC unroll 8
+        for (int q = 0; q < F && q * L < floats; ++q) {
+          const auto s = Sigmoid(d, t[q]);
+          const auto count = static_cast<std::size_t>(std::min(L, floats - q * L));
+          StorePart(d, s, g.sigmoid + first + q * L, count);
+          StorePart(d, hn::Mul(t[q], s), g.c + first + q * L, count);
+        }
+      }
+    }
+  }
+}
+
+inline void Deinterleave(std::ptrdiff_t n, const float* x, float* even, float* odd) {
+  std::ptrdiff_t i = 0;
+#if HWY_TARGET != HWY_SCALAR
+  const hn::ScalableTag<float> d;
+  const std::ptrdiff_t step = 2 * static_cast<std::ptrdiff_t>(hn::Lanes(d));
+  for (; i + step <= n; i += step) {
+    const auto lower = hn::LoadU(d, x + i), upper = hn::LoadU(d, x + i + step / 2);
+    hn::StoreU(hn::ConcatEven(d, upper, lower), d, even + i / 2);
+    hn::StoreU(hn::ConcatOdd(d, upper, lower), d, odd + i / 2);
+  }
+#endif
+  for (; i < n; ++i) (i % 2 == 0 ? even : odd)[i / 2] = x[i];
 }
 
 // Only the input gradient of a first layer runs it (training does not): a plain loop.

@@ -253,8 +253,6 @@ void blocked_gemm(const Gemm& g) {
 // kNarrowGroup (columns per pass), kAlignedHeads (whether to shift the heads at all) and
 //   template <int N, int V>
 //   narrow_block(shift, rows, k, a, lda, b, b_step, b_stride, bias, c, ldc).
-constexpr int kNarrowMax = 16;
-
 template <typename Kernel, int N, int... V>
 void narrow_rows(int vectors, int shift, int rows, int k, const float* a, long lda, const float* b,
                  long b_step, long b_stride, const float* bias, float* c, long ldc,

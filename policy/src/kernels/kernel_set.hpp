@@ -69,6 +69,36 @@ struct OffsetGemm {
 
 /// The k block of the blocked products (gemm.hpp, Blocking::KC).
 constexpr int kProductKBlock = 256;
+/// Products of at most this many columns run on the narrow kernels (gemm.hpp), which start each
+/// sum from the bias rather than adding it at the end: other bits than the blocked products'.
+constexpr int kNarrowMax = 16;
+
+/// The filters of a PixelConv: one vector of each output pixel's filters on AVX2, half of one
+/// on AVX-512 (the image encoder's first layer).
+constexpr int kPixelConvFilters = 8;
+
+/// The forward product of a convolution of kPixelConvFilters filters, C = SiLU(W P + b 1^T),
+/// with the output pixels in the vector lanes and the 8 filters' weights broadcast: the offset
+/// product puts the filters in the lanes, which fill half of an AVX-512 vector. P (K x N) is read
+/// in place, P(p, j) = input[patch_offsets[p] + pixel_offsets[j]], and the pixels of one output
+/// row must be consecutive floats of the input: pixel_offsets[r width + x] = pixel_offsets[r width]
+/// + x (a channels-first map whose padded rows are stored by column phase, conv_encoder.cpp; only
+/// each row's first offset is read). W is kPixelConvFilters x K (ld kPixelConvFilters) and the
+/// bias is not null. C and `sigmoid` are kPixelConvFilters x N with ld kPixelConvFilters, each
+/// pixel's filters together as the encoder stores its maps. For N > kNarrowMax they get the bits
+/// offset_gemm gives on the same product with Epilogue::silu (each sum in the same order, blocked
+/// by kProductKBlock in k the same way).
+struct PixelConv {
+  int k = 0;
+  int rows = 0, width = 0;  ///< N = rows width: output rows (samples x height) of `width` pixels
+  const float* weights = nullptr;
+  const float* bias = nullptr;
+  const float* input = nullptr;
+  const long* patch_offsets = nullptr;
+  const long* pixel_offsets = nullptr;
+  float* c = nullptr;
+  float* sigmoid = nullptr;
+};
 
 /// Handles the degenerate shapes (m, n or k <= 0; k = 0 writes C = bias 1^T) and returns
 /// true; false for a real product. Every set's gemm starts with it.
@@ -130,6 +160,12 @@ struct KernelSet {
   void (*gemm)(const Gemm& problem);
   /// gemm with op(B) read through offsets (OffsetGemm), the same bits.
   void (*offset_gemm)(const OffsetGemm& problem);
+  /// A convolution of kPixelConvFilters filters with its pixels in the lanes (PixelConv): the
+  /// bits of offset_gemm on that product.
+  void (*pixel_conv)(const PixelConv& problem);
+  /// even[i] = x[2 i] and odd[i] = x[2 i + 1] for the n floats of x: a row of an image stored
+  /// by column phase for a convolution of stride 2 (PixelConv).
+  void (*deinterleave)(std::ptrdiff_t n, const float* x, float* even, float* odd);
   /// s = sigmoid(z), a = z s over n values (training: s is kept for the backward pass); a may be z.
   void (*silu_forward)(std::ptrdiff_t n, const float* z, float* s, float* a);
   /// delta *= SiLU'(z) over n values, from s = sigmoid(z) and a = SiLU(z) = z s:

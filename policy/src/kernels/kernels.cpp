@@ -40,6 +40,8 @@ constexpr auto* kBoxMullerParts = &box_muller_parts_libm;
 const KernelSet* TargetKernels() {
   static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>,
                                   vector_offset_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>,
+                                  PixelConvForward,
+                                  Deinterleave,
                                   SiluForward,
                                   SiluBackward,
                                   SiluInPlace,

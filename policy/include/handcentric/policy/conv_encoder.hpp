@@ -12,8 +12,10 @@
 // (conv2d.hpp gives a layer's layout), so that Adam, clipping and model files see one array.
 // float32 on the run-time dispatched kernels (kernels.hpp): one product per layer with the bias
 // and SiLU in its epilogue, reading its patches in place from the zero-padded input (an
-// implicit im2col, kernels::OffsetGemm: no patch matrix is written); backward the two products
-// of the gradients and col2im (row2im for the first layer's input).
+// implicit im2col, kernels::OffsetGemm: no patch matrix is written); a first layer of 8 filters
+// with the output pixels in the vector lanes instead (kernels::PixelConv, the same bits), its
+// padded rows stored by column phase so that a row's windows start at consecutive floats;
+// backward the two products of the gradients and col2im (row2im for the first layer's input).
 // Below the first layer, the padded maps live only one L2-sized chunk of samples at a time:
 // backward pads them again from the map below rather than keeping a whole batch's.
 #include <Eigen/Core>
