@@ -261,12 +261,14 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
                           std::to_string(input_shape().width) + " per column)");
   }
   const Eigen::Index batch = images.cols();
+  // The kernels count a layer's products in int: its patch matrix (K x pixels of the batch, read
+  // in place) must have fewer than 2^31 entries.
   for (const Conv2d& layer : layers_) {
     const Eigen::Index columns = batch * layer.output().height * layer.output().width;
     if (columns * layer.patch_size() >= (Eigen::Index{1} << 31)) {
       throw InvalidArgument(
           "ConvEncoder batch of " + std::to_string(batch) +
-          " images makes a patch matrix of more than 2^31 entries: "
+          " images reads more than 2^31 patch entries in one layer: "
           "use a batch of at most " +
           std::to_string(((Eigen::Index{1} << 31) - 1) /
                          (columns / std::max<Eigen::Index>(batch, 1) * layer.patch_size())));

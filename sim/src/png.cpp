@@ -45,38 +45,40 @@ int paeth(int a, int b, int c) {
   return pb <= pc ? b : c;
 }
 
-// Row `row` filtered by filter type `type` (0 none, 1 sub, 2 up, 3 average, 4 Paeth) into
-// `out` (row bytes); `above` is the previous row, or zeros for the first.
+// Row `row` filtered by filter type `type` into `out` (row bytes); `above` is the previous row,
+// or zeros for the first.
 void filter_row(int type, const std::uint8_t* row, const std::uint8_t* above, std::size_t bytes,
-                std::uint8_t* out) {
+                std::uint8_t* out, PngPredictor predict) {
   for (std::size_t i = 0; i < bytes; ++i) {
     const int left = i >= kChannels ? row[i - kChannels] : 0;
-    const int up = above[i];
     const int up_left = i >= kChannels ? above[i - kChannels] : 0;
-    int prediction = 0;
-    switch (type) {
-      case 1:
-        prediction = left;
-        break;
-      case 2:
-        prediction = up;
-        break;
-      case 3:
-        prediction = (left + up) / 2;
-        break;
-      case 4:
-        prediction = paeth(left, up, up_left);
-        break;
-      default:
-        break;
-    }
-    out[i] = static_cast<std::uint8_t>(row[i] - prediction);
+    out[i] = static_cast<std::uint8_t>(row[i] - predict(type, left, above[i], up_left));
   }
 }
 
 }  // namespace
 
+int png_prediction(int type, int left, int up, int up_left) {
+  switch (type) {
+    case 1:
+      return left;
+    case 2:
+      return up;
+    case 3:
+      return (left + up) / 2;
+    case 4:
+      return paeth(left, up, up_left);
+    default:
+      return 0;
+  }
+}
+
 std::string encode_png(const std::uint8_t* rgb, std::size_t size, int width, int height) {
+  return encode_png_predicting(rgb, size, width, height, png_prediction);
+}
+
+std::string encode_png_predicting(const std::uint8_t* rgb, std::size_t size, int width, int height,
+                                  PngPredictor predict) {
   if (width < 1 || height < 1 || width >= kMaxSide || height >= kMaxSide) {
     throw InvalidArgument("encode_png: a " + std::to_string(width) + " x " +
                           std::to_string(height) + " image: each side must be in [1, 2^24)");
@@ -98,7 +100,7 @@ std::string encode_png(const std::uint8_t* rgb, std::size_t size, int width, int
     int best = 0;
     unsigned long best_cost = std::numeric_limits<unsigned long>::max();
     for (int type = 0; type < 5; ++type) {
-      filter_row(type, row, above, row_bytes, candidates[type].data());
+      filter_row(type, row, above, row_bytes, candidates[type].data(), predict);
       unsigned long cost = 0;  // the bytes read as signed: small residuals cost little
       for (const std::uint8_t b : candidates[type]) cost += b < 128 ? b : 256 - b;
       if (cost < best_cost) {

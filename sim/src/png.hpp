@@ -15,4 +15,13 @@ namespace handcentric::sim {
 /// Throws InvalidArgument for a size outside [1, 2^24) per side or a buffer of another length.
 std::string encode_png(const std::uint8_t* rgb, std::size_t size, int width, int height);
 
+/// The prediction of filter type `type` (0 none, 1 sub, 2 up, 3 average, 4 Paeth; section 9)
+/// for a byte from the bytes left of it, above it and above-left.
+int png_prediction(int type, int left, int up, int up_left);
+using PngPredictor = int (*)(int type, int left, int up, int up_left);
+/// encode_png with the filters' predictions from `predict` rather than png_prediction: the
+/// tests plant a wrong one (tests/sim/test_png.cpp) and see a decoder's pixels differ.
+std::string encode_png_predicting(const std::uint8_t* rgb, std::size_t size, int width, int height,
+                                  PngPredictor predict);
+
 }  // namespace handcentric::sim

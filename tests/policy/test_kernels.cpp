@@ -387,9 +387,9 @@ TEST_CASE("pixel_products_have_the_bits_of_the_offset_product", "[unit]") {
     const kernels::KernelSet* set = set_pointer;
     for (int k : {1, 9, 54, 300}) {
       // rows x width: n > 16, the products offset_gemm runs on the blocked nest.
-      for (const auto& [rows, width] : std::vector<std::pair<int, int>>{
+      for (const auto& shape : std::vector<std::pair<int, int>>{
                {20, 1}, {4, 5}, {3, 16}, {3, 17}, {2, 32}, {3, 33}, {2, 47}}) {
-        const int n = rows * width;
+        const int rows = shape.first, width = shape.second, n = rows * width;
         const long span = 2L * k + 3L * width + 1;
         const std::vector<float> input = random_floats(static_cast<std::size_t>(4 * span), rng);
         const std::vector<float> weights =

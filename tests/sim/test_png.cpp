@@ -1,7 +1,7 @@
 // write_png's files (sim/src/png.cpp) read back by a decoder written here from the PNG
 // specification (chunks and their CRCs, IHDR, one zlib stream, the five row filters undone):
 // the pixels come back bit for bit on images that make the encoder choose every filter, and a
-// damaged file or a changed pixel is seen.
+// damaged file, a changed pixel or an encoder with a wrong filter is seen.
 #include <zlib.h>
 
 #include <catch2/catch.hpp>
@@ -16,6 +16,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/draw.hpp"
 #include "handcentric/sim/scenes.hpp"
+#include "png.hpp"
 
 using namespace handcentric;
 using namespace handcentric::sim;
@@ -174,4 +175,39 @@ TEST_CASE("mutant_png_a_damaged_file_or_a_changed_pixel_is_seen", "[unit]") {
   CHECK_THROWS_AS(write_png(png_path(), Image{3, 2, std::vector<std::uint8_t>(17)}),
                   InvalidArgument);
   CHECK_FALSE(std::filesystem::exists(png_path()));
+}
+
+// Planted faults in the encoder's filters (png.hpp, encode_png_predicting): Paeth's tie between
+// up and up-left broken the other way, the average rounded up. Either makes the encoder filter
+// some row with a prediction the decoder (the specification's) does not make.
+int png_paeth_tie_to_up_left(int type, int left, int up, int up_left) {
+  if (type != 4) return png_prediction(type, left, up, up_left);
+  const int p = left + up - up_left, pa = std::abs(p - left), pb = std::abs(p - up),
+            pc = std::abs(p - up_left);
+  if (pa <= pb && pa <= pc) return left;
+  return pb < pc ? up : up_left;
+}
+int png_average_rounded_up(int type, int left, int up, int up_left) {
+  return type == 3 ? (left + up + 1) / 2 : png_prediction(type, left, up, up_left);
+}
+
+TEST_CASE("mutant_png_encoders_with_a_wrong_filter_are_seen", "[unit]") {
+  // The images of the round-trip test: whether a fault shows depends on which filter wins which
+  // row, so each mutant must show on at least one of them.
+  int right = 0, paeth_seen = 0, average_seen = 0;
+  for (const auto& [width, height] :
+       std::vector<std::pair<int, int>>{{1, 1}, {2, 3}, {37, 20}, {64, 48}, {257, 41}}) {
+    const Image image = png_test_image(width, height, static_cast<std::uint32_t>(width * height));
+    const auto decoded_with = [&image](PngPredictor predict) {
+      return png_decode(encode_png_predicting(image.rgb.data(), image.rgb.size(), image.width,
+                                              image.height, predict))
+          .image.rgb;
+    };
+    right += decoded_with(png_prediction) == image.rgb;
+    paeth_seen += decoded_with(png_paeth_tie_to_up_left) != image.rgb;
+    average_seen += decoded_with(png_average_rounded_up) != image.rgb;
+  }
+  CHECK(right == 5);
+  CHECK(paeth_seen > 0);
+  CHECK(average_seen > 0);
 }
