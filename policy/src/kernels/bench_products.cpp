@@ -1,8 +1,9 @@
 // The products of one training step of the anchor network (57 -> 256 -> 256 -> 256 -> 24, batch
-// 256), one at a time, on the kernel set this CPU runs (or HANDCENTRIC_KERNELS): where a step's
-// time goes, per product. items/s x 1e-9 = GFLOP/s. It times the private kernel interface
-// (kernel_set.hpp), which is why it lives here and not in bench/, whose benchmarks use the
-// public API only. Built as build/bench/bench_kernels with the other benchmarks.
+// 256) and of the image encoders, one at a time, on the kernel set this CPU runs (or
+// HANDCENTRIC_KERNELS): where a step's time goes, per product. items/s x 1e-9 = GFLOP/s. It times
+// the private kernel interface (kernel_set.hpp), which is why it lives here and not in bench/,
+// whose benchmarks use the public API only. Built as build/bench/bench_kernels with the other
+// benchmarks.
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -99,6 +100,52 @@ BENCHMARK_CAPTURE(product, conv2_d_patches, Op::transpose, Op::none, 144, 4 * kP
                   Epilogue::none);
 BENCHMARK_CAPTURE(product, conv3_d_patches, Op::transpose, Op::none, 288, 9 * kPixels3, 32,
                   Epilogue::none);
+
+// The image policies' default first layer (6 x 48 x 64 -> 8 filters of 3 x 3, stride 2: 24 x 32
+// output pixels, K = 54) on one chunk of 3 samples, as ConvEncoder runs it, from the padded maps
+// stored by column phase: the offset product (8 filters in the lanes, half an AVX-512 vector)
+// against pixel_conv (the pixels in the lanes), both with the SiLU epilogue and the same bits.
+void first_layer(benchmark::State& state, bool pixels_in_lanes) {
+  constexpr int kChannels = 6, kHeight = 48, kWidth = 64, kFilters = 8, kSamples = 3;
+  constexpr int kOutHeight = 24, kOutWidth = 32, kK = 9 * kChannels;
+  constexpr long kPhase = (kWidth + 2) / 2, kRow = 2 * kPhase, kPlane = kRow * (kHeight + 2),
+                 kSample = kPlane * kChannels;
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+  std::vector<float> maps(static_cast<std::size_t>(kSample) * kSamples);
+  for (float& x : maps) x = uniform(rng);
+  std::vector<float> weights(static_cast<std::size_t>(kFilters) * kK), bias(kFilters);
+  for (float& w : weights) w = 0.1f * uniform(rng);
+  for (float& b : bias) b = uniform(rng);
+  std::vector<long> patches, pixels;
+  for (int ky = 0; ky < 3; ++ky)
+    for (int kx = 0; kx < 3; ++kx)
+      for (int c = 0; c < kChannels; ++c)
+        patches.push_back(c * kPlane + ky * kRow + kx % 2 * kPhase + kx / 2);
+  for (int b = 0; b < kSamples; ++b)
+    for (int oy = 0; oy < kOutHeight; ++oy)
+      for (int ox = 0; ox < kOutWidth; ++ox) pixels.push_back(b * kSample + 2L * oy * kRow + ox);
+  const int n = static_cast<int>(pixels.size());
+  std::vector<float> c(static_cast<std::size_t>(kFilters) * n), sigmoid(c.size());
+  const auto& kernels = handcentric::policy::kernels::active();
+  Gemm gemm{Op::none, Op::none,    kFilters, n,           kK,       weights.data(),
+            kFilters, maps.data(), kK,       bias.data(), c.data(), kFilters};
+  gemm.epilogue = Epilogue::silu;
+  gemm.sigmoid = sigmoid.data();
+  gemm.lds = kFilters;
+  for (auto _ : state) {
+    if (pixels_in_lanes) {
+      kernels.pixel_conv({kK, kSamples * kOutHeight, kOutWidth, weights.data(), bias.data(),
+                          maps.data(), patches.data(), pixels.data(), c.data(), sigmoid.data()});
+    } else {
+      kernels.offset_gemm({gemm, patches.data(), pixels.data()});
+    }
+    benchmark::DoNotOptimize(c.data());
+  }
+  state.SetItemsProcessed(state.iterations() * 2L * kFilters * n * kK);  // flops
+}
+BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_filters_in_lanes, false);
+BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_pixels_in_lanes, true);
 
 }  // namespace
 
