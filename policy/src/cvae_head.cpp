@@ -50,10 +50,8 @@ class CvaeHead final : public Head {
 
   double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
                     std::mt19937_64& rng) override {
-    a_ = actions;
-    o_ = observations;
-    action_normalizer_.normalize(a_);
-    observation_normalizer_.normalize(o_);
+    action_normalizer_.normalize(actions, a_);
+    observation_normalizer_.normalize(observations, o_);
     noise_.resize(config_.cvae_latent, actions.cols());
     fill_standard_normal(rng, noise_);
     const double loss = cvae_loss_and_gradients<float>(encoder_, decoder_, a_, o_, noise_,

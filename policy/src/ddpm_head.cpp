@@ -83,10 +83,8 @@ void DdpmHead::read(ByteReader& in) {
 
 double DdpmHead::train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
                             std::mt19937_64& rng) {
-  a_ = actions;
-  o_ = observations;
-  action_normalizer_.normalize(a_);
-  observation_normalizer_.normalize(o_);
+  action_normalizer_.normalize(actions, a_);
+  observation_normalizer_.normalize(observations, o_);
   const Eigen::Index batch = a_.cols();
   const int T = config_.ddpm_train_steps;
   noise_.resize(a_.rows(), batch);

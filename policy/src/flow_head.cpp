@@ -14,10 +14,8 @@ namespace handcentric::policy {
 
 double FlowHead::train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
                             std::mt19937_64& rng) {
-  a_ = actions;
-  o_ = observations;
-  action_normalizer_.normalize(a_);
-  observation_normalizer_.normalize(o_);
+  action_normalizer_.normalize(actions, a_);
+  observation_normalizer_.normalize(observations, o_);
   return train_normalized(rng);
 }
 

@@ -66,10 +66,8 @@ Eigen::MatrixXf ImageFlowHead::network_observation(ConvEncoder& encoder, Spatial
 
 double ImageFlowHead::train_step(const Eigen::MatrixXf& actions,
                                  const Eigen::MatrixXf& observations, std::mt19937_64& rng) {
-  a_ = actions;
-  o_ = observations;
-  action_normalizer_.normalize(a_);
-  observation_normalizer_.normalize(o_);
+  action_normalizer_.normalize(actions, a_);
+  observation_normalizer_.normalize(observations, o_);
   network_o_ = network_observation(encoder_, spatial_softmax_, o_);
   draw_flow_sample(rng);
   assemble(x_, t_, network_o_, input_);

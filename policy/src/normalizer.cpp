@@ -62,8 +62,18 @@ void Normalizer::normalize(Eigen::Ref<Eigen::MatrixXf> columns) const {
     throw InvalidArgument("Normalizer: vectors of length " + std::to_string(columns.rows()) +
                           ", expected " + std::to_string(dimension()));
   }
-  columns.colwise() -= mean_f_;
-  columns.array().colwise() *= inv_scale_f_.array();
+  // One pass, each value rounded after the subtraction and after the product.
+  columns.array() = (columns.array().colwise() - mean_f_.array()).colwise() * inv_scale_f_.array();
+}
+
+void Normalizer::normalize(const Eigen::Ref<const Eigen::MatrixXf>& columns,
+                           Eigen::MatrixXf& out) const {
+  if (columns.rows() != dimension()) {
+    throw InvalidArgument("Normalizer: vectors of length " + std::to_string(columns.rows()) +
+                          ", expected " + std::to_string(dimension()));
+  }
+  out.resize(columns.rows(), columns.cols());
+  out.array() = (columns.array().colwise() - mean_f_.array()).colwise() * inv_scale_f_.array();
 }
 
 void Normalizer::denormalize(Eigen::Ref<Eigen::MatrixXf> columns) const {

@@ -33,6 +33,9 @@ class Normalizer {
 
   /// In place, column by column: x <- (x - mean) / scale.
   void normalize(Eigen::Ref<Eigen::MatrixXf> columns) const;
+  /// out = the columns normalized, in one pass (out resized to their shape): the bits of a copy
+  /// normalized in place, without the pass of the copy (a training batch of images is tens of MB).
+  void normalize(const Eigen::Ref<const Eigen::MatrixXf>& columns, Eigen::MatrixXf& out) const;
   /// In place: x <- mean + scale * x.
   void denormalize(Eigen::Ref<Eigen::MatrixXf> columns) const;
 
