@@ -374,8 +374,9 @@ TEST_CASE("offset_products_have_the_bits_of_the_product_on_their_matrix", "[unit
   }
 }
 
-// pixel_conv (the image encoder's first layer of 8 filters, with the pixels in the lanes) must
-// give offset_gemm's bits on the same product with the SiLU epilogue, wherever offset_gemm runs
+// pixel_conv (the image encoder's first layer of 8 filters, with the pixels in the lanes on
+// AVX-512, the offset product itself on the other targets) must give offset_gemm's bits on the
+// same product with the SiLU epilogue, wherever offset_gemm runs
 // the blocked nest (more than 16 pixels): C and the sigmoid, rows of every width against the
 // vectors (a partial tile, one pixel), k within one k block and beyond it (the blocked nest's
 // order of the sums), overlapping windows at random offsets.

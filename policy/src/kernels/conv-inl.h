@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <vector>
 
 #include <hwy/highway.h>
 
@@ -115,6 +116,28 @@ HWY_INLINE void ForEachPatchLine(const ConvPatches& g, Run&& run, Pad&& padding)
   }
 }
 
+#if HWY_TARGET != HWY_AVX3 && HWY_TARGET != HWY_AVX3_DL
+// Only AVX-512 has vectors twice as wide as 8 filters: on AVX2 the offset product's tile already
+// fills its vectors, and the portable targets keep theirs in memory. There pixel_conv is the
+// offset product itself (its bits by definition), on every output pixel's offset; the pixel tile
+// and its transposition also cost each of those targets seconds to half a minute of compilation
+// under the sanitizers.
+inline void PixelConvForward(const PixelConv& g) {
+  constexpr int F = kPixelConvFilters;
+  const long n = static_cast<long>(g.rows) * g.width;
+  std::vector<long> pixels(static_cast<std::size_t>(std::max(n, 1L)));
+  for (long r = 0; r < g.rows; ++r) {
+    for (int x = 0; x < g.width; ++x) pixels[r * g.width + x] = g.pixel_offsets[r * g.width] + x;
+  }
+  Gemm product{Op::none, Op::none, F, static_cast<int>(n), g.k, g.weights, F, g.input, g.k,
+               g.bias,   g.c,      F};
+  product.epilogue = Epilogue::silu;
+  product.sigmoid = g.sigmoid;
+  product.lds = F;
+  vector_offset_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>(
+      {product, g.patch_offsets, pixels.data()});
+}
+#else
 /// Transposes kPixelConvFilters vectors in place: v[f] holds filter f of the vector's pixels
 /// (lane i: pixel i), and after it v[q] holds the filters of pixels q L / F ... (q + 1) L / F,
 /// each pixel's F filters together (L lanes, F = kPixelConvFilters, both powers of two). Read as
@@ -123,8 +146,6 @@ HWY_INLINE void ForEachPatchLine(const ConvPatches& g, Run&& run, Pad&& padding)
 /// even elements of the whole array, then the odd ones) rotates every index right by one bit.
 template <class D>
 HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
-// One lane (HWY_SCALAR) is its own transpose, and that target has no ConcatEven.
-#if HWY_TARGET != HWY_SCALAR
   constexpr int kVectorLanes = static_cast<int>(hn::MaxLanes(D()));
   constexpr int kHalf = kPixelConvFilters / 2;
 #pragma GCC unroll 4
@@ -138,10 +159,6 @@ HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
 #pragma GCC unroll 8
     for (int f = 0; f < kPixelConvFilters; ++f) v[f] = next[f];
   }
-#else
-  (void)d;
-  (void)v;
-#endif
 }
 
 /// One tile of PixelConvForward: `pixels` <= V L consecutive pixels of one output row (`row`:
@@ -194,9 +211,8 @@ inline void PixelConvForward(const PixelConv& g) {
   using D = hn::ScalableTag<float>;
   const D d;
   constexpr int F = kPixelConvFilters, L = static_cast<int>(hn::MaxLanes(D()));
-  // V F accumulators, V vectors of pixels and a broadcast: 19 of AVX-512's 32 registers, 10 of
-  // AVX2's 16.
-  constexpr int V = kRegisters == 32 ? 2 : 1;
+  // V F accumulators, V vectors of pixels and a broadcast: 19 of AVX-512's 32 registers.
+  constexpr int V = 2;
   alignas(64) float z[F][V * L];
   for (long r = 0; r < g.rows; ++r) {
     const float* row = g.input + g.pixel_offsets[r * g.width];
@@ -227,6 +243,8 @@ inline void PixelConvForward(const PixelConv& g) {
     }
   }
 }
+
+#endif  // the portable targets
 
 inline void Deinterleave(std::ptrdiff_t n, const float* x, float* even, float* odd) {
   std::ptrdiff_t i = 0;

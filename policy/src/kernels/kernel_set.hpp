@@ -79,7 +79,8 @@ constexpr int kPixelConvFilters = 8;
 
 /// The forward product of a convolution of kPixelConvFilters filters, C = SiLU(W P + b 1^T),
 /// with the output pixels in the vector lanes and the 8 filters' weights broadcast: the offset
-/// product puts the filters in the lanes, which fill half of an AVX-512 vector. P (K x N) is read
+/// product puts the filters in the lanes, which fill half of an AVX-512 vector. (On the other
+/// targets, whose vectors 8 filters fill, it is the offset product.) P (K x N) is read
 /// in place, P(p, j) = input[patch_offsets[p] + pixel_offsets[j]], and the pixels of one output
 /// row must be consecutive floats of the input: pixel_offsets[r width + x] = pixel_offsets[r width]
 /// + x (a channels-first map whose padded rows are stored by column phase, conv_encoder.cpp; only
