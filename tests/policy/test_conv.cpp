@@ -6,8 +6,8 @@
 // its forward, and the float encoder's by directional differences of its own. Each check is seen
 // failing on kernel sets with a planted fault (a mutant product reading its patches in place,
 // col2im, row2im, input-gradient product or SiLU', the first layer's pixel product or its rows'
-// split by column phase), on every target. Then the model-file record of
-// the encoder and the typed errors of bad shapes.
+// split by column phase), on every target. Then the model-file record of the encoder and the
+// typed errors of bad shapes.
 #include <catch2/catch.hpp>
 
 #include <algorithm>

@@ -12,6 +12,8 @@
 #include <set>
 #include <string>
 #include <unistd.h>
+#include <utility>
+#include <vector>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/draw.hpp"
@@ -137,12 +139,29 @@ Image png_test_image(int width, int height, std::uint32_t seed) {
   return image;
 }
 
+// Sizes from one pixel to rows longer than 256 bytes, for the round trip and the planted faults.
+const std::vector<std::pair<int, int>> kPngTestSizes = {
+    {1, 1}, {2, 3}, {37, 20}, {64, 48}, {257, 41}};
+
+// Planted faults in the encoder's filters (png.hpp, encode_png_predicting): Paeth's tie between
+// up and up-left broken the other way, the average rounded up. Either makes the encoder filter
+// some row with a prediction the decoder (the specification's) does not make.
+int png_paeth_tie_to_up_left(int type, int left, int up, int up_left) {
+  if (type != 4) return png_prediction(type, left, up, up_left);
+  const int p = left + up - up_left, pa = std::abs(p - left), pb = std::abs(p - up),
+            pc = std::abs(p - up_left);
+  if (pa <= pb && pa <= pc) return left;
+  return pb < pc ? up : up_left;
+}
+int png_average_rounded_up(int type, int left, int up, int up_left) {
+  return type == 3 ? (left + up + 1) / 2 : png_prediction(type, left, up, up_left);
+}
+
 }  // namespace
 
 TEST_CASE("png_files_decode_to_their_pixels_bit_for_bit_with_every_filter", "[unit]") {
   std::set<int> filters;
-  for (const auto& [width, height] :
-       std::vector<std::pair<int, int>>{{1, 1}, {2, 3}, {37, 20}, {64, 48}, {257, 41}}) {
+  for (const auto& [width, height] : kPngTestSizes) {
     INFO(width << " x " << height);
     const Image image = png_test_image(width, height, static_cast<std::uint32_t>(width * height));
     const std::string bytes = png_written(image);
@@ -177,26 +196,11 @@ TEST_CASE("mutant_png_a_damaged_file_or_a_changed_pixel_is_seen", "[unit]") {
   CHECK_FALSE(std::filesystem::exists(png_path()));
 }
 
-// Planted faults in the encoder's filters (png.hpp, encode_png_predicting): Paeth's tie between
-// up and up-left broken the other way, the average rounded up. Either makes the encoder filter
-// some row with a prediction the decoder (the specification's) does not make.
-int png_paeth_tie_to_up_left(int type, int left, int up, int up_left) {
-  if (type != 4) return png_prediction(type, left, up, up_left);
-  const int p = left + up - up_left, pa = std::abs(p - left), pb = std::abs(p - up),
-            pc = std::abs(p - up_left);
-  if (pa <= pb && pa <= pc) return left;
-  return pb < pc ? up : up_left;
-}
-int png_average_rounded_up(int type, int left, int up, int up_left) {
-  return type == 3 ? (left + up + 1) / 2 : png_prediction(type, left, up, up_left);
-}
-
 TEST_CASE("mutant_png_encoders_with_a_wrong_filter_are_seen", "[unit]") {
   // The images of the round-trip test: whether a fault shows depends on which filter wins which
   // row, so each mutant must show on at least one of them.
   int right = 0, paeth_seen = 0, average_seen = 0;
-  for (const auto& [width, height] :
-       std::vector<std::pair<int, int>>{{1, 1}, {2, 3}, {37, 20}, {64, 48}, {257, 41}}) {
+  for (const auto& [width, height] : kPngTestSizes) {
     const Image image = png_test_image(width, height, static_cast<std::uint32_t>(width * height));
     const auto decoded_with = [&image](PngPredictor predict) {
       return png_decode(encode_png_predicting(image.rgb.data(), image.rgb.size(), image.width,
