@@ -372,7 +372,15 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
     // dW (out x K) = delta patches^T and db = delta 1, the row sums of the product's A, added up
     // while it packs delta: for the first layer in one product, its patches^T (N x K) read in
     // place from the padded images forward() kept; below, chunk by chunk (in the loop).
-    if (l == 0) {
+    if (l == 0 && out == kernels::kPixelConvFilters && n > kernels::kNarrowMax) {
+      // The pixels in the lanes, as forward() did (pixel_conv_weights: other bits than the
+      // offset product on AVX-512).
+      const PaddedInput& padded = padded_[0];
+      set.pixel_conv_weights({k, batch_ * layer.output().height, layer.output().width,
+                              padded.maps.data(), padded.patch_offsets.data(),
+                              padded.pixel_offsets.data(), delta.data(), d_weights, d_bias});
+      if (!d_input) break;
+    } else if (l == 0) {
       const PaddedInput& padded = padded_[0];
       kernels::Gemm d_product{Op::none, Op::none,           out, k,       n,         delta.data(),
                               out,      padded.maps.data(), n,   nullptr, d_weights, out};

@@ -284,6 +284,11 @@ void pixel_conv_short_k(const kernels::PixelConv& problem) {
   if (wrong.k > 1) wrong.k -= 1;  // the first layer's last patch entry left out
   g_base->pixel_conv(wrong);
 }
+void pixel_conv_weights_row_short(const kernels::PixelConvGradient& problem) {
+  kernels::PixelConvGradient wrong = problem;
+  if (wrong.rows > 1) wrong.rows -= 1;  // the first layer's dW without the batch's last row
+  g_base->pixel_conv_weights(wrong);
+}
 void deinterleave_swapped(std::ptrdiff_t n, const float* x, float* even, float* odd) {
   // Each column phase gets the other's floats (a row of the first layer's padded copy misread).
   for (std::ptrdiff_t i = 0; i < n; ++i) {
@@ -322,6 +327,10 @@ std::vector<Mutant> mutants_of(const kernels::KernelSet& base) {
       mutant(
           "the first layer's pixel product one k term short", true,
           [](Set& set) { set.pixel_conv = pixel_conv_short_k; },
+          [](const Case& c) { return c.layers.front().out_channels == 8; }),
+      mutant(
+          "the first layer's weight gradient a row of pixels short", false,
+          [](Set& set) { set.pixel_conv_weights = pixel_conv_weights_row_short; },
           [](const Case& c) { return c.layers.front().out_channels == 8; }),
       mutant(
           "the first layer's rows split into the wrong column phases", true,

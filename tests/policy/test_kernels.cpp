@@ -374,6 +374,23 @@ TEST_CASE("offset_products_have_the_bits_of_the_product_on_their_matrix", "[unit
   }
 }
 
+// The input of a PixelConv or PixelConvGradient: k patch entries at random offsets (windows that
+// overlap) and `rows` rows of `width` consecutive pixels each, from random starts.
+struct RowWindows {
+  std::vector<float> input;
+  std::vector<long> patches, pixels;
+  RowWindows(int k, int rows, int width, std::mt19937_64& rng)
+      : patches(static_cast<std::size_t>(k)), pixels(static_cast<std::size_t>(rows) * width) {
+    const long span = 2L * k + 3L * width + 1;
+    input = random_floats(static_cast<std::size_t>(4 * span), rng);
+    for (long& offset : patches) offset = static_cast<long>(uniform01(rng) * span);
+    for (int r = 0; r < rows; ++r) {
+      const long start = static_cast<long>(uniform01(rng) * 2 * span);
+      for (int x = 0; x < width; ++x) pixels[static_cast<std::size_t>(r) * width + x] = start + x;
+    }
+  }
+};
+
 // pixel_conv (the image encoder's first layer of 8 filters, with the pixels in the lanes on
 // AVX-512, the offset product itself on the other targets) must give offset_gemm's bits on the
 // same product with the SiLU epilogue, wherever offset_gemm runs
@@ -391,18 +408,12 @@ TEST_CASE("pixel_products_have_the_bits_of_the_offset_product", "[unit]") {
       for (const auto& shape : std::vector<std::pair<int, int>>{
                {20, 1}, {4, 5}, {3, 16}, {3, 17}, {2, 32}, {3, 33}, {2, 47}}) {
         const int rows = shape.first, width = shape.second, n = rows * width;
-        const long span = 2L * k + 3L * width + 1;
-        const std::vector<float> input = random_floats(static_cast<std::size_t>(4 * span), rng);
         const std::vector<float> weights =
             random_floats(static_cast<std::size_t>(kFilters) * k, rng);
         const std::vector<float> bias = random_floats(kFilters, rng);
-        std::vector<long> patches(static_cast<std::size_t>(k)), pixels(static_cast<std::size_t>(n));
-        for (long& offset : patches) offset = static_cast<long>(uniform01(rng) * span);
-        for (int r = 0; r < rows; ++r) {
-          const long start = static_cast<long>(uniform01(rng) * 2 * span);
-          for (int x = 0; x < width; ++x)
-            pixels[static_cast<std::size_t>(r * width + x)] = start + x;
-        }
+        const RowWindows windows(k, rows, width, rng);
+        const std::vector<float>& input = windows.input;
+        const std::vector<long>&patches = windows.patches, &pixels = windows.pixels;
         const std::size_t size = static_cast<std::size_t>(kFilters) * n;
         std::vector<float> c(size, 7.0f), sigmoid(size, 7.0f);
         const auto expected_run = [&] {
@@ -432,6 +443,92 @@ TEST_CASE("pixel_products_have_the_bits_of_the_offset_product", "[unit]") {
           CHECK(pixel_run(wrong.data(), k).first != expected.first);
           CHECK(pixel_run(patches.data(), k - 1).first != expected.first);
         }
+      }
+    }
+  }
+}
+
+// pixel_conv_weights (the first layer's weight gradient, dW = delta P^T and db = delta 1): the
+// sums of a double reference on every target, for rows of every width against the vectors
+// (partial vectors, one pixel), more rows than one chunk, k with and without a tail of entries
+// beside the 6-entry tiles, and overlapping windows at random offsets; the offset product's
+// bits on the targets where it is that product. dW and db are written, not accumulated.
+TEST_CASE("pixel_weight_gradients_are_the_sums_of_the_double_reference", "[unit]") {
+  constexpr int kFilters = kernels::kPixelConvFilters;
+  std::mt19937_64 rng(31);
+  for (const auto& [name, set_pointer] : every_target()) {
+    INFO("target " << name);
+    const kernels::KernelSet* set = set_pointer;
+    const bool offset_product = name.rfind("AVX3", 0) != 0;  // the pixels in the lanes on AVX-512
+    for (int k : {1, 7, 54}) {
+      for (const auto& shape : std::vector<std::pair<int, int>>{
+               {20, 1}, {4, 5}, {3, 16}, {3, 17}, {30, 32}, {3, 33}, {2, 47}}) {
+        const int rows = shape.first, width = shape.second, n = rows * width;
+        const std::vector<float> delta = random_floats(static_cast<std::size_t>(kFilters) * n, rng);
+        const RowWindows windows(k, rows, width, rng);
+        const std::vector<float>& input = windows.input;
+        const std::vector<long>&patches = windows.patches, &pixels = windows.pixels;
+        // The reference, and the scale of each sum (the sum of its terms' magnitudes).
+        std::vector<double> weights(static_cast<std::size_t>(kFilters) * k), bias(kFilters);
+        std::vector<double> weight_scale(weights.size()), bias_scale(kFilters);
+        for (int j = 0; j < n; ++j) {
+          for (int f = 0; f < kFilters; ++f) {
+            const double d = delta[static_cast<std::size_t>(j) * kFilters + f];
+            bias[f] += d;
+            bias_scale[f] += std::abs(d);
+            for (int p = 0; p < k; ++p) {
+              const double term = d * input[patches[p] + pixels[j]];
+              weights[static_cast<std::size_t>(p) * kFilters + f] += term;
+              weight_scale[static_cast<std::size_t>(p) * kFilters + f] += std::abs(term);
+            }
+          }
+        }
+        std::vector<float> d_weights(weights.size()), d_bias(kFilters);
+        const auto run = [&](const long* patch_offsets, int terms, int row_count) {
+          std::fill(d_weights.begin(), d_weights.end(), 7.0f);
+          std::fill(d_bias.begin(), d_bias.end(), 7.0f);
+          set->pixel_conv_weights({terms, row_count, width, input.data(), patch_offsets,
+                                   pixels.data(), delta.data(), d_weights.data(), d_bias.data()});
+          // The worst error against the reference, in units of float rounding of the terms.
+          double worst = 0;
+          for (std::size_t i = 0; i < weights.size(); ++i) {
+            worst = std::max(worst, std::abs(d_weights[i] - weights[i]) / weight_scale[i]);
+          }
+          for (int f = 0; f < kFilters; ++f) {
+            worst = std::max(worst, std::abs(d_bias[f] - bias[f]) / bias_scale[f]);
+          }
+          return worst;
+        };
+        INFO("k " << k << " rows " << rows << " width " << width);
+        // n terms of float rounding at most (each term and each addition), 1e-7 apiece.
+        CHECK(run(patches.data(), k, rows) < 1e-7 * (n + 2));
+        if (offset_product) {
+          std::vector<float> expected_weights(weights.size(), 7.0f), expected_bias(kFilters, 7.0f);
+          kernels::Gemm product{Op::none,
+                                Op::none,
+                                kFilters,
+                                k,
+                                n,
+                                delta.data(),
+                                kFilters,
+                                input.data(),
+                                n,
+                                nullptr,
+                                expected_weights.data(),
+                                kFilters};
+          product.a_row_sums = expected_bias.data();
+          set->offset_gemm({product, pixels.data(), patches.data()});
+          run(patches.data(), k, rows);
+          CHECK(d_weights == expected_weights);
+          CHECK(d_bias == expected_bias);
+        }
+        // Planted faults: the last patch entry read from the first one's place; a row left out.
+        if (k >= 2) {
+          std::vector<long> wrong = patches;
+          wrong.back() = wrong.front() == wrong.back() ? wrong.back() + 1 : wrong.front();
+          CHECK(run(wrong.data(), k, rows) > 1e-3);
+        }
+        if (rows >= 2) CHECK(run(patches.data(), k, rows - 1) > 1e-3);
       }
     }
   }

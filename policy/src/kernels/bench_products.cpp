@@ -102,17 +102,29 @@ BENCHMARK_CAPTURE(product, conv3_d_patches, Op::transpose, Op::none, 288, 9 * kP
                   Epilogue::none);
 
 // The image policies' default first layer (6 x 48 x 64 -> 8 filters of 3 x 3, stride 2: 24 x 32
-// output pixels, K = 54) on one chunk of 3 samples, as ConvEncoder runs it, from the padded maps
-// stored by column phase: the offset product (8 filters in the lanes, half an AVX-512 vector)
-// against pixel_conv (the pixels in the lanes), both with the SiLU epilogue and the same bits.
-void first_layer(benchmark::State& state, bool pixels_in_lanes) {
-  constexpr int kChannels = 6, kHeight = 48, kWidth = 64, kFilters = 8, kSamples = 3;
+// output pixels, K = 54) as ConvEncoder runs it, from the padded maps stored by column phase.
+// Forward, on one chunk of 3 samples: the offset product (8 filters in the lanes, half an AVX-512
+// vector) against pixel_conv (the pixels in the lanes), both with the SiLU epilogue and the same
+// bits. The weight gradient dW = delta P^T and db, on 64 samples (one product over the batch's
+// copy, which backward reads whole): the offset product with the row sums of delta against
+// pixel_conv_weights.
+enum class FirstLayer {
+  forward_filters_in_lanes,
+  forward_pixels_in_lanes,
+  weights_filters_in_lanes,
+  weights_pixels_in_lanes
+};
+void first_layer(benchmark::State& state, FirstLayer mode) {
+  const bool forward =
+      mode == FirstLayer::forward_filters_in_lanes || mode == FirstLayer::forward_pixels_in_lanes;
+  constexpr int kChannels = 6, kHeight = 48, kWidth = 64, kFilters = 8;
   constexpr int kOutHeight = 24, kOutWidth = 32, kK = 9 * kChannels;
+  const int samples = forward ? 3 : 64;
   constexpr long kPhase = (kWidth + 2) / 2, kRow = 2 * kPhase, kPlane = kRow * (kHeight + 2),
                  kSample = kPlane * kChannels;
   std::mt19937 rng(2);
   std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
-  std::vector<float> maps(static_cast<std::size_t>(kSample) * kSamples);
+  std::vector<float> maps(static_cast<std::size_t>(kSample) * samples);
   for (float& x : maps) x = uniform(rng);
   std::vector<float> weights(static_cast<std::size_t>(kFilters) * kK), bias(kFilters);
   for (float& w : weights) w = 0.1f * uniform(rng);
@@ -122,30 +134,52 @@ void first_layer(benchmark::State& state, bool pixels_in_lanes) {
     for (int kx = 0; kx < 3; ++kx)
       for (int c = 0; c < kChannels; ++c)
         patches.push_back(c * kPlane + ky * kRow + kx % 2 * kPhase + kx / 2);
-  for (int b = 0; b < kSamples; ++b)
+  for (int b = 0; b < samples; ++b)
     for (int oy = 0; oy < kOutHeight; ++oy)
       for (int ox = 0; ox < kOutWidth; ++ox) pixels.push_back(b * kSample + 2L * oy * kRow + ox);
   const int n = static_cast<int>(pixels.size());
   std::vector<float> c(static_cast<std::size_t>(kFilters) * n), sigmoid(c.size());
+  for (float& x : c) x = uniform(rng);  // delta, for the weight gradient
   const auto& kernels = handcentric::policy::kernels::active();
   Gemm gemm{Op::none, Op::none,    kFilters, n,           kK,       weights.data(),
             kFilters, maps.data(), kK,       bias.data(), c.data(), kFilters};
   gemm.epilogue = Epilogue::silu;
   gemm.sigmoid = sigmoid.data();
   gemm.lds = kFilters;
+  Gemm d_weights{Op::none, Op::none, kFilters,       kK,      n, c.data(), kFilters, maps.data(),
+                 n,        nullptr,  weights.data(), kFilters};
+  d_weights.a_row_sums = bias.data();
   for (auto _ : state) {
-    if (pixels_in_lanes) {
-      kernels.pixel_conv({kK, kSamples * kOutHeight, kOutWidth, weights.data(), bias.data(),
-                          maps.data(), patches.data(), pixels.data(), c.data(), sigmoid.data()});
-    } else {
-      kernels.offset_gemm({gemm, patches.data(), pixels.data()});
+    switch (mode) {
+      case FirstLayer::forward_filters_in_lanes:
+        kernels.offset_gemm({gemm, patches.data(), pixels.data()});
+        break;
+      case FirstLayer::forward_pixels_in_lanes:
+        kernels.pixel_conv({kK, samples * kOutHeight, kOutWidth, weights.data(), bias.data(),
+                            maps.data(), patches.data(), pixels.data(), c.data(), sigmoid.data()});
+        break;
+      case FirstLayer::weights_filters_in_lanes:
+        kernels.offset_gemm({d_weights, pixels.data(), patches.data()});
+        break;
+      case FirstLayer::weights_pixels_in_lanes:
+        kernels.pixel_conv_weights({kK, samples * kOutHeight, kOutWidth, maps.data(),
+                                    patches.data(), pixels.data(), c.data(), weights.data(),
+                                    bias.data()});
+        break;
     }
     benchmark::DoNotOptimize(c.data());
+    benchmark::DoNotOptimize(weights.data());
   }
   state.SetItemsProcessed(state.iterations() * 2L * kFilters * n * kK);  // flops
 }
-BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_filters_in_lanes, false);
-BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_pixels_in_lanes, true);
+BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_filters_in_lanes,
+                  FirstLayer::forward_filters_in_lanes);
+BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_pixels_in_lanes,
+                  FirstLayer::forward_pixels_in_lanes);
+BENCHMARK_CAPTURE(first_layer, default_conv1_weights_filters_in_lanes,
+                  FirstLayer::weights_filters_in_lanes);
+BENCHMARK_CAPTURE(first_layer, default_conv1_weights_pixels_in_lanes,
+                  FirstLayer::weights_pixels_in_lanes);
 
 }  // namespace
 

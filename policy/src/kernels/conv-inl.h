@@ -1,6 +1,7 @@
 // Private, per target: col2im and row2im (kernel_set.hpp, ConvPatches), which add a patch
 // matrix's gradient back onto the pixels its entries were read from (the input gradient of a
-// convolution), and the first layer's forward product with the pixels in the lanes (PixelConv).
+// convolution), and the first layer's forward product and weight gradient with the pixels in the
+// lanes (PixelConv, PixelConvGradient).
 // The other forward products read their patches in place (OffsetGemm), so nothing writes a patch
 // matrix; those products are the GEMM driver's.
 
@@ -8,6 +9,7 @@
 #include <cstddef>
 #include <vector>
 
+#include <hwy/aligned_allocator.h>
 #include <hwy/highway.h>
 
 #include "kernels/kernel_set.hpp"
@@ -122,13 +124,21 @@ HWY_INLINE void ForEachPatchLine(const ConvPatches& g, Run&& run, Pad&& padding)
 // offset product itself (its bits by definition), on every output pixel's offset; the pixel tile
 // and its transposition also cost each of those targets seconds to half a minute of compilation
 // under the sanitizers.
+
+/// The offset of every pixel of `rows` rows of `width` consecutive floats, from each row's first.
+inline std::vector<long> EveryPixelOffset(int rows, int width, const long* row_offsets) {
+  const long n = static_cast<long>(rows) * width;
+  std::vector<long> pixels(static_cast<std::size_t>(std::max(n, 1L)));
+  for (long r = 0; r < rows; ++r) {
+    for (int x = 0; x < width; ++x) pixels[r * width + x] = row_offsets[r * width] + x;
+  }
+  return pixels;
+}
+
 inline void PixelConvForward(const PixelConv& g) {
   constexpr int F = kPixelConvFilters;
   const long n = static_cast<long>(g.rows) * g.width;
-  std::vector<long> pixels(static_cast<std::size_t>(std::max(n, 1L)));
-  for (long r = 0; r < g.rows; ++r) {
-    for (int x = 0; x < g.width; ++x) pixels[r * g.width + x] = g.pixel_offsets[r * g.width] + x;
-  }
+  const std::vector<long> pixels = EveryPixelOffset(g.rows, g.width, g.pixel_offsets);
   Gemm product{Op::none, Op::none, F, static_cast<int>(n), g.k, g.weights, F, g.input, g.k,
                g.bias,   g.c,      F};
   product.epilogue = Epilogue::silu;
@@ -137,19 +147,30 @@ inline void PixelConvForward(const PixelConv& g) {
   vector_offset_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>(
       {product, g.patch_offsets, pixels.data()});
 }
+
+/// dW = delta P^T and db = delta 1 as the offset product with the row sums of its A (the bits
+/// it has always had on these targets).
+inline void PixelConvWeights(const PixelConvGradient& g) {
+  constexpr int F = kPixelConvFilters;
+  const long n = static_cast<long>(g.rows) * g.width;
+  const std::vector<long> pixels = EveryPixelOffset(g.rows, g.width, g.pixel_offsets);
+  Gemm product{
+      Op::none, Op::none,    F, g.k, static_cast<int>(n), g.delta, F, g.input, static_cast<int>(n),
+      nullptr,  g.d_weights, F};
+  product.a_row_sums = g.d_bias;
+  vector_offset_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>(
+      {product, pixels.data(), g.patch_offsets});
+}
 #else
-/// Transposes kPixelConvFilters vectors in place: v[f] holds filter f of the vector's pixels
-/// (lane i: pixel i), and after it v[q] holds the filters of pixels q L / F ... (q + 1) L / F,
-/// each pixel's F filters together (L lanes, F = kPixelConvFilters, both powers of two). Read as
-/// one array of F L floats, the element at index m = f L + i goes to n = i F + f: m's bits
-/// rotated right by log2(L). One round of ConcatEven and ConcatOdd over the vectors' pairs (the
-/// even elements of the whole array, then the odd ones) rotates every index right by one bit.
-template <class D>
-HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
-  constexpr int kVectorLanes = static_cast<int>(hn::MaxLanes(D()));
+/// Rotates the element indices of kPixelConvFilters vectors, read as one array of F L floats
+/// (L lanes, F = kPixelConvFilters, both powers of two), right by kRounds bits: one round of
+/// ConcatEven and ConcatOdd over the vectors' pairs (the even elements of the whole array, then
+/// the odd ones) rotates every index right by one bit.
+template <int kRounds, class D>
+HWY_INLINE void RotateElementIndices(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
   constexpr int kHalf = kPixelConvFilters / 2;
 #pragma GCC unroll 4
-  for (int round = 1; round < kVectorLanes; round *= 2) {
+  for (int round = 0; round < kRounds; ++round) {
     hn::Vec<D> next[kPixelConvFilters];
 #pragma GCC unroll 4
     for (int t = 0; t < kHalf; ++t) {
@@ -159,6 +180,27 @@ HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
 #pragma GCC unroll 8
     for (int f = 0; f < kPixelConvFilters; ++f) v[f] = next[f];
   }
+}
+
+constexpr int Log2(int power_of_two) {
+  return power_of_two <= 1 ? 0 : 1 + Log2(power_of_two / 2);
+}
+
+/// Transposes kPixelConvFilters vectors in place: v[f] holds filter f of the vector's pixels
+/// (lane i: pixel i), and after it v[q] holds the filters of pixels q L / F ... (q + 1) L / F,
+/// each pixel's F filters together. The element at index m = f L + i goes to n = i F + f: m's
+/// bits rotated right by log2(L).
+template <class D>
+HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
+  RotateElementIndices<Log2(static_cast<int>(hn::MaxLanes(D())))>(d, v);
+}
+
+/// The inverse: v[q] holds L / F pixels' filters together (as the encoder stores a map and its
+/// gradient), and after it v[f] holds filter f of the L pixels (lane i: pixel i). Index
+/// n = i F + f goes to m = f L + i: n's bits rotated right by log2(F).
+template <class D>
+HWY_INLINE void TransposePixels(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
+  RotateElementIndices<Log2(kPixelConvFilters)>(d, v);
 }
 
 /// One tile of PixelConvForward: `pixels` <= V L consecutive pixels of one output row (`row`:
@@ -242,6 +284,125 @@ inline void PixelConvForward(const PixelConv& g) {
       }
     }
   }
+}
+
+/// Rows of output pixels per chunk of PixelConvWeights: the chunk's delta (transposed, 1 KB a
+/// row of 32 pixels) and the image rows its windows read (~3 KB a row of the default 6-channel
+/// image) stay in L1 through the chunk's 2 (K / 6) passes. Measured on the default first layer
+/// (bench_kernels, first_layer): 8 rows ~100 GFLOP/s, 16 ~99, 32 ~80, 64 ~70.
+constexpr int kWeightChunkRows = 8;
+
+/// One pass of PixelConvWeights over a chunk: for kFilters filters from `filter` and kEntries patch
+/// entries from `entry`, the chunk's products summed per lane and added to lane_sums (lanes
+/// kept apart: entry e, filter f at lane_sums + (e F + f) L). delta_t holds the chunk's delta
+/// transposed, F vectors per vector of pixels (lane i: pixel i, zero past a row's end).
+template <int kFilters, int kEntries, bool kFullRows, class D>
+HWY_INLINE void PixelWeightTile(D d, const PixelConvGradient& g, long r0, int chunk_rows,
+                                const float* delta_t, int filter, int entry, float* lane_sums) {
+  constexpr int F = kPixelConvFilters, L = static_cast<int>(hn::MaxLanes(D()));
+  const int vectors = (g.width + L - 1) / L;
+  hn::Vec<D> acc[kEntries][kFilters];
+#pragma GCC unroll 8
+  for (int e = 0; e < kEntries; ++e) {
+#pragma GCC unroll 8
+    for (int f = 0; f < kFilters; ++f) acc[e][f] = hn::Zero(d);
+  }
+  for (int r = 0; r < chunk_rows; ++r) {
+    const float* row = g.input + g.pixel_offsets[(r0 + r) * g.width];
+    for (int v = 0; v < vectors; ++v) {
+      const float* delta_v = delta_t + (static_cast<long>(r) * vectors + v) * F * L;
+      hn::Vec<D> delta[kFilters];
+#pragma GCC unroll 8
+      for (int f = 0; f < kFilters; ++f) delta[f] = hn::Load(d, delta_v + (filter + f) * L);
+      const std::size_t pixels = static_cast<std::size_t>(std::min(L, g.width - v * L));
+#pragma GCC unroll 8
+      for (int e = 0; e < kEntries; ++e) {
+        // Past a row's end delta is zero and the image is not read (a masked load).
+        const float* at = row + g.patch_offsets[entry + e] + v * L;
+        const auto x = kFullRows ? hn::LoadU(d, at) : LoadPart(d, at, pixels);
+#pragma GCC unroll 8
+        for (int f = 0; f < kFilters; ++f) acc[e][f] = hn::MulAdd(x, delta[f], acc[e][f]);
+      }
+    }
+  }
+#pragma GCC unroll 8
+  for (int e = 0; e < kEntries; ++e) {
+#pragma GCC unroll 8
+    for (int f = 0; f < kFilters; ++f) {
+      float* sum = lane_sums + (static_cast<long>(entry + e) * F + filter + f) * L;
+      hn::Store(hn::Add(hn::Load(d, sum), acc[e][f]), d, sum);
+    }
+  }
+}
+
+/// dW = delta P^T and db = delta 1 with the pixels in the lanes: each (entry, filter) sum is
+/// kept in L partial sums, one per lane, over chunks of kWeightChunkRows rows, and the lanes are
+/// added at the end. A tile of 4 filters x 6 entries makes 24 full-width multiply-adds per 10
+/// loads; the offset product's tile, with the filters in the lanes, makes one half-width
+/// multiply-add per load (each patch value feeds the 8 filters and nothing else).
+inline void PixelConvWeights(const PixelConvGradient& g) {
+  using D = hn::ScalableTag<float>;
+  const D d;
+  constexpr int F = kPixelConvFilters, L = static_cast<int>(hn::MaxLanes(D()));
+  constexpr int kTileFilters = 4, kTileEntries = 6;
+  const int vectors = (g.width + L - 1) / L;
+  auto lane_sums = hwy::AllocateAligned<float>(static_cast<std::size_t>(g.k + 1) * F * L);
+  auto delta_t = hwy::AllocateAligned<float>(
+      static_cast<std::size_t>(std::min<long>(kWeightChunkRows, g.rows)) * vectors * F * L);
+  std::fill(lane_sums.get(), lane_sums.get() + static_cast<std::size_t>(g.k + 1) * F * L, 0.0f);
+  float* bias_sums = lane_sums.get() + static_cast<long>(g.k) * F * L;
+  for (long r0 = 0; r0 < g.rows; r0 += kWeightChunkRows) {
+    const int chunk_rows = static_cast<int>(std::min<long>(kWeightChunkRows, g.rows - r0));
+    // The chunk's delta, each vector of pixels transposed to its filters; db's lanes on the way.
+    hn::Vec<D> bias[F];
+#pragma GCC unroll 8
+    for (int f = 0; f < F; ++f) bias[f] = hn::Load(d, bias_sums + f * L);
+    for (int r = 0; r < chunk_rows; ++r) {
+      for (int v = 0; v < vectors; ++v) {
+        const float* in = g.delta + ((r0 + r) * g.width + static_cast<long>(v) * L) * F;
+        const int floats = std::min(L, g.width - v * L) * F;
+        hn::Vec<D> t[F];
+#pragma GCC unroll 8
+        for (int q = 0; q < F; ++q) {
+          t[q] =
+              LoadPart(d, in + q * L, static_cast<std::size_t>(std::clamp(floats - q * L, 0, L)));
+        }
+        TransposePixels(d, t);
+        float* out = delta_t.get() + (static_cast<long>(r) * vectors + v) * F * L;
+#pragma GCC unroll 8
+        for (int f = 0; f < F; ++f) {
+          hn::Store(t[f], d, out + f * L);
+          bias[f] = hn::Add(bias[f], t[f]);
+        }
+      }
+    }
+#pragma GCC unroll 8
+    for (int f = 0; f < F; ++f) hn::Store(bias[f], d, bias_sums + f * L);
+    for (int filter = 0; filter < F; filter += kTileFilters) {
+      int entry = 0;
+      for (; entry + kTileEntries <= g.k; entry += kTileEntries) {
+        if (g.width % L == 0) {
+          PixelWeightTile<kTileFilters, kTileEntries, true>(d, g, r0, chunk_rows, delta_t.get(),
+                                                            filter, entry, lane_sums.get());
+        } else {
+          PixelWeightTile<kTileFilters, kTileEntries, false>(d, g, r0, chunk_rows, delta_t.get(),
+                                                             filter, entry, lane_sums.get());
+        }
+      }
+      for (; entry < g.k; ++entry) {
+        PixelWeightTile<kTileFilters, 1, false>(d, g, r0, chunk_rows, delta_t.get(), filter, entry,
+                                                lane_sums.get());
+      }
+    }
+  }
+  for (int e = 0; e < g.k; ++e) {
+    for (int f = 0; f < F; ++f) {
+      g.d_weights[static_cast<long>(e) * F + f] = hn::GetLane(
+          hn::SumOfLanes(d, hn::Load(d, lane_sums.get() + (static_cast<long>(e) * F + f) * L)));
+    }
+  }
+  for (int f = 0; f < F; ++f)
+    g.d_bias[f] = hn::GetLane(hn::SumOfLanes(d, hn::Load(d, bias_sums + f * L)));
 }
 
 #endif  // the portable targets

@@ -101,6 +101,26 @@ struct PixelConv {
   float* sigmoid = nullptr;
 };
 
+/// The weight gradient of a PixelConv: dW = delta P^T (kPixelConvFilters x K, ld
+/// kPixelConvFilters, as PixelConv's W) and db = delta 1, with P read as PixelConv reads it (the
+/// pixels of one output row consecutive floats of the input; only each row's first offset is
+/// read) and delta kPixelConvFilters x N (ld kPixelConvFilters, each pixel's filters together, as
+/// the encoder stores a map's gradient). dW and db are written, not accumulated. On AVX-512 the
+/// pixels go in the lanes and each sum is split over the lanes and over chunks of rows, added up
+/// at the end: not offset_gemm's order of the terms, so other bits than its product (float sums
+/// of the same terms, as accurate). On the other targets it is offset_gemm on delta and P^T with
+/// a_row_sums = db, that product's bits.
+struct PixelConvGradient {
+  int k = 0;
+  int rows = 0, width = 0;  ///< N = rows width, as PixelConv
+  const float* input = nullptr;
+  const long* patch_offsets = nullptr;
+  const long* pixel_offsets = nullptr;
+  const float* delta = nullptr;
+  float* d_weights = nullptr;
+  float* d_bias = nullptr;
+};
+
 /// Handles the degenerate shapes (m, n or k <= 0; k = 0 writes C = bias 1^T) and returns
 /// true; false for a real product. Every set's gemm starts with it.
 bool trivial_gemm(const Gemm& problem);
@@ -164,6 +184,8 @@ struct KernelSet {
   /// A convolution of kPixelConvFilters filters with its pixels in the lanes (PixelConv): the
   /// bits of offset_gemm on that product.
   void (*pixel_conv)(const PixelConv& problem);
+  /// Its weight gradient (PixelConvGradient), with the pixels in the lanes on AVX-512.
+  void (*pixel_conv_weights)(const PixelConvGradient& problem);
   /// even[i] = x[2 i] and odd[i] = x[2 i + 1] for the n floats of x: a row of an image stored
   /// by column phase for a convolution of stride 2 (PixelConv).
   void (*deinterleave)(std::ptrdiff_t n, const float* x, float* even, float* odd);

@@ -41,6 +41,7 @@ const KernelSet* TargetKernels() {
   static constexpr KernelSet kSet{vector_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>,
                                   vector_offset_gemm<GemmKernel, ShortGemmKernel, HalfGemmKernel>,
                                   PixelConvForward,
+                                  PixelConvWeights,
                                   Deinterleave,
                                   SiluForward,
                                   SiluBackward,
