@@ -3,9 +3,9 @@
 # LeakSanitizer) and UndefinedBehaviorSanitizer into ${ASAN_BUILD_DIR:-build-asan} (-O1 with line
 # tables, no benchmarks, the libFuzzer targets too, with coverage feedback on the parsers of
 # outside data only: on every file it made the tests 1.5-2.8x slower), runs the ctest labels
-# unit, property and proofs there, then every fuzz target for ${FUZZ_SECONDS:-20} s
+# unit, property and proofs there, then every fuzz target for ${FUZZ_SECONDS:-15} s
 # (scripts/fuzz.sh, same tree;
-# 20 s in CI for its 25 minutes: the longer runs of docs/RELIABILITY.md, 60 s and 240 s per
+# 15 s in CI for its 25 minutes: the longer runs of docs/RELIABILITY.md, 60 s and 240 s per
 # target, found nothing).
 # A report aborts the test or fuzz run that caused it, so any report fails this script and CI.
 # Prints the build, test and fuzz times last. docs/RELIABILITY.md has the measured figures.
@@ -85,7 +85,7 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 
-FUZZ_BUILD_DIR="$build_dir" FUZZ_CXX="$cxx" bash "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-20}"
+FUZZ_BUILD_DIR="$build_dir" FUZZ_CXX="$cxx" bash "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-15}"
 fuzzed=$(date +%s)
 echo "sanitize: build $((built - start)) s, tests $((tested - built)) s" \
      "(labels unit, property, proofs)," \

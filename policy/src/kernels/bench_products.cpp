@@ -105,9 +105,9 @@ BENCHMARK_CAPTURE(product, conv3_d_patches, Op::transpose, Op::none, 288, 9 * kP
 // output pixels, K = 54) as ConvEncoder runs it, from the padded maps stored by column phase.
 // Forward, on one chunk of 3 samples: the offset product (8 filters in the lanes, half an AVX-512
 // vector) against pixel_conv (the pixels in the lanes), both with the SiLU epilogue and the same
-// bits. The weight gradient dW = delta P^T and db, on 64 samples (one product over the batch's
-// copy, which backward reads whole): the offset product with the row sums of delta against
-// pixel_conv_weights.
+// bits. The weight gradient dW = delta P^T and db, on 64 and 256 samples (one product over the
+// batch's copy, which backward reads whole: 5 and 20 MB, the latter from memory rather than L3):
+// the offset product with the row sums of delta against pixel_conv_weights.
 enum class FirstLayer {
   forward_filters_in_lanes,
   forward_pixels_in_lanes,
@@ -119,7 +119,7 @@ void first_layer(benchmark::State& state, FirstLayer mode) {
       mode == FirstLayer::forward_filters_in_lanes || mode == FirstLayer::forward_pixels_in_lanes;
   constexpr int kChannels = 6, kHeight = 48, kWidth = 64, kFilters = 8;
   constexpr int kOutHeight = 24, kOutWidth = 32, kK = 9 * kChannels;
-  const int samples = forward ? 3 : 64;
+  const int samples = forward ? 3 : static_cast<int>(state.range(0));
   constexpr long kPhase = (kWidth + 2) / 2, kRow = 2 * kPhase, kPlane = kRow * (kHeight + 2),
                  kSample = kPlane * kChannels;
   std::mt19937 rng(2);
@@ -177,9 +177,13 @@ BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_filters_in_lanes,
 BENCHMARK_CAPTURE(first_layer, default_conv1_forward_silu_pixels_in_lanes,
                   FirstLayer::forward_pixels_in_lanes);
 BENCHMARK_CAPTURE(first_layer, default_conv1_weights_filters_in_lanes,
-                  FirstLayer::weights_filters_in_lanes);
+                  FirstLayer::weights_filters_in_lanes)
+    ->Arg(64)
+    ->Arg(256);
 BENCHMARK_CAPTURE(first_layer, default_conv1_weights_pixels_in_lanes,
-                  FirstLayer::weights_pixels_in_lanes);
+                  FirstLayer::weights_pixels_in_lanes)
+    ->Arg(64)
+    ->Arg(256);
 
 }  // namespace
 
