@@ -68,6 +68,16 @@ double ImageFlowHead::train_step(const Eigen::MatrixXf& actions,
                                  const Eigen::MatrixXf& observations, std::mt19937_64& rng) {
   action_normalizer_.normalize(actions, a_);
   observation_normalizer_.normalize(observations, o_);
+  return train_normalized(rng);
+}
+
+double ImageFlowHead::train_step_on(const Minibatch& batch, std::mt19937_64& rng) {
+  action_normalizer_.normalize(batch.set_actions, batch.columns, a_);
+  observation_normalizer_.normalize(batch.set_observations, batch.columns, o_);
+  return train_normalized(rng);
+}
+
+double ImageFlowHead::train_normalized(std::mt19937_64& rng) {
   network_o_ = network_observation(encoder_, spatial_softmax_, o_);
   draw_flow_sample(rng);
   assemble(x_, t_, network_o_, input_);

@@ -39,6 +39,10 @@ class ImageFlowHead final : public FlowHead {
                std::mt19937_64& rng) override;
   double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
                     std::mt19937_64& rng) override;
+  /// train_step on the drawn columns normalized straight from the training set (the same bits,
+  /// without the trainer's copy of the batch: tens of MB of images a step).
+  double train_step_on(const Minibatch& batch, std::mt19937_64& rng) override;
+  bool reads_the_set() const override { return true; }
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override;
   void finish_training() override;
   /// NetworkHead's record, then the encoder's (ConvEncoder::write).
@@ -53,6 +57,8 @@ class ImageFlowHead final : public FlowHead {
   /// for spatial_softmax features) run forward.
   Eigen::MatrixXf network_observation(ConvEncoder& encoder, SpatialSoftmax& softmax,
                                       const Eigen::MatrixXf& o) const;
+  /// The step after normalization: a_ and o_ hold the batch's normalized columns.
+  double train_normalized(std::mt19937_64& rng);
 
   int proprio_rows_ = 0;
   ConvEncoder encoder_;

@@ -76,6 +76,25 @@ void Normalizer::normalize(const Eigen::Ref<const Eigen::MatrixXf>& columns,
   out.array() = (columns.array().colwise() - mean_f_.array()).colwise() * inv_scale_f_.array();
 }
 
+void Normalizer::normalize(const Eigen::Ref<const Eigen::MatrixXf>& set,
+                           std::span<const Eigen::Index> picked, Eigen::MatrixXf& out) const {
+  if (set.rows() != dimension()) {
+    throw InvalidArgument("Normalizer: vectors of length " + std::to_string(set.rows()) +
+                          ", expected " + std::to_string(dimension()));
+  }
+  for (const Eigen::Index i : picked) {
+    if (i < 0 || i >= set.cols()) {
+      throw InvalidArgument("Normalizer: column " + std::to_string(i) + " picked from a set of " +
+                            std::to_string(set.cols()) + " columns");
+    }
+  }
+  out.resize(set.rows(), static_cast<Eigen::Index>(picked.size()));
+  for (std::size_t j = 0; j < picked.size(); ++j) {
+    out.col(static_cast<Eigen::Index>(j)).array() =
+        (set.col(picked[j]).array() - mean_f_.array()) * inv_scale_f_.array();
+  }
+}
+
 void Normalizer::denormalize(Eigen::Ref<Eigen::MatrixXf> columns) const {
   if (columns.rows() != dimension()) {
     throw InvalidArgument("Normalizer: vectors of length " + std::to_string(columns.rows()) +

@@ -109,8 +109,10 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
         "the training data has a value beyond the float32 range (|x| > 3.4e38): express poses and "
         "points in metres and radians");
   }
-  Eigen::MatrixXf batch_actions(actions.rows(), config.batch_size);
-  Eigen::MatrixXf batch_observations(observations.rows(), config.batch_size);
+  // Not filled (nor allocated) for a head that reads the set's columns itself.
+  const bool gather = !head->reads_the_set();
+  Eigen::MatrixXf batch_actions(actions.rows(), gather ? config.batch_size : 0);
+  Eigen::MatrixXf batch_observations(observations.rows(), gather ? config.batch_size : 0);
   std::vector<Eigen::Index> columns(static_cast<std::size_t>(config.batch_size));
   const Minibatch batch{actions, observations, columns, batch_actions, batch_observations};
 
@@ -122,6 +124,7 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
     for (int j = 0; j < config.batch_size; ++j) {
       const auto i = static_cast<Eigen::Index>(rng() % n);
       columns[static_cast<std::size_t>(j)] = i;
+      if (!gather) continue;
       batch_actions.col(j) = actions.col(i);
       batch_observations.col(j) = observations.col(i);
     }

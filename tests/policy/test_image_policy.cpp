@@ -11,6 +11,7 @@
 #include "handcentric/policy/binary_io.hpp"
 #include "handcentric/policy/conv_encoder.hpp"
 #include "handcentric/policy/errors.hpp"
+#include "handcentric/policy/head.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "throws.hpp"
@@ -74,6 +75,51 @@ TEST_CASE("image_policies_train_their_encoder_end_to_end", "[unit]") {
   const LearnedPolicy points = train_policy(test::small_config(HeadKind::flow, "hand_centric", 2),
                                             test::small_scenes(8, 2), 3);
   CHECK(image_encoder(points.head()) == nullptr);
+}
+
+// The trainer hands an image head the drawn columns of the training set without copying them
+// out (Head::reads_the_set): the head normalizes them from the set, and must train the bits it
+// trains on the same columns copied out, step after step (the loss, then every weight written).
+TEST_CASE("an_image_head_trains_the_same_bits_from_the_sets_columns_as_from_a_copy", "[unit]") {
+  const PolicyConfig config = image_policy(1).config();
+  std::mt19937_64 data_rng(5);
+  Eigen::MatrixXd actions(config.action_dimension, 40);
+  Eigen::MatrixXd observations(config.observation_dimension, 40);
+  for (Eigen::Index i = 0; i < actions.size(); ++i) actions(i) = uniform01(data_rng) - 0.5;
+  for (Eigen::Index i = 0; i < observations.size(); ++i) observations(i) = uniform01(data_rng);
+  const Eigen::MatrixXf set_actions = actions.cast<float>();
+  const Eigen::MatrixXf set_observations = observations.cast<float>();
+  const std::vector<Eigen::Index> columns = {3, 3, 39, 0, 17, 22, 8, 8, 31, 12, 5, 26};
+  const auto n = static_cast<Eigen::Index>(columns.size());
+  Eigen::MatrixXf copied_actions(set_actions.rows(), n);
+  Eigen::MatrixXf copied_observations(set_observations.rows(), n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    copied_actions.col(j) = set_actions.col(columns[static_cast<std::size_t>(j)]);
+    copied_observations.col(j) = set_observations.col(columns[static_cast<std::size_t>(j)]);
+  }
+  const Eigen::MatrixXf none;
+  const Minibatch batch{set_actions, set_observations, columns, none, none};
+  const auto trained = [&](bool from_the_set, const Eigen::MatrixXf& observations_copy) {
+    const std::unique_ptr<Head> head = make_head(config);
+    std::mt19937_64 rng(7);
+    head->prepare(actions, observations, rng);
+    std::vector<double> losses;
+    for (int step = 0; step < 3; ++step) {
+      losses.push_back(from_the_set ? head->train_step_on(batch, rng)
+                                    : head->train_step(copied_actions, observations_copy, rng));
+    }
+    head->finish_training();
+    ByteWriter out;
+    head->write(out);
+    return std::pair{losses, out.bytes()};
+  };
+  CHECK(make_head(config)->reads_the_set());
+  const auto from_the_set = trained(true, copied_observations);
+  CHECK(from_the_set == trained(false, copied_observations));
+  // The planted fault: one pixel of one copied column changed trains other weights.
+  Eigen::MatrixXf changed = copied_observations;
+  changed(changed.rows() - 1, 4) += 0.25f;
+  CHECK(from_the_set.second != trained(false, changed).second);
 }
 
 TEST_CASE("image_models_record_their_encoder_and_need_their_camera", "[unit]") {

@@ -27,7 +27,8 @@ namespace handcentric::policy {
 
 /// A minibatch as the trainer draws it: the columns `columns` of the whole training set
 /// (`set_actions`, `set_observations`: float32, the trainer's copy of what prepare() saw), and
-/// those columns copied out, in that order (`actions`, `observations`).
+/// those columns copied out, in that order (`actions`, `observations`), unless the head
+/// reads_the_set() (then they are not filled).
 struct Minibatch {
   const Eigen::MatrixXf& set_actions;
   const Eigen::MatrixXf& set_observations;
@@ -56,6 +57,9 @@ class Head {
   virtual double train_step_on(const Minibatch& batch, std::mt19937_64& rng) {
     return train_step(batch.actions, batch.observations, rng);
   }
+  /// True when train_step_on reads only the set's columns (batch.set_actions,
+  /// batch.set_observations, batch.columns), so the trainer need not copy the batch out.
+  virtual bool reads_the_set() const { return false; }
   /// The optimizer's learning rate for the next train_step calls (the trainer's schedule).
   virtual void set_learning_rate(double learning_rate) = 0;
 

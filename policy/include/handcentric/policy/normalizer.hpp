@@ -5,6 +5,8 @@
 // (a hand-centric action or observation) it gives an invariant vector, so it cannot break the
 // invariance that Theorem 1 rests on; only a map that looked at the world pose could.
 // (tests/policy: normalized_hand_centric_vectors_stay_se3_invariant.)
+#include <span>
+
 #include <Eigen/Core>
 
 namespace handcentric::policy {
@@ -36,6 +38,11 @@ class Normalizer {
   /// out = the columns normalized, in one pass (out resized to their shape): the bits of a copy
   /// normalized in place, without the pass of the copy (a training batch of images is tens of MB).
   void normalize(const Eigen::Ref<const Eigen::MatrixXf>& columns, Eigen::MatrixXf& out) const;
+  /// out = columns `picked` of `set` normalized (out.col(j) from set.col(picked[j])), in one
+  /// pass: the bits of normalize() on those columns copied out, without the copy (a training
+  /// step's draw from the training set). Every index must be a column of `set`.
+  void normalize(const Eigen::Ref<const Eigen::MatrixXf>& set, std::span<const Eigen::Index> picked,
+                 Eigen::MatrixXf& out) const;
   /// In place: x <- mean + scale * x.
   void denormalize(Eigen::Ref<Eigen::MatrixXf> columns) const;
 
