@@ -8,6 +8,17 @@
 
 namespace handcentric::policy {
 
+namespace {
+
+void require_length(Eigen::Index rows, Eigen::Index dimension) {
+  if (rows != dimension) {
+    throw InvalidArgument("Normalizer: vectors of length " + std::to_string(rows) + ", expected " +
+                          std::to_string(dimension));
+  }
+}
+
+}  // namespace
+
 Normalizer::Normalizer(Eigen::Index dimension)
     : Normalizer(Eigen::VectorXd::Zero(dimension), Eigen::VectorXd::Ones(dimension)) {}
 
@@ -58,30 +69,21 @@ Normalizer Normalizer::fit(const Eigen::MatrixXd& data) {
 }
 
 void Normalizer::normalize(Eigen::Ref<Eigen::MatrixXf> columns) const {
-  if (columns.rows() != dimension()) {
-    throw InvalidArgument("Normalizer: vectors of length " + std::to_string(columns.rows()) +
-                          ", expected " + std::to_string(dimension()));
-  }
+  require_length(columns.rows(), dimension());
   // One pass, each value rounded after the subtraction and after the product.
   columns.array() = (columns.array().colwise() - mean_f_.array()).colwise() * inv_scale_f_.array();
 }
 
 void Normalizer::normalize(const Eigen::Ref<const Eigen::MatrixXf>& columns,
                            Eigen::MatrixXf& out) const {
-  if (columns.rows() != dimension()) {
-    throw InvalidArgument("Normalizer: vectors of length " + std::to_string(columns.rows()) +
-                          ", expected " + std::to_string(dimension()));
-  }
+  require_length(columns.rows(), dimension());
   out.resize(columns.rows(), columns.cols());
   out.array() = (columns.array().colwise() - mean_f_.array()).colwise() * inv_scale_f_.array();
 }
 
 void Normalizer::normalize(const Eigen::Ref<const Eigen::MatrixXf>& set,
                            std::span<const Eigen::Index> picked, Eigen::MatrixXf& out) const {
-  if (set.rows() != dimension()) {
-    throw InvalidArgument("Normalizer: vectors of length " + std::to_string(set.rows()) +
-                          ", expected " + std::to_string(dimension()));
-  }
+  require_length(set.rows(), dimension());
   for (const Eigen::Index i : picked) {
     if (i < 0 || i >= set.cols()) {
       throw InvalidArgument("Normalizer: column " + std::to_string(i) + " picked from a set of " +
@@ -96,10 +98,7 @@ void Normalizer::normalize(const Eigen::Ref<const Eigen::MatrixXf>& set,
 }
 
 void Normalizer::denormalize(Eigen::Ref<Eigen::MatrixXf> columns) const {
-  if (columns.rows() != dimension()) {
-    throw InvalidArgument("Normalizer: vectors of length " + std::to_string(columns.rows()) +
-                          ", expected " + std::to_string(dimension()));
-  }
+  require_length(columns.rows(), dimension());
   columns.array().colwise() *= scale_f_.array();
   columns.colwise() += mean_f_;
 }

@@ -182,17 +182,13 @@ HWY_INLINE void RotateElementIndices(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
   }
 }
 
-constexpr int Log2(int power_of_two) {
-  return power_of_two <= 1 ? 0 : 1 + Log2(power_of_two / 2);
-}
-
 /// Transposes kPixelConvFilters vectors in place: v[f] holds filter f of the vector's pixels
 /// (lane i: pixel i), and after it v[q] holds the filters of pixels q L / F ... (q + 1) L / F,
 /// each pixel's F filters together. The element at index m = f L + i goes to n = i F + f: m's
 /// bits rotated right by log2(L).
 template <class D>
 HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
-  RotateElementIndices<Log2(static_cast<int>(hn::MaxLanes(D())))>(d, v);
+  RotateElementIndices<static_cast<int>(hwy::FloorLog2(hn::MaxLanes(D())))>(d, v);
 }
 
 /// The inverse: v[q] holds L / F pixels' filters together (as the encoder stores a map and its
@@ -200,7 +196,7 @@ HWY_INLINE void TransposeFilters(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
 /// n = i F + f goes to m = f L + i: n's bits rotated right by log2(F).
 template <class D>
 HWY_INLINE void TransposePixels(D d, hn::Vec<D> (&v)[kPixelConvFilters]) {
-  RotateElementIndices<Log2(kPixelConvFilters)>(d, v);
+  RotateElementIndices<static_cast<int>(hwy::FloorLog2(kPixelConvFilters))>(d, v);
 }
 
 /// One tile of PixelConvForward: `pixels` <= V L consecutive pixels of one output row (`row`:
