@@ -157,32 +157,47 @@ void reserve_padded(const Conv2d& layer, bool channels_first, int count, PaddedI
   }
 }
 
-// Copies `count` samples of a layer's input (sample b at source + b source_stride) into padded
-// samples first, first + 1, ... (reserve_padded made room), interiors only.
-void pad(const Conv2d& layer, bool channels_first, const float* source, long source_stride,
-         int first, int count, PaddedInput& padded, const kernels::KernelSet& set) {
-  const PaddedLayout l = padded_layout(layer, channels_first);
+// Copies `count` samples of a hidden layer's input (sample b at source + b source_stride,
+// (height, width, channels)) into padded samples first, first + 1, ... (reserve_padded made
+// room), interiors only.
+void pad_maps(const Conv2d& layer, const float* source, long source_stride, int first, int count,
+              PaddedInput& padded) {
+  const PaddedLayout l = padded_layout(layer, false);
   const ImageShape& in = layer.input();
-  const int pad = layer.padding();
+  const long run = static_cast<long>(in.width) * in.channels;
   for (int b = 0; b < count; ++b) {
     float* sample = padded.maps.data() + (first + b) * l.sample;
-    if (!channels_first) {
-      const long run = static_cast<long>(in.width) * in.channels;
-      for (int y = 0; y < in.height; ++y) {
-        const float* from = source + b * source_stride + y * run;
-        std::copy(from, from + run, sample + (y + pad) * l.row + l.column(pad));
-      }
-      continue;
+    for (int y = 0; y < in.height; ++y) {
+      const float* from = source + b * source_stride + y * run;
+      std::copy(from, from + run,
+                sample + (y + layer.padding()) * l.row + l.column(layer.padding()));
     }
+  }
+}
+
+// Copies images[first], ..., images[first + count - 1] (each (channels, height, width)) into the
+// first layer's padded samples of the same numbers, interiors only, each value normalized on the
+// way when `mean` is given: (x - mean) inv_scale, as kernels' deinterleave does it.
+void pad_images(const Conv2d& layer, const std::vector<const float*>& images, const float* mean,
+                const float* inv_scale, int first, int count, PaddedInput& padded,
+                const kernels::KernelSet& set) {
+  const PaddedLayout l = padded_layout(layer, true);
+  const ImageShape& in = layer.input();
+  const int pad = layer.padding();
+  for (int b = first; b < first + count; ++b) {
+    float* sample = padded.maps.data() + b * l.sample;
     for (int c = 0; c < in.channels; ++c) {
       for (int y = 0; y < in.height; ++y) {
-        const float* from =
-            source + b * source_stride + (static_cast<long>(c) * in.height + y) * in.width;
+        const long row = (static_cast<long>(c) * in.height + y) * in.width;
+        const float* from = images[b] + row;
+        const float* row_mean = mean == nullptr ? nullptr : mean + row;
+        const float* row_inv_scale = mean == nullptr ? nullptr : inv_scale + row;
         float* to = sample + c * l.plane + (y + pad) * l.row;
         if (l.stride == 2) {
           // x even: padded column x + pad in phase pad mod 2 at (x + pad) / 2 = x / 2 + pad / 2;
           // x odd: in the other phase at (x - 1) / 2 + (pad + 1) / 2.
-          set.deinterleave(in.width, from, to + l.column(pad), to + l.column(pad + 1));
+          set.deinterleave(in.width, from, row_mean, row_inv_scale, to + l.column(pad),
+                           to + l.column(pad + 1));
           continue;
         }
         // Phase by phase: the columns x with (x + pad) mod stride = q go to phase q in order.
@@ -190,7 +205,15 @@ void pad(const Conv2d& layer, bool channels_first, const float* source, long sou
           const int x_first = ((q - pad) % l.stride + l.stride) % l.stride;
           float* phase = to + q * l.phase + (x_first + pad) / l.stride;
           const int columns = x_first < in.width ? (in.width - 1 - x_first) / l.stride + 1 : 0;
-          for (int i = 0; i < columns; ++i) phase[i] = from[x_first + i * l.stride];
+          for (int i = 0; i < columns; ++i) {
+            const int x = x_first + i * l.stride;
+            float v = from[x];
+            if (row_mean != nullptr) {  // two roundings, as deinterleave's
+              v -= row_mean[x];
+              v *= row_inv_scale[x];
+            }
+            phase[i] = v;
+          }
         }
       }
     }
@@ -242,6 +265,10 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
   return forward(images, kernels::active());
 }
 
+const ConvEncoder::Matrix& ConvEncoder::forward(const PickedImages& images) {
+  return forward(images, kernels::active());
+}
+
 const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>& d_features) {
   return backward(d_features, kernels::active(), true);
 }
@@ -260,7 +287,47 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
                           std::to_string(input_shape().height) + " x " +
                           std::to_string(input_shape().width) + " per column)");
   }
-  const Eigen::Index batch = images.cols();
+  std::vector<const float*> samples(static_cast<std::size_t>(images.cols()));
+  for (std::size_t b = 0; b < samples.size(); ++b)
+    samples[b] = images.data() + static_cast<Eigen::Index>(b) * images.outerStride();
+  return forward(samples, nullptr, nullptr, set);
+}
+
+const ConvEncoder::Matrix& ConvEncoder::forward(const PickedImages& images,
+                                                const kernels::KernelSet& set) {
+  if (layers_.empty()) throw InvalidArgument("ConvEncoder::forward on an encoder without layers");
+  const Eigen::Index rows = images.set.rows();
+  if (images.first_row < 0 || images.first_row > rows - input_size()) {
+    throw InvalidArgument("ConvEncoder: images from row " + std::to_string(images.first_row) +
+                          " of a set of " + std::to_string(rows) + " rows, but an image has " +
+                          std::to_string(input_size()) + " rows: pass a first_row in [0, " +
+                          std::to_string(std::max<Eigen::Index>(rows - input_size(), 0)) + "]");
+  }
+  const bool normalized = !images.mean.empty() || !images.inv_scale.empty();
+  if (normalized && (static_cast<Eigen::Index>(images.mean.size()) != input_size() ||
+                     static_cast<Eigen::Index>(images.inv_scale.size()) != input_size())) {
+    throw InvalidArgument("ConvEncoder: a mean of " + std::to_string(images.mean.size()) +
+                          " and an inv_scale of " + std::to_string(images.inv_scale.size()) +
+                          " values for images of " + std::to_string(input_size()) +
+                          ": give both with one value per image row, or neither");
+  }
+  std::vector<const float*> samples;
+  samples.reserve(images.columns.size());
+  for (const Eigen::Index j : images.columns) {
+    if (j < 0 || j >= images.set.cols()) {
+      throw InvalidArgument("ConvEncoder: column " + std::to_string(j) + " picked from a set of " +
+                            std::to_string(images.set.cols()) + " columns");
+    }
+    samples.push_back(images.set.data() + j * images.set.outerStride() + images.first_row);
+  }
+  return forward(samples, normalized ? images.mean.data() : nullptr,
+                 normalized ? images.inv_scale.data() : nullptr, set);
+}
+
+const ConvEncoder::Matrix& ConvEncoder::forward(const std::vector<const float*>& images,
+                                                const float* mean, const float* inv_scale,
+                                                const kernels::KernelSet& set) {
+  const Eigen::Index batch = static_cast<Eigen::Index>(images.size());
   // The kernels count a layer's products in int: its patch matrix (K x pixels of the batch, read
   // in place) must have fewer than 2^31 entries.
   for (const Conv2d& layer : layers_) {
@@ -297,11 +364,10 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const Eigen::Ref<const Matrix>& 
       // layer's to the start of its chunk's room.
       const int at = l == 0 ? b0 : 0;
       if (l == 0) {
-        pad(layer, true, images.data() + b0 * images.outerStride(), images.outerStride(), at, count,
-            padded, set);
+        pad_images(layer, images, mean, inv_scale, b0, count, padded, set);
       } else {
-        pad(layer, false, activation_[l - 1].data() + b0 * layer.input().size(),
-            layer.input().size(), at, count, padded, set);
+        pad_maps(layer, activation_[l - 1].data() + b0 * layer.input().size(), layer.input().size(),
+                 at, count, padded);
       }
       if (l == 0 && out == kernels::kPixelConvFilters && count * pixels > kernels::kNarrowMax) {
         // Eight filters fill half of an AVX-512 vector: the pixels go in the lanes instead (the
@@ -401,7 +467,7 @@ const ConvEncoder::Matrix& ConvEncoder::backward(const Eigen::Ref<const Matrix>&
       const float* delta_chunk = delta.data() + b0 * layer.output().size();
       if (l > 0) {
         PaddedInput& padded = padded_[l];
-        pad(layer, false, activation_[l - 1].data() + b0 * below, below, 0, count, padded, set);
+        pad_maps(layer, activation_[l - 1].data() + b0 * below, below, 0, count, padded);
         kernels::Gemm d_product{
             Op::none, Op::none,           out, k,       count * pixels, delta_chunk,
             out,      padded.maps.data(), k,   nullptr, d_weights,      out};

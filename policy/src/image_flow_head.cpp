@@ -56,10 +56,16 @@ void ImageFlowHead::prepare(const Eigen::MatrixXd& actions, const Eigen::MatrixX
 
 Eigen::MatrixXf ImageFlowHead::network_observation(ConvEncoder& encoder, SpatialSoftmax& softmax,
                                                    const Eigen::MatrixXf& o) const {
-  const Eigen::MatrixXf& maps = encoder.forward(o.bottomRows(o.rows() - proprio_rows_));
+  return with_features(softmax, o.topRows(proprio_rows_),
+                       encoder.forward(o.bottomRows(o.rows() - proprio_rows_)));
+}
+
+Eigen::MatrixXf ImageFlowHead::with_features(SpatialSoftmax& softmax,
+                                             const Eigen::Ref<const Eigen::MatrixXf>& proprio,
+                                             const Eigen::MatrixXf& maps) const {
   const Eigen::MatrixXf& features = keypoints_ ? softmax.forward(maps) : maps;
-  Eigen::MatrixXf out(proprio_rows_ + features.rows(), o.cols());
-  out.topRows(proprio_rows_) = o.topRows(proprio_rows_);
+  Eigen::MatrixXf out(proprio_rows_ + features.rows(), maps.cols());
+  out.topRows(proprio_rows_) = proprio;
   out.bottomRows(features.rows()) = features;
   return out;
 }
@@ -68,17 +74,42 @@ double ImageFlowHead::train_step(const Eigen::MatrixXf& actions,
                                  const Eigen::MatrixXf& observations, std::mt19937_64& rng) {
   action_normalizer_.normalize(actions, a_);
   observation_normalizer_.normalize(observations, o_);
-  return train_normalized(rng);
+  network_o_ = network_observation(encoder_, spatial_softmax_, o_);
+  return train_from_features(rng);
 }
 
 double ImageFlowHead::train_step_on(const Minibatch& batch, std::mt19937_64& rng) {
   action_normalizer_.normalize(batch.set_actions, batch.columns, a_);
-  observation_normalizer_.normalize(batch.set_observations, batch.columns, o_);
-  return train_normalized(rng);
+  // The proprioception rows normalized here, the images by the encoder's first layer as it
+  // reads them from the set (the same two roundings per value as normalize()).
+  const Eigen::VectorXf& mean = observation_normalizer_.mean_float();
+  const Eigen::VectorXf& inv_scale = observation_normalizer_.inv_scale_float();
+  const Eigen::MatrixXf& set = batch.set_observations;
+  if (set.rows() != observation_normalizer_.dimension()) {
+    throw InvalidArgument("ImageFlowHead: a training set of " + std::to_string(set.rows()) +
+                          " observation rows, expected " +
+                          std::to_string(observation_normalizer_.dimension()));
+  }
+  o_.resize(proprio_rows_, static_cast<Eigen::Index>(batch.columns.size()));
+  for (std::size_t j = 0; j < batch.columns.size(); ++j) {
+    const Eigen::Index column = batch.columns[j];
+    if (column < 0 || column >= set.cols()) {
+      throw InvalidArgument("ImageFlowHead: column " + std::to_string(column) +
+                            " picked from a set of " + std::to_string(set.cols()) + " columns");
+    }
+    o_.col(static_cast<Eigen::Index>(j)).array() =
+        (set.col(column).head(proprio_rows_).array() - mean.head(proprio_rows_).array()) *
+        inv_scale.head(proprio_rows_).array();
+  }
+  const std::size_t pixels = static_cast<std::size_t>(set.rows() - proprio_rows_);
+  const PickedImages images{set, proprio_rows_, batch.columns,
+                            std::span<const float>(mean.data() + proprio_rows_, pixels),
+                            std::span<const float>(inv_scale.data() + proprio_rows_, pixels)};
+  network_o_ = with_features(spatial_softmax_, o_, encoder_.forward(images));
+  return train_from_features(rng);
 }
 
-double ImageFlowHead::train_normalized(std::mt19937_64& rng) {
-  network_o_ = network_observation(encoder_, spatial_softmax_, o_);
+double ImageFlowHead::train_from_features(std::mt19937_64& rng) {
   draw_flow_sample(rng);
   assemble(x_, t_, network_o_, input_);
   const double loss = mse_loss<float>(network_.forward(input_), target_, d_output_);

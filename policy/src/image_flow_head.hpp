@@ -39,8 +39,10 @@ class ImageFlowHead final : public FlowHead {
                std::mt19937_64& rng) override;
   double train_step(const Eigen::MatrixXf& actions, const Eigen::MatrixXf& observations,
                     std::mt19937_64& rng) override;
-  /// train_step on the drawn columns normalized straight from the training set (the same bits,
-  /// without the trainer's copy of the batch: tens of MB of images a step).
+  /// train_step on the drawn columns read straight from the training set: the proprioception
+  /// normalized here, the images by the encoder's first layer as it pads them (PickedImages).
+  /// The same bits, without the trainer's copy of the batch nor a normalized one (tens of MB of
+  /// images a step each).
   double train_step_on(const Minibatch& batch, std::mt19937_64& rng) override;
   bool reads_the_set() const override { return true; }
   Eigen::MatrixXf sample(const Eigen::MatrixXf& observations, std::mt19937_64& rng) const override;
@@ -57,8 +59,13 @@ class ImageFlowHead final : public FlowHead {
   /// for spatial_softmax features) run forward.
   Eigen::MatrixXf network_observation(ConvEncoder& encoder, SpatialSoftmax& softmax,
                                       const Eigen::MatrixXf& o) const;
-  /// The step after normalization: a_ and o_ hold the batch's normalized columns.
-  double train_normalized(std::mt19937_64& rng);
+  /// [proprio; features] from the normalized proprioception rows and the encoder's output maps.
+  Eigen::MatrixXf with_features(SpatialSoftmax& softmax,
+                                const Eigen::Ref<const Eigen::MatrixXf>& proprio,
+                                const Eigen::MatrixXf& maps) const;
+  /// The step once a_ holds the batch's normalized actions and network_o_ its network
+  /// observations (encoder_ run forward on its images).
+  double train_from_features(std::mt19937_64& rng);
 
   int proprio_rows_ = 0;
   ConvEncoder encoder_;

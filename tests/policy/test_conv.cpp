@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <span>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -26,6 +27,7 @@
 #include "handcentric/policy/conv_encoder.hpp"
 #include "handcentric/policy/errors.hpp"
 #include "handcentric/policy/kernels.hpp"
+#include "handcentric/policy/normalizer.hpp"
 #include "kernels/kernel_set.hpp"
 #include "throws.hpp"
 
@@ -289,11 +291,17 @@ void pixel_conv_weights_row_short(const kernels::PixelConvGradient& problem) {
   if (wrong.rows > 1) wrong.rows -= 1;  // the first layer's dW without the batch's last row
   g_base->pixel_conv_weights(wrong);
 }
-void deinterleave_swapped(std::ptrdiff_t n, const float* x, float* even, float* odd) {
+void deinterleave_swapped(std::ptrdiff_t n, const float* x, const float* mean,
+                          const float* inv_scale, float* even, float* odd) {
   // Each column phase gets the other's floats (a row of the first layer's padded copy misread).
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     const std::ptrdiff_t other = (i ^ 1) < n ? (i ^ 1) : i;
-    (i % 2 == 0 ? even : odd)[i / 2] = x[other];
+    float v = x[other];
+    if (mean != nullptr) {
+      v -= mean[other];
+      v *= inv_scale[other];
+    }
+    (i % 2 == 0 ? even : odd)[i / 2] = v;
   }
 }
 
@@ -641,4 +649,71 @@ TEST_CASE("a_copy_of_an_encoder_is_its_weights_not_its_last_batch", "[unit]") {
   HC_CHECK_THROWS(assigned.backward_parameters(d_features), InvalidArgument,
                   Catch::Contains("call forward() first"));
   CHECK(assigned.forward(images) == features);
+}
+
+// Training reads its batch from the training set: forward(PickedImages) normalizes each value
+// as the first layer pads it. It must give the bits of the encoder run on those columns
+// normalized by the Normalizer, forward and backward, on every target, at strides 1, 2 and 3
+// (deinterleave's vectors and the scalar phases). Planted fault: the images read one row early.
+TEST_CASE("picked_images_normalized_as_read_give_the_bits_of_a_normalized_copy", "[unit]") {
+  std::mt19937_64 rng(71);
+  constexpr int kProprioRows = 3;
+  for (const Case& c : kCases) {
+    const Eigen::Index rows = kProprioRows + c.input.size();
+    const Eigen::MatrixXf set_columns = random_matrix(rows, c.batch + 3, rng).cast<float>();
+    Eigen::VectorXd mean(rows), scale(rows);
+    for (Eigen::Index i = 0; i < rows; ++i) {
+      mean[i] = uniform01(rng) - 0.5;
+      scale[i] = 0.2 + uniform01(rng);
+    }
+    const Normalizer normalizer(mean, scale);
+    // Columns out of order, one of them twice.
+    std::vector<Eigen::Index> picked;
+    for (int b = 0; b < c.batch; ++b) picked.push_back((2 * b + 1) % (c.batch + 3));
+    picked.back() = picked.front();
+    Eigen::MatrixXf copy;
+    normalizer.normalize(set_columns, picked, copy);
+    const Eigen::MatrixXf images = copy.bottomRows(c.input.size());
+    const auto n = static_cast<std::size_t>(c.input.size());
+    const std::span<const float> image_mean(normalizer.mean_float().data() + kProprioRows, n);
+    const std::span<const float> image_inv_scale(normalizer.inv_scale_float().data() + kProprioRows,
+                                                 n);
+    const Eigen::MatrixXf d_features =
+        random_matrix(encoder_of(c, 72).output_size(), c.batch, rng).cast<float>();
+    for (const auto& [name, set] : conv_targets()) {
+      INFO(c.name << ", target " << name);
+      ConvEncoder encoder = encoder_of(c, 72);
+      const Eigen::MatrixXf features = encoder.forward(images, *set);
+      const Eigen::MatrixXf d_images = encoder.backward(d_features, *set);
+      const Eigen::VectorXf gradient = encoder.gradient();
+      CHECK(encoder.forward(
+                PickedImages{set_columns, kProprioRows, picked, image_mean, image_inv_scale},
+                *set) == features);
+      CHECK(encoder.backward(d_features, *set) == d_images);
+      CHECK(encoder.gradient() == gradient);
+      CHECK(encoder.forward(
+                PickedImages{set_columns, kProprioRows - 1, picked, image_mean, image_inv_scale},
+                *set) != features);
+    }
+  }
+}
+
+TEST_CASE("picked_images_outside_the_set_are_refused_with_the_value_and_the_fix", "[unit]") {
+  const Case& c = kCases[0];
+  ConvEncoder encoder = encoder_of(c, 73);
+  const Eigen::Index n = c.input.size();
+  const Eigen::MatrixXf set_columns = Eigen::MatrixXf::Zero(n + 2, 4);
+  const std::vector<float> ones(static_cast<std::size_t>(n), 1.0f);
+  const std::vector<Eigen::Index> good = {0, 3}, outside = {0, 4};
+  CHECK(encoder.forward(PickedImages{set_columns, 2, good, ones, ones}).cols() == 2);
+  HC_CHECK_THROWS(encoder.forward(PickedImages{set_columns, 3, good, ones, ones}), InvalidArgument,
+                  Catch::Contains("from row 3") && Catch::Contains("[0, 2]"));
+  HC_CHECK_THROWS(encoder.forward(PickedImages{set_columns, 2, outside, ones, ones}),
+                  InvalidArgument, Catch::Contains("column 4 picked from a set of 4 columns"));
+  HC_CHECK_THROWS(encoder.forward(PickedImages{set_columns, 2, good, ones, {}}), InvalidArgument,
+                  Catch::Contains("give both"));
+  HC_CHECK_THROWS(
+      encoder.forward(PickedImages{set_columns, 2, good, std::span<const float>(ones).first(3),
+                                   std::span<const float>(ones).first(3)}),
+      InvalidArgument, Catch::Contains("a mean of 3"));
 }

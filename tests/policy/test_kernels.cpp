@@ -23,6 +23,7 @@
 #include "handcentric/policy/adam.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/mlp.hpp"
+#include "handcentric/policy/normalizer.hpp"
 #include "kernels/asan_lanes.hpp"
 #include "kernels/kernel_set.hpp"
 #include "throws.hpp"
@@ -535,19 +536,40 @@ TEST_CASE("pixel_weight_gradients_are_the_sums_of_the_double_reference", "[unit]
 }
 
 // deinterleave splits a row into its even and odd floats (the first layer's padded rows by
-// column phase), every length around the vectors' widths.
+// column phase), every length around the vectors' widths; with a mean and an inv_scale, each
+// value normalized first with Normalizer::normalize's bits (the test compares with that
+// function's output on the same row). Planted fault: an inv_scale a rounding step off.
 TEST_CASE("deinterleave_splits_a_row_into_its_even_and_odd_floats", "[unit]") {
   std::mt19937_64 rng(29);
   for (const auto& [name, set] : every_target()) {
     for (int n = 0; n <= 70; ++n) {
       INFO("target " << name << " n " << n);
       const std::vector<float> x = random_floats(static_cast<std::size_t>(n), rng);
-      // One float of guard past each half: nothing may be written there.
-      std::vector<float> even((n + 1) / 2 + 1, 5.0f), odd(n / 2 + 1, 5.0f);
-      set->deinterleave(n, x.data(), even.data(), odd.data());
-      bool right = even.back() == 5.0f && odd.back() == 5.0f;
-      for (int i = 0; i < n; ++i) right = right && (i % 2 == 0 ? even : odd)[i / 2] == x[i];
-      CHECK(right);
+      Eigen::VectorXd mean(n), scale(n);
+      for (int i = 0; i < n; ++i) {
+        mean[i] = 3.0 * uniform01(rng) - 1.5;
+        scale[i] = 0.01 + 3.0 * uniform01(rng);
+      }
+      const Normalizer normalizer(mean, scale);
+      Eigen::MatrixXf expected = Eigen::Map<const Eigen::MatrixXf>(x.data(), n, 1);
+      normalizer.normalize(expected);
+      Eigen::VectorXf wrong_inv_scale = normalizer.inv_scale_float();
+      for (float& s : wrong_inv_scale) s = std::nextafter(s, 100.0f);
+      const auto split = [&](const float* m, const float* s, const float* values) {
+        // One float of guard past each half: nothing may be written there.
+        std::vector<float> even((n + 1) / 2 + 1, 5.0f), odd(n / 2 + 1, 5.0f);
+        set->deinterleave(n, x.data(), m, s, even.data(), odd.data());
+        bool right = even.back() == 5.0f && odd.back() == 5.0f;
+        for (int i = 0; i < n; ++i) right = right && (i % 2 == 0 ? even : odd)[i / 2] == values[i];
+        return right;
+      };
+      CHECK(split(nullptr, nullptr, x.data()));
+      CHECK(split(normalizer.mean_float().data(), normalizer.inv_scale_float().data(),
+                  expected.data()));
+      // Planted fault: each 1 / scale one float up (a product can round to the same float, but
+      // not all of eight).
+      if (n >= 8)
+        CHECK_FALSE(split(normalizer.mean_float().data(), wrong_inv_scale.data(), expected.data()));
     }
   }
 }

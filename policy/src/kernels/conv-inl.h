@@ -403,18 +403,33 @@ inline void PixelConvWeights(const PixelConvGradient& g) {
 
 #endif  // the portable targets
 
-inline void Deinterleave(std::ptrdiff_t n, const float* x, float* even, float* odd) {
+inline void Deinterleave(std::ptrdiff_t n, const float* x, const float* mean,
+                         const float* inv_scale, float* even, float* odd) {
   std::ptrdiff_t i = 0;
 #if HWY_TARGET != HWY_SCALAR
   const hn::ScalableTag<float> d;
   const std::ptrdiff_t step = 2 * static_cast<std::ptrdiff_t>(hn::Lanes(d));
+  const auto load = [&](std::ptrdiff_t at) {
+    const auto v = hn::LoadU(d, x + at);
+    return mean == nullptr
+               ? v
+               : hn::Mul(hn::Sub(v, hn::LoadU(d, mean + at)), hn::LoadU(d, inv_scale + at));
+  };
   for (; i + step <= n; i += step) {
-    const auto lower = hn::LoadU(d, x + i), upper = hn::LoadU(d, x + i + step / 2);
+    const auto lower = load(i), upper = load(i + step / 2);
     hn::StoreU(hn::ConcatEven(d, upper, lower), d, even + i / 2);
     hn::StoreU(hn::ConcatOdd(d, upper, lower), d, odd + i / 2);
   }
 #endif
-  for (; i < n; ++i) (i % 2 == 0 ? even : odd)[i / 2] = x[i];
+  for (; i < n; ++i) {
+    // Two statements: the subtraction is rounded before the product, as in the vectors.
+    float v = x[i];
+    if (mean != nullptr) {
+      v -= mean[i];
+      v *= inv_scale[i];
+    }
+    (i % 2 == 0 ? even : odd)[i / 2] = v;
+  }
 }
 
 // Only the input gradient of a first layer runs it (training does not): a plain loop.

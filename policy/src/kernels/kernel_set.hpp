@@ -186,9 +186,13 @@ struct KernelSet {
   void (*pixel_conv)(const PixelConv& problem);
   /// Its weight gradient (PixelConvGradient), with the pixels in the lanes on AVX-512.
   void (*pixel_conv_weights)(const PixelConvGradient& problem);
-  /// even[i] = x[2 i] and odd[i] = x[2 i + 1] for the n floats of x: a row of an image stored
-  /// by column phase for a convolution of stride 2 (PixelConv).
-  void (*deinterleave)(std::ptrdiff_t n, const float* x, float* even, float* odd);
+  /// even[i] = v[2 i] and odd[i] = v[2 i + 1] for the n values v of a row: a row of an image
+  /// stored by column phase for a convolution of stride 2 (PixelConv). v = x, or with mean and
+  /// inv_scale (n each; both or neither) v[i] = (x[i] - mean[i]) inv_scale[i], rounded after the
+  /// subtraction and after the product: Normalizer::normalize's bits, the training batch
+  /// normalized as it is read.
+  void (*deinterleave)(std::ptrdiff_t n, const float* x, const float* mean, const float* inv_scale,
+                       float* even, float* odd);
   /// s = sigmoid(z), a = z s over n values (training: s is kept for the backward pass); a may be z.
   void (*silu_forward)(std::ptrdiff_t n, const float* z, float* s, float* a);
   /// delta *= SiLU'(z) over n values, from s = sigmoid(z) and a = SiLU(z) = z s:

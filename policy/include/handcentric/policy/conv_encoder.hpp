@@ -20,6 +20,7 @@
 // backward pads them again from the map below rather than keeping a whole batch's.
 #include <Eigen/Core>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "handcentric/policy/conv2d.hpp"
@@ -38,6 +39,19 @@ struct PaddedInput {
   Eigen::VectorXf maps;  ///< room for `samples` padded samples, whose borders are zero
   int samples = 0;
   std::vector<long> patch_offsets, pixel_offsets;
+};
+
+/// A batch of images read where they lie and normalized as the first layer reads them: a
+/// training step's draw from its training set, without writing the normalized batch (tens of
+/// MB at batch 256). Sample b is rows [first_row, first_row + input_size()) of column
+/// columns[b] of `set`; value i of each is read as (x - mean[i]) inv_scale[i], rounded after the
+/// subtraction and after the product (Normalizer::normalize's bits), or as it is when mean and
+/// inv_scale are both empty.
+struct PickedImages {
+  Eigen::Ref<const Eigen::MatrixXf> set;
+  Eigen::Index first_row = 0;
+  std::span<const Eigen::Index> columns;
+  std::span<const float> mean, inv_scale;
 };
 
 /// One layer of a ConvEncoder (the input channels come from the layer before).
@@ -88,6 +102,11 @@ class ConvEncoder {
   /// Training forward pass (keeps what backward() needs): images (input_size x B) to
   /// features (output_size x B). Throws InvalidArgument for another number of rows.
   const Matrix& forward(const Eigen::Ref<const Matrix>& images);
+  /// The same on picked, normalized images (PickedImages): the bits of forward() on those
+  /// columns normalized by a Normalizer. Throws InvalidArgument for a first_row that leaves no
+  /// room for an image, a column outside the set, or a mean or inv_scale of another length than
+  /// input_size() (or one without the other).
+  const Matrix& forward(const PickedImages& images);
   /// Backward pass from d loss / d features (output_size x B) of the last forward(): sets
   /// gradient() and returns d loss / d images (input_size x B).
   const Matrix& backward(const Eigen::Ref<const Matrix>& d_features);
@@ -99,6 +118,7 @@ class ConvEncoder {
   /// With input_gradient false, backward() is backward_parameters(): d loss / d images is not
   /// computed and the matrix returned holds an earlier one.
   const Matrix& forward(const Eigen::Ref<const Matrix>& images, const kernels::KernelSet& set);
+  const Matrix& forward(const PickedImages& images, const kernels::KernelSet& set);
   const Matrix& backward(const Eigen::Ref<const Matrix>& d_features, const kernels::KernelSet& set,
                          bool input_gradient = true);
 
@@ -111,6 +131,11 @@ class ConvEncoder {
   static ConvEncoder read(ByteReader& in);
 
  private:
+  /// forward() on the images that start at images[b], normalized with mean and inv_scale
+  /// (input_size() each) unless mean is null.
+  const Matrix& forward(const std::vector<const float*>& images, const float* mean,
+                        const float* inv_scale, const kernels::KernelSet& set);
+
   std::vector<Conv2d> layers_;
   std::vector<Eigen::Index> offsets_;
   Vector parameters_;

@@ -32,6 +32,9 @@ class Normalizer {
   /// noise and no velocity there (a planar task's z and tilt stay exactly at their constant).
   const Eigen::VectorXd& active() const { return active_; }
   const Eigen::VectorXf& active_float() const { return active_f_; }
+  /// The mean and 1 / scale in float, as normalize() applies them: (x - mean) * inv_scale.
+  const Eigen::VectorXf& mean_float() const { return mean_f_; }
+  const Eigen::VectorXf& inv_scale_float() const { return inv_scale_f_; }
 
   /// In place, column by column: x <- (x - mean) / scale.
   void normalize(Eigen::Ref<Eigen::MatrixXf> columns) const;
