@@ -297,11 +297,16 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const PickedImages& images,
                                                 const kernels::KernelSet& set) {
   if (layers_.empty()) throw InvalidArgument("ConvEncoder::forward on an encoder without layers");
   const Eigen::Index rows = images.set.rows();
+  if (rows < input_size()) {
+    throw InvalidArgument("ConvEncoder: a set of " + std::to_string(rows) +
+                          " rows holds no image of " + std::to_string(input_size()) +
+                          " rows: pass a set with the images in its columns");
+  }
   if (images.first_row < 0 || images.first_row > rows - input_size()) {
     throw InvalidArgument("ConvEncoder: images from row " + std::to_string(images.first_row) +
                           " of a set of " + std::to_string(rows) + " rows, but an image has " +
                           std::to_string(input_size()) + " rows: pass a first_row in [0, " +
-                          std::to_string(std::max<Eigen::Index>(rows - input_size(), 0)) + "]");
+                          std::to_string(rows - input_size()) + "]");
   }
   const bool normalized = !images.mean.empty() || !images.inv_scale.empty();
   if (normalized && (static_cast<Eigen::Index>(images.mean.size()) != input_size() ||

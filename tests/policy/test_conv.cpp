@@ -708,6 +708,8 @@ TEST_CASE("picked_images_outside_the_set_are_refused_with_the_value_and_the_fix"
   CHECK(encoder.forward(PickedImages{set_columns, 2, good, ones, ones}).cols() == 2);
   HC_CHECK_THROWS(encoder.forward(PickedImages{set_columns, 3, good, ones, ones}), InvalidArgument,
                   Catch::Contains("from row 3") && Catch::Contains("[0, 2]"));
+  HC_CHECK_THROWS(encoder.forward(PickedImages{set_columns.topRows(n - 1), 0, good, ones, ones}),
+                  InvalidArgument, Catch::Contains("holds no image of " + std::to_string(n)));
   HC_CHECK_THROWS(encoder.forward(PickedImages{set_columns, 2, outside, ones, ones}),
                   InvalidArgument, Catch::Contains("column 4 picked from a set of 4 columns"));
   HC_CHECK_THROWS(encoder.forward(PickedImages{set_columns, 2, good, ones, {}}), InvalidArgument,
