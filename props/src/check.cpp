@@ -88,9 +88,15 @@ namespace {
 
 // Prefetch passes (batch.hpp). The first generates the cases (RapidCheck, as the real pass
 // will) and keeps them; the others run the kept cases not yet answered in full, as far as their
-// cached answers go. A pass stops starting cases once it has recorded kMaxPendingPerPass inputs
-// (memory); only the first kMaxPrefetchCases cases are kept and prefetched, and after
-// kMaxPrefetchPasses the real pass evaluates what is left one input at a time.
+// cached answers go. A pass stops starting cases once it has recorded its share of inputs: the
+// first kFirstPassInputs, each pass after it twice as many as the one before, up to
+// kMaxPendingPerPass (memory). A map that fails does so in its first cases as a rule, and the
+// cases after a known failure are never asked for: the first passes find it before the whole
+// check's inputs are evaluated, where an invariant map's cost grows only by the few extra
+// flushes. Only the first kMaxPrefetchCases cases are kept and prefetched, and after
+// kMaxPrefetchPasses the real pass evaluates what is left one input at a time. The answers, and
+// so the verdicts, are the same whatever the passes' sizes: they only fill the cache.
+constexpr std::size_t kFirstPassInputs = 64;
 constexpr std::size_t kMaxPendingPerPass = std::size_t{1} << 15;
 constexpr std::size_t kMaxPrefetchCases = std::size_t{1} << 14;
 constexpr int kMaxPrefetchPasses = 64;
@@ -113,8 +119,9 @@ PrefetchedCases run_prefetch_passes(const CaseFunction& run_case, Group group,
   // The real pass stops at its first failing case and shrinks it one input at a time: cases
   // after the first one known to fail need no answers.
   std::size_t first_failure = kept;
+  std::size_t share = kFirstPassInputs;
   auto run = [&](std::size_t k) {
-    if (k >= first_failure || done[k] || passes.recorded() >= kMaxPendingPerPass) return;
+    if (k >= first_failure || done[k] || passes.recorded() >= share) return;
     try {
       CaseOutcome outcome = run_case(out.cases[k].first, out.cases[k].second);
       if (!outcome.holds) first_failure = k;
@@ -138,10 +145,12 @@ PrefetchedCases run_prefetch_passes(const CaseFunction& run_case, Group group,
         description, seed, cases);
   });
   int pass = 1;
-  for (; pass < kMaxPrefetchPasses && passes.flush() > 0; ++pass)
+  for (; pass < kMaxPrefetchPasses && passes.flush() > 0; ++pass) {
+    share = std::min(2 * share, kMaxPendingPerPass);
     passes.pass([&] {
       for (std::size_t k = 0; k < out.cases.size(); ++k) run(k);
     });
+  }
   out.failed = first_failure < kept;
   out.complete = kept == static_cast<std::size_t>(cases) && pass < kMaxPrefetchPasses &&
                  out.cases.size() == kept &&
