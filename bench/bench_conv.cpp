@@ -3,7 +3,8 @@
 //   RGB-D 4 x 48 x 64 -> conv 16 (3x3, stride 2, pad 1) -> conv 32 (same) -> conv 32 (same),
 //   SiLU after each -> flatten (32 x 6 x 8 = 1536) -> 256 -> 256 -> 24 (SiLU), MSE to a target,
 //   Adam (lr 1e-3) on the encoder's and the MLP's parameters;
-// at batch 64 and 256 (items/s = training samples/s), and the encoder's forward alone.
+// at batch 64 and 256 (items/s = training samples/s), forward and backward one slice of
+// kImageTrainSlice samples at a time as the image head trains, and the encoder's forward alone.
 // BM_default_encoder_train_step: the same step on the image policies' default encoder
 // (experiments::Insert3dImageSettings: two cameras' normals and depth, 6 x 48 x 64 -> conv 8,
 // 16, 16, 16, the same 3 x 3 stride-2 layers -> 16 x 3 x 4 = 192 -> 256 -> 256 -> 24), whose
@@ -11,6 +12,7 @@
 // Numbers and commands: docs/BENCHMARKS.md, "Image encoder".
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <random>
 
 #include "handcentric/core/sampling.hpp"
@@ -35,8 +37,11 @@ Eigen::MatrixXf random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937
   return m;
 }
 
+// The image head's step (image_flow_head.cpp): forward and backward one slice of `slice`
+// samples at a time, the gradients summed over the slices, one Adam step; slice = batch is the
+// step on the whole batch at once.
 void train_steps(benchmark::State& state, const ImageShape& image,
-                 const std::vector<ConvLayerSpec>& layers) {
+                 const std::vector<ConvLayerSpec>& layers, int slice) {
   const int batch = static_cast<int>(state.range(0));
   std::mt19937_64 rng(1);
   ConvEncoder encoder(image, layers);
@@ -46,23 +51,42 @@ void train_steps(benchmark::State& state, const ImageShape& image,
   Adam encoder_adam(encoder.parameter_count(), {}), mlp_adam(mlp.parameter_count(), {});
   const Eigen::MatrixXf images = random_matrix(image.size(), batch, rng);
   const Eigen::MatrixXf target = random_matrix(24, batch, rng);
-  Eigen::MatrixXf d_output(24, batch);
+  Eigen::MatrixXf d_output;
+  Eigen::VectorXf mlp_gradient, encoder_gradient;
+  const auto d_scale = static_cast<float>(2.0 / static_cast<double>(target.size()));  // MSE
   for (auto _ : state) {
-    const Eigen::MatrixXf& output = mlp.forward(encoder.forward(images));
-    d_output = (output - target) * (2.0f / static_cast<float>(output.size()));  // MSE
-    encoder.backward_parameters(mlp.backward(d_output));
-    mlp_adam.step(mlp.parameters(), mlp.gradient());
-    encoder_adam.step(encoder.parameters(), encoder.gradient());
+    for (int first = 0; first < batch; first += slice) {
+      const int count = std::min(slice, batch - first);
+      const Eigen::MatrixXf& output = mlp.forward(encoder.forward(images.middleCols(first, count)));
+      d_output = (output - target.middleCols(first, count)) * d_scale;
+      encoder.backward_parameters(mlp.backward(d_output));
+      if (first == 0) {
+        mlp_gradient = mlp.gradient();
+        encoder_gradient = encoder.gradient();
+      } else {
+        mlp_gradient += mlp.gradient();
+        encoder_gradient += encoder.gradient();
+      }
+    }
+    mlp_adam.step(mlp.parameters(), mlp_gradient);
+    encoder_adam.step(encoder.parameters(), encoder_gradient);
     benchmark::DoNotOptimize(encoder.parameters().data());
   }
   state.SetItemsProcessed(state.iterations() * batch);
 }
 
 void BM_conv_train_step(benchmark::State& state) {
-  train_steps(state, kImage, kLayers);
+  train_steps(state, kImage, kLayers, kImageTrainSlice);
 }
 void BM_default_encoder_train_step(benchmark::State& state) {
-  train_steps(state, kDefaultImage, kDefaultLayers);
+  train_steps(state, kDefaultImage, kDefaultLayers, kImageTrainSlice);
+}
+// The step of the default encoder with slices of state.range(1) samples (the whole batch at 0):
+// how kImageTrainSlice was chosen.
+void BM_sliced_default_encoder_train_step(benchmark::State& state) {
+  const int slice = static_cast<int>(state.range(1));
+  train_steps(state, kDefaultImage, kDefaultLayers,
+              slice > 0 ? slice : static_cast<int>(state.range(0)));
 }
 // Wall time (UseRealTime), as PyTorch's side measures: on a shared machine the CPU time would
 // leave out the waits for a core that PyTorch's rate includes.
@@ -75,6 +99,11 @@ BENCHMARK(BM_conv_train_step)
 BENCHMARK(BM_default_encoder_train_step)
     ->Arg(64)
     ->Arg(256)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0)
+    ->UseRealTime();
+BENCHMARK(BM_sliced_default_encoder_train_step)
+    ->ArgsProduct({{256}, {0, 8, 12, 16, 24, 32, 64}})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0)
     ->UseRealTime();

@@ -2,11 +2,11 @@
 // encoded by a ConvEncoder trained end to end.
 #include "image_flow_head.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "handcentric/core/errors.hpp"
-#include "handcentric/policy/losses.hpp"
 
 namespace handcentric::policy {
 
@@ -74,8 +74,11 @@ double ImageFlowHead::train_step(const Eigen::MatrixXf& actions,
                                  const Eigen::MatrixXf& observations, std::mt19937_64& rng) {
   action_normalizer_.normalize(actions, a_);
   observation_normalizer_.normalize(observations, o_);
-  network_o_ = network_observation(encoder_, spatial_softmax_, o_);
-  return train_from_features(rng);
+  const Eigen::Index pixels = o_.rows() - proprio_rows_;
+  return train_in_slices(rng,
+                         [&](Eigen::Index first, Eigen::Index count) -> const Eigen::MatrixXf& {
+                           return encoder_.forward(o_.bottomRows(pixels).middleCols(first, count));
+                         });
 }
 
 double ImageFlowHead::train_step_on(const Minibatch& batch, std::mt19937_64& rng) {
@@ -102,38 +105,74 @@ double ImageFlowHead::train_step_on(const Minibatch& batch, std::mt19937_64& rng
         inv_scale.head(proprio_rows_).array();
   }
   const std::size_t pixels = static_cast<std::size_t>(set.rows() - proprio_rows_);
-  const PickedImages images{set, proprio_rows_, batch.columns,
-                            std::span<const float>(mean.data() + proprio_rows_, pixels),
-                            std::span<const float>(inv_scale.data() + proprio_rows_, pixels)};
-  network_o_ = with_features(spatial_softmax_, o_, encoder_.forward(images));
-  return train_from_features(rng);
+  const std::span<const float> pixel_mean(mean.data() + proprio_rows_, pixels);
+  const std::span<const float> pixel_inv_scale(inv_scale.data() + proprio_rows_, pixels);
+  return train_in_slices(
+      rng, [&](Eigen::Index first, Eigen::Index count) -> const Eigen::MatrixXf& {
+        const PickedImages images{
+            set, proprio_rows_,
+            batch.columns.subspan(static_cast<std::size_t>(first), static_cast<std::size_t>(count)),
+            pixel_mean, pixel_inv_scale};
+        return encoder_.forward(images);
+      });
 }
 
-double ImageFlowHead::train_from_features(std::mt19937_64& rng) {
-  draw_flow_sample(rng);
-  assemble(x_, t_, network_o_, input_);
-  const double loss = mse_loss<float>(network_.forward(input_), target_, d_output_);
-  // End to end: the MLP's input gradient, its feature rows (the last ones), into the encoder.
-  const Eigen::MatrixXf& d_input = network_.backward(d_output_);
-  const Eigen::Index features = network_o_.rows() - proprio_rows_;
-  if (keypoints_) {
-    encoder_.backward_parameters(spatial_softmax_.backward(d_input.bottomRows(features)));
-  } else {
-    encoder_.backward_parameters(d_input.bottomRows(features));
+void ImageFlowHead::set_train_slice(int samples) {
+  if (samples < 1) {
+    throw InvalidArgument("ImageFlowHead: a training slice of " + std::to_string(samples) +
+                          " samples; use 1 or more");
+  }
+  train_slice_ = samples;
+}
+
+template <typename Encode>
+double ImageFlowHead::train_in_slices(std::mt19937_64& rng, const Encode& encode) {
+  const Eigen::Index batch = a_.cols();
+  if (batch == 0) throw InvalidArgument("ImageFlowHead: a training step on no samples");
+  draw_flow_sample(rng);  // for the whole batch: the same draws whatever the slices
+  // Eq. (5)'s loss is the mean over the whole batch's entries, so each slice's output gradient
+  // is scaled by 2 / (the batch's entries), as mse_loss scales it.
+  const auto entries = static_cast<double>(target_.size());
+  const auto d_scale = static_cast<float>(2.0 / entries);
+  double squared_error = 0.0;
+  for (Eigen::Index first = 0; first < batch; first += train_slice_) {
+    const Eigen::Index count = std::min<Eigen::Index>(train_slice_, batch - first);
+    const Eigen::MatrixXf& maps = encode(first, count);
+    network_o_ =
+        with_features(spatial_softmax_, o_.topRows(proprio_rows_).middleCols(first, count), maps);
+    assemble(x_.middleCols(first, count), t_.segment(first, count), network_o_, input_);
+    d_output_ = network_.forward(input_) - target_.middleCols(first, count);
+    squared_error += static_cast<double>(d_output_.squaredNorm());
+    d_output_ *= d_scale;
+    // End to end: the MLP's input gradient, its feature rows (the last ones), into the encoder.
+    const Eigen::MatrixXf& d_input = network_.backward(d_output_);
+    const Eigen::Index features = network_o_.rows() - proprio_rows_;
+    if (keypoints_) {
+      encoder_.backward_parameters(spatial_softmax_.backward(d_input.bottomRows(features)));
+    } else {
+      encoder_.backward_parameters(d_input.bottomRows(features));
+    }
+    if (first == 0) {
+      network_gradient_ = network_.gradient();
+      encoder_gradient_ = encoder_.gradient();
+    } else {
+      network_gradient_ += network_.gradient();
+      encoder_gradient_ += encoder_.gradient();
+    }
   }
   // One clip over both gradients: the norm of their concatenation.
   double scale = 1.0;
   if (config_.gradient_clip > 0.0) {
-    const double norm = std::sqrt(static_cast<double>(network_.gradient().squaredNorm()) +
-                                  static_cast<double>(encoder_.gradient().squaredNorm()));
+    const double norm = std::sqrt(static_cast<double>(network_gradient_.squaredNorm()) +
+                                  static_cast<double>(encoder_gradient_.squaredNorm()));
     if (norm > config_.gradient_clip) scale = config_.gradient_clip / norm;
   }
-  adam_.step(network_.parameters(), network_.gradient(), static_cast<float>(scale));
+  adam_.step(network_.parameters(), network_gradient_, static_cast<float>(scale));
   encoder_adam_.set_learning_rate(adam_.learning_rate());
-  encoder_adam_.step(encoder_.parameters(), encoder_.gradient(), static_cast<float>(scale));
+  encoder_adam_.step(encoder_.parameters(), encoder_gradient_, static_cast<float>(scale));
   average_.update(network_.parameters());
   encoder_average_.update(encoder_.parameters());
-  return loss;
+  return squared_error / entries;
 }
 
 Eigen::MatrixXf ImageFlowHead::sample(const Eigen::MatrixXf& observations,

@@ -9,11 +9,13 @@
 // one soft-argmax point (x, y) per channel of it (spatial_softmax.hpp).
 //
 // Trained end to end: eq. (5)'s loss is backpropagated through the MLP into the features and on
-// through the encoder (ConvEncoder::backward_parameters); the MLP's and the encoder's gradients
-// are clipped together by their joint norm, and each set of weights takes the same Adam step (Adam
-// is elementwise, so two Adams are one Adam over both). Both normalizers see the whole
-// observation: each pixel is shifted and scaled by its training mean and spread, a constant map
-// that keeps an invariant image invariant (normalizer.hpp).
+// through the encoder (ConvEncoder::backward_parameters), one slice of kImageTrainSlice samples
+// at a time (conv_encoder.hpp: the slice's activations stay in cache), the gradients summed
+// over the slices; the MLP's and the encoder's gradients are clipped together by their joint
+// norm, and each set of weights takes the same Adam step (Adam is elementwise, so two Adams are
+// one Adam over both). Both normalizers see the whole observation: each pixel is shifted and
+// scaled by its training mean and spread, a constant map that keeps an invariant image invariant
+// (normalizer.hpp).
 #include <vector>
 
 #include "flow_head.hpp"
@@ -53,6 +55,13 @@ class ImageFlowHead final : public FlowHead {
   void read(ByteReader& in) override;
 
   const ConvEncoder& encoder() const { return encoder_; }
+  /// The last training step's gradients (the MLP's, the encoder's), summed over its slices,
+  /// before clipping.
+  const Eigen::VectorXf& network_gradient() const { return network_gradient_; }
+  const Eigen::VectorXf& encoder_gradient() const { return encoder_gradient_; }
+  /// Samples per slice of a training step (kImageTrainSlice unless set): the tests compare
+  /// slicings. Throws InvalidArgument for less than 1.
+  void set_train_slice(int samples);
 
  private:
   /// [proprioception; features] of normalized observations o, with `encoder` (and `softmax`
@@ -63,9 +72,13 @@ class ImageFlowHead final : public FlowHead {
   Eigen::MatrixXf with_features(SpatialSoftmax& softmax,
                                 const Eigen::Ref<const Eigen::MatrixXf>& proprio,
                                 const Eigen::MatrixXf& maps) const;
-  /// The step once a_ holds the batch's normalized actions and network_o_ its network
-  /// observations (encoder_ run forward on its images).
-  double train_from_features(std::mt19937_64& rng);
+  /// The step once a_ holds the batch's normalized actions and o_'s first rows its normalized
+  /// proprioception: eq. (5)'s sample drawn for the whole batch, then forward and backward
+  /// through the MLP and the encoder one slice of train_slice_ samples at a time, the gradients
+  /// summed over the slices, one clip and one Adam step. encode(first, count) runs encoder_
+  /// forward on those samples' images and returns its maps.
+  template <typename Encode>
+  double train_in_slices(std::mt19937_64& rng, const Encode& encode);
 
   int proprio_rows_ = 0;
   ConvEncoder encoder_;
@@ -74,6 +87,8 @@ class ImageFlowHead final : public FlowHead {
   Adam encoder_adam_;
   WeightAverage encoder_average_;
   Eigen::MatrixXf network_o_;
+  Eigen::VectorXf network_gradient_, encoder_gradient_;  ///< summed over a step's slices
+  int train_slice_ = kImageTrainSlice;
 };
 
 }  // namespace handcentric::policy

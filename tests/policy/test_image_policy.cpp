@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "fixtures.hpp"
@@ -14,6 +15,7 @@
 #include "handcentric/policy/head.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
+#include "image_flow_head.hpp"
 #include "throws.hpp"
 
 using namespace handcentric;
@@ -33,6 +35,18 @@ float encoder_change(const LearnedPolicy& a, const LearnedPolicy& b) {
   REQUIRE(before != nullptr);
   REQUIRE(after != nullptr);
   return (before->parameters() - after->parameters()).cwiseAbs().maxCoeff();
+}
+
+// `count` training samples of config's shape: actions uniform in [-0.5, 0.5), observations
+// (proprioception and pixels) in [0, 1).
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> random_samples(const PolicyConfig& config,
+                                                           Eigen::Index count, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  Eigen::MatrixXd actions(config.action_dimension, count);
+  Eigen::MatrixXd observations(config.observation_dimension, count);
+  for (Eigen::Index i = 0; i < actions.size(); ++i) actions(i) = uniform01(rng) - 0.5;
+  for (Eigen::Index i = 0; i < observations.size(); ++i) observations(i) = uniform01(rng);
+  return {actions, observations};
 }
 
 std::string rechecksummed(std::string bytes) {
@@ -82,14 +96,15 @@ TEST_CASE("image_policies_train_their_encoder_end_to_end", "[unit]") {
 // trains on the same columns copied out, step after step (the loss, then every weight written).
 TEST_CASE("an_image_head_trains_the_same_bits_from_the_sets_columns_as_from_a_copy", "[unit]") {
   const PolicyConfig config = image_policy(1).config();
-  std::mt19937_64 data_rng(5);
-  Eigen::MatrixXd actions(config.action_dimension, 40);
-  Eigen::MatrixXd observations(config.observation_dimension, 40);
-  for (Eigen::Index i = 0; i < actions.size(); ++i) actions(i) = uniform01(data_rng) - 0.5;
-  for (Eigen::Index i = 0; i < observations.size(); ++i) observations(i) = uniform01(data_rng);
+  const auto samples = random_samples(config, 40, 5);
+  const Eigen::MatrixXd& actions = samples.first;  // named, not bound: the lambdas below use them
+  const Eigen::MatrixXd& observations = samples.second;
   const Eigen::MatrixXf set_actions = actions.cast<float>();
   const Eigen::MatrixXf set_observations = observations.cast<float>();
-  const std::vector<Eigen::Index> columns = {3, 3, 39, 0, 17, 22, 8, 8, 31, 12, 5, 26};
+  // 37 columns: two whole slices of kImageTrainSlice samples and a part of one.
+  const std::vector<Eigen::Index> columns = {3,  3,  39, 0,  17, 22, 8,  8,  31, 12, 5,  26, 1,
+                                             2,  4,  6,  7,  9,  10, 11, 13, 14, 15, 16, 18, 19,
+                                             20, 21, 23, 24, 25, 27, 28, 29, 30, 32, 33};
   const auto n = static_cast<Eigen::Index>(columns.size());
   Eigen::MatrixXf copied_actions(set_actions.rows(), n);
   Eigen::MatrixXf copied_observations(set_observations.rows(), n);
@@ -120,6 +135,47 @@ TEST_CASE("an_image_head_trains_the_same_bits_from_the_sets_columns_as_from_a_co
   Eigen::MatrixXf changed = copied_observations;
   changed(changed.rows() - 1, 4) += 0.25f;
   CHECK(from_the_set.second != trained(false, changed).second);
+}
+
+// An image head runs its training step forward and backward one slice of samples at a time
+// (kImageTrainSlice), summing the gradients over the slices: whatever the slicing, the step's
+// gradient is the whole batch's, up to the rounding of the sums' order (a few float epsilons
+// relative to its norm). 37 samples in slices of 16 (16, 16 and 5), 5, 1 and all 37. A slice
+// scaled by its own size, a slice left out, or actions paired with another slice's images would
+// each move the gradient by a large fraction of it. The planted fault: the same comparison
+// against a batch with one pixel changed.
+TEST_CASE("an_image_heads_sliced_step_has_the_whole_batchs_gradient", "[unit]") {
+  const PolicyConfig config = image_policy(1).config();
+  const auto samples = random_samples(config, 37, 11);
+  const Eigen::MatrixXd& actions = samples.first;  // named, not bound: the lambdas below use them
+  const Eigen::MatrixXd& observations = samples.second;
+  const Eigen::MatrixXf batch_actions = actions.cast<float>();
+  const auto step = [&](int slice, const Eigen::MatrixXf& batch_observations) {
+    ImageFlowHead head(config);
+    std::mt19937_64 rng(7);
+    head.prepare(actions, observations, rng);
+    head.set_train_slice(slice);
+    const double loss = head.train_step(batch_actions, batch_observations, rng);
+    Eigen::VectorXf gradient(head.network_gradient().size() + head.encoder_gradient().size());
+    gradient << head.network_gradient(), head.encoder_gradient();
+    return std::pair{loss, gradient};
+  };
+  const Eigen::MatrixXf batch_observations = observations.cast<float>();
+  const auto [whole_loss, whole] = step(37, batch_observations);
+  REQUIRE(whole.norm() > 0.0f);
+  const auto relative_distance = [&](const Eigen::VectorXf& gradient) {
+    return (gradient - whole).norm() / whole.norm();
+  };
+  for (const int slice : {kImageTrainSlice, 5, 1}) {
+    INFO("slices of " << slice);
+    const auto [loss, gradient] = step(slice, batch_observations);
+    CHECK(loss == Approx(whole_loss).epsilon(1e-6));
+    CHECK(relative_distance(gradient) < 1e-5f);
+  }
+  Eigen::MatrixXf changed = batch_observations;
+  changed(changed.rows() - 1, 20) += 0.25f;
+  CHECK(relative_distance(step(kImageTrainSlice, changed).second) > 1e-5f);
+  CHECK_THROWS_AS(ImageFlowHead(config).set_train_slice(0), InvalidArgument);
 }
 
 TEST_CASE("image_models_record_their_encoder_and_need_their_camera", "[unit]") {

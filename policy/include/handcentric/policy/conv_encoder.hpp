@@ -54,6 +54,14 @@ struct PickedImages {
   std::span<const float> mean, inv_scale;
 };
 
+/// Samples per slice of an image policy's training step: forward and backward run through the
+/// encoder and the MLP one slice at a time, and the parameter gradients are summed over the
+/// slices (the whole batch's gradient, in another order of its sums). A slice's images and
+/// activations (about 0.2 MB a sample for the default two-camera image) stay in cache from its
+/// forward pass to its backward pass, where a batch of 256 (50 MB) would go through memory.
+/// Chosen with bench_conv (docs/BENCHMARKS.md, "Eighth round").
+inline constexpr int kImageTrainSlice = 16;
+
 /// One layer of a ConvEncoder (the input channels come from the layer before).
 struct ConvLayerSpec {
   int out_channels = 16;
