@@ -102,13 +102,15 @@ std::string format_witness(const Witness& witness) {
     out << "\nthe map's own rounding response here: " << format_number(witness.rounding_response)
         << " (its outputs' change when the inputs move by a few units of rounding)";
   }
+  // Off the case the difference persisted (check.cpp, decide_pointwise); whether that rules out
+  // rounding depends on the map's rounding response there.
   if (witness.off_case && witness.rounding_response >= witness.error) {
-    out << "\nthe map's own rounding moves its output here as much as g does: it sits on a "
-           "discontinuity at every scene near this one (e.g. it bins a quantity that is on a bin "
-           "edge by construction), so this NO says its output is decided by rounding, not that g "
-           "is treated differently by design";
-  }
-  if (witness.off_case) {
+    out << "\nthis scene is the case drawn, moved off it by a small random amount: the difference "
+           "persists there, but the map's own rounding moves its output as much as g does: it "
+           "sits on a discontinuity at every scene near this one (e.g. it bins a quantity that is "
+           "on a bin edge by construction, or encodes an angle that jumps at pi), so this witness "
+           "cannot tell a symmetry breaking from an output decided by rounding";
+  } else if (witness.off_case) {
     out << "\nthis scene is the case drawn, moved off it by a small random amount: the "
            "difference persists there, so it is no bin edge or rounding";
   }

@@ -221,7 +221,7 @@ TEST_CASE("any_exception_of_the_function_under_test_stops_the_check_and_is_rethr
 TEST_CASE("a_map_on_a_bin_edge_by_construction_fails_and_its_witness_says_so", "[property]") {
   // The Euler angles of T_0^{-1} T_0 (the identity, up to rounding) binned at 5 degrees: every
   // scene sits on the edge at 0, so no move off the case leaves it. The NO stands, and the
-  // witness says the output is decided by rounding there.
+  // witness says it cannot tell that from an output decided by rounding.
   const props::SceneFunction on_edge = [](const Scene& scene) -> Eigen::VectorXd {
     const RigidTransform& T0 = scene.world_T_hand0();
     const Eigen::Vector3d angles = euler(T0.inverse_compose(T0).rotation().matrix());
@@ -235,4 +235,7 @@ TEST_CASE("a_map_on_a_bin_edge_by_construction_fails_and_its_witness_says_so", "
   REQUIRE(verdict.witness.has_value());
   CHECK(verdict.witness->rounding_response >= verdict.witness->error);
   CHECK_THAT(props::format_witness(*verdict.witness), Catch::Contains("decided by rounding"));
+  // ... and only that: not also that the difference off the case rules rounding out.
+  CHECK_THAT(props::format_witness(*verdict.witness),
+             !Catch::Contains("so it is no bin edge or rounding"));
 }
