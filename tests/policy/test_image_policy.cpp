@@ -161,7 +161,9 @@ TEST_CASE("an_image_heads_sliced_step_has_the_whole_batchs_gradient", "[unit]") 
     return std::pair{loss, gradient};
   };
   const Eigen::MatrixXf batch_observations = observations.cast<float>();
-  const auto [whole_loss, whole] = step(37, batch_observations);
+  const auto whole_step = step(37, batch_observations);
+  const double whole_loss = whole_step.first;
+  const Eigen::VectorXf& whole = whole_step.second;  // named, not bound: a lambda uses it
   REQUIRE(whole.norm() > 0.0f);
   const auto relative_distance = [&](const Eigen::VectorXf& gradient) {
     return (gradient - whole).norm() / whole.norm();
