@@ -177,7 +177,14 @@ TEST_CASE("an_image_heads_sliced_step_has_the_whole_batchs_gradient", "[unit]") 
   Eigen::MatrixXf changed = batch_observations;
   changed(changed.rows() - 1, 20) += 0.25f;
   CHECK(relative_distance(step(kImageTrainSlice, changed).second) > 1e-5f);
-  CHECK_THROWS_AS(ImageFlowHead(config).set_train_slice(0), InvalidArgument);
+  HC_CHECK_THROWS(ImageFlowHead(config).set_train_slice(0), InvalidArgument,
+                  Catch::Contains("slice of 0 samples"));
+  // A step on no samples is refused by name (Adam would get an empty gradient).
+  ImageFlowHead empty(config);
+  std::mt19937_64 rng(7);
+  empty.prepare(actions, observations, rng);
+  HC_CHECK_THROWS(empty.train_step(batch_actions.leftCols(0), batch_observations.leftCols(0), rng),
+                  InvalidArgument, Catch::Contains("no samples"));
 }
 
 TEST_CASE("image_models_record_their_encoder_and_need_their_camera", "[unit]") {
