@@ -49,7 +49,9 @@ void add_table2_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--seed", options->seed,
                   "seed of the demos and training; evaluation scenes use seed + 1")
       ->capture_default_str();
-  cmd->add_option("--jobs", options->jobs, "trainings at once (0: one per hardware thread)")
+  cmd->add_option("--jobs", options->jobs,
+                  "cores to use: key-point trainings at once, and the threads of each image "
+                  "training, one image row at a time (0: one per hardware thread)")
       ->capture_default_str();
   cmd->add_option("--steps", options->steps,
                   "Adam steps per policy (0: automatic: the library's budget for the key-point "

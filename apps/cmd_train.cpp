@@ -32,6 +32,7 @@
 #include "handcentric/experiments/table2.hpp"
 #include "handcentric/policy/kernels.hpp"
 #include "handcentric/policy/model_file.hpp"
+#include "handcentric/policy/slice_team.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/demos.hpp"
 #include "handcentric/sim/insert3d/demos.hpp"
@@ -51,6 +52,7 @@ struct TrainOptions {
   std::shared_ptr<ImageFlags> image = std::make_shared<ImageFlags>();
   std::uint64_t seed = 1;
   int max_demos = 0;
+  int threads = 0;  ///< 0: policy::training_threads()
   sim::TrainingData data;
   bool quiet = false;
 };
@@ -149,8 +151,8 @@ int run_train(const TrainOptions& options) {
     if (terminal && p.step == p.steps) std::fprintf(stderr, "\n");
   };
   const auto start = std::chrono::steady_clock::now();
-  const policy::LearnedPolicy trained =
-      policy::train_policy(config, scenes, options.seed, progress, report_every, camera);
+  const policy::LearnedPolicy trained = policy::train_policy(config, scenes, options.seed, progress,
+                                                             report_every, camera, options.threads);
   policy::save_model(trained, options.out);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -254,6 +256,11 @@ void add_train_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"key_points", "image"}))
       ->capture_default_str();
   add_image_options(cmd, options->image);
+  cmd->add_option("--threads", options->threads,
+                  "threads of an image policy's training steps (the same model for any number; "
+                  "0 = this machine's cores)")
+      ->check(CLI::Range(0, policy::SliceTeam::kMaxThreads))
+      ->capture_default_str();
   cmd->add_flag("--quiet", options->quiet, "no progress display");
   cmd->callback([options, &exit_code] { exit_code = run_train(*options); });
 }

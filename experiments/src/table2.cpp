@@ -24,6 +24,7 @@
 #include "handcentric/experiments/results_page.hpp"
 #include "handcentric/experiments/wilson.hpp"
 #include "handcentric/policy/model_file.hpp"
+#include "handcentric/policy/slice_team.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/insert3d/camera.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
@@ -182,8 +183,10 @@ std::string image_summary(const policy::PolicyConfig& config) {
   return text.str();
 }
 
+// `threads`: the image policy's training steps (the key-point policies train on one).
 Table2Row run_method(const Table2Options& options, const std::string& method,
-                     policy::ObservationKind observation, const std::vector<Scene>& scenes) {
+                     policy::ObservationKind observation, const std::vector<Scene>& scenes,
+                     int threads) {
   policy::PolicyConfig config;
   config.task = policy::kTaskInsert3d;
   config.representation = method;
@@ -194,8 +197,9 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
   if (image) camera = options.image.apply(config);
   const auto start = std::chrono::steady_clock::now();
   const auto model = std::make_shared<const policy::LearnedPolicy>(
-      image ? policy::train_policy(config, scenes, options.seed, {}, 100, camera)
-            : policy::train_policy(config, with_slot_key_points(scenes), options.seed));
+      image ? policy::train_policy(config, scenes, options.seed, {}, 100, camera, threads)
+            : policy::train_policy(config, with_slot_key_points(scenes), options.seed, {}, 100,
+                                   nullptr, 1));
   const double train_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (options.save_models) {
@@ -272,31 +276,46 @@ std::vector<Table2Row> run_table2(const Table2Options& options) {
   const std::size_t count = options.methods.size() * options.observations.size();
   std::vector<Table2Row> rows(count);
   std::vector<std::exception_ptr> errors(count);
-  std::atomic<std::size_t> next{0};
   std::mutex print;
-  const auto worker = [&] {
-    for (std::size_t m = next++; m < count; m = next++) {
-      try {
-        const std::size_t o = m / options.methods.size();
-        rows[m] = run_method(options, options.methods[m % options.methods.size()],
-                             options.observations[o], scenes[o]);
-        if (!options.quiet) {
-          const std::lock_guard<std::mutex> lock(print);
-          std::cerr << "table2: " << row_label(rows[m]) << " (trained in "
-                    << static_cast<long>(rows[m].train_seconds) << " s) train "
-                    << rows[m].train.success_rate() << " ood " << rows[m].ood.success_rate()
-                    << " random-se3 " << rows[m].random_se3.success_rate() << "\n";
-        }
-      } catch (...) {
-        errors[m] = std::current_exception();
+  const auto run_row = [&](std::size_t m, int threads) {
+    try {
+      const std::size_t o = m / options.methods.size();
+      rows[m] = run_method(options, options.methods[m % options.methods.size()],
+                           options.observations[o], scenes[o], threads);
+      if (!options.quiet) {
+        const std::lock_guard<std::mutex> lock(print);
+        std::cerr << "table2: " << row_label(rows[m]) << " (trained in "
+                  << static_cast<long>(rows[m].train_seconds) << " s) train "
+                  << rows[m].train.success_rate() << " ood " << rows[m].ood.success_rate()
+                  << " random-se3 " << rows[m].random_se3.success_rate() << "\n";
       }
+    } catch (...) {
+      errors[m] = std::current_exception();
     }
   };
+  const auto image_row = [&](std::size_t m) {
+    return options.observations[m / options.methods.size()] == policy::ObservationKind::image;
+  };
   const int hardware = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-  const int jobs =
-      std::min<int>(options.jobs > 0 ? options.jobs : hardware, static_cast<int>(rows.size()));
+  const int jobs = options.jobs > 0 ? options.jobs : hardware;
+  // An image row's training runs its steps on `jobs` threads (SliceTeam), one row at a time: a
+  // step's slices keep every core busy to the end, where rows side by side would leave one idle
+  // while the last row trains alone. Key-point rows train on one thread each, `jobs` at a time.
+  for (std::size_t m = 0; m < count; ++m) {
+    if (image_row(m)) run_row(m, std::min(jobs, policy::SliceTeam::kMaxThreads));
+  }
+  std::vector<std::size_t> key_point_rows;
+  for (std::size_t m = 0; m < count; ++m) {
+    if (!image_row(m)) key_point_rows.push_back(m);
+  }
+  std::atomic<std::size_t> next{0};
+  const auto worker = [&] {
+    for (std::size_t k = next++; k < key_point_rows.size(); k = next++)
+      run_row(key_point_rows[k], 1);
+  };
   std::vector<std::thread> threads;
-  for (int j = 1; j < jobs; ++j) threads.emplace_back(worker);
+  for (int j = 1; j < std::min<int>(jobs, static_cast<int>(key_point_rows.size())); ++j)
+    threads.emplace_back(worker);
   worker();
   for (std::thread& thread : threads) thread.join();
   for (const std::exception_ptr& error : errors) {

@@ -1,8 +1,11 @@
 #include "handcentric/policy/head.hpp"
 
+#include <string>
+
 #include "handcentric/core/errors.hpp"
 #include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/losses.hpp"
+#include "handcentric/policy/slice_team.hpp"
 #include "handcentric/policy/time_embedding.hpp"
 #include "image_flow_head.hpp"
 #include "network_head.hpp"
@@ -31,6 +34,13 @@ void check_image_config(const PolicyConfig& config, const std::string& where) {
   }
 }
 }  // namespace
+
+void Head::set_threads(int threads) {
+  if (threads < 1 || threads > SliceTeam::kMaxThreads) {
+    throw InvalidArgument("training threads " + std::to_string(threads) + ": use 1 to " +
+                          std::to_string(SliceTeam::kMaxThreads));
+  }
+}
 
 std::unique_ptr<Head> make_head(const PolicyConfig& config) {
   config.validate();

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "handcentric/core/errors.hpp"
 
@@ -75,10 +76,11 @@ double ImageFlowHead::train_step(const Eigen::MatrixXf& actions,
   action_normalizer_.normalize(actions, a_);
   observation_normalizer_.normalize(observations, o_);
   const Eigen::Index pixels = o_.rows() - proprio_rows_;
-  return train_in_slices(rng,
-                         [&](Eigen::Index first, Eigen::Index count) -> const Eigen::MatrixXf& {
-                           return encoder_.forward(o_.bottomRows(pixels).middleCols(first, count));
-                         });
+  return train_in_slices(
+      rng,
+      [&](ConvEncoder& encoder, Eigen::Index first, Eigen::Index count) -> const Eigen::MatrixXf& {
+        return encoder.forward(o_.bottomRows(pixels).middleCols(first, count));
+      });
 }
 
 double ImageFlowHead::train_step_on(const Minibatch& batch, std::mt19937_64& rng) {
@@ -108,12 +110,13 @@ double ImageFlowHead::train_step_on(const Minibatch& batch, std::mt19937_64& rng
   const std::span<const float> pixel_mean(mean.data() + proprio_rows_, pixels);
   const std::span<const float> pixel_inv_scale(inv_scale.data() + proprio_rows_, pixels);
   return train_in_slices(
-      rng, [&](Eigen::Index first, Eigen::Index count) -> const Eigen::MatrixXf& {
+      rng,
+      [&](ConvEncoder& encoder, Eigen::Index first, Eigen::Index count) -> const Eigen::MatrixXf& {
         const PickedImages images{
             set, proprio_rows_,
             batch.columns.subspan(static_cast<std::size_t>(first), static_cast<std::size_t>(count)),
             pixel_mean, pixel_inv_scale};
-        return encoder_.forward(images);
+        return encoder.forward(images);
       });
 }
 
@@ -125,6 +128,11 @@ void ImageFlowHead::set_train_slice(int samples) {
   train_slice_ = samples;
 }
 
+void ImageFlowHead::set_threads(int threads) {
+  Head::set_threads(threads);  // checks the range
+  threads_ = threads;
+}
+
 template <typename Encode>
 double ImageFlowHead::train_in_slices(std::mt19937_64& rng, const Encode& encode) {
   const Eigen::Index batch = a_.cols();
@@ -134,32 +142,59 @@ double ImageFlowHead::train_in_slices(std::mt19937_64& rng, const Encode& encode
   // is scaled by 2 / (the batch's entries), as mse_loss scales it.
   const auto entries = static_cast<double>(target_.size());
   const auto d_scale = static_cast<float>(2.0 / entries);
-  double squared_error = 0.0;
-  for (Eigen::Index first = 0; first < batch; first += train_slice_) {
-    const Eigen::Index count = std::min<Eigen::Index>(train_slice_, batch - first);
-    const Eigen::MatrixXf& maps = encode(first, count);
-    network_o_ =
-        with_features(spatial_softmax_, o_.topRows(proprio_rows_).middleCols(first, count), maps);
-    assemble(x_.middleCols(first, count), t_.segment(first, count), network_o_, input_);
-    d_output_ = network_.forward(input_) - target_.middleCols(first, count);
-    squared_error += static_cast<double>(d_output_.squaredNorm());
-    d_output_ *= d_scale;
-    // End to end: the MLP's input gradient, its feature rows (the last ones), into the encoder.
-    const Eigen::MatrixXf& d_input = network_.backward(d_output_);
-    const Eigen::Index features = network_o_.rows() - proprio_rows_;
-    if (keypoints_) {
-      encoder_.backward_parameters(spatial_softmax_.backward(d_input.bottomRows(features)));
-    } else {
-      encoder_.backward_parameters(d_input.bottomRows(features));
-    }
-    if (first == 0) {
-      network_gradient_ = network_.gradient();
-      encoder_gradient_ = encoder_.gradient();
-    } else {
-      network_gradient_ += network_.gradient();
-      encoder_gradient_ += encoder_.gradient();
-    }
+
+  // No more lanes than slices; lanes beyond the first compute on copies of the weights.
+  const Eigen::Index slices = (batch + train_slice_ - 1) / train_slice_;
+  const int lanes = static_cast<int>(std::min<Eigen::Index>(threads_, slices));
+  if (!team_ || team_->threads() != lanes) team_ = std::make_unique<SliceTeam>(lanes);
+  if (lane_buffers_.size() < static_cast<std::size_t>(lanes)) lane_buffers_.resize(lanes);
+  while (lane_networks_.size() + 1 < static_cast<std::size_t>(lanes))
+    lane_networks_.push_back(LaneNetworks{network_, encoder_, spatial_softmax_});
+  for (int lane = 1; lane < lanes; ++lane) {
+    LaneNetworks& copy = lane_networks_[static_cast<std::size_t>(lane - 1)];
+    copy.network.parameters() = network_.parameters();
+    copy.encoder.parameters() = encoder_.parameters();
   }
+  const auto networks = [&](int lane) {
+    if (lane == 0) return std::tie(network_, encoder_, spatial_softmax_);
+    LaneNetworks& copy = lane_networks_[static_cast<std::size_t>(lane - 1)];
+    return std::tie(copy.network, copy.encoder, copy.softmax);
+  };
+
+  const auto compute = [&](int lane, long first, long count) {
+    auto [network, encoder, softmax] = networks(lane);
+    LaneBuffers& buffers = lane_buffers_[static_cast<std::size_t>(lane)];
+    const Eigen::MatrixXf& maps = encode(encoder, first, count);
+    buffers.network_o =
+        with_features(softmax, o_.topRows(proprio_rows_).middleCols(first, count), maps);
+    assemble(x_.middleCols(first, count), t_.segment(first, count), buffers.network_o,
+             buffers.input);
+    buffers.d_output = network.forward(buffers.input) - target_.middleCols(first, count);
+    buffers.squared_error = static_cast<double>(buffers.d_output.squaredNorm());
+    buffers.d_output *= d_scale;
+    // End to end: the MLP's input gradient, its feature rows (the last ones), into the encoder.
+    const Eigen::MatrixXf& d_input = network.backward(buffers.d_output);
+    const Eigen::Index features = buffers.network_o.rows() - proprio_rows_;
+    if (keypoints_) {
+      encoder.backward_parameters(softmax.backward(d_input.bottomRows(features)));
+    } else {
+      encoder.backward_parameters(d_input.bottomRows(features));
+    }
+  };
+  double squared_error = 0.0;
+  const auto add = [&](int lane, long first) {  // in slice order (SliceTeam)
+    auto [network, encoder, softmax] = networks(lane);
+    if (first == 0) {
+      network_gradient_ = network.gradient();
+      encoder_gradient_ = encoder.gradient();
+    } else {
+      network_gradient_ += network.gradient();
+      encoder_gradient_ += encoder.gradient();
+    }
+    squared_error += lane_buffers_[static_cast<std::size_t>(lane)].squared_error;
+  };
+  team_->run(batch, train_slice_, compute, add);
+
   // One clip over both gradients: the norm of their concatenation.
   double scale = 1.0;
   if (config_.gradient_clip > 0.0) {

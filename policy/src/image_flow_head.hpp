@@ -16,10 +16,12 @@
 // one Adam over both). Both normalizers see the whole observation: each pixel is shifted and
 // scaled by its training mean and spread, a constant map that keeps an invariant image invariant
 // (normalizer.hpp).
+#include <memory>
 #include <vector>
 
 #include "flow_head.hpp"
 #include "handcentric/policy/conv_encoder.hpp"
+#include "handcentric/policy/slice_team.hpp"
 #include "handcentric/policy/spatial_softmax.hpp"
 
 namespace handcentric::policy {
@@ -62,6 +64,7 @@ class ImageFlowHead final : public FlowHead {
   /// Samples per slice of a training step (kImageTrainSlice unless set): the tests compare
   /// slicings. Throws InvalidArgument for less than 1.
   void set_train_slice(int samples);
+  void set_threads(int threads) override;
 
  private:
   /// [proprioception; features] of normalized observations o, with `encoder` (and `softmax`
@@ -74,11 +77,25 @@ class ImageFlowHead final : public FlowHead {
                                 const Eigen::MatrixXf& maps) const;
   /// The step once a_ holds the batch's normalized actions and o_'s first rows its normalized
   /// proprioception: eq. (5)'s sample drawn for the whole batch, then forward and backward
-  /// through the MLP and the encoder one slice of train_slice_ samples at a time, the gradients
-  /// summed over the slices, one clip and one Adam step. encode(first, count) runs encoder_
-  /// forward on those samples' images and returns its maps.
+  /// through the MLP and the encoder one slice of train_slice_ samples at a time, on threads_
+  /// lanes (SliceTeam), the gradients summed in slice order, one clip and one Adam step.
+  /// encode(encoder, first, count) runs `encoder` (a lane's) forward on those samples' images
+  /// and returns its maps.
   template <typename Encode>
   double train_in_slices(std::mt19937_64& rng, const Encode& encode);
+
+  /// What a training lane beyond the first computes with: its own MLP and encoder (the head's
+  /// weights, copied in at each step) for their activations and gradients.
+  struct LaneNetworks {
+    Mlp network;
+    ConvEncoder encoder;
+    SpatialSoftmax softmax;
+  };
+  /// A lane's slice buffers (the first lane's included).
+  struct LaneBuffers {
+    Eigen::MatrixXf network_o, input, d_output;
+    double squared_error = 0.0;
+  };
 
   int proprio_rows_ = 0;
   ConvEncoder encoder_;
@@ -86,9 +103,12 @@ class ImageFlowHead final : public FlowHead {
   SpatialSoftmax spatial_softmax_;
   Adam encoder_adam_;
   WeightAverage encoder_average_;
-  Eigen::MatrixXf network_o_;
   Eigen::VectorXf network_gradient_, encoder_gradient_;  ///< summed over a step's slices
   int train_slice_ = kImageTrainSlice;
+  int threads_ = 1;
+  std::unique_ptr<SliceTeam> team_;          ///< made at the first step, remade when resized
+  std::vector<LaneNetworks> lane_networks_;  ///< lanes 1, 2, ... (lane 0 is the head's own)
+  std::vector<LaneBuffers> lane_buffers_;    ///< lanes 0, 1, ...
 };
 
 }  // namespace handcentric::policy

@@ -6,11 +6,13 @@
 #include <string>
 #include <numbers>
 #include <random>
+#include <thread>
 #include <vector>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/policy/c8_planar.hpp"
+#include "handcentric/policy/slice_team.hpp"
 
 namespace handcentric::policy {
 
@@ -56,9 +58,14 @@ void require_camera(const ImageSource* camera) {
 }
 }  // namespace
 
+int training_threads() {
+  const auto cores = static_cast<int>(std::thread::hardware_concurrency());
+  return std::clamp(cores, 1, SliceTeam::kMaxThreads);
+}
+
 LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes,
                            std::uint64_t seed, const ProgressCallback& progress, int report_every,
-                           std::shared_ptr<const ImageSource> camera) {
+                           std::shared_ptr<const ImageSource> camera, int threads) {
   config.validate();
   const auto representation = make_representation(config.representation);
   const bool image = config.observation == ObservationKind::image;
@@ -66,13 +73,17 @@ LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes
   return train_policy(config,
                       encode_scenes(*representation, scenes, config.history_length,
                                     config.chunk_length, image ? camera.get() : nullptr),
-                      seed, progress, report_every, camera);
+                      seed, progress, report_every, camera, threads);
 }
 
 LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64_t seed,
                            const ProgressCallback& progress, int report_every,
-                           std::shared_ptr<const ImageSource> camera) {
+                           std::shared_ptr<const ImageSource> camera, int threads) {
   config.validate();
+  if (threads < 0) {
+    throw InvalidArgument("train_policy: " + std::to_string(threads) +
+                          " threads; use 0 (this machine's cores) or 1 or more");
+  }
   if (config.observation == ObservationKind::image) {
     require_camera(camera.get());
     const ImageShape shape = camera->shape();
@@ -99,6 +110,7 @@ LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64
   config.hand_points = data.hand_points;
   config.world_points = data.world_points;
   std::shared_ptr<Head> head = make_head(config);
+  head->set_threads(threads > 0 ? threads : training_threads());
 
   std::mt19937_64 rng(seed);
   head->prepare(data.actions, data.observations, rng);

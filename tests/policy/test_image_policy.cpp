@@ -187,6 +187,46 @@ TEST_CASE("an_image_heads_sliced_step_has_the_whole_batchs_gradient", "[unit]") 
                   InvalidArgument, Catch::Contains("no samples"));
 }
 
+// A step's slices on several threads (SliceTeam) give the weights of one thread, bit for bit:
+// each slice's gradient is added in slice order whichever lane computed it. 37 samples in
+// slices of 5 (8 slices) over three steps, on 2 threads, 3 (the last round short of a lane)
+// and 9 (more than the slices: a lane is left out), with both kinds of image features. Summing
+// each lane's slices first and then the lanes (the sums in another order) changes the last
+// bits of the weights, which this comparison of bytes sees.
+TEST_CASE("an_image_heads_steps_give_the_same_bits_on_any_number_of_threads", "[unit]") {
+  for (const ImageFeatures features : {ImageFeatures::flatten, ImageFeatures::spatial_softmax}) {
+    PolicyConfig config = image_policy(1).config();
+    config.image_features = features;
+    const auto samples = random_samples(config, 37, 13);
+    const Eigen::MatrixXf batch_actions = samples.first.cast<float>();
+    const Eigen::MatrixXf batch_observations = samples.second.cast<float>();
+    const auto weights = [&](int threads) {
+      ImageFlowHead head(config);
+      std::mt19937_64 rng(5);
+      head.prepare(samples.first, samples.second, rng);
+      head.set_train_slice(5);
+      head.set_threads(threads);
+      for (int step = 0; step < 3; ++step) head.train_step(batch_actions, batch_observations, rng);
+      Eigen::VectorXf all(head.network().parameters().size() + head.encoder().parameter_count());
+      all << head.network().parameters(), head.encoder().parameters();
+      return all;
+    };
+    const Eigen::VectorXf one = weights(1);
+    for (const int threads : {2, 3, 9}) {
+      INFO(to_string(features) << " features, " << threads << " threads");
+      const Eigen::VectorXf many = weights(threads);
+      REQUIRE(many.size() == one.size());
+      CHECK(std::memcmp(many.data(), one.data(), sizeof(float) * one.size()) == 0);
+    }
+  }
+  HC_CHECK_THROWS(ImageFlowHead(image_policy(1).config()).set_threads(0), InvalidArgument,
+                  Catch::Contains("training threads 0"));
+  HC_CHECK_THROWS(
+      train_policy(test::small_image_config("hand_centric", 1), test::small_scenes(4, 2), 3, {},
+                   100, std::make_shared<const test::BlobCamera>(), -1),
+      InvalidArgument, Catch::Contains("-1 threads"));
+}
+
 TEST_CASE("image_models_record_their_encoder_and_need_their_camera", "[unit]") {
   const LearnedPolicy policy = image_policy(20);
   const std::string bytes = serialize_model(policy);

@@ -97,7 +97,8 @@ struct Table2Options {
   int trials = 100;
   std::string out = "table2";
   std::uint64_t seed = 1;
-  int jobs = 0;   ///< trainings at once; 0: one per hardware thread
+  int jobs = 0;   ///< cores: key-point trainings at once, an image training's threads
+                  ///< (one image row at a time); 0: one per hardware thread
   int steps = 0;  ///< Adam steps per policy; 0: automatic (the key-point rows: the library's
                   ///< budget; the image rows: Insert3dImageSettings::steps)
   std::vector<std::string> methods = {"hand_centric", "relative", "absolute"};

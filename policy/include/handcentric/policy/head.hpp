@@ -62,6 +62,10 @@ class Head {
   virtual bool reads_the_set() const { return false; }
   /// The optimizer's learning rate for the next train_step calls (the trainer's schedule).
   virtual void set_learning_rate(double learning_rate) = 0;
+  /// Threads the next train_step calls may use (1 until set). The image heads run a step's
+  /// slices on them (slice_team.hpp: the same weights, bit for bit, for any number); the others
+  /// train on one. Throws InvalidArgument for threads outside 1..SliceTeam::kMaxThreads.
+  virtual void set_threads(int threads);
 
   /// Called once after the last train_step: with config.ema_decay > 0 the head's weights
   /// become their moving average (weight_average.hpp), which is what sample() and write() use.

@@ -1,7 +1,7 @@
 #pragma once
 // Training a LearnedPolicy from scenes: encode with the representation, fit normalization, then
 // config.steps Adam steps on minibatches drawn with replacement. Deterministic: the same
-// config, scenes and seed give the same weights, bit for bit (on one thread).
+// config, scenes and seed give the same weights, bit for bit, on any number of threads.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -54,23 +54,29 @@ inline constexpr int kC8BudgetMaxSteps = 10000;
 /// Throws InvalidArgument for a step outside 1..steps.
 double learning_rate_at(const PolicyConfig& config, int step);
 
+/// The threads a training uses when it is given 0: this machine's cores
+/// (std::thread::hardware_concurrency, at least 1, at most SliceTeam::kMaxThreads).
+int training_threads();
+
 /// Trains `config.head` on `scenes` with `config.representation` (config.steps = 0: the
 /// automatic budget for scenes.size() samples). An image policy (config.observation = image)
 /// needs `camera`, which renders each scene's image (image_source.hpp); the trainer sets
 /// config.image_* from it, and the policy returned keeps it. The encoder is trained end to end
-/// with the head. Dimensions and point counts
-/// in the returned policy's config come from the data. `progress` (optional) is called about
-/// every `report_every` steps and after the last step. Throws InvalidArgument for a bad config
-/// or a non-finite loss (diverged training), InvalidScene for bad scenes (dataset.hpp).
+/// with the head, each step's slices on `threads` threads (0: training_threads(); only the
+/// image heads use more than one, Head::set_threads), the same weights bit for bit for any
+/// number. Dimensions and point counts in the returned policy's config come from the data.
+/// `progress` (optional) is called about every `report_every` steps and after the last step.
+/// Throws InvalidArgument for a bad config, a negative thread count or a non-finite loss
+/// (diverged training), InvalidScene for bad scenes (dataset.hpp).
 LearnedPolicy train_policy(PolicyConfig config, const std::vector<Scene>& scenes,
                            std::uint64_t seed, const ProgressCallback& progress = {},
                            int report_every = 100,
-                           std::shared_ptr<const ImageSource> camera = nullptr);
+                           std::shared_ptr<const ImageSource> camera = nullptr, int threads = 0);
 
 /// The same on already encoded data (benchmarks; `config.representation` must still name the
 /// representation that encoded it).
 LearnedPolicy train_policy(PolicyConfig config, const Dataset& data, std::uint64_t seed,
                            const ProgressCallback& progress = {}, int report_every = 100,
-                           std::shared_ptr<const ImageSource> camera = nullptr);
+                           std::shared_ptr<const ImageSource> camera = nullptr, int threads = 0);
 
 }  // namespace handcentric::policy
