@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Our image encoder + MLP training step (bench_conv) against PyTorch (Debian's python3-torch,
 # CPU, its convolutions on oneDNN) on the same network, in one run on this machine. Prints both
-# throughputs per batch size and last one line per batch, `ratio at batch B: X (wall), Y (CPU
-# time, 1 thread)`: X = our training samples/s / PyTorch's best samples/s (1 or 2 threads, either
-# memory format), Y = the same per second of CPU time, each on one thread (on a shared machine
-# the wall times include waits for a core, which differ between the two runs).
+# throughputs per batch size and last one line per batch, `ratio at batch B: X (machine), Y
+# (ours on 1 thread), Z (CPU time, 1 thread each)`: X = our training samples/s on 2 threads (a
+# step's slices on two lanes, SliceTeam) / PyTorch's best samples/s (1 or 2 threads, either
+# memory format), Y = the same with ours on 1 thread, Z = the same per second of CPU time, each on
+# one thread (on a shared machine the wall times include waits for a core, which differ between
+# the two runs).
 #
 #   bench/vs_pytorch_conv.sh [BUILD_DIR] [NETWORK]   (defaults: build, bench)
 #
@@ -12,8 +14,8 @@
 # policies' default encoder (BM_default_encoder_train_step: 6 x 48 x 64 -> 8, 16, 16, 16).
 #
 # As bench/vs_pytorch.sh: /usr/bin/python3 (Debian's torch imports only there), both sides
-# pinned with taskset when it exists, ours on core 0, PyTorch on core 0 (1 thread) and cores 0
-# and 1 (2 threads), in both memory formats (its best is taken). PyTorch's Linear layers run on
+# pinned with taskset when it exists, each on core 0 (1 thread) and cores 0 and 1 (2 threads),
+# PyTorch in both memory formats (its best is taken). PyTorch's Linear layers run on
 # the BLAS it loads (printed): scripts/install-deps.sh installs OpenBLAS (libopenblas0), which
 # the alternatives system then prefers; a run on the reference BLAS, whose slow Linear layers
 # would flatter us, is flagged in the output.
@@ -44,14 +46,18 @@ fi
 echo "handcentric's kernels: ${HANDCENTRIC_KERNELS:-best for this CPU}; network: $network"
 pin() { if command -v taskset >/dev/null; then taskset -c "$1" "${@:2}"; else "${@:2}"; fi; }
 
-ours_json="$(pin 0 "$bench" --benchmark_filter="$filter" \
+# Ours on one thread (core 0), then on two (cores 0 and 1: a step's slices on two lanes,
+# SliceTeam), as PyTorch runs on one and two.
+ours_json="$(pin 0 "$bench" --benchmark_filter="^$filter/[0-9]+/1/" \
+  --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"
+ours2_json="$(pin 0,1 "$bench" --benchmark_filter="^$filter/[0-9]+/2/" \
   --benchmark_repetitions=3 --benchmark_format=json 2>/dev/null)"
 torch_lines="$(pin 0 "$python" "$here/vs_pytorch_conv.py" --threads 1 --network "$network"
                pin 0,1 "$python" "$here/vs_pytorch_conv.py" --threads 2 --network "$network")"
 echo "$torch_lines" | sed 's/^/pytorch: /'
 "$python" -c '
 import json, sys
-ours, ours_cpu = {}, {}
+ours, ours_cpu, ours2 = {}, {}, {}
 for b in json.loads(sys.argv[1])["benchmarks"]:
     if b.get("run_type") != "iteration":
         continue
@@ -59,6 +65,10 @@ for b in json.loads(sys.argv[1])["benchmarks"]:
     ours[batch] = max(ours.get(batch, 0.0), b["items_per_second"])
     cpu_seconds = b["cpu_time"] * {"ms": 1e-3, "us": 1e-6, "ns": 1e-9, "s": 1.0}[b["time_unit"]]
     ours_cpu[batch] = max(ours_cpu.get(batch, 0.0), batch / cpu_seconds)
+for b in json.loads(sys.argv[3])["benchmarks"]:
+    if b.get("run_type") == "iteration":
+        batch = int(b["name"].split("/")[1])
+        ours2[batch] = max(ours2.get(batch, 0.0), b["items_per_second"])
 torch, best_of, torch_cpu = {}, {}, {}
 for line in sys.argv[2].splitlines():
     run = json.loads(line)
@@ -72,11 +82,16 @@ for line in sys.argv[2].splitlines():
 print("pytorch BLAS: %s%s" % (blas, " (the reference BLAS: its Linear layers are slow)"
                               if "/blas/" in blas else ""))
 for batch in sorted(ours):
-    print("handcentric: batch %d train %.0f samples/s (%.0f per CPU second); pytorch best %.0f "
-          "samples/s (%s; 1 thread: %.0f per CPU second)" %
-          (batch, ours[batch], ours_cpu[batch], torch[batch], best_of[batch], torch_cpu[batch]))
-# The CPU-time ratio (1 thread each) is the one to read on a shared machine.
+    print("handcentric: batch %d train %.0f samples/s on 1 thread (%.0f per CPU second), %.0f on "
+          "2; pytorch best %.0f samples/s (%s; 1 thread: %.0f per CPU second)" %
+          (batch, ours[batch], ours_cpu[batch], ours2.get(batch, 0.0), torch[batch],
+           best_of[batch], torch_cpu[batch]))
+# Both sides on the whole machine (ours on 2 threads, PyTorch at its best of 1 or 2), and per
+# core: ours on 1 thread against PyTorch at its best, and per CPU second on 1 thread each (the
+# one to read on a shared machine).
 for batch in sorted(ours):
-    print("ratio at batch %d: %.3f (wall), %.3f (CPU time, 1 thread)" %
-          (batch, ours[batch] / torch[batch], ours_cpu[batch] / torch_cpu[batch]))' \
-  "$ours_json" "$torch_lines"
+    print("ratio at batch %d: %.3f (machine: ours on 2 threads, wall), %.3f (ours on 1 thread, "
+          "wall), %.3f (CPU time, 1 thread each)" %
+          (batch, ours2.get(batch, 0.0) / torch[batch], ours[batch] / torch[batch],
+           ours_cpu[batch] / torch_cpu[batch]))' \
+  "$ours_json" "$torch_lines" "$ours2_json"
