@@ -219,6 +219,13 @@ TEST_CASE("an_image_heads_steps_give_the_same_bits_on_any_number_of_threads", "[
       CHECK(std::memcmp(many.data(), one.data(), sizeof(float) * one.size()) == 0);
     }
   }
+  // Through the trainer (train_policy's threads), the model files' bytes.
+  const auto trained = [](int threads) {
+    return serialize_model(train_policy(test::small_image_config("hand_centric", 4),
+                                        test::small_scenes(40, 2), 3, {}, 100,
+                                        std::make_shared<const test::BlobCamera>(), threads));
+  };
+  CHECK(trained(1) == trained(3));
   HC_CHECK_THROWS(ImageFlowHead(image_policy(1).config()).set_threads(0), InvalidArgument,
                   Catch::Contains("training threads 0"));
   HC_CHECK_THROWS(
