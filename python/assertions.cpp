@@ -139,7 +139,8 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
       holds = law->invariant;
     } else {
       props::CheckOptions check = props::with_view(c.check, v.view);
-      check.shrink = false;  // only the yes or no is wanted
+      check.shrink = false;                         // only the yes or no is wanted
+      check.extra_cases = props::witness_cases(v);  // the law at the pointwise witness too
       holds = props::check_policy_distribution(*python_policy, v.group, check, c.distribution)
                   .invariant;
     }

@@ -158,6 +158,30 @@ PrefetchedCases run_prefetch_passes(const CaseFunction& run_case, Group group,
   return out;
 }
 
+// The same for CheckOptions::extra_cases, which run after the search: their inputs are asked for
+// in passes of their own, so that a batched map answers them in a few calls, not one per input.
+void prefetch_extra_cases(const CaseFunction& run_case,
+                          const std::vector<std::pair<Scene, RigidTransform>>& extra_cases) {
+  if (extra_cases.empty()) return;
+  PrefetchPasses passes;
+  std::vector<char> done(extra_cases.size(), 0);
+  for (int pass = 0; pass < kMaxPrefetchPasses; ++pass) {
+    passes.pass([&] {
+      for (std::size_t k = 0; k < extra_cases.size(); ++k) {
+        if (done[k]) continue;
+        try {
+          (void)run_case(extra_cases[k].first, extra_cases[k].second);
+          done[k] = 1;
+        } catch (const PendingEvaluation&) {
+        } catch (...) {
+          done[k] = 1;  // the real pass meets the error again
+        }
+      }
+    });
+    if (passes.flush() == 0) break;
+  }
+}
+
 }  // namespace
 
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
@@ -180,6 +204,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   if (options.prefetch) {
     prefetched =
         run_prefetch_passes(run_case, group, options.shape, description, options.seed, cases);
+    prefetch_extra_cases(run_case, options.extra_cases);
     if (before_real_pass) before_real_pass();
   }
   Verdict verdict;
@@ -264,6 +289,17 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   };
   if (!searched) run_silently(property, description, options.seed, cases);
   if (error) std::rethrow_exception(error);
+  bool extra_witness = false;
+  for (std::size_t k = 0; k < options.extra_cases.size() && !verdict.witness; ++k) {
+    CaseOutcome outcome;
+    const bool holds =
+        search_case(options.extra_cases[k].first, options.extra_cases[k].second, outcome);
+    if (error) std::rethrow_exception(error);
+    if (!holds) {
+      verdict.witness = std::move(outcome.witness);
+      extra_witness = true;
+    }
+  }
   if (!verdict.witness && verdict.cases == verdict.discontinuities) {
     // Every case was near the identity (or sat on a discontinuity): nothing was shown either way.
     throw Error(to_string(component) + " under " + to_string(group) + " (" + to_string(mode) +
@@ -276,6 +312,11 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   }
   verdict.invariant = !verdict.witness.has_value();
   if (shape.workspace) verdict.note = shape.workspace->verdict_note();
+  if (extra_witness) {
+    verdict.note += std::string(verdict.note.empty() ? "" : "; ") +
+                    "every drawn case held; the witness is the pointwise check's (the same "
+                    "group and view), run here as an extra case, where this check fails too";
+  }
   if (shape.recorded) {
     verdict.note += (verdict.note.empty() ? "" : "; ") + shape.recorded->verdict_note();
   }

@@ -8,7 +8,11 @@
 #include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
-namespace {}  // namespace
+
+std::vector<std::pair<Scene, RigidTransform>> witness_cases(const Verdict& verdict) {
+  if (!verdict.witness) return {};
+  return {{verdict.witness->scene, verdict.witness->g}};
+}
 
 Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
                           const std::function<Verdict(const CheckOptions&)>& recheck) {
@@ -36,6 +40,7 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target,
                    const ClassifierOptions& options, View view, Classification& out,
                    const std::function<void()>& tick) {
   const CheckOptions check = with_view(options.check, view);
+  std::vector<std::vector<std::pair<Scene, RigidTransform>>> witnesses;  // per component, group
   for (Component component : {Component::flow_input, Component::flow_target}) {
     const auto f = [&](std::uint64_t noise_seed, double t) {
       return component == Component::flow_input ? flow_input_of(target, noise_seed, t)
@@ -46,17 +51,27 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target,
       out.verdicts.push_back(with_float32_note(
           check_invariance(fn, component, group, check), options,
           [&](const CheckOptions& o) { return check_invariance(fn, component, group, o); }));
+      witnesses.push_back(witness_cases(out.verdicts.back()));
       tick();
     }
   }
   if (!options.in_distribution) return;
+  std::size_t k = 0;
   for (Component component : {Component::flow_input, Component::flow_target}) {
     for (Group group : options.groups) {
+      // The pointwise witness of this component and group is one more case (extra_cases).
+      const auto with_witness = [&witnesses, k](CheckOptions o) {
+        o.extra_cases = witnesses[k];
+        return o;
+      };
       out.verdicts.push_back(with_float32_note(
-          check_distribution_invariance(target, component, group, check, options.distribution),
+          check_distribution_invariance(target, component, group, with_witness(check),
+                                        options.distribution),
           options, [&](const CheckOptions& o) {
-            return check_distribution_invariance(target, component, group, o, options.distribution);
+            return check_distribution_invariance(target, component, group, with_witness(o),
+                                                 options.distribution);
           }));
+      ++k;
       tick();
     }
   }

@@ -135,18 +135,26 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
   };
   for (View view : options.views) {
     const CheckOptions check = with_view(options.check, view);
+    std::vector<std::vector<std::pair<Scene, RigidTransform>>> witnesses;  // per group
     for (Group group : options.groups) {
       out.verdicts.push_back(with_float32_note(
           check_policy_equivariance(*policy, group, check), options,
           [&](const CheckOptions& o) { return check_policy_equivariance(*policy, group, o); }));
+      witnesses.push_back(witness_cases(out.verdicts.back()));
       tick();
     }
     if (!options.in_distribution) continue;
-    for (Group group : options.groups) {
+    for (std::size_t k = 0; k < options.groups.size(); ++k) {
+      const Group group = options.groups[k];
+      // The pointwise witness of this group is one more case (CheckOptions::extra_cases).
+      const auto with_witness = [&witnesses, k](CheckOptions o) {
+        o.extra_cases = witnesses[k];
+        return o;
+      };
       out.verdicts.push_back(with_float32_note(
-          check_policy_distribution(*policy, group, check, options.distribution), options,
-          [&](const CheckOptions& o) {
-            return check_policy_distribution(*policy, group, o, options.distribution);
+          check_policy_distribution(*policy, group, with_witness(check), options.distribution),
+          options, [&](const CheckOptions& o) {
+            return check_policy_distribution(*policy, group, with_witness(o), options.distribution);
           }));
       tick();
     }

@@ -233,3 +233,58 @@ TEST_CASE("float32_rounding_gets_a_note_and_passes_at_float32_tolerance", "[prop
                     Catch::Matchers::Contains("--tolerance"));
   CHECK_THROWS_WITH(props::parse_precision("float16"), Catch::Matchers::Contains("float16"));
 }
+
+namespace {
+
+// Hand-centric actions (eq. 1) but pushed 5 cm along world x where the hand is within `radius`
+// of a fixed world point: the planted fault of the next test, breaking the symmetry on a small
+// part of the scenes only.
+class WorldSpotActions final : public Representation {
+ public:
+  std::string name() const override { return "world_spot_actions"; }
+  Eigen::VectorXd encode_actions(const Scene& scene) const override {
+    Eigen::VectorXd a = inner_.encode_actions(scene);
+    if ((scene.world_T_hand0().translation() - Eigen::Vector3d(1.0, 0.0, 0.0)).norm() < 0.5)
+      a(0) += 0.05;
+    return a;
+  }
+  Eigen::VectorXd encode_observation(const Scene& scene) const override {
+    return inner_.encode_observation(scene);
+  }
+  std::vector<RigidTransform> decode_actions(const Eigen::VectorXd& actions,
+                                             const RigidTransform& world_T_hand0) const override {
+    return inner_.decode_actions(actions, world_T_hand0);
+  }
+
+ private:
+  HandCentricRepresentation inner_;
+};
+
+}  // namespace
+
+// As for whole policies (test_policy_audit.cpp), the flow target's in-distribution check runs
+// the pointwise witness of its component and group as one more case: the rectified flow's target
+// a - eps has law N(a, I), which differs wherever a does, so the NO found pointwise is a NO in
+// law too, where the 5 drawn in-distribution cases all miss the spot.
+TEST_CASE("a_flow_targets_in_distribution_check_also_runs_its_pointwise_witness", "[property]") {
+  props::ClassifierOptions options = fast_classifier();
+  options.check.cases = 1000;  // the default: 200 cases miss the spot
+  options.views = {props::View::eye_in_hand};
+  options.groups = {Group::translation};
+  const auto target = std::make_shared<RectifiedFlow>(std::make_shared<WorldSpotActions>());
+  const props::Classification c = props::classify_flow_target(target, options);
+  const props::Verdict* pointwise =
+      props::find_verdict(c, Component::flow_target, Mode::pointwise, Group::translation);
+  const props::Verdict* in_law =
+      props::find_verdict(c, Component::flow_target, Mode::distribution, Group::translation);
+  REQUIRE(pointwise != nullptr);
+  REQUIRE(in_law != nullptr);
+  CHECK_FALSE(pointwise->invariant);
+  CHECK_FALSE(in_law->invariant);
+  CHECK(in_law->method == props::Method::exact_gaussian);
+  CHECK_THAT(in_law->note, Catch::Contains("the witness is the pointwise check's"));
+  const props::Verdict drawn_only = props::check_distribution_invariance(
+      target, Component::flow_target, Group::translation,
+      props::with_view(options.check, props::View::eye_in_hand), options.distribution);
+  CHECK(drawn_only.invariant);
+}

@@ -388,19 +388,18 @@ TEST_CASE("policy_exec_hands_a_plugin_the_images_of_its_hellos_cameras", "[unit]
         "' --cases 40 --view eye_in_hand --group " + groups + " --json");
     INFO(result.err);
     REQUIRE(result.exit_code == 0);
-    return nlohmann::json::parse(result.out)
-        .at("policies")
-        .at(0)
-        .at("summary")
-        .at("eye_in_hand")
-        .at("pointwise");
+    return nlohmann::json::parse(result.out).at("policies").at(0).at("summary").at("eye_in_hand");
   };
-  const auto eye = audit("eye_in_hand", "se3");
+  const auto eye = audit("eye_in_hand", "se3").at("pointwise");
   CHECK(eye.at("se3") == true);
+  // The camera fixed in the world sees the scene in few cases: the 10 drawn in-distribution
+  // cases miss it, and the in-distribution NO comes from the pointwise witness, run as one more
+  // case (CheckOptions::extra_cases); before, this cell said "yes".
   const auto fixed = audit("third_person", "se2");
-  CHECK(fixed.at("se2") == false);
-  CHECK(audit("eye_in_hand floor", "se2").at("se2") == true);
-  CHECK(audit("eye_in_hand floor", "se3").at("se3") == false);
+  CHECK(fixed.at("pointwise").at("se2") == false);
+  CHECK(fixed.at("distribution").at("se2") == false);
+  CHECK(audit("eye_in_hand floor", "se2").at("pointwise").at("se2") == true);
+  CHECK(audit("eye_in_hand floor", "se3").at("pointwise").at("se3") == false);
   // --witness-dir: the two images the policy saw of the witness, as PNGs.
   const std::string dir = (std::filesystem::temp_directory_path() / "handcentric_witness_images");
   std::filesystem::remove_all(dir);

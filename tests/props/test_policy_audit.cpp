@@ -325,3 +325,65 @@ TEST_CASE("a_tested_yes_states_the_mean_shift_and_the_scale_ratio_it_would_find"
   CHECK_THAT(json, Catch::Matchers::Contains("\"detectable_scale_ratio\": 1.99") &&
                        Catch::Matchers::Contains("\"method\": \"partly_exact\""));
 }
+
+namespace {
+
+// Equivariant (a hand-frame step, hand-frame noise) except where the hand is within
+// `radius` of a fixed world point: there a world-frame push is added, as a policy that reads a
+// camera fixed in the world acts differently only when the scene is in that camera's view. The
+// planted fault of the next test: it breaks the symmetry on a small part of the scenes.
+class WorldSpotPolicy final : public props::NoisyPolicy {
+ public:
+  explicit WorldSpotPolicy(double radius) : radius_(radius) {}
+  std::string name() const override { return "world_spot"; }
+  Eigen::Index noise_dimension() const override { return 3 * kAuditChunk; }
+  std::vector<RigidTransform> act(const Scene& o, const Eigen::VectorXd& noise) const override {
+    const RigidTransform& T_0 = o.world_T_hand0();
+    const bool seen = (T_0.translation() - Eigen::Vector3d(1.0, 0.0, 0.0)).norm() < radius_;
+    std::vector<RigidTransform> chunk;
+    for (int k = 0; k < kAuditChunk; ++k) {
+      const Eigen::Vector3d hand_step =
+          Eigen::Vector3d(0.01 * (k + 1), 0.0, 0.0) + 0.01 * noise.segment<3>(3 * k);
+      Eigen::Vector3d p = T_0 * hand_step;
+      if (seen) p += Eigen::Vector3d(0.05, 0.0, 0.0);
+      chunk.push_back(RigidTransform::unchecked(T_0.rotation().matrix(), p));
+    }
+    return chunk;
+  }
+
+ private:
+  double radius_;
+};
+
+}  // namespace
+
+// The in-distribution check runs the pointwise check's witness as one more case
+// (CheckOptions::extra_cases): a policy that breaks the symmetry only where the hand is near one
+// world point fails pointwise (1000 cases find the spot) while the 10 drawn in-distribution
+// cases all miss it, and a "yes in distribution" beside a pointwise NO whose law differs too
+// would be a false yes. With the witness the in-distribution verdict is NO, decided exactly (the
+// chunk is affine in the noise), and says where its witness came from. The drawn cases alone
+// (check_policy_distribution without extra cases) pass: the gap the witness closes.
+TEST_CASE("an_in_distribution_check_also_runs_the_pointwise_witness", "[property]") {
+  const auto policy = std::make_shared<WorldSpotPolicy>(0.5);
+  props::ClassifierOptions options;
+  options.views = {props::View::eye_in_hand};
+  options.groups = {Group::translation};
+  const props::Classification c = props::classify_policy(policy, options);
+  REQUIRE(c.verdicts.size() == 2);
+  const props::Verdict& pointwise = c.verdicts[0];
+  const props::Verdict& in_law = c.verdicts[1];
+  REQUIRE(pointwise.mode == props::Mode::pointwise);
+  REQUIRE(in_law.mode == props::Mode::distribution);
+  CHECK_FALSE(pointwise.invariant);
+  CHECK_FALSE(in_law.invariant);
+  CHECK(in_law.method == props::Method::exact_gaussian);
+  REQUIRE(in_law.witness);
+  CHECK(in_law.witness->scene.world_T_hand0().translation() ==
+        pointwise.witness->scene.world_T_hand0().translation());
+  CHECK_THAT(in_law.note, Catch::Contains("the witness is the pointwise check's"));
+  const props::Verdict drawn_only = props::check_policy_distribution(
+      *policy, Group::translation, props::with_view(options.check, props::View::eye_in_hand),
+      options.distribution);
+  CHECK(drawn_only.invariant);
+}

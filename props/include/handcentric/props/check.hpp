@@ -25,6 +25,8 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <utility>
+#include <vector>
 
 #include "handcentric/core/chunk_policy.hpp"
 #include "handcentric/core/flow_target.hpp"
@@ -59,6 +61,13 @@ struct CheckOptions {
   /// (BatchedPolicy, BatchedRepresentation) is asked for many inputs at once. The verdict is the
   /// same; for a map that is not batched it only costs time.
   bool prefetch = false;
+  /// Cases run after the drawn ones, and counted with them: the classifiers hand an
+  /// in-distribution check the witness of the pointwise check of the same component, group and
+  /// view, a scene where the values already differ, so the law most likely differs there too.
+  /// Without it, a map that breaks the symmetry on a small part of the scenes (a camera fixed in
+  /// the world that sees the scene in one case of 65) could fail pointwise and still pass the
+  /// few in-distribution cases by luck. A witness found here is not shrunk (it already was).
+  std::vector<std::pair<Scene, RigidTransform>> extra_cases;
 };
 
 /// Eye-in-hand scenes (no world points): Theorem 1's assumption.

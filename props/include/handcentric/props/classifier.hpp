@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "handcentric/core/flow_target.hpp"
@@ -65,6 +66,10 @@ Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
 /// and sets the verdict's note when it holds.
 Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
                           const std::function<Verdict(const CheckOptions&)>& recheck);
+
+/// The witness of a failed verdict as one (scene, g) case for another check
+/// (CheckOptions::extra_cases), or none when it held.
+std::vector<std::pair<Scene, RigidTransform>> witness_cases(const Verdict& verdict);
 
 /// `check` with the scenes of `view` (its world-point counts), everything else kept; a fixed
 /// count of world points (min = max >= 1) in `check` is kept for the third-person view.
