@@ -54,6 +54,8 @@ def make_policy(fault=None):
         chunk = T0 @ hand0_T_handk
         if fault == "world_noise":
             chunk[:, :3, 3] += 0.05 * noise[8:8 + 3 * K].reshape(K, 3)
+        if fault == "world_spot" and np.linalg.norm(T0[:3, 3] - [1.0, 0.0, 0.0]) < 0.5:
+            chunk[:, 0, 3] += 0.05  # pushed along world x where the hand is near one world point
         return chunk
 
     policy.__qualname__ = "policy_" + (fault or "hand_centric")

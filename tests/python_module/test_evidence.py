@@ -253,6 +253,19 @@ def test_the_in_law_hint_appears_only_when_the_law_holds():
     assert "mode='distribution'" not in message and "in law" not in message, message
 
 
+def test_no_in_law_hint_where_the_law_differs_at_the_pointwise_witness():
+    # world_spot breaks the symmetry only where the hand is near one world point: the pointwise
+    # check (1000 cases) finds it, and the 10 drawn in-distribution cases miss it. Its law
+    # differs at the pointwise witness, which the in-law check runs too: no hint to a mode that
+    # fails as well (without the witness, the hint said it held in law).
+    with pytest.raises(AssertionError) as failure:
+        handcentric.assert_equivariant(make_policy("world_spot"), "translation", cases=1000,
+                                       views="eye_in_hand")
+    message = str(failure.value)
+    assert "not equivariant under translation" in message
+    assert "mode='distribution'" not in message and "in law" not in message, message
+
+
 def test_a_failing_cell_says_on_which_case_it_failed():
     result = handcentric.audit_policy(make_policy("world_noise"), groups=("translation",
                                                                           "rotation"),
