@@ -28,7 +28,7 @@ struct SliceTeam::Shared {
   const Compute* compute = nullptr;
   const Add* add = nullptr;
   long batch = 0, slice = 0, slices = 0;
-  int threads = 1;
+  int threads = 1;  ///< lanes, set once by the constructor
   long added = 0;  ///< slices [0, added) are in the sum
   bool failed = false;
   std::exception_ptr error;
@@ -98,6 +98,7 @@ SliceTeam::SliceTeam(int threads) : threads_(threads), shared_(std::make_unique<
     throw InvalidArgument("SliceTeam: " + std::to_string(threads) + " threads; use 1 to " +
                           std::to_string(kMaxThreads));
   }
+  shared_->threads = threads;
   try {
     for (int lane = 1; lane < threads; ++lane) {
       shared_->workers.emplace_back([shared = shared_.get(), lane] { shared->work(lane); });
@@ -135,7 +136,6 @@ void SliceTeam::run(long batch, long slice, const Compute& compute, const Add& a
     shared.batch = batch;
     shared.slice = slice;
     shared.slices = slices;
-    shared.threads = threads_;
     shared.added = 0;
     shared.failed = false;
     shared.error = nullptr;

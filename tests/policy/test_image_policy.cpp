@@ -190,9 +190,10 @@ TEST_CASE("an_image_heads_sliced_step_has_the_whole_batchs_gradient", "[unit]") 
 // A step's slices on several threads (SliceTeam) give the weights of one thread, bit for bit:
 // each slice's gradient is added in slice order whichever lane computed it. 37 samples in
 // slices of 5 (8 slices) over three steps, on 2 threads, 3 (the last round short of a lane)
-// and 9 (more than the slices: a lane is left out), with both kinds of image features. Summing
-// each lane's slices first and then the lanes (the sums in another order) changes the last
-// bits of the weights, which this comparison of bytes sees.
+// and 9 (more than the slices: a lane is left out), with both kinds of image features, compared
+// byte for byte. Mutants run by hand: a lane adding its slice without waiting for the one before
+// (the sums in completion order) and a lane computing on weights not refreshed at the step both
+// fail it.
 TEST_CASE("an_image_heads_steps_give_the_same_bits_on_any_number_of_threads", "[unit]") {
   for (const ImageFeatures features : {ImageFeatures::flatten, ImageFeatures::spatial_softmax}) {
     PolicyConfig config = image_policy(1).config();
