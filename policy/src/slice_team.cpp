@@ -29,7 +29,7 @@ struct SliceTeam::Shared {
   const Add* add = nullptr;
   long batch = 0, slice = 0, slices = 0;
   int threads = 1;  ///< lanes, set once by the constructor
-  long added = 0;  ///< slices [0, added) are in the sum
+  long added = 0;   ///< slices [0, added) are in the sum
   bool failed = false;
   std::exception_ptr error;
 
