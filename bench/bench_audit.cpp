@@ -1,7 +1,7 @@
 // The audit's speed: the whole built-in audit (four representations and ActionFlow's target,
 // all groups, both modes, both views, 1000 cases) should take under 2 s, and an
 // --exec audit should spend its time in the plug-in, not in the pipe. Figures and the exact
-// command: docs/BENCHMARKS.md, "Audit (props)".
+// command: docs/BENCHMARKS.md, "Audit".
 #include <benchmark/benchmark.h>
 
 #include <memory>

@@ -186,7 +186,7 @@ TEST_CASE("the_camera_frames_show_every_fourth_pose_and_the_last", "[unit]") {
 }
 
 // The rollout picture's two camera panels fit beside the view for the image models' camera
-// (64 x 48, the default since session 14) as for the task's 32 x 24: 8x the smaller, 4x the
+// (64 x 48, the default) as for the task's 32 x 24: 8x the smaller, 4x the
 // larger. At 8x, the 64 x 48 panels ran off the canvas (OpenCV's region check threw).
 TEST_CASE("the_rollout_picture_fits_the_camera_panels_of_any_image_size", "[unit]") {
   const insert3d::TaskScene scene =

@@ -83,7 +83,8 @@ struct Perturbation {
 /// from the copies (relative 0.10 -> 0.66, hand-centric 0.98 -> 1.00, docs/EXPERIMENTS.md); the
 /// hand-centric image policy turns too late on the scenes that start with the largest yaw, and
 /// copies turned by up to 5 deg fix that (28/30 -> 29/30 on every set at --seed 1000, 26/30 ->
-/// 30/30 at --seed 2000, losing no scene; docs/SIM.md, "Levers tried on branch img5").
+/// 30/30 at --seed 2000, losing no scene; docs/SIM.md, "The defaults and the measurements
+/// behind them").
 Perturbation insert3d_default_perturbation(policy::ObservationKind observation);
 
 /// The training scenes of `demos` (H, K) and their perturbed copies (demo after demo), drawn

@@ -59,7 +59,7 @@ struct PickedImages {
 /// slices (the whole batch's gradient, in another order of its sums). A slice's images and
 /// activations (about 0.2 MB a sample for the default two-camera image) stay in cache from its
 /// forward pass to its backward pass, where a batch of 256 (50 MB) would go through memory.
-/// Chosen with bench_conv (docs/BENCHMARKS.md, "Eighth round").
+/// Chosen with bench_conv (docs/BENCHMARKS.md, "Image encoder": the slicing).
 inline constexpr int kImageTrainSlice = 16;
 
 /// One layer of a ConvEncoder (the input channels come from the layer before).
