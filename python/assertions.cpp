@@ -104,7 +104,7 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                         py::handle views, py::handle cases, std::uint64_t seed,
                         std::optional<double> tolerance, const std::string& precision,
                         py::handle noise_length, py::handle extra_poses, py::handle scalars,
-                        const Setup& setup) {
+                        py::handle rng, py::handle reset, const Setup& setup) {
   require_numpy("assert_equivariant");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -114,14 +114,19 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                           "'; use pointwise (the same noise for o and g o), "
                           "distribution (independent noise) or both");
   }
-  const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
-                                         extra_poses, scalars, setup);
+  CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
+                                   extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
   c.in_distribution = mode != "pointwise";
+  set_policy_call(o, c, rng, reset, "assert_equivariant");
   ProgressLine progress("assert_equivariant", o.quiet);
   c.progress = std::ref(progress);
   const auto python_policy = batched_policy(policy, noise, o);
   props::Classification result = props::classify_policy(python_policy, c);
+  // mode "both" asked for pointwise verdicts too: without the same draws on both sides there are
+  // none, which is not a pass.
+  if (mode == "both" && result.preflight && !result.preflight->repeatable)
+    throw props::OwnRandomness(result.preflight->note);
   if (mode == "distribution") {
     std::erase_if(result.verdicts,
                   [](const props::Verdict& v) { return v.mode != props::Mode::distribution; });

@@ -1,6 +1,7 @@
 #include "callables.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <pybind11/stl.h>
 #include <utility>
 
@@ -195,30 +196,100 @@ PythonPolicy::PythonPolicy(py::object policy, Eigen::Index noise, CallOptions op
     : policy_(std::move(policy)),
       noise_(noise),
       options_(std::move(options)),
-      name_("python: " + callable_name(policy_)) {}
+      name_("python: " + callable_name(policy_)) {
+  if (!options_.rng.empty()) rng_module_ = py::module_::import("handcentric._rng");
+}
+
+void PythonPolicy::watch_draws(bool on) const {
+  watching_ = on;
+  if (on) draws_.clear();
+}
+
+std::optional<std::vector<std::string>> PythonPolicy::last_draws() const {
+  return draws_;
+}
+
+namespace {
+
+/// The seed of one row's call under rng=: FNV-1a over the audit's seed and the row's noise bytes,
+/// so the same noise gives the same draws (o and g o, paired) and other noise other draws (the
+/// in-distribution samples, independent).
+std::uint64_t row_seed(std::uint64_t base, const Eigen::VectorXd& noise) {
+  std::uint64_t h = 1469598103934665603ULL;
+  const auto mix = [&h](std::uint64_t bits) {
+    for (int b = 0; b < 8; ++b) h = (h ^ ((bits >> (8 * b)) & 0xffU)) * 1099511628211ULL;
+  };
+  mix(base);
+  for (Eigen::Index i = 0; i < noise.size(); ++i) {
+    std::uint64_t bits = 0;
+    const double x = noise(i);
+    std::memcpy(&bits, &x, sizeof(bits));
+    mix(bits);
+  }
+  return h >> 1;  // below 2**63: torch.manual_seed takes it
+}
+
+}  // namespace
 
 std::vector<std::vector<RigidTransform>> PythonPolicy::act_batch(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
+  if (options_.rng.empty() && options_.stacked) return call_once(observations, noises);
+  // One scene per call; and under rng= one row per call, each seeded from its own noise, so that
+  // the row's draws do not depend on what else shares its batch.
+  std::vector<std::vector<RigidTransform>> out;
+  for (std::size_t i = 0; i < observations.size(); ++i) {
+    auto one = call_once({observations[i]}, {noises[i]});
+    out.push_back(std::move(one.front()));
+  }
+  return out;
+}
+
+std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
   const ArrayKind& kind = options_.arrays;
+  if (!options_.reset.is_none()) (void)call(options_.reset);
+  py::kwargs seeded;
+  if (!options_.rng.empty()) {
+    const py::dict extra = rng_module_.attr("seed_before_call")(
+        options_.rng, row_seed(options_.rng_seed, *noises.front()), kind.device);
+    for (auto item : extra) seeded[item.first] = item.second;
+  }
+  py::object before;
+  if (watching_) before = py::module_::import("handcentric._rng").attr("snapshot")();
+  const auto watched = [&](py::object result) {
+    if (watching_) {
+      for (auto name : py::module_::import("handcentric._rng").attr("advanced")(before)) {
+        const std::string n = py::str(name);
+        if (std::find(draws_.begin(), draws_.end(), n) == draws_.end()) draws_.push_back(n);
+      }
+    }
+    return result;
+  };
+  const auto kwargs = [&](const std::vector<const Scene*>& rows) {
+    py::kwargs kw = extras_kwargs(rows, options_);
+    for (auto item : seeded) kw[item.first] = item.second;
+    return kw;
+  };
   const std::string what = "the chunk returned by policy " + name_;
   std::vector<std::vector<RigidTransform>> out;
   if (!options_.stacked) {
     for (std::size_t i = 0; i < observations.size(); ++i) {
       const Scene& o = *observations[i];
-      py::object result = call(
+      py::object result = watched(call(
           policy_, for_callable(array_of(o.world_T_hand_history), kind),
           for_callable(array_of(o.hand_points), kind), for_callable(array_of(o.world_points), kind),
-          for_callable(array_of(*noises[i]), kind), **extras_kwargs({&o}, options_));
+          for_callable(array_of(*noises[i]), kind), **kwargs({&o})));
       out.push_back(poses_from(result, what, true, "(K, 4, 4)"));
     }
     return out;
   }
   py::object result =
-      call(policy_, for_callable(stacked_history(observations), kind),
-           for_callable(stacked_hand_points(observations), kind),
-           for_callable(stacked_world_points(observations), kind),
-           for_callable(stacked_vectors(noises), kind), **extras_kwargs(observations, options_));
+      watched(call(policy_, for_callable(stacked_history(observations), kind),
+                   for_callable(stacked_hand_points(observations), kind),
+                   for_callable(stacked_world_points(observations), kind),
+                   for_callable(stacked_vectors(noises), kind), **kwargs(observations)));
   const auto a = real_array(result, what);
   const auto B = static_cast<py::ssize_t>(observations.size());
   if (a.ndim() != 4 || a.shape(0) != B || a.shape(1) < 1 || a.shape(2) != 4 || a.shape(3) != 4) {

@@ -10,6 +10,8 @@
 // checks first, so Ctrl-C stops an audit within one call or one batch).
 #include <pybind11/pybind11.h>
 
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,12 @@ struct CallOptions {
   bool extras = false;   ///< pass extra_poses= and scalars= keywords (the audit asked for some)
   /// When set: pass images={view: (C, h, w) or (B, C, h, w) float32} rendered by this rig.
   std::shared_ptr<const props::CameraRig> cameras;
+  /// A policy's own random draws made alike on both sides (handcentric/_rng.py): "" (off),
+  /// "torch", "numpy" or "generator"; seeded before each call from rng_seed and the row's noise.
+  std::string rng;
+  std::uint64_t rng_seed = 0;
+  /// Called with no arguments before every call of a policy (e.g. LeRobot's policy.reset), or None.
+  py::object reset = py::none();
 };
 
 /// images={view: array} as a callable receives them for `scenes` (one: (C, h, w); stacked:
@@ -73,12 +81,21 @@ class PythonPolicy final : public props::BatchPolicy {
   std::vector<std::vector<RigidTransform>> act_batch(
       const std::vector<const Scene*>& observations,
       const std::vector<const Eigen::VectorXd*>& noises) const override;
+  std::optional<std::vector<std::string>> last_draws() const override;
+  void watch_draws(bool on) const override;
 
  private:
+  /// One call of the callable on these rows, after reset() and the seeding of options.rng.
+  std::vector<std::vector<RigidTransform>> call_once(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const;
   py::object policy_;
   Eigen::Index noise_;
   CallOptions options_;
   std::string name_;
+  py::object rng_module_;  ///< handcentric._rng, imported when first needed
+  mutable bool watching_ = false;
+  mutable std::vector<std::string> draws_;  ///< generators advanced since watch_draws(true)
 };
 
 }  // namespace handcentric::python

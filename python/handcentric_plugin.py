@@ -86,6 +86,7 @@ import contextlib
 import json
 import math
 import numbers
+import struct
 import sys
 import traceback
 
@@ -561,7 +562,8 @@ def _encode_array(a):
 # ----------------------------------------------------------------------------- the loop
 
 def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, batched=False,
-                 batch_size=256, encoding="base64", cameras=None, stdin=None, stdout=None):
+                 batch_size=256, encoding="base64", cameras=None, rng=None, reset=None,
+                 stdin=None, stdout=None):
     """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
 
     policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
@@ -574,8 +576,18 @@ def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, 
         the audit renders each observation's images and the policy gets images={view: (C,h,w)}
         float32 as a keyword ((B,C,h,w) batched), as audit_policy(..., cameras=...) passes them
         (docs/AUDIT_YOUR_POLICY.md). Needs NumPy.
+    rng: None, "torch", "numpy" or "generator": the policy draws random numbers of its own
+        (torch.randn inside, a DDPM sampler's per-step noise). Each observation is then asked in
+        a call of its own, after seeding that generator from the observation's noise vector
+        ("generator": a seeded torch.Generator passed as generator=), so that o and g o, which
+        the audit asks with the same noise, get the same draws. Without it the audit's
+        preflight finds answers that differ on the same observation and gives no verdict.
+    reset: a function of no arguments called before every call (e.g. LeRobot's policy.reset),
+        for a policy that keeps state between calls (an action queue, a history).
     extra_poses, scalars, hello, encoding, stdin, stdout: as for serve().
     """
+    if rng is not None or reset is not None:
+        policy = _paired_policy(policy, rng, reset, batched)
     if cameras is not None:
         if np is None:
             _die(1, "handcentric_plugin: serve_policy(..., cameras=...) needs NumPy, which does "
@@ -589,6 +601,63 @@ def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, 
     serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, batched=batched,
           batch_size=batch_size, encoding=encoding, stdin=stdin, stdout=stdout, _policy=policy,
           _noise=noise, _cameras=cameras)
+
+
+def _noise_seed(noise):
+    """A seed below 2**63 from the bytes of one noise vector (the same vector, the same seed)."""
+    import hashlib
+    values = noise.tolist() if hasattr(noise, "tolist") else list(noise)
+    digest = hashlib.sha256(struct.pack("<%dd" % len(values), *values)).digest()
+    return int.from_bytes(digest[:8], "little") >> 1
+
+
+def _seed_generator(rng, seed):
+    """Seeds the generator of mode `rng`; returns the keywords the call gets."""
+    if rng == "torch":
+        import torch
+        torch.manual_seed(seed)
+        return {}
+    if rng == "numpy":
+        np.random.seed(seed % (1 << 32))
+        return {}
+    import torch
+    generator = torch.Generator()
+    generator.manual_seed(seed)
+    return {"generator": generator}
+
+
+def _paired_policy(policy, rng, reset, batched):
+    """policy called after reset() and, with rng, one observation per call with its generator
+    seeded from that observation's noise (serve_policy's rng= and reset=)."""
+    if rng not in (None, "torch", "numpy", "generator"):
+        raise ValueError('rng=%r is not a mode; use "torch", "numpy", "generator" or None' % (rng,))
+    if rng == "numpy" and np is None:
+        raise ValueError('rng="numpy" needs NumPy, which does not import in %s' % sys.executable)
+    if reset is not None and not callable(reset):
+        raise TypeError("reset must be a function of no arguments (e.g. policy.reset), got %r"
+                        % (reset,))
+
+    def one_call(history, hand_points, world_points, noise, kwargs, seed_noise):
+        if reset is not None:
+            reset()
+        extra = _seed_generator(rng, _noise_seed(seed_noise)) if rng is not None else {}
+        return policy(history, hand_points, world_points, noise, **dict(kwargs, **extra))
+
+    def call(history, hand_points, world_points, noise, **kwargs):
+        if rng is None or not batched:
+            return one_call(history, hand_points, world_points, noise, kwargs, noise)
+
+        def row(value, i):
+            return {k: row(v, i) for k, v in value.items()} if isinstance(value, dict) \
+                else value[i:i + 1]
+        def as_numpy(x):  # a torch result, on any device, with or without grad
+            return x.detach().cpu().numpy() if hasattr(x, "detach") else np.asarray(x)
+        chunks = [as_numpy(one_call(history[i:i + 1], hand_points[i:i + 1],
+                                      world_points[i:i + 1], noise[i:i + 1],
+                                      {k: row(v, i) for k, v in kwargs.items()}, noise[i]))
+                  for i in range(len(noise))]
+        return np.concatenate(chunks, axis=0)
+    return call
 
 
 def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=None,

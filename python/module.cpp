@@ -113,14 +113,15 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
 py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py::handle cases,
                       std::uint64_t seed, std::optional<double> tolerance,
                       const std::string& precision, py::handle noise_length, py::handle extra_poses,
-                      py::handle scalars, const Setup& setup) {
+                      py::handle scalars, py::handle rng, py::handle reset, const Setup& setup) {
   require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
   const int noise = noise_of(noise_length);
-  const CommonOptions o =
+  CommonOptions o =
       common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
+  set_policy_call(o, c, rng, reset, "audit_policy");
   ProgressLine progress("audit_policy", o.quiet);
   c.progress = std::ref(progress);
   const props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
@@ -162,6 +163,13 @@ PYBIND11_MODULE(_core, m) {
 
   static py::exception<Error> error_type(m, "Error", PyExc_RuntimeError);
   static py::exception<ShapeError> shape_error_type(m, "ShapeError", PyExc_ValueError);
+  // A policy that is not a function of its inputs as called (props/preflight.hpp).
+  static py::exception<props::StatefulPolicy> stateful_type(m, "StatefulPolicyError",
+                                                            error_type.ptr());
+  static py::exception<props::BatchCoupling> coupling_type(m, "BatchCouplingError",
+                                                           error_type.ptr());
+  static py::exception<props::OwnRandomness> randomness_type(m, "OwnRandomnessError",
+                                                             error_type.ptr());
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
@@ -169,6 +177,12 @@ PYBIND11_MODULE(_core, m) {
       e.error->restore();  // the callable's own exception, with its traceback
     } catch (const ShapeError& e) {
       PyErr_SetString(shape_error_type.ptr(), e.what());
+    } catch (const props::StatefulPolicy& e) {
+      PyErr_SetString(stateful_type.ptr(), e.what());
+    } catch (const props::BatchCoupling& e) {
+      PyErr_SetString(coupling_type.ptr(), e.what());
+    } catch (const props::OwnRandomness& e) {
+      PyErr_SetString(randomness_type.ptr(), e.what());
     } catch (const DtypeError& e) {
       PyErr_SetString(PyExc_TypeError, e.what());
     } catch (const InvalidArgument& e) {
@@ -237,22 +251,27 @@ rectified flow's (eq. 5).
       "audit_policy",
       [](py::object policy, py::handle groups, py::handle views, py::handle cases,
          std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
-         py::handle noise, py::handle extra_poses, py::handle scalars,
-         HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
+         py::handle reset, HANDCENTRIC_SETUP_PARAMETERS) {
         return audit_policy(std::move(policy), groups, views, cases, seed, tolerance, precision,
-                            noise, extra_poses, scalars, HANDCENTRIC_SETUP_VALUE);
+                            noise, extra_poses, scalars, rng, reset, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
       py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
       py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
       py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
-      py::arg("scalars") = py::tuple(), HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
 Returns one policy of `audit --json`.
 policy(history, hand_points, world_points, noise) -> (K, 4, 4), the world-frame chunk
-T_1..T_K; noise is a float64 vector of `noise` standard normals and must be the policy's only
-randomness. noise: 1 to MAX_NOISE (65536).
+T_1..T_K; noise is a float64 vector of `noise` standard normals. noise: 1 to MAX_NOISE (65536).
+Before any verdict a preflight asks a few observations again (the result's "preflight"): a
+policy whose answer depends on earlier calls raises StatefulPolicyError (reset=policy.reset,
+called before every call, starts each afresh), one whose rows depend on their batch
+BatchCouplingError; one that draws its own random numbers gets no pointwise verdicts unless
+rng="torch" / "numpy" / "generator" seeds its draws alike for o and g o (one row per call).
 )doc") +
        kSetupDoc)
           .c_str());
@@ -288,21 +307,23 @@ Every view in `views` must hold.
       [](py::object policy, const std::string& group, const std::string& mode, py::handle views,
          py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
          const std::string& precision, py::handle noise, py::handle extra_poses, py::handle scalars,
-         HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle rng, py::handle reset, HANDCENTRIC_SETUP_PARAMETERS) {
         assert_equivariant(std::move(policy), group, mode, views, cases, seed, tolerance, precision,
-                           noise, extra_poses, scalars, HANDCENTRIC_SETUP_VALUE);
+                           noise, extra_poses, scalars, rng, reset, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("group"), py::kw_only(), py::arg("mode") = "pointwise",
       py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
       py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
       py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
-      py::arg("scalars") = py::tuple(), HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Raise AssertionError unless policy(g o, n) = g policy(o, n) under `group`.
 
 The error carries the shrunk witness.
 mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which
 implies the law's), "distribution" (independent noise: the laws compared) or "both".
-Every view in `views` must hold.
+Every view in `views` must hold. rng= and reset= as in audit_policy; a policy that draws its
+own random numbers without rng= raises OwnRandomnessError for "pointwise" and "both".
 )doc") +
        kSetupDoc)
           .c_str());

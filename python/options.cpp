@@ -266,6 +266,29 @@ props::ClassifierOptions classifier_for(const CommonOptions& o) {
   return c;
 }
 
+void set_policy_call(CommonOptions& o, props::ClassifierOptions& c, py::handle rng,
+                     py::handle reset, const std::string& caller) {
+  if (!rng.is_none() && !py::isinstance<py::str>(rng))
+    throw DtypeError("rng must be None or a mode name, got a " + type_name(rng));
+  o.call.rng = py::str(py::module_::import("handcentric._rng").attr("check_mode")(rng));
+  o.call.rng_seed = o.audit.seed;
+  if (!reset.is_none() && !PyCallable_Check(reset.ptr())) {
+    throw DtypeError(
+        "reset must be None or a callable taking no arguments (e.g. policy.reset), "
+        "got a " +
+        type_name(reset));
+  }
+  o.call.reset = py::reinterpret_borrow<py::object>(reset);
+  props::PreflightSpelling& say = c.preflight_spelling;
+  say.rng = "rng=\"torch\" (or \"numpy\", or \"generator\" for a generator= keyword)";
+  say.reset = "reset= (e.g. reset=policy.reset)";
+  say.noise = "draw from the noise argument instead";
+  say.distribution = caller == "assert_equivariant"
+                         ? "mode=\"distribution\" asserts the law, which needs no pairing"
+                         : "its in-distribution verdicts stand: they need no pairing";
+  say.eval = "policy.eval() (no batch statistics)";
+}
+
 /// The callables as the checks see them (props/batch.hpp): answers cached, and batched when the
 /// caller gave batch_size.
 std::shared_ptr<props::BatchedRepresentation> batched_representation(py::object actions,

@@ -204,6 +204,24 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
       out << " (the largest over the cells; per cell in the JSON's detectable_shift and "
              "detectable_scale_ratio); smaller differences can hide\n";
     }
+    // What the pointwise "yes" cells could have missed (verdict.hpp: detectable_frequency).
+    int fewest_cases = 0;
+    for (const Verdict& verdict : classification.verdicts) {
+      if (verdict.invariant && verdict.mode == Mode::pointwise &&
+          (fewest_cases == 0 || verdict.cases < fewest_cases))
+        fewest_cases = verdict.cases;
+    }
+    if (fewest_cases > 0) {
+      char frequency[32];
+      std::snprintf(frequency, sizeof(frequency), "%.2g", detectable_frequency(fewest_cases));
+      out << "  note: a pointwise 'yes' on " << fewest_cases
+          << " far cases finds, with 99% probability, a breaking that occurs in at least "
+          << frequency
+          << " of the (scene, g) draws (per cell in the JSON's detectable_frequency); rarer ones "
+             "can hide\n";
+    }
+    if (classification.preflight && !classification.preflight->repeatable)
+      out << "  no pointwise verdict: " << classification.preflight->note << "\n";
     if (const auto& injectivity = classification.injectivity) {
       if (injectivity->injective == false) {
         out << "  !!! NOT INJECTIVE";

@@ -90,7 +90,19 @@ nlohmann::json witness_json(const Witness& w, Method method) {
 
 // What a pointwise decision adds to a check (check.hpp): the cases that sat on a discontinuity.
 void add_rounding_fields(nlohmann::json& check, const Verdict& v) {
-  if (v.mode == Mode::pointwise) check["discontinuities"] = v.discontinuities;
+  if (v.mode != Mode::pointwise) return;
+  check["discontinuities"] = v.discontinuities;
+  // What a pointwise "yes" could have missed (verdict.hpp).
+  if (v.invariant) check["detectable_frequency"] = detectable_frequency(v.cases);
+}
+
+// Its calls and rows are left out: a batched audit asks more (the batch check), and its JSON is
+// the unbatched one's, byte for byte (batch.hpp).
+nlohmann::json preflight_json(const Preflight& p) {
+  return {{"repeatable", p.repeatable},
+          {"note", p.note},
+          {"draws", p.draws},
+          {"repeat_difference", p.repeat_difference}};
 }
 
 nlohmann::json injectivity_json(const Injectivity& injectivity) {
@@ -226,7 +238,9 @@ std::string policy_audit_json(const std::vector<Classification>& policies) {
       checks.push_back(check);
       summary[to_string(v.view)][to_string(v.mode)][to_string(v.group)] = v.invariant;
     }
-    out.push_back({{"name", policy.name}, {"summary", summary}, {"checks", checks}});
+    nlohmann::json entry = {{"name", policy.name}, {"summary", summary}, {"checks", checks}};
+    if (policy.preflight) entry["preflight"] = preflight_json(*policy.preflight);
+    out.push_back(entry);
   }
   return nlohmann::json({{"policies", out}}).dump(2) + "\n";
 }

@@ -173,6 +173,20 @@ std::vector<RigidTransform> BatchedPolicy::act(const Scene& observation,
   return *cache_.find(key);
 }
 
+std::vector<std::vector<RigidTransform>> BatchedPolicy::counted_act_batch(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  std::vector<std::vector<RigidTransform>> chunks = policy_->act_batch(observations, noises);
+  ++batches_;
+  evaluations_ += observations.size();
+  if (chunks.size() != observations.size()) {
+    throw InvalidArgument("policy " + name() + " returned " + std::to_string(chunks.size()) +
+                          " chunks for a batch of " + std::to_string(observations.size()) +
+                          " observations; it must return one chunk per observation");
+  }
+  return chunks;
+}
+
 void BatchedPolicy::evaluate(const std::vector<const Pending*>& inputs) const {
   std::vector<const Scene*> observations;
   std::vector<const Eigen::VectorXd*> noises;
@@ -180,14 +194,7 @@ void BatchedPolicy::evaluate(const std::vector<const Pending*>& inputs) const {
     observations.push_back(&p->observation);
     noises.push_back(&p->noise);
   }
-  std::vector<std::vector<RigidTransform>> chunks = policy_->act_batch(observations, noises);
-  ++batches_;
-  evaluations_ += inputs.size();
-  if (chunks.size() != inputs.size()) {
-    throw InvalidArgument("policy " + name() + " returned " + std::to_string(chunks.size()) +
-                          " chunks for a batch of " + std::to_string(inputs.size()) +
-                          " observations; it must return one chunk per observation");
-  }
+  std::vector<std::vector<RigidTransform>> chunks = counted_act_batch(observations, noises);
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     if (chunk_length_ == 0) chunk_length_ = chunks[i].size();
     if (chunks[i].size() != chunk_length_) {
@@ -197,6 +204,28 @@ void BatchedPolicy::evaluate(const std::vector<const Pending*>& inputs) const {
     }
     cache_.put(inputs[i]->key, std::move(chunks[i]));
   }
+}
+
+std::vector<std::vector<RigidTransform>> BatchedPolicy::act_fresh(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  std::vector<std::vector<RigidTransform>> out;
+  policy_->watch_draws(true);
+  try {
+    const auto size = static_cast<std::size_t>(batch_size_);
+    for (std::size_t at = 0; at < observations.size(); at += size) {
+      const std::size_t end = std::min(observations.size(), at + size);
+      const std::vector<const Scene*> rows(observations.begin() + at, observations.begin() + end);
+      const std::vector<const Eigen::VectorXd*> row_noises(noises.begin() + at,
+                                                           noises.begin() + end);
+      for (auto& chunk : counted_act_batch(rows, row_noises)) out.push_back(std::move(chunk));
+    }
+  } catch (...) {
+    policy_->watch_draws(false);
+    throw;
+  }
+  policy_->watch_draws(false);
+  return out;
 }
 
 std::size_t BatchedPolicy::flush() {

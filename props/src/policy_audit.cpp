@@ -4,6 +4,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
+#include "handcentric/props/preflight.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 
@@ -51,6 +52,49 @@ std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& 
 }
 
 }  // namespace detail
+
+namespace {
+
+/// One story per report: a policy that is a function of its inputs (the preflight passed) and
+/// equivariant pointwise on every case is equivariant in law there too, so a pointwise "yes"
+/// beside an in-distribution NO means the drawn pointwise cases missed what the law check found.
+/// The pointwise check is run again with the law's witness as one more case: a NO there replaces
+/// the "yes", with that witness. If it still holds (the fixed noise agrees where other noise
+/// values do not), the law's NO says so in its note.
+void agree_on_the_evidence(const NoisyPolicy& policy, Group group, const CheckOptions& check,
+                           const ClassifierOptions& options, Verdict& point, Verdict& law) {
+  CheckOptions again = check;
+  again.extra_cases = witness_cases(law);
+  const auto recheck = [&](const CheckOptions& o) {
+    CheckOptions with_case = o;
+    with_case.extra_cases = again.extra_cases;
+    return check_policy_equivariance(policy, group, with_case);
+  };
+  Verdict rechecked = with_float32_note(recheck(again), options, recheck);
+  const auto add_note = [](Verdict& v, const std::string& note) {
+    v.note = v.note.empty() ? note : v.note + "; " + note;
+  };
+  if (!rechecked.invariant) {
+    add_note(rechecked, "found at the in-distribution check's witness, run as one more case");
+    point = std::move(rechecked);
+  } else {
+    add_note(law,
+             "the pointwise check holds at this witness with the audit's fixed noise; the "
+             "laws differ over other noise values there");
+  }
+}
+
+}  // namespace
+
+std::vector<std::vector<RigidTransform>> NoisyPolicy::act_fresh(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  std::vector<std::vector<RigidTransform>> out;
+  out.reserve(observations.size());
+  for (std::size_t i = 0; i < observations.size(); ++i)
+    out.push_back(act(*observations[i], *noises[i]));
+  return out;
+}
 
 SeededPolicy::SeededPolicy(std::shared_ptr<const ChunkPolicy> policy) : policy_(std::move(policy)) {
   if (!policy_) throw InvalidArgument("SeededPolicy needs a policy, got null");
@@ -128,15 +172,29 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
   if (!policy) throw InvalidArgument("classify_policy needs a policy, got null");
   Classification out;
   out.name = policy->name();
+  bool pointwise = true;
+  if (options.preflight && !options.views.empty()) {
+    PreflightOptions preflight;
+    preflight.check = with_view(options.check, options.views.front());
+    preflight.spelling = options.preflight_spelling;
+    out.preflight = preflight_policy(*policy, preflight);
+    pointwise = out.preflight->repeatable;
+  }
+  if (!pointwise && !options.in_distribution) {
+    // Nothing left to decide: the one line says why and what to do.
+    throw OwnRandomness(out.preflight->note);
+  }
   const int total = static_cast<int>(options.views.size() * options.groups.size()) *
-                    (options.in_distribution ? 2 : 1);
+                    ((options.in_distribution ? 1 : 0) + (pointwise ? 1 : 0));
   auto tick = [&] {
     if (options.progress) options.progress(static_cast<int>(out.verdicts.size()), total);
   };
   for (View view : options.views) {
     const CheckOptions check = with_view(options.check, view);
-    std::vector<std::vector<std::pair<Scene, RigidTransform>>> witnesses;  // per group
+    std::vector<std::vector<std::pair<Scene, RigidTransform>>> witnesses(
+        pointwise ? 0 : options.groups.size());  // per group
     for (Group group : options.groups) {
+      if (!pointwise) break;
       out.verdicts.push_back(with_float32_note(
           check_policy_equivariance(*policy, group, check), options,
           [&](const CheckOptions& o) { return check_policy_equivariance(*policy, group, o); }));
@@ -144,6 +202,8 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
       tick();
     }
     if (!options.in_distribution) continue;
+    const std::size_t first_pointwise =
+        out.verdicts.size() - (pointwise ? options.groups.size() : 0);
     for (std::size_t k = 0; k < options.groups.size(); ++k) {
       const Group group = options.groups[k];
       // The pointwise witness of this group is one more case (CheckOptions::extra_cases).
@@ -157,6 +217,12 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
             return check_policy_distribution(*policy, group, with_witness(o), options.distribution);
           }));
       tick();
+      if (pointwise) {
+        Verdict& point = out.verdicts[first_pointwise + k];
+        Verdict& law = out.verdicts.back();
+        if (point.invariant && !law.invariant)
+          agree_on_the_evidence(*policy, group, check, options, point, law);
+      }
     }
   }
   return out;

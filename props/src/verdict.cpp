@@ -1,5 +1,6 @@
 #include "handcentric/props/verdict.hpp"
 
+#include <cmath>
 #include <sstream>
 
 #include "handcentric/core/format.hpp"
@@ -115,6 +116,11 @@ std::string format_witness(const Witness& witness) {
            "difference persists there, so it is no bin edge or rounding";
   }
   return out.str();
+}
+
+double detectable_frequency(int cases) {
+  if (cases <= 0) return 1.0;
+  return -std::expm1(std::log(0.01) / cases);  // 1 - 0.01^(1/n), accurate for large n
 }
 
 }  // namespace handcentric::props

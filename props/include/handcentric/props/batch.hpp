@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -118,6 +119,12 @@ class BatchPolicy {
   /// True when act_batch takes observations of several shapes in one call (a plug-in whose
   /// helper splits them): then a batch is any batch_size inputs, in the order recorded.
   virtual bool mixed_shapes() const { return false; }
+  /// As NoisyPolicy::last_draws, for the last act_batch call (a Python callable watches torch's,
+  /// NumPy's and Python's global generators while watch_draws(true)).
+  virtual std::optional<std::vector<std::string>> last_draws() const { return std::nullopt; }
+  /// Asks the policy to record last_draws() from now on (true) or to stop (false): watching
+  /// costs a copy of each generator's state per call, so only the preflight watches.
+  virtual void watch_draws(bool /*on*/) const {}
 };
 
 /// A representation that encodes many scenes at once.
@@ -181,6 +188,15 @@ class BatchedPolicy final : public NoisyPolicy, public Prefetcher {
   std::vector<RigidTransform> act(const Scene& observation,
                                   const Eigen::VectorXd& noise) const override;
   std::size_t flush() override;
+  /// act_batch on the policy itself (no cache), in calls of at most batch_size; the policy
+  /// records which global generators each call drew from (last_draws).
+  std::vector<std::vector<RigidTransform>> act_fresh(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override;
+  bool batched() const override { return batch_size_ > 1; }
+  std::optional<std::vector<std::string>> last_draws() const override {
+    return policy_->last_draws();
+  }
   /// Calls of act_batch so far, and the inputs they carried (for benchmarks and tests).
   std::size_t batches() const { return batches_; }
   std::size_t evaluations() const { return evaluations_; }
@@ -192,6 +208,10 @@ class BatchedPolicy final : public NoisyPolicy, public Prefetcher {
     std::string key;
   };
   void evaluate(const std::vector<const Pending*>& inputs) const;
+  /// policy_->act_batch, counted, its number of chunks checked.
+  std::vector<std::vector<RigidTransform>> counted_act_batch(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const;
 
   std::shared_ptr<const BatchPolicy> policy_;
   int batch_size_;

@@ -20,6 +20,7 @@
 #include "handcentric/props/check.hpp"
 #include "handcentric/props/distribution.hpp"
 #include "handcentric/props/injectivity.hpp"
+#include "handcentric/props/preflight.hpp"
 #include "handcentric/props/verdict.hpp"
 
 namespace handcentric::props {
@@ -41,6 +42,11 @@ struct ClassifierOptions {
   /// The advice that ends the float32 note, in the caller's words (the Python module says
   /// precision="float32").
   std::string float32_advice = "rerun with --precision float32";
+  /// Run the preflight of a whole policy (preflight.hpp) before its verdicts: a policy that is
+  /// not a function of its inputs gets no pointwise verdict or none at all.
+  bool preflight = true;
+  /// The fixes the preflight's messages name, in the caller's words.
+  PreflightSpelling preflight_spelling;
   /// Called after each verdict (and the injectivity check) with how many are done of how many
   /// the classification runs: a progress line. May throw to stop the classification.
   std::function<void(int done, int total)> progress;
@@ -50,6 +56,7 @@ struct Classification {
   std::string name;
   std::vector<Verdict> verdicts;           ///< one per (view, component, mode, group) checked
   std::optional<Injectivity> injectivity;  ///< representations only
+  std::optional<Preflight> preflight;      ///< whole policies, when ClassifierOptions::preflight
 };
 
 /// `flow`: the flow to audit; null = the rectified flow of `representation` (eq. 5).

@@ -17,6 +17,7 @@
 // Both views and all groups, as for representations (classifier.hpp).
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,17 @@ class NoisyPolicy {
   /// T_1..T_K for `observation` (its history, points, extras; its chunk is ignored).
   virtual std::vector<RigidTransform> act(const Scene& observation,
                                           const Eigen::VectorXd& noise) const = 0;
+  /// The chunks for (observations[i], noises[i]) asked afresh, past any cache, in ONE call when
+  /// batched(): the questions of the preflight (preflight.hpp), which asks the same observation
+  /// several times and compares rows across batches. Default: act() on each.
+  virtual std::vector<std::vector<RigidTransform>> act_fresh(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const;
+  /// True when act_fresh asks its observations as the rows of one batch.
+  virtual bool batched() const { return false; }
+  /// The global random generators the last act_fresh call drew from (e.g. "torch's CPU
+  /// generator"), empty when none; nullopt when the policy cannot tell (a C++ policy, a plug-in).
+  virtual std::optional<std::vector<std::string>> last_draws() const { return std::nullopt; }
 };
 
 /// A ChunkPolicy, whose noise comes from a seed, as a NoisyPolicy: the noise vector's bits are

@@ -100,6 +100,11 @@ struct Verdict {
   std::optional<Witness> witness;  ///< present when !invariant
 };
 
+/// What a pointwise "yes" on `cases` far cases could have missed: the smallest frequency f of
+/// violating (scene, g) draws that at least one of `cases` independent draws hits with 99%
+/// probability, 1 - 0.01^(1/cases) (about 4.6 / cases). 1 when cases is 0.
+double detectable_frequency(int cases);
+
 /// A compact, multi-line rendering of a witness (17 digits, so it reproduces the doubles).
 std::string format_witness(const Witness& witness);
 
