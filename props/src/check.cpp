@@ -314,8 +314,10 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   if (shape.workspace) verdict.note = shape.workspace->verdict_note();
   if (extra_witness) {
     verdict.note += std::string(verdict.note.empty() ? "" : "; ") +
-                    "every drawn case held; the witness is the pointwise check's (the same "
-                    "group and view), run here as an extra case, where this check fails too";
+                    "every drawn case held; the witness is the " +
+                    (mode == Mode::pointwise ? "in-distribution" : "pointwise") +
+                    " check's (the same group and view), run here as an extra case, where this "
+                    "check fails too";
   }
   if (shape.recorded) {
     verdict.note += (verdict.note.empty() ? "" : "; ") + shape.recorded->verdict_note();

@@ -75,8 +75,7 @@ void agree_on_the_evidence(const NoisyPolicy& policy, Group group, const CheckOp
     v.note = v.note.empty() ? note : v.note + "; " + note;
   };
   if (!rechecked.invariant) {
-    add_note(rechecked, "found at the in-distribution check's witness, run as one more case");
-    point = std::move(rechecked);
+    point = std::move(rechecked);  // its note names where its witness came from (check.cpp)
   } else {
     add_note(law,
              "the pointwise check holds at this witness with the audit's fixed noise; the "

@@ -280,3 +280,29 @@ def test_a_failing_cell_says_on_which_case_it_failed():
                                        views="eye_in_hand", cases=CASES)
     failing = [c for c in representation["checks"] if not c["invariant"]]
     assert failing and all(c["failed_at_case"] >= 1 for c in failing)
+
+
+def test_a_deterministic_policy_is_never_yes_pointwise_beside_no_in_distribution():
+    """One story per report. A policy pushed 5 cm along world x only where its hand is within
+    0.8 m of (1, 0, 0): 4 cases per check miss that ball on most seeds. Where the in-distribution
+    check hits it and the pointwise one did not, the pointwise check is run again at the law's
+    witness with the same noise, and both cells say NO on that evidence. (Without the recheck,
+    seeds 2, 5 and 7 gave pointwise "yes" beside in-distribution "NO".)"""
+    from policies import make_policy
+    base = make_policy()
+
+    def spot(history, hand_points, world_points, noise):
+        chunk = base(history, hand_points, world_points, noise)
+        if np.linalg.norm(history[0][:3, 3] - [1.0, 0.0, 0.0]) < 0.8:
+            chunk[:, 0, 3] += 0.05
+        return chunk
+    rechecked = 0
+    for seed in range(1, 9):
+        report = handcentric.audit_policy(spot, groups=["translation"], views=["eye_in_hand"],
+                                          cases=4, seed=seed, quiet=True)
+        cells = {c["mode"]: c for c in report["checks"]}
+        assert not (cells["pointwise"]["equivariant"] and not cells["distribution"]["equivariant"])
+        if "the in-distribution check's" in cells["pointwise"].get("note", ""):
+            rechecked += 1
+            assert cells["pointwise"]["witness"] is not None
+    assert rechecked == 3  # seeds 2, 5 and 7
