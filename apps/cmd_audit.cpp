@@ -332,8 +332,8 @@ int run_audit(const AuditCommandOptions& options) {
       << used.distribution.cases << " per in-distribution cell, seed " << audit.seed
       << "; tolerance " << relative << " (1 + L)"
       << (options.tolerance > 0.0                        ? " (--tolerance)"
-          : audit.precision == props::Precision::float32 ? " (float32 rounding)"
-                                                         : "")
+          : audit.precision != props::Precision::float64 ? " (" + options.precision + " rounding)"
+                                                         : std::string())
       << (audit.workspace ? "; every case inside the workspace " + audit.workspace->describe() +
                                 ", g * scene too (--workspace)"
                           : std::string())
@@ -386,7 +386,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--tolerance", options->tolerance,
                   "REL in the pointwise tolerance REL * (1 + L); default 1e-9 (float64 rounding)");
   cmd->add_option("--precision", options->precision,
-                  "float64, or float32 for a representation computed in float32 (REL = 1e-4)")
+                  "the arithmetic the map is computed in: float64, float32 (REL = 3.8e-6), "
+                  "bfloat16 or float16 (REL = 2^-7)")
       ->capture_default_str();
   cmd->add_option("--witness-dir", options->witness_dir,
                   "with --policy-exec and a plug-in that sees cameras: save the images of each "

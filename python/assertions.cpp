@@ -80,7 +80,7 @@ void assert_invariant(py::object fn, const std::string& group, const std::string
     for (props::View view : c.views) {
       const props::CheckOptions check = props::with_view(c.check, view);
       const props::SceneFunction f = props::observation_of(representation);
-      result.verdicts.push_back(props::with_float32_note(
+      result.verdicts.push_back(props::with_precision_note(
           props::check_invariance(f, component, o.audit.groups[0], check), c,
           [&](const props::CheckOptions& again) {
             return props::check_invariance(f, component, o.audit.groups[0], again);

@@ -274,22 +274,38 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
   };
   const std::string what = "the chunk returned by policy " + name_;
   std::vector<std::vector<RigidTransform>> out;
+  // A (chunk, gripper) tuple or a dict of outputs, named as what it is, not as an array NumPy
+  // cannot read.
+  const auto chunk_only = [&](py::object result) {
+    if (py::isinstance<py::tuple>(result) || py::isinstance<py::dict>(result)) {
+      const bool dict = py::isinstance<py::dict>(result);
+      throw DtypeError(
+          what + " is a " + type_name(result) +
+          (dict ? " with keys " + std::string(py::str(py::list(result)))
+                : " of " + std::to_string(py::len(result)) + " items") +
+          "; a policy returns its world-frame chunk alone, " +
+          (options_.stacked ? "(B, K, 4, 4)" : "(K, 4, 4)") +
+          " poses world_T_hand. Grippers, flags and pose vectors (position + quaternion or 6D) "
+          "are not read yet: return the 4x4 poses only");
+    }
+    return result;
+  };
   if (!options_.stacked) {
     for (std::size_t i = 0; i < observations.size(); ++i) {
       const Scene& o = *observations[i];
-      py::object result = watched(call(
+      py::object result = chunk_only(watched(call(
           policy_, for_callable(array_of(o.world_T_hand_history), kind),
           for_callable(array_of(o.hand_points), kind), for_callable(array_of(o.world_points), kind),
-          for_callable(array_of(*noises[i]), kind), **kwargs({&o})));
+          for_callable(array_of(*noises[i]), kind), **kwargs({&o}))));
       out.push_back(poses_from(result, what, true, "(K, 4, 4)"));
     }
     return out;
   }
-  py::object result =
+  py::object result = chunk_only(
       watched(call(policy_, for_callable(stacked_history(observations), kind),
                    for_callable(stacked_hand_points(observations), kind),
                    for_callable(stacked_world_points(observations), kind),
-                   for_callable(stacked_vectors(noises), kind), **kwargs(observations)));
+                   for_callable(stacked_vectors(noises), kind), **kwargs(observations))));
   const auto a = real_array(result, what);
   const auto B = static_cast<py::ssize_t>(observations.size());
   if (a.ndim() != 4 || a.shape(0) != B || a.shape(1) < 1 || a.shape(2) != 4 || a.shape(3) != 4) {
@@ -297,8 +313,11 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
                      " observations; expected (" + std::to_string(B) +
                      ", K, 4, 4), one chunk per observation");
   }
-  require_finite(a.data(), a.size(), what);
   for (py::ssize_t i = 0; i < B; ++i) {
+    // Per row, so that a NaN names its row (the batch is then asked row by row, batch.cpp, and
+    // the audit names the case and the observation).
+    require_finite(a.data() + i * a.shape(1) * 16, a.shape(1) * 16,
+                   what + "[" + std::to_string(i) + "]");
     out.push_back(loose_poses(a.data() + i * a.shape(1) * 16, a.shape(1),
                               what + "[" + std::to_string(i) + "]"));
   }

@@ -175,6 +175,23 @@ PYBIND11_MODULE(_core, m) {
       if (p) std::rethrow_exception(p);
     } catch (const PythonCallError& e) {
       e.error->restore();  // the callable's own exception, with its traceback
+      if (!e.context().empty()) {
+        // Where the audit was (the case, its seed, the observation), as a note under the
+        // traceback (PEP 678), the exception itself unchanged.
+        PyObject *type = nullptr, *value = nullptr, *traceback = nullptr;
+        PyErr_Fetch(&type, &value, &traceback);
+        PyErr_NormalizeException(&type, &value, &traceback);
+        if (value != nullptr && PyObject_HasAttrString(value, "add_note")) {
+          PyObject* note = PyUnicode_FromString(("handcentric: " + e.context()).c_str());
+          if (note != nullptr) {
+            PyObject* done = PyObject_CallMethod(value, "add_note", "O", note);
+            Py_XDECREF(done);
+            Py_DECREF(note);
+          }
+          PyErr_Clear();
+        }
+        PyErr_Restore(type, value, traceback);
+      }
     } catch (const ShapeError& e) {
       PyErr_SetString(shape_error_type.ptr(), e.what());
     } catch (const props::StatefulPolicy& e) {

@@ -223,11 +223,13 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
   o.audit.groups = groups_of(groups);
   o.audit.views = views_of(views);
   o.audit.seed = seed;
-  o.audit.precision = props::parse_precision(precision);
+  o.audit.precision = props::parse_precision(precision, "precision");
+  o.audit.tolerance_option = "tolerance";
   if (tolerance) {
     if (!(*tolerance > 0.0)) {
       throw InvalidArgument("tolerance must be in (0, 1), got " + std::to_string(*tolerance) +
-                            "; or leave it None for the precision's (1e-9 float64, 1e-4 float32)");
+                            "; or leave it None for the precision's (1e-9 float64, 3.8e-6 "
+                            "float32, 2^-7 bfloat16 and float16)");
     }
     o.audit.relative_tolerance = *tolerance;
   }
@@ -253,7 +255,9 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
 
 props::ClassifierOptions classifier_for(const CommonOptions& o) {
   props::ClassifierOptions c = props::classifier_options(o.audit);
-  c.float32_advice = "pass precision=\"float32\"";
+  c.precision_advice = [](const std::string& precision) {
+    return "pass precision=\"" + precision + "\"";
+  };
   props::SceneShape& shape = c.check.shape;
   shape.extra_pose_names = o.extra_poses;
   shape.scalar_names = o.scalars;

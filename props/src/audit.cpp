@@ -62,10 +62,45 @@ std::vector<std::string> auditable_names() {
   return names;
 }
 
-Precision parse_precision(const std::string& name) {
+Precision parse_precision(const std::string& name, const std::string& option) {
   if (name == "float64") return Precision::float64;
   if (name == "float32") return Precision::float32;
-  throw InvalidArgument("unknown --precision '" + name + "'; use float64 (the default) or float32");
+  if (name == "bfloat16") return Precision::bfloat16;
+  if (name == "float16") return Precision::float16;
+  throw InvalidArgument("unknown " + option + " '" + name +
+                        "'; use float64 (the default), float32, bfloat16 or float16: the "
+                        "arithmetic the policy or representation is computed in");
+}
+
+double unit_roundoff(Precision precision) {
+  switch (precision) {
+    case Precision::float32:
+      return kFloat32UnitRoundoff;
+    case Precision::bfloat16:
+      return kBfloat16UnitRoundoff;
+    case Precision::float16:
+      return kFloat16UnitRoundoff;
+    case Precision::float64:
+      break;
+  }
+  return kFloat64UnitRoundoff;
+}
+
+double probe_unit_roundoff(Precision precision) {
+  return std::min(unit_roundoff(precision), kFloat32UnitRoundoff);
+}
+
+double precision_relative_tolerance(Precision precision) {
+  switch (precision) {
+    case Precision::float32:
+      return kFloat32RelativeTolerance;
+    case Precision::bfloat16:
+    case Precision::float16:
+      return kHalfPrecisionRelativeTolerance;
+    case Precision::float64:
+      break;
+  }
+  return kRelativeTolerance;
 }
 
 int checked_cases(long long cases) {
@@ -81,11 +116,11 @@ int checked_cases(long long cases) {
 double audit_relative_tolerance(const AuditOptions& options) {
   const double relative = options.relative_tolerance;
   if (!(relative >= 0.0 && relative < 1.0)) {
-    throw InvalidArgument("--tolerance must be a number in (0, 1), got " + format_number(relative) +
-                          "; e.g. --tolerance 1e-6, or --precision float32");
+    throw InvalidArgument(options.tolerance_option + " must be a number in (0, 1), got " +
+                          format_number(relative) + "; e.g. 1e-6, or a lower precision");
   }
   if (relative > 0.0) return relative;
-  return options.precision == Precision::float32 ? kFloat32RelativeTolerance : kRelativeTolerance;
+  return precision_relative_tolerance(options.precision);
 }
 
 ClassifierOptions classifier_options(const AuditOptions& options) {
@@ -99,8 +134,8 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
   classifier.check.cases = options.cases;
   classifier.check.seed = options.seed;
   classifier.check.relative_tolerance = audit_relative_tolerance(options);
-  classifier.check.unit_roundoff =
-      options.precision == Precision::float32 ? kFloat32UnitRoundoff : kFloat64UnitRoundoff;
+  classifier.check.unit_roundoff = probe_unit_roundoff(options.precision);
+  classifier.check.output_unit_roundoff = unit_roundoff(options.precision);
   classifier.distribution.cases = std::max(10, (options.cases + 99) / 100);
   classifier.injectivity_cases = std::max(100, options.cases / 5);
   if (options.workspace) options.workspace->validate();

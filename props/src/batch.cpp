@@ -161,7 +161,9 @@ std::vector<RigidTransform> BatchedPolicy::act(const Scene& observation,
   key.append(reinterpret_cast<const char*>(noise.data()),
              sizeof(double) * static_cast<std::size_t>(noise.size()));
   if (const auto* hit = cache_.find(key)) return *hit;
-  if (prefetching()) {
+  // An input that failed in a batch is asked alone, where it fails again inside its case, so
+  // that the error names that case (check.cpp).
+  if (prefetching() && !failing_.count(key)) {
     if (pending_keys_.emplace(key, true).second) {
       pending_.push_back({observation, noise, std::move(key)});
       detail::enlist(const_cast<BatchedPolicy&>(*this));
@@ -175,8 +177,10 @@ std::vector<RigidTransform> BatchedPolicy::act(const Scene& observation,
 
 std::vector<std::vector<RigidTransform>> BatchedPolicy::counted_act_batch(
     const std::vector<const Scene*>& observations,
-    const std::vector<const Eigen::VectorXd*>& noises) const {
-  std::vector<std::vector<RigidTransform>> chunks = policy_->act_batch(observations, noises);
+    const std::vector<const Eigen::VectorXd*>& noises, bool fresh) const {
+  std::vector<std::vector<RigidTransform>> chunks =
+      fresh ? policy_->act_batch_fresh(observations, noises)
+            : policy_->act_batch(observations, noises);
   ++batches_;
   evaluations_ += observations.size();
   if (chunks.size() != observations.size()) {
@@ -218,7 +222,7 @@ std::vector<std::vector<RigidTransform>> BatchedPolicy::act_fresh(
       const std::vector<const Scene*> rows(observations.begin() + at, observations.begin() + end);
       const std::vector<const Eigen::VectorXd*> row_noises(noises.begin() + at,
                                                            noises.begin() + end);
-      for (auto& chunk : counted_act_batch(rows, row_noises)) out.push_back(std::move(chunk));
+      for (auto& chunk : counted_act_batch(rows, row_noises, true)) out.push_back(std::move(chunk));
     }
   } catch (...) {
     policy_->watch_draws(false);
@@ -236,7 +240,24 @@ std::size_t BatchedPolicy::flush() {
   const auto batches = batches_of(pending, batch_size_, [mixed](const Pending& p) {
     return mixed ? std::string() : detail::shape_key(p.observation, false);
   });
-  for (const auto& batch : batches) evaluate(batch);
+  for (const auto& batch : batches) {
+    try {
+      evaluate(batch);
+    } catch (const InvalidArgument&) {
+      // One of its inputs got an answer that cannot be read (NaN, a wrong shape or type, not a
+      // pose): find the first such one alone (the inputs before it are answered and cached,
+      // those after it asked again in the next pass). Other errors (a Python exception, Ctrl-C,
+      // a plug-in that stopped) stop the audit at once, as before.
+      for (const Pending* input : batch) {
+        try {
+          evaluate({input});
+        } catch (const InvalidArgument&) {
+          failing_.insert(input->key);
+          break;
+        }
+      }
+    }
+  }
   return pending.size();
 }
 

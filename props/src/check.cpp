@@ -222,11 +222,24 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   if (shape.workspace && !shape.recorded) (void)shape.workspace->room_for(group);
   if (shape.workspace && shape.recorded) shape.recorded->require_inside(*shape.workspace);
   int shrink_evaluations = 0;
+  int drawn = 0;  // cases drawn by the search
   // One case of the search: false when it failed (or raised: `error`).
+  std::string case_label;  // set before each search_case: "case 12", "the extra case 1"
   auto search_case = [&](const Scene& scene, const RigidTransform& g, CaseOutcome& outcome,
                          bool decided = false) {
     try {
       if (!decided) outcome = run_case(scene, g);
+    } catch (Error& e) {
+      // The function under test could not answer here: say where, so that it can be replayed.
+      e.add_context("raised in " + case_label + " of the " + to_string(component) + " (" +
+                    to_string(mode) + ") check under " + to_string(group) + " (" +
+                    to_string(view_of(shape)) + " view, seed " + std::to_string(options.seed) +
+                    "), whose observation o has " + observation_summary(scene) +
+                    " and g = " + pose_summary(g) +
+                    ": the map was asked about o, g o or a scene a rounding step from them; the "
+                    "same seed asks them again");
+      error = std::current_exception();
+      return false;
     } catch (...) {
       // Not a counterexample: the function under test could not answer (a handcentric::Error,
       // a Python exception, a missing module). The check stops and the caller sees it.
@@ -257,6 +270,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
     for (std::size_t k = 0; k < prefetched.cases.size(); ++k) {
       std::optional<CaseOutcome>& kept = prefetched.outcomes[k];
       CaseOutcome outcome = kept ? std::move(*kept) : CaseOutcome{};
+      case_label = "case " + std::to_string(k + 1);
       if (!search_case(prefetched.cases[k].first, prefetched.cases[k].second, outcome,
                        kept.has_value())) {
         searched = false;
@@ -277,6 +291,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
       return;  // budget spent: keep the witness
     const auto [scene, g] = draw_case(shape, group);
     CaseOutcome outcome;
+    case_label = searching ? "case " + std::to_string(++drawn) : "a shrinking step";
     const bool holds = search_case(scene, g, outcome);
     // Failing the property ends RapidCheck's search at once (its shrinking then sees every
     // candidate pass, above), so a callable that raises costs one call whatever `cases` is.
@@ -292,6 +307,7 @@ Verdict run_check(const CaseFunction& run_case, Component component, Group group
   bool extra_witness = false;
   for (std::size_t k = 0; k < options.extra_cases.size() && !verdict.witness; ++k) {
     CaseOutcome outcome;
+    case_label = "the extra case " + std::to_string(k + 1);
     const bool holds =
         search_case(options.extra_cases[k].first, options.extra_cases[k].second, outcome);
     if (error) std::rethrow_exception(error);

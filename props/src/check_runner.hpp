@@ -103,8 +103,10 @@ Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk);
 /// policy.act(observation, noise), each pose checked: a chunk pose that is not a rigid transform
 /// (a rotation block scaled by a bug) cannot be compared as one, so it stops the audit
 /// (InvalidArgument naming the pose).
+/// `pose_tolerance`: output_pose_tolerance of the audit's precision.
 std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& observation,
-                                        const Eigen::VectorXd& noise);
+                                        const Eigen::VectorXd& noise,
+                                        double pose_tolerance = kOutputPoseTolerance);
 
 /// Runs a RapidCheck property (it calls RC_FAIL to fail) for `cases` cases from `seed`, printing
 /// nothing: the caller records what it needs from inside the property.

@@ -1,6 +1,7 @@
 #include "handcentric/props/classifier.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
@@ -14,22 +15,39 @@ std::vector<std::pair<Scene, RigidTransform>> witness_cases(const Verdict& verdi
   return {{verdict.witness->scene, verdict.witness->g}};
 }
 
-Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
-                          const std::function<Verdict(const CheckOptions&)>& recheck) {
-  if (!options.float32_note || verdict.invariant || verdict.method == Method::energy_test ||
-      options.check.relative_tolerance >= kFloat32RelativeTolerance) {
+Verdict with_precision_note(Verdict verdict, const ClassifierOptions& options,
+                            const std::function<Verdict(const CheckOptions&)>& recheck) {
+  if (!options.precision_note || verdict.invariant || verdict.method == Method::energy_test)
     return verdict;
-  }
-  CheckOptions loose = with_view(options.check, verdict.view);
-  loose.relative_tolerance = kFloat32RelativeTolerance;
-  loose.unit_roundoff = kFloat32UnitRoundoff;
-  loose.shrink = false;
-  if (recheck(loose).invariant) {
-    verdict.note += std::string(verdict.note.empty() ? "" : "; ") + "fails at tolerance " +
-                    format_number(options.check.relative_tolerance) +
-                    " (1 + L) but holds at float32 rounding, " +
-                    format_number(kFloat32RelativeTolerance) +
-                    " (1 + L): the errors look like float32 rounding; " + options.float32_advice;
+  struct Lower {
+    const char* name;
+    double floor, output_unit;
+  };
+  // The witness's error relative to its scene.
+  const double relative =
+      verdict.witness ? verdict.witness->error / (1.0 + verdict.witness->length_scale) : 0.0;
+  for (const Lower& lower :
+       {Lower{"float32", kFloat32RelativeTolerance, kFloat32UnitRoundoff},
+        Lower{"bfloat16", kHalfPrecisionRelativeTolerance, kBfloat16UnitRoundoff}}) {
+    if (options.check.relative_tolerance >= lower.floor) continue;
+    // float32 is always tried (a bin edge at float32's off-case scale passes at any error);
+    // bfloat16 only when the witness's error is within 8 of its floors, as each try reruns the
+    // whole check.
+    if (lower.output_unit > kFloat32UnitRoundoff && !(relative <= kRoundingMultiple * lower.floor))
+      continue;
+    CheckOptions loose = with_view(options.check, verdict.view);
+    loose.relative_tolerance = lower.floor;
+    loose.unit_roundoff = kFloat32UnitRoundoff;  // audit.hpp: probe_unit_roundoff
+    loose.output_unit_roundoff = lower.output_unit;
+    loose.shrink = false;
+    if (recheck(loose).invariant) {
+      verdict.note += std::string(verdict.note.empty() ? "" : "; ") + "fails at tolerance " +
+                      format_number(options.check.relative_tolerance) + " (1 + L) but holds at " +
+                      lower.name + " rounding, " + format_number(lower.floor) +
+                      " (1 + L): the errors look like " + lower.name + " rounding; " +
+                      options.precision_advice(lower.name);
+      break;
+    }
   }
   return verdict;
 }
@@ -48,7 +66,7 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target,
     };
     for (Group group : options.groups) {
       const SceneFunction fn = f(check.noise_seed, check.flow_time);
-      out.verdicts.push_back(with_float32_note(
+      out.verdicts.push_back(with_precision_note(
           check_invariance(fn, component, group, check), options,
           [&](const CheckOptions& o) { return check_invariance(fn, component, group, o); }));
       witnesses.push_back(witness_cases(out.verdicts.back()));
@@ -64,7 +82,7 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target,
         o.extra_cases = witnesses[k];
         return o;
       };
-      out.verdicts.push_back(with_float32_note(
+      out.verdicts.push_back(with_precision_note(
           check_distribution_invariance(target, component, group, with_witness(check),
                                         options.distribution),
           options, [&](const CheckOptions& o) {
@@ -139,7 +157,7 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
       const Component component = part.first;
       const SceneFunction& f = part.second;
       for (Group group : options.groups) {
-        out.verdicts.push_back(with_float32_note(
+        out.verdicts.push_back(with_precision_note(
             check_invariance(f, component, group, check), options,
             [&](const CheckOptions& o) { return check_invariance(f, component, group, o); }));
         tick();

@@ -37,15 +37,20 @@ Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk) {
 }
 
 std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& observation,
-                                        const Eigen::VectorXd& noise) {
+                                        const Eigen::VectorXd& noise, double pose_tolerance) {
   std::vector<RigidTransform> chunk = policy.act(observation, noise);
   for (std::size_t k = 0; k < chunk.size(); ++k) {
-    const std::string defect = pose_defect(chunk[k].matrix());
+    const std::string defect = pose_defect(chunk[k].matrix(), pose_tolerance);
     if (!defect.empty()) {
       throw InvalidArgument("policy '" + policy.name() + "' returned chunk pose " +
                             std::to_string(k) + " (T_" + std::to_string(k + 1) + ") " +
                             format_matrix(chunk[k].matrix()) + ": " + defect +
-                            "; a policy returns world_T_hand poses [[R, p], [0, 0, 0, 1]]");
+                            "; a policy returns world_T_hand poses [[R, p], [0, 0, 0, 1]]" +
+                            (pose_tolerance < output_pose_tolerance(kBfloat16UnitRoundoff)
+                                 ? " (one that computes in float32, bfloat16 or float16 says "
+                                   "so with the audit's precision: precision= in Python, "
+                                   "--precision on the command line)"
+                                 : ""));
     }
   }
   return chunk;
@@ -70,7 +75,7 @@ void agree_on_the_evidence(const NoisyPolicy& policy, Group group, const CheckOp
     with_case.extra_cases = again.extra_cases;
     return check_policy_equivariance(policy, group, with_case);
   };
-  Verdict rechecked = with_float32_note(recheck(again), options, recheck);
+  Verdict rechecked = with_precision_note(recheck(again), options, recheck);
   const auto add_note = [](Verdict& v, const std::string& note) {
     v.note = v.note.empty() ? note : v.note + "; " + note;
   };
@@ -115,19 +120,21 @@ std::vector<RigidTransform> SeededPolicy::act(const Scene& observation,
 Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options) {
   const Eigen::VectorXd noise = fixed_noise(policy.noise_dimension(), options.noise_seed);
+  const double poses = output_pose_tolerance(
+      options.output_unit_roundoff > 0.0 ? options.output_unit_roundoff : options.unit_roundoff);
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
     detail::PointwiseSides sides;
     sides.compare = [&](const Scene& s, Witness& witness) {
       const std::vector<RigidTransform> g_a =
-          detail::moved_by(g, detail::checked_act(policy, s, noise));
-      const std::vector<RigidTransform> a_g = detail::checked_act(policy, g * s, noise);
+          detail::moved_by(g, detail::checked_act(policy, s, noise, poses));
+      const std::vector<RigidTransform> a_g = detail::checked_act(policy, g * s, noise, poses);
       witness.before = detail::flatten(g_a);
       witness.after = detail::flatten(a_g);
       witness.error = detail::chunk_distance(g_a, a_g);  // eq. (4)
     };
     sides.response = [&](const Scene& a, const Scene& b) {
-      return detail::chunk_distance(detail::checked_act(policy, a, noise),
-                                    detail::checked_act(policy, b, noise));
+      return detail::chunk_distance(detail::checked_act(policy, a, noise, poses),
+                                    detail::checked_act(policy, b, noise, poses));
     };
     sides.ask = [&](const Scene& s) { (void)policy.act(s, noise); };
     return detail::decide_pointwise(sides, scene, g, options);
@@ -140,15 +147,18 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options,
                                   const DistributionOptions& distribution) {
   detail::require_distribution_options(distribution);
+  const double poses = output_pose_tolerance(
+      options.output_unit_roundoff > 0.0 ? options.output_unit_roundoff : options.unit_roundoff);
   detail::LawStatistics statistics;
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
     const Scene moved = g * scene;
     detail::NoisePair pair;
-    pair.before = [&policy, &scene, g](const Eigen::VectorXd& noise) {
-      return detail::flatten_affine(detail::moved_by(g, detail::checked_act(policy, scene, noise)));
+    pair.before = [&policy, &scene, g, poses](const Eigen::VectorXd& noise) {
+      return detail::flatten_affine(
+          detail::moved_by(g, detail::checked_act(policy, scene, noise, poses)));
     };
-    pair.after = [&policy, &moved](const Eigen::VectorXd& noise) {
-      return detail::flatten_affine(detail::checked_act(policy, moved, noise));
+    pair.after = [&policy, &moved, poses](const Eigen::VectorXd& noise) {
+      return detail::flatten_affine(detail::checked_act(policy, moved, noise, poses));
     };
     pair.noise_dimension = policy.noise_dimension();
     pair.name = policy.name() + ": the chunk";
@@ -194,7 +204,7 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
         pointwise ? 0 : options.groups.size());  // per group
     for (Group group : options.groups) {
       if (!pointwise) break;
-      out.verdicts.push_back(with_float32_note(
+      out.verdicts.push_back(with_precision_note(
           check_policy_equivariance(*policy, group, check), options,
           [&](const CheckOptions& o) { return check_policy_equivariance(*policy, group, o); }));
       witnesses.push_back(witness_cases(out.verdicts.back()));
@@ -210,7 +220,7 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
         o.extra_cases = witnesses[k];
         return o;
       };
-      out.verdicts.push_back(with_float32_note(
+      out.verdicts.push_back(with_precision_note(
           check_policy_distribution(*policy, group, with_witness(check), options.distribution),
           options, [&](const CheckOptions& o) {
             return check_policy_distribution(*policy, group, with_witness(o), options.distribution);

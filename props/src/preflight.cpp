@@ -63,7 +63,18 @@ class Asker {
   /// result.draws.
   Chunks ask(const std::vector<const Scene*>& scenes) {
     const std::vector<const Eigen::VectorXd*> noises(scenes.size(), &noise_);
-    Chunks out = policy_.act_fresh(scenes, noises);
+    Chunks out;
+    try {
+      out = policy_.act_fresh(scenes, noises);
+    } catch (Error& e) {
+      std::string which;
+      for (std::size_t i = 0; i < scenes.size(); ++i)
+        which += "; [" + std::to_string(i) + "] " + observation_summary(*scenes[i]);
+      e.add_context(
+          "raised in the preflight, which asks these observations before any case (seed " +
+          std::to_string(options_.check.seed) + ", the same seed asks them again)" + which);
+      throw;
+    }
     ++result_.calls;
     result_.rows += static_cast<int>(scenes.size());
     if (const auto draws = policy_.last_draws()) {
@@ -145,12 +156,14 @@ Preflight preflight_policy(const NoisyPolicy& policy, const PreflightOptions& op
       throw StatefulPolicy(
           who + " answered the same observation differently at every call (" +
           metres(result.repeat_difference) + " apart) " +
-          (policy.last_draws() ? "without drawing from torch's, NumPy's or Python's global "
-                                 "random generators"
-                               : "(whether it drew random numbers cannot be seen here)") +
-          ": it keeps state between calls (an action queue, a temporal ensembler) or draws from "
-          "a generator of its own. Pass " +
-          say.reset + " for state, or " + say.rng +
+          (policy.last_draws()
+               ? "without drawing from torch's, NumPy's or Python's global random generators: "
+                 "it keeps state between calls (an action queue, a temporal ensembler) or draws "
+                 "from a generator of its own"
+               : "(whether it drew random numbers cannot be seen here): it draws random numbers "
+                 "of its own or keeps state between calls (an action queue, a temporal "
+                 "ensembler)") +
+          ". Pass " + say.reset + " for state, or " + say.rng +
           " to seed its draws alike on both sides; no verdict is given on a policy as called "
           "here");
     }

@@ -111,11 +111,15 @@ Scene nearby_scene(const Scene& scene, double eta, std::mt19937_64& rng, bool pl
   });
 }
 
-std::string pose_defect(const Eigen::Matrix4d& M) {
+double output_pose_tolerance(double unit_roundoff) {
+  return std::max(kOutputPoseTolerance, 2.0 * std::sqrt(unit_roundoff));
+}
+
+std::string pose_defect(const Eigen::Matrix4d& M, double tolerance) {
   if (!M.allFinite()) return "it holds a non-finite number";
   const double last_row =
       std::max({std::abs(M(3, 0)), std::abs(M(3, 1)), std::abs(M(3, 2)), std::abs(M(3, 3) - 1.0)});
-  if (!(last_row <= kOutputPoseTolerance)) {
+  if (!(last_row <= tolerance)) {
     return "its last row is (" + format_number(M(3, 0)) + ", " + format_number(M(3, 1)) + ", " +
            format_number(M(3, 2)) + ", " + format_number(M(3, 3)) + "), not (0, 0, 0, 1)";
   }
@@ -123,12 +127,10 @@ std::string pose_defect(const Eigen::Matrix4d& M) {
   const double orthonormality =
       (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   const double determinant = R.determinant();
-  if (!(orthonormality <= kOutputPoseTolerance) ||
-      !(std::abs(determinant - 1.0) <= kOutputPoseTolerance)) {
+  if (!(orthonormality <= tolerance) || !(std::abs(determinant - 1.0) <= tolerance)) {
     return "its rotation block is not a rotation: |R^T R - I|_max = " +
            format_number(orthonormality) + ", det R = " + format_number(determinant) +
-           " (each must be within " + format_number(kOutputPoseTolerance) +
-           " of a rotation's 0 and 1)";
+           " (each must be within " + format_number(tolerance) + " of a rotation's 0 and 1)";
   }
   return {};
 }

@@ -1,6 +1,7 @@
 #include "handcentric/props/verdict.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "handcentric/core/format.hpp"
@@ -121,6 +122,24 @@ std::string format_witness(const Witness& witness) {
 double detectable_frequency(int cases) {
   if (cases <= 0) return 1.0;
   return -std::expm1(std::log(0.01) / cases);  // 1 - 0.01^(1/n), accurate for large n
+}
+
+std::string pose_summary(const RigidTransform& T) {
+  // 4 significant digits: enough to recognise a scene; the seed replays it exactly.
+  const auto short_vector = [](const Eigen::Vector3d& v) {
+    char buffer[96];
+    std::snprintf(buffer, sizeof buffer, "[%.4g, %.4g, %.4g]", v.x(), v.y(), v.z());
+    return std::string(buffer);
+  };
+  return "(p = " + short_vector(T.translation()) + " m, r = " + short_vector(T.rotation().log()) +
+         ")";
+}
+
+std::string observation_summary(const Scene& scene) {
+  return "T_0 = " + pose_summary(scene.world_T_hand0()) +
+         " with H = " + std::to_string(scene.history_length()) + ", " +
+         std::to_string(scene.hand_points.size()) + " hand points, " +
+         std::to_string(scene.world_points.size()) + " world points";
 }
 
 }  // namespace handcentric::props

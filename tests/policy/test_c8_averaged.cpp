@@ -58,7 +58,7 @@ std::vector<props::Verdict> audit(std::shared_ptr<const ChunkPolicy> policy, int
   options.groups = {props::Group::c8, props::Group::se2};
   options.views = {props::View::eye_in_hand};
   options.in_distribution = false;
-  options.float32_note = false;
+  options.precision_note = false;
   options.check.cases = cases;
   options.check.shape.planar = true;
   options.check.shape.min_history = options.check.shape.max_history = 2;

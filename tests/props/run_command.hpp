@@ -56,8 +56,18 @@ inline std::string python_example() {
 }
 /// `python tests/props/plugins/<file> [arguments]`.
 inline std::string test_plugin(const std::string& file, const std::string& arguments = "") {
-  return python() + " " + HANDCENTRIC_SOURCE_DIR + "/tests/props/plugins/" + file +
-         (arguments.empty() ? "" : " " + arguments);
+  // Appended step by step: GCC 12 warns (-Warray-bounds, a false positive) on the one-expression
+  // form with a conditional " " + arguments in some unity batches of this suite.
+  std::string command = python();
+  command += ' ';
+  command += HANDCENTRIC_SOURCE_DIR;
+  command += "/tests/props/plugins/";
+  command += file;
+  if (!arguments.empty()) {
+    command += ' ';
+    command += arguments;
+  }
+  return command;
 }
 inline std::string faulty_plugin(const std::string& mode) {
   return test_plugin("faulty.py", mode);

@@ -231,7 +231,10 @@ TEST_CASE("float32_rounding_gets_a_note_and_passes_at_float32_tolerance", "[prop
   audit.relative_tolerance = -1.0;
   CHECK_THROWS_WITH(props::audit_relative_tolerance(audit),
                     Catch::Matchers::Contains("--tolerance"));
-  CHECK_THROWS_WITH(props::parse_precision("float16"), Catch::Matchers::Contains("float16"));
+  CHECK_THROWS_WITH(props::parse_precision("float8"),
+                    Catch::Matchers::Contains("unknown --precision 'float8'"));
+  CHECK_THROWS_WITH(props::parse_precision("half", "precision"),
+                    Catch::Matchers::Contains("unknown precision 'half'"));
 }
 
 namespace {

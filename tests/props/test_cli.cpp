@@ -178,11 +178,11 @@ TEST_CASE("float32_rounding_is_named_and_precision_float32_accepts_it", "[unit]"
             .at("checks")
             .at(0)
             .at("invariant") == true);
-  for (const char* bad : {"--tolerance -1", "--tolerance 2", "--precision float16"}) {
+  for (const char* bad : {"--tolerance -1", "--tolerance 2", "--precision float8"}) {
     const auto result =
         test::run_command(test::cli() + " audit --repr hand_centric --cases 5 " + bad);
     CHECK(result.exit_code == 1);
-    CHECK_THAT(result.err, Contains("--tolerance") || Contains("float16"));
+    CHECK_THAT(result.err, Contains("--tolerance") || Contains("float8"));
   }
 }
 

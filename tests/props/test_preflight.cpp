@@ -8,6 +8,7 @@
 
 #include "handcentric/props/policy_audit.hpp"
 #include "handcentric/props/preflight.hpp"
+#include "run_command.hpp"
 
 using namespace handcentric;
 
@@ -186,4 +187,27 @@ TEST_CASE("a_pointwise_yes_states_the_frequency_it_would_have_found", "[unit]") 
   // 99%: the chance that n draws all miss a set of frequency f is 1%.
   const double f = props::detectable_frequency(200);
   CHECK(std::pow(1.0 - f, 200) == Approx(0.01));
+}
+
+// Over the pipe: the plug-in's own draws cannot be seen, so answers that differ at every call are
+// no verdict at all; serve_policy(..., rng="numpy") seeds them alike for o and g o. The planted
+// fault under rng: the same draws added in the world frame, NO under rotation.
+TEST_CASE("a_plugin_that_draws_its_own_noise_is_audited_once_it_seeds_its_draws", "[unit]") {
+  const std::string options = " --group rotation --view eye_in_hand --cases 40 --json";
+  const auto audit = [&](const std::string& arguments) {
+    return test::run_command(test::cli() + " audit --policy-exec '" +
+                             test::test_plugin("policy_hand_centric.py", arguments) + "'" +
+                             options);
+  };
+  const test::CommandResult unseeded = audit("own_noise");
+  CHECK(unseeded.exit_code == 1);
+  CHECK_THAT(unseeded.err, Catch::Contains("at every call") &&
+                               Catch::Contains("cannot be seen here") &&
+                               Catch::Contains("serve_policy(..., rng="));
+  const test::CommandResult seeded = audit("own_noise --rng");
+  CHECK(seeded.exit_code == 0);
+  CHECK_THAT(seeded.out, !Catch::Contains("\"equivariant\": false"));
+  const test::CommandResult world = audit("own_noise_world --rng");
+  CHECK(world.exit_code == 0);
+  CHECK_THAT(world.out, Catch::Contains("\"equivariant\": false"));
 }

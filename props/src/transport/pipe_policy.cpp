@@ -107,7 +107,8 @@ std::vector<RigidTransform> PipePolicy::act(const Scene& observation,
                                             const Eigen::VectorXd& noise) const {
   capabilities();
   std::string request = key(observation, noise);
-  if (const auto hit = cache_.find(request); hit != cache_.end()) return hit->second;
+  if (const auto hit = cache_.find(request); hit != cache_.end() && !past_cache_)
+    return hit->second;
   PluginReply reply = exchange_one(observation, noise);
   return remember(std::move(request), std::move(reply),
                   "request " + std::to_string(connection_.last_id()));
@@ -141,7 +142,7 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const Scene& observation = *observations[i];
     std::string request = key(observation, *noises[i]);
-    if (const auto hit = cache_.find(request); hit != cache_.end()) {
+    if (const auto hit = cache_.find(request); hit != cache_.end() && !past_cache_) {
       out[i] = hit->second;
       continue;
     }
@@ -173,6 +174,20 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
     }
   }
   return out;
+}
+
+std::vector<std::vector<RigidTransform>> PipePolicy::act_fresh(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  past_cache_ = true;
+  try {
+    auto out = act_batch(observations, noises);
+    past_cache_ = false;
+    return out;
+  } catch (...) {
+    past_cache_ = false;
+    throw;
+  }
 }
 
 }  // namespace handcentric::props

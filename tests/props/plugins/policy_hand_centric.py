@@ -15,6 +15,12 @@ argv[1] picks a planted fault (the audit must find each):
   forgets_T0    decodes without T_0 (T_k = hand0_T_handk): equivariant under nothing
   world_velocity feeds the network the world-frame step p_0 - p_-1 (history order matters):
                 translation-equivariant only
+  own_noise     adds 1 cm of noise per step drawn from NumPy's global generator inside, in the
+                hand frame (equivariant for the same draws): without --rng the audit's preflight
+                sees answers that differ at every call and gives no verdict; with --rng (served
+                with rng="numpy") it is equivariant
+  own_noise_world  the same noise added in the world frame: with --rng, not equivariant under
+                rotations
 --batched (after the fault, if any): the same policy served batched, row by row (each row as
 the unbatched call computes it, so the audit's JSON must not change); --batched row_bias adds
 1e-7 times the row's index in its batch to every translation (an answer that depends on its
@@ -33,7 +39,8 @@ ARGS = sys.argv[1:]
 BATCHED = "--batched" in ARGS
 ROW_BIAS = "row_bias" in ARGS
 TEXT = "text" in ARGS
-FAULT = ([a for a in ARGS if a not in ("--batched", "row_bias", "text")] or [""])[0]
+SEEDED = "--rng" in ARGS
+FAULT = ([a for a in ARGS if a not in ("--batched", "row_bias", "text", "--rng")] or [""])[0]
 K = 4
 RNG = np.random.default_rng(7)
 W1 = RNG.normal(size=(32, 6 + 3 + 8)) * 0.3
@@ -57,6 +64,9 @@ def policy(history, hand_points, world_points, noise):
     chunk = T0 @ hand0_T_handk
     if FAULT == "world_noise":
         chunk[:, :3, 3] += 0.05 * noise[8:8 + 3 * K].reshape(K, 3)
+    if FAULT.startswith("own_noise"):
+        step = 0.01 * np.random.normal(size=(K, 3))
+        chunk[:, :3, 3] += step if FAULT == "own_noise_world" else step @ T0[:3, :3].T
     return chunk
 
 
@@ -68,8 +78,9 @@ def policy_batch(history, hand_points, world_points, noise):
 
 
 if __name__ == "__main__":
+    rng = "numpy" if SEEDED else None
     if BATCHED:
         hp.serve_policy(policy_batch, batched=True, batch_size=64,
-                        encoding=None if TEXT else "base64")
+                        encoding=None if TEXT else "base64", rng=rng)
     else:
-        hp.serve_policy(policy)
+        hp.serve_policy(policy, rng=rng)

@@ -10,6 +10,22 @@ namespace handcentric {
 class Error : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
+  /// The message, then the context added by a caller that knows where it happened (the audit
+  /// names the case, the seed and the observation of an error raised by the policy).
+  const char* what() const noexcept override {
+    return full_.empty() ? std::runtime_error::what() : full_.c_str();
+  }
+  /// Appends " (context)" to what(); the dynamic type is kept, so a caller that catches by
+  /// reference, adds where, and rethrows changes nothing else.
+  void add_context(const std::string& context) {
+    full_ = std::string(what()) + " (" + context + ")";
+    context_ = context_.empty() ? context : context_ + "; " + context;
+  }
+  /// What add_context added, "" when nothing was.
+  const std::string& context() const { return context_; }
+
+ private:
+  std::string full_, context_;
 };
 
 /// A matrix or quaternion that is not a rotation: non-finite, not orthonormal, det = -1, zero.

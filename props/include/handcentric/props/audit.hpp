@@ -15,11 +15,31 @@
 
 namespace handcentric::props {
 
-/// The arithmetic a representation is computed in, which sets the pointwise tolerance.
-enum class Precision { float64, float32 };
+/// The arithmetic a map is computed in, which sets the pointwise tolerance and the unit of
+/// rounding of the rounding probe (tolerance.hpp).
+enum class Precision { float64, float32, bfloat16, float16 };
 
-/// "float64" -> float64, "float32" -> float32; throws InvalidArgument naming the value otherwise.
-Precision parse_precision(const std::string& name);
+/// "float64", "float32", "bfloat16" or "float16"; throws InvalidArgument naming the value, the
+/// option as the caller spells it (`option`: "--precision" on the command line, "precision" in
+/// Python) and the names otherwise.
+Precision parse_precision(const std::string& name, const std::string& option = "--precision");
+
+/// The unit roundoff of a precision: 2^-53, 2^-24, 2^-8 (bfloat16), 2^-11 (float16).
+double unit_roundoff(Precision precision);
+
+/// The unit of rounding the rounding probe moves inputs by (check.hpp, step 2): the precision's
+/// own for float64 and float32; float32's for the 16-bit formats. A 16-bit pipeline as shipped
+/// runs its network in 16 bits on hand-frame inputs, which are the same for o and g o, and does
+/// its world-frame arithmetic in float32 or better. Probing at 2^-8 would excuse any leak the
+/// network is sensitive to: a 2 cm world-frame leak behind a bfloat16 network passed pointwise
+/// so, while the law check found it. A pipeline that takes world-frame differences in 16 bits
+/// is not equivariant up to its output's rounding (its network amplifies that rounding) and gets
+/// NO.
+double probe_unit_roundoff(Precision precision);
+
+/// The REL of a precision's pointwise floor: kRelativeTolerance (float64),
+/// kFloat32RelativeTolerance, kHalfPrecisionRelativeTolerance (both 16-bit formats).
+double precision_relative_tolerance(Precision precision);
 
 struct AuditOptions {
   std::vector<Group> groups = all_groups();
@@ -27,9 +47,10 @@ struct AuditOptions {
   int cases = kDefaultCases;  ///< pointwise cases per cell
   std::uint64_t seed = 1;
   Precision precision = Precision::float64;
-  /// REL of the tolerance REL * (1 + L); 0 = from `precision` (kRelativeTolerance for float64,
-  /// kFloat32RelativeTolerance for float32).
+  /// REL of the tolerance REL * (1 + L); 0 = from `precision` (precision_relative_tolerance).
   double relative_tolerance = 0.0;
+  /// How the caller spells the tolerance option in messages ("--tolerance", "tolerance=").
+  std::string tolerance_option = "--tolerance";
   /// Draw every case inside this box, g * scene included (workspace.hpp); none: anywhere.
   std::optional<Workspace> workspace;
   /// Draw every scene from these (observation/recorded.hpp); none: random scenes.

@@ -23,6 +23,7 @@
 #include <optional>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "handcentric/core/representation.hpp"
@@ -119,6 +120,13 @@ class BatchPolicy {
   /// True when act_batch takes observations of several shapes in one call (a plug-in whose
   /// helper splits them): then a batch is any batch_size inputs, in the order recorded.
   virtual bool mixed_shapes() const { return false; }
+  /// act_batch past any cache the policy keeps of its own (a plug-in's): the preflight's repeated
+  /// questions must reach the policy. Default: act_batch.
+  virtual std::vector<std::vector<RigidTransform>> act_batch_fresh(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const {
+    return act_batch(observations, noises);
+  }
   /// As NoisyPolicy::last_draws, for the last act_batch call (a Python callable watches torch's,
   /// NumPy's and Python's global generators while watch_draws(true)).
   virtual std::optional<std::vector<std::string>> last_draws() const { return std::nullopt; }
@@ -208,10 +216,10 @@ class BatchedPolicy final : public NoisyPolicy, public Prefetcher {
     std::string key;
   };
   void evaluate(const std::vector<const Pending*>& inputs) const;
-  /// policy_->act_batch, counted, its number of chunks checked.
+  /// policy_->act_batch (act_batch_fresh when `fresh`), counted, its number of chunks checked.
   std::vector<std::vector<RigidTransform>> counted_act_batch(
       const std::vector<const Scene*>& observations,
-      const std::vector<const Eigen::VectorXd*>& noises) const;
+      const std::vector<const Eigen::VectorXd*>& noises, bool fresh = false) const;
 
   std::shared_ptr<const BatchPolicy> policy_;
   int batch_size_;
@@ -219,6 +227,7 @@ class BatchedPolicy final : public NoisyPolicy, public Prefetcher {
   mutable AnswerCache<std::vector<RigidTransform>> cache_;
   mutable std::vector<Pending> pending_;
   mutable std::unordered_map<std::string, bool> pending_keys_;
+  std::unordered_set<std::string> failing_;  ///< inputs that failed in a batch: asked alone
   mutable std::size_t chunk_length_ = 0;
   mutable std::size_t batches_ = 0, evaluations_ = 0;
 };

@@ -50,6 +50,11 @@ struct CheckOptions {
   /// The unit roundoff of the arithmetic the map is computed in (2^-53 double, 2^-24 float32):
   /// how far rounding_perturbation moves the inputs when a case is above the floor.
   double unit_roundoff = kFloat64UnitRoundoff;
+  /// The unit roundoff of the numbers the policy returns, which sets how far its output poses
+  /// may be from rigid transforms (output_pose_tolerance); 0: unit_roundoff. A 16-bit policy
+  /// returns 16-bit poses while its world-frame arithmetic, what the rounding probe models, is
+  /// float32 (audit.hpp, Precision).
+  double output_unit_roundoff = 0.0;
   /// Scenes moved slightly off a case above the floor and the map's rounding, to tell a bin
   /// edge from a symmetry breaking (step 3 above). 0 decides on steps 1 and 2 alone: then every
   /// such case fails, bin edges included (a test's planted fault).

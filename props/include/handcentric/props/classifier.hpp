@@ -36,12 +36,13 @@ struct ClassifierOptions {
   bool in_distribution = true;
   bool injectivity = true;      ///< run check_injectivity on a representation
   int injectivity_cases = 200;  ///< chunk pairs it tries (on third-person scenes)
-  /// When a cell fails at a tolerance below float32 rounding, re-check it at
-  /// kFloat32RelativeTolerance and say in the verdict's note if it would pass there.
-  bool float32_note = true;
-  /// The advice that ends the float32 note, in the caller's words (the Python module says
-  /// precision="float32").
-  std::string float32_advice = "rerun with --precision float32";
+  /// When a cell fails at a tolerance below a lower precision's rounding, re-check it there
+  /// (float32, then bfloat16) and say in the verdict's note if it would pass (with_precision_note).
+  bool precision_note = true;
+  /// The advice that ends that note for a precision's name, in the caller's words (the Python
+  /// module says precision="float32").
+  std::function<std::string(const std::string& precision)> precision_advice =
+      [](const std::string& precision) { return "rerun with --precision " + precision; };
   /// Run the preflight of a whole policy (preflight.hpp) before its verdicts: a policy that is
   /// not a function of its inputs gets no pointwise verdict or none at all.
   bool preflight = true;
@@ -67,12 +68,14 @@ Classification classify_representation(std::shared_ptr<const Representation> rep
 Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
                                     const ClassifierOptions& options = {});
 
-/// A failure at a tolerance tighter than float32 rounding that passes at float32 rounding is
-/// worth a sentence: the map is probably right and computed in float32. If options ask for it
-/// and `verdict` failed below kFloat32RelativeTolerance, reruns `recheck` there (no shrinking)
-/// and sets the verdict's note when it holds.
-Verdict with_float32_note(Verdict verdict, const ClassifierOptions& options,
-                          const std::function<Verdict(const CheckOptions&)>& recheck);
+/// A failure at a tolerance tighter than a lower precision's rounding that passes at that
+/// rounding is worth a sentence: the map is probably right and computed in that precision. If
+/// options ask for it and `verdict` failed below kFloat32RelativeTolerance, reruns `recheck`
+/// there (no shrinking) and sets the verdict's note when it holds; when it does not, and the
+/// witness's error is within reach of bfloat16 rounding (at most 8 sqrt(2^-8) (1 + L)), the
+/// same at bfloat16's floor and unit (tolerance.hpp).
+Verdict with_precision_note(Verdict verdict, const ClassifierOptions& options,
+                            const std::function<Verdict(const CheckOptions&)>& recheck);
 
 /// The witness of a failed verdict as one (scene, g) case for another check
 /// (CheckOptions::extra_cases), or none when it held.

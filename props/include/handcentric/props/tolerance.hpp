@@ -28,6 +28,8 @@ constexpr double kRelativeTolerance = 1e-9;
 // Unit roundoff of the arithmetic a map is computed in: what one rounding can do, relative.
 constexpr double kFloat64UnitRoundoff = 0x1p-53;
 constexpr double kFloat32UnitRoundoff = 0x1p-24;
+constexpr double kFloat16UnitRoundoff = 0x1p-11;  // IEEE half: 11 significant bits
+constexpr double kBfloat16UnitRoundoff = 0x1p-8;  // bfloat16: 8 significant bits
 
 // The float32 floor (`--precision float32`): 64 units of float32 rounding, 3.8e-6 (1 + L). A pose
 // pipeline in float32 rounds its inputs and each of a few products at the scene's length scale
@@ -36,6 +38,13 @@ constexpr double kFloat32UnitRoundoff = 0x1p-24;
 // rounding) is measured per case instead (check.hpp). The floor stays far below a task's
 // clearance (1 mm for the peg): a leak of 0.6 mm at L = 10 m is 14 times over it.
 constexpr double kFloat32RelativeTolerance = 64 * kFloat32UnitRoundoff;
+
+// The floor of the 16-bit formats (`precision="bfloat16"` or `"float16"`): 2^-7 (1 + L), two
+// units of bfloat16 rounding, 0.8% of the scene's size. 64 units, as for float32, would be a
+// quarter of it and hide any leak; a 16-bit pipeline's rounding above this floor is measured per
+// case instead (the rounding probe at the format's unit, check.hpp). What such a "yes" cannot
+// see is a breaking below 2^-7 (1 + L).
+constexpr double kHalfPrecisionRelativeTolerance = 0x1p-7;
 constexpr double kNearIdentity = 1e-6;
 
 // A case whose error is at most kRoundingMultiple times the map's measured response to a
@@ -45,15 +54,21 @@ constexpr double kRoundingMultiple = 8.0;
 // Units of rounding each input coordinate moves by in rounding_perturbation.
 constexpr double kRoundingPerturbationUlps = 4.0;
 
-/// How far a policy's output pose may be from a rigid transform: |R^T R - I|_max, |det R - 1|
-/// and the last row's distance from 0 0 0 1. 1e-5 is ~170 units of float32 rounding, which a
-/// float32 policy's rotations stay well within; a rotation block scaled or sheared by a bug is
-/// off by O(1).
+/// How far a policy's output pose may be from a rigid transform at float64: |R^T R - I|_max,
+/// |det R - 1| and the last row's distance from 0 0 0 1. A rotation block scaled or sheared by a
+/// bug is off by O(1).
 constexpr double kOutputPoseTolerance = 1e-5;
 
-/// Empty when M = [[R, p], [0, 0, 0, 1]] with R a rotation within kOutputPoseTolerance (and
-/// every entry finite); else one sentence with the offending numbers.
-std::string pose_defect(const Eigen::Matrix4d& M);
+/// The output pose check at unit roundoff u: max(kOutputPoseTolerance, 2 sqrt(u)), twice the
+/// worst loss of a well-posed pose computation (the rounding cap of check.hpp): 4.9e-4 for
+/// float32 (a 6D rotation orthonormalized in float32 was seen at 1.4e-5), 0.044 for float16,
+/// 0.125 for bfloat16 (R_0 R_k multiplied in bfloat16 was seen at 0.068, 17 units), far below a
+/// bug's O(1).
+double output_pose_tolerance(double unit_roundoff);
+
+/// Empty when M = [[R, p], [0, 0, 0, 1]] with R a rotation within `tolerance` (and every entry
+/// finite); else one sentence with the offending numbers.
+std::string pose_defect(const Eigen::Matrix4d& M, double tolerance = kOutputPoseTolerance);
 
 /// L: the largest translation norm of any pose or point of the scene (0 for an empty scene).
 double length_scale(const Scene& scene);

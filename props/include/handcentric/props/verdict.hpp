@@ -105,6 +105,13 @@ struct Verdict {
 /// probability, 1 - 0.01^(1/cases) (about 4.6 / cases). 1 when cases is 0.
 double detectable_frequency(int cases);
 
+/// One line: a pose's position and rotation vector at 4 significant digits.
+std::string pose_summary(const RigidTransform& T);
+
+/// One line: the hand now (T_0's position and rotation vector) and the sizes of an observation,
+/// for an error that names where it happened (a witness prints the scene in full).
+std::string observation_summary(const Scene& scene);
+
 /// A compact, multi-line rendering of a witness (17 digits, so it reproduces the doubles).
 std::string format_witness(const Witness& witness);
 

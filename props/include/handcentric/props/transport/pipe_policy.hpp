@@ -38,6 +38,15 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   /// batches of batch_size() observations of any shapes (one at a time when the plug-in does not
   /// batch).
   /// A batched line may mix shapes (docs/AUDIT.md, "--exec"): fewer round trips.
+  /// Asked past the cache (the preflight, preflight.hpp): each request goes to the plug-in.
+  std::vector<std::vector<RigidTransform>> act_fresh(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override;
+  std::vector<std::vector<RigidTransform>> act_batch_fresh(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override {
+    return act_fresh(observations, noises);
+  }
   bool mixed_shapes() const override { return true; }
   std::vector<std::vector<RigidTransform>> act_batch(
       const std::vector<const Scene*>& observations,
@@ -73,6 +82,7 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   mutable std::optional<PluginCapabilities> capabilities_;
   std::optional<Scene> probe_;  ///< use_probe()'s scene
   mutable std::unordered_map<std::string, std::vector<RigidTransform>> cache_;
+  mutable bool past_cache_ = false;  ///< during act_fresh: no answer is taken from cache_
   mutable std::size_t chunk_length_ = 0;
 };
 
