@@ -308,7 +308,7 @@ def test_a_deterministic_policy_is_never_yes_pointwise_beside_no_in_distribution
     assert rechecked == 3  # seeds 2, 5 and 7
 
 
-def test_a_binned_hand_centric_map_is_invariant_in_distribution_too_and_its_numbers_leave_out_edges():
+def test_a_binned_hand_centric_map_is_invariant_in_law_too_and_its_numbers_leave_out_edges():
     """1 cm voxels and 5 degree Euler bins of the hand-frame chunk, by floor: invariant, with bin
     edges where a hand at rest puts its hand-frame angles at exactly 0. The pointwise check counts
     those edge cases as discontinuities; the in-distribution one now moves a differing case off

@@ -37,7 +37,8 @@ def bf16_pipeline(leak=0.0, cast=True):
         R_k = torch.stack([a, b, torch.cross(a, b, dim=-1)], -1).double()
         out = torch.zeros(len(T0), K, 4, 4, dtype=torch.float64)
         out[..., :3, :3] = R0[:, None] @ R_k
-        out[..., :3, 3] = p0[:, None] + (R0[:, None] @ (0.05 * y[..., :3]).double()[..., None])[..., 0]
+        step = (0.05 * y[..., :3]).double()[..., None]  # in the hand frame
+        out[..., :3, 3] = p0[:, None] + (R0[:, None] @ step)[..., 0]
         out[..., :3, 3] += torch.tensor([leak, 0.0, 0.0], dtype=torch.float64)
         out[..., 3, 3] = 1.0
         return out.bfloat16().double() if cast else out
