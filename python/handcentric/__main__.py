@@ -107,7 +107,7 @@ def make_parser():
         sub.add_argument("--cases", type=_bounded(1, handcentric.MAX_CASES), metavar="N",
                          help="cases per check, 1 to %d" % handcentric.MAX_CASES)
         sub.add_argument("--seed", type=int, metavar="S", help="RapidCheck's seed (default 1)")
-        sub.add_argument("--precision", choices=("float64", "float32"),
+        sub.add_argument("--precision", choices=("float64", "float32", "bfloat16", "float16"),
                          help="the arithmetic of the callable, for the tolerance "
                               "(default float64)")
         sub.add_argument("--batch-size", type=_bounded(1, handcentric.MAX_BATCH_SIZE),
@@ -147,6 +147,12 @@ def make_parser():
     common(policy, "the policy (history, hand_points, world_points, noise) -> (K, 4, 4)")
     policy.add_argument("--noise", type=_bounded(1, handcentric.MAX_NOISE), metavar="N",
                         help="standard normals per call, 1 to %d" % handcentric.MAX_NOISE)
+    policy.add_argument("--rng", choices=("torch", "numpy", "generator"),
+                        help="the policy draws its own random numbers from this generator: seed "
+                             "it alike for o and g o (rng=; one observation per call)")
+    policy.add_argument("--reset", metavar="MODULE:FUNCTION",
+                        help="a function of no arguments called before every call of the policy "
+                             "(reset=; e.g. a policy's reset, for one that keeps state)")
     return parser
 
 
@@ -155,7 +161,7 @@ def _keywords(args):
     out = {}
     for option in ("groups", "views", "cases", "seed", "precision", "batch_size", "noise",
                    "array", "device", "history", "hand_points", "world_points", "chunk",
-                   "quiet"):
+                   "quiet", "rng"):
         value = getattr(args, option, None)
         if value is not None:
             out[option] = tuple(value) if isinstance(value, list) else value
@@ -188,6 +194,9 @@ def summary_lines(result):
              for row in [header] + rows]
     if "injective" in result:
         lines.append("injective: %s" % ("yes" if result["injective"] else "NO"))
+    preflight = result.get("preflight") or {}
+    if preflight.get("note"):
+        lines.append("no pointwise verdict: %s" % preflight["note"])
     return lines
 
 
@@ -203,6 +212,8 @@ def main(argv=None):
                     keywords[option] = load_callable(getattr(args, option))
             result = handcentric.audit(target, **keywords)
         else:
+            if args.reset:
+                keywords["reset"] = load_callable(args.reset)
             result = handcentric.audit_policy(target, **keywords)
     except BadTarget as e:
         parser.error(str(e))

@@ -201,3 +201,28 @@ def test_rng_and_reset_are_refused_by_name():
         handcentric.audit_policy(base, rng="cuda", quiet=True)
     with pytest.raises(TypeError, match="reset must be None or a callable"):
         handcentric.audit_policy(base, reset=3, quiet=True)
+
+
+def test_the_command_line_takes_rng_and_reset_and_prints_the_preflight(tmp_path, capsys):
+    """python -m handcentric audit-policy: --rng and --reset as audit_policy's rng= and reset=;
+    a policy with its own noise and no --rng gets the one line instead of pointwise rows."""
+    from handcentric import __main__ as cli
+    (tmp_path / "shipped.py").write_text(
+        "import sys\n"
+        "sys.path.insert(0, %r)\n"
+        "from test_preflight import HistoryBuffer, own_noise\n"
+        "noisy = own_noise('numpy', 'hand')\n"
+        "stateful = HistoryBuffer()\n"
+        "reset = stateful.reset\n" % str(__import__("os").path.dirname(__file__)))
+    target = str(tmp_path / "shipped.py")
+    common = ["--groups", "se3", "--views", "eye_in_hand", "--cases", "20", "--quiet"]
+    assert cli.main(["audit-policy", target + ":noisy"] + common) == 0
+    out = capsys.readouterr().out
+    assert "no pointwise verdict:" in out and "pointwise" not in out.split("no pointwise")[0]
+    assert cli.main(["audit-policy", target + ":noisy", "--rng", "numpy"] + common) == 0
+    out = capsys.readouterr().out
+    assert "pointwise" in out and "NO" not in out
+    assert cli.main(["audit-policy", target + ":stateful"] + common) == 1
+    assert "previous call" in capsys.readouterr().err
+    assert cli.main(["audit-policy", target + ":stateful", "--reset", target + ":reset"]
+                    + common) == 0
