@@ -184,34 +184,9 @@ void prefetch_extra_cases(const CaseFunction& run_case,
 
 }  // namespace
 
-Verdict run_check(const CaseFunction& decide_case, Component component, Group group, Mode mode,
+Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget,
                   const std::function<void()>& before_real_pass) {
-  // Off the case for laws too (check.hpp, step 3): two laws that differ at a case sitting on a
-  // bin edge (a hand at rest, whose hand-frame angles are exactly 0, binned by floor) and agree
-  // with the case moved slightly off it differ by a discontinuity, not by g. Without this, a
-  // binned hand-centric map was "yes" pointwise (its edge cases counted) and NO in distribution.
-  const CaseFunction run_case =
-      mode != Mode::distribution || options.off_case_draws < 1
-          ? decide_case
-          : CaseFunction([&decide_case, &options](const Scene& scene, const RigidTransform& g) {
-              CaseOutcome outcome = decide_case(scene, g);
-              if (outcome.holds || outcome.provisional) return outcome;
-              std::mt19937_64 rng(options.seed ^ 0xbb67ae8584caa73bULL);
-              const double eta = off_case_scale(options.unit_roundoff);
-              for (int d = 0; d < options.off_case_draws; ++d) {
-                CaseOutcome off =
-                    decide_case(nearby_scene(scene, eta, rng, options.shape.planar), g);
-                if (off.provisional) return off;  // a prefetch pass: decided in the real one
-                if (!off.holds) {
-                  off.witness.off_case = true;
-                  return off;
-                }
-              }
-              outcome.holds = true;
-              outcome.discontinuity = true;
-              return outcome;
-            });
   if (cases < 1)
     throw InvalidArgument("a check needs at least 1 case, got " + std::to_string(cases));
   if (!(options.relative_tolerance > 0.0) || !std::isfinite(options.relative_tolerance)) {
@@ -274,10 +249,7 @@ Verdict run_check(const CaseFunction& decide_case, Component component, Group gr
     if (searching) {
       const double e = std::isnan(outcome.witness.error) ? std::numeric_limits<double>::infinity()
                                                          : outcome.witness.error;
-      // The number beside a verdict leaves out the cases that sat on a discontinuity (their
-      // count is in the note): a "yes" beside an error of a whole bin would read as a breaking.
-      if (!(outcome.holds && outcome.discontinuity))
-        verdict.max_error = std::max(verdict.max_error, e);
+      verdict.max_error = std::max(verdict.max_error, e);
       verdict.min_p_value = std::min(verdict.min_p_value, outcome.witness.p_value);
       if (near_identity(g, scene)) {
         ++verdict.near_identity_cases;

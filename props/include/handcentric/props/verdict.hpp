@@ -79,7 +79,7 @@ struct Verdict {
   View view = View::eye_in_hand;
   Method method = Method::compared;
   bool invariant = false;       ///< the check held on every case (and on at least one far case)
-  double max_error = 0.0;       ///< largest error seen (before shrinking), discontinuities left out
+  double max_error = 0.0;       ///< largest error seen (before shrinking)
   double min_p_value = 1.0;     ///< distribution mode: smallest p-value seen
   int cases = 0;                ///< cases run with g far from the identity (tolerance.hpp)
   int near_identity_cases = 0;  ///< cases run with g near the identity (run, not counted)
