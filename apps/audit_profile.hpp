@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "handcentric/props/profile.hpp"
+#include "handcentric/props/checks/profile.hpp"
 
 namespace handcentric::apps {
 

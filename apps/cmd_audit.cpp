@@ -25,10 +25,10 @@
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/transport/pipe_policy.hpp"
 #include "handcentric/props/transport/pipe_representation.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 #include "handcentric/sim/draw.hpp"
 
 namespace handcentric::apps {

@@ -14,9 +14,9 @@
 #include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
-#include "handcentric/props/batch.hpp"
-#include "handcentric/props/classifier.hpp"
-#include "handcentric/props/profile.hpp"
+#include "handcentric/props/transport/batch.hpp"
+#include "handcentric/props/checks/classifier.hpp"
+#include "handcentric/props/checks/profile.hpp"
 #include "handcentric/props/transport/pipe_policy.hpp"
 #include "handcentric/props/transport/pipe_representation.hpp"
 

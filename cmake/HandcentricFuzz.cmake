@@ -22,7 +22,7 @@ set_property(CACHE HANDCENTRIC_FUZZ_COVERAGE PROPERTY STRINGS all parsers)
 set(HANDCENTRIC_FUZZ_PARSER_SOURCES
   sim/src/demos.cpp sim/src/demo_file.cpp
   policy/src/model_file.cpp policy/src/binary_io.cpp
-  props/src/transport/plugin_protocol.cpp props/src/transport/wire_arrays.cpp
+  props/src/transport/plugin_protocol.cpp props/src/wire_arrays.cpp
   core/src/rigid_transform.cpp core/src/rotation.cpp)
 
 if(HANDCENTRIC_FUZZ)

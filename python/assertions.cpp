@@ -5,8 +5,8 @@
 
 #include "arrays.hpp"
 #include "handcentric/core/errors.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 #include "handcentric/props/verdict.hpp"
 
 namespace handcentric::python {

@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "arrays.hpp"
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/observation/camera_rig.hpp"
 
 namespace handcentric::python {

@@ -5,11 +5,12 @@
 // instead of a pipe).
 //
 // Errors. The checks stop and rethrow a handcentric::Error thrown by the function under test and
-// treat any other exception as a counterexample (props/src/check.cpp). A Python exception inside
-// a callable is therefore carried through the checks as PythonCallError (a handcentric::Error
-// holding the Python exception) and restored, traceback included, once the C++ call returns.
-// A result of the wrong shape or dtype stops the audit with ShapeError / DtypeError naming what
-// was returned and what was expected. The GIL is held throughout: the checks are sequential.
+// treat any other exception as a counterexample (props/src/checks/check.cpp). A Python exception
+// inside a callable is therefore carried through the checks as PythonCallError (a
+// handcentric::Error holding the Python exception) and restored, traceback included, once the C++
+// call returns. A result of the wrong shape or dtype stops the audit with ShapeError / DtypeError
+// naming what was returned and what was expected. The GIL is held throughout: the checks are
+// sequential.
 //
 // No verdict without evidence. The audits need NumPy to build the callables' arguments: without
 // it they raise ImportError at once, naming the interpreter and the fix, instead of checking
@@ -41,10 +42,10 @@
 #include "handcentric/core/scene.hpp"
 #include "handcentric/core/so3.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/classifier.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/checks/classifier.hpp"
 #include "handcentric/props/transport/plugin_protocol.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 #include "handcentric/props/verdict.hpp"
 #include "handcentric/sim/demos.hpp"
 #include "arrays.hpp"

@@ -16,8 +16,8 @@
 
 #include "callables.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/batch.hpp"
-#include "handcentric/props/classifier.hpp"
+#include "handcentric/props/transport/batch.hpp"
+#include "handcentric/props/checks/classifier.hpp"
 
 namespace handcentric::python {
 

@@ -8,7 +8,7 @@
 #include "arrays.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
-#include "handcentric/props/profile.hpp"
+#include "handcentric/props/checks/profile.hpp"
 
 namespace handcentric::python {
 namespace {

@@ -81,7 +81,8 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^a_batched_exec_audit_gives_the_unbatched_json|^a_batched_policy_exec_audit_gives_the_unbatched|'\
 '^table1_cli_writes_the_table_beside_the_papers|^table1_cli_an_existing_run_needs_resume|'\
 '^table2_cli_image_rows_beside_the_key_point_rows|^table1_audits_every_model_and_shows|'\
-'^float32_rounding_is_named_and_precision_float32'
+'^float32_rounding_is_named_and_precision_float32|^a_plugin_that_draws_its_own_noise|'\
+'^policy_exec_hands_a_plugin_the_images'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 

@@ -47,4 +47,14 @@ std::string format_matrix(const Eigen::Ref<const Eigen::MatrixXd>& matrix) {
   return text + "]";
 }
 
+std::string one_line(std::string text, std::size_t limit) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' '))
+    text.pop_back();
+  for (char& c : text) {
+    if (c == '\n' || c == '\r') c = '|';
+  }
+  if (text.size() > limit) text = text.substr(0, limit) + "...";
+  return text;
+}
+
 }  // namespace handcentric

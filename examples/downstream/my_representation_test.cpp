@@ -7,7 +7,7 @@
 #include <handcentric/core/representation.hpp>
 #include <handcentric/core/so3.hpp>
 #include <handcentric/props/catch.hpp>
-#include <handcentric/props/generators.hpp>
+#include <handcentric/props/observation/generators.hpp>
 #include <handcentric/props/show.hpp>
 
 namespace {

@@ -7,7 +7,7 @@
 
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/policy/trainer.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 
 int main() {
   using namespace handcentric;

@@ -11,7 +11,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/experiments/document_markdown.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/transport/pipe_representation.hpp"
 
 namespace handcentric::experiments {

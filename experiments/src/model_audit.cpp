@@ -7,7 +7,7 @@
 #include "handcentric/experiments/insert3d_image.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 
 namespace handcentric::experiments {
 

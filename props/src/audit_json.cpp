@@ -3,7 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 
 namespace handcentric::props {
 namespace {

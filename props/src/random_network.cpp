@@ -5,7 +5,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
-#include "handcentric/props/check.hpp"
+#include "handcentric/props/noisy_policy.hpp"
 
 namespace handcentric::props {
 

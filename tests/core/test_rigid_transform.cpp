@@ -7,7 +7,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/props/show.hpp"
 
 using namespace handcentric;

@@ -6,7 +6,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/scene.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/props/show.hpp"
 
 using namespace handcentric;

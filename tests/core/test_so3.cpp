@@ -11,7 +11,7 @@
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/core/so3.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/props/show.hpp"
 #include "mutants.hpp"
 

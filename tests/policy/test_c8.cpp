@@ -9,7 +9,7 @@
 #include "handcentric/policy/c8_flow.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 
 using namespace handcentric;
 using namespace handcentric::policy;

@@ -15,8 +15,8 @@
 #include "handcentric/policy/c8_planar.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
-#include "handcentric/props/policy_audit.hpp"
-#include "handcentric/props/profile.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
+#include "handcentric/props/checks/profile.hpp"
 #include "throws.hpp"
 
 using namespace handcentric;

@@ -8,8 +8,8 @@
 #include "handcentric/policy/normalizer.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/observation/generators.hpp"
 
 using namespace handcentric;
 using namespace handcentric::policy;

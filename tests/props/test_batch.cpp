@@ -8,8 +8,8 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/batch.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/transport/batch.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 #include "handcentric/props/random_network.hpp"
 
 using namespace handcentric;

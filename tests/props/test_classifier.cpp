@@ -6,7 +6,7 @@
 
 #include "handcentric/core/representations.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/classifier.hpp"
+#include "handcentric/props/checks/classifier.hpp"
 #include "mutants.hpp"
 
 using namespace handcentric;

@@ -10,7 +10,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/sampling.hpp"
-#include "handcentric/props/distribution.hpp"
+#include "handcentric/props/checks/distribution.hpp"
 #include "mutants.hpp"
 
 using namespace handcentric;

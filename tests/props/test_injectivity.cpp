@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "handcentric/core/representations.hpp"
-#include "handcentric/props/injectivity.hpp"
+#include "handcentric/props/checks/injectivity.hpp"
 #include "mutants.hpp"
 
 using namespace handcentric;

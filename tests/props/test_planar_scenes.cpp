@@ -7,7 +7,7 @@
 
 #include <random>
 
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/props/tolerance.hpp"
 
 using namespace handcentric;

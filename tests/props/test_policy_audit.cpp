@@ -8,7 +8,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 #include "handcentric/props/random_network.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "mutants.hpp"

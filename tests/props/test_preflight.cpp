@@ -6,8 +6,8 @@
 #include <memory>
 #include <random>
 
-#include "handcentric/props/policy_audit.hpp"
-#include "handcentric/props/preflight.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
+#include "handcentric/props/checks/preflight.hpp"
 #include "run_command.hpp"
 
 using namespace handcentric;

@@ -13,7 +13,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
-#include "handcentric/props/profile.hpp"
+#include "handcentric/props/checks/profile.hpp"
 #include "handcentric/props/random_network.hpp"
 #include "run_command.hpp"
 

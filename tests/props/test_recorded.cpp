@@ -11,10 +11,10 @@
 #include "handcentric/core/representations.hpp"
 #include "handcentric/props/audit.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/props/observation/recorded.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 
 using namespace handcentric;
 using props::Group;

@@ -11,9 +11,9 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/classifier.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/checks/classifier.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 #include "handcentric/props/tolerance.hpp"
 
 using namespace handcentric;

@@ -8,7 +8,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
-#include "handcentric/props/check.hpp"
+#include "handcentric/props/checks/check.hpp"
 #include "handcentric/props/random_network.hpp"
 #include "mutants.hpp"
 

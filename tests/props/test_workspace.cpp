@@ -5,10 +5,10 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/generators.hpp"
-#include "handcentric/props/policy_audit.hpp"
-#include "handcentric/props/workspace.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/observation/generators.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
+#include "handcentric/props/observation/workspace.hpp"
 
 using namespace handcentric;
 using props::Group;

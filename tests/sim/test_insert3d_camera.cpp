@@ -8,7 +8,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/sim/insert3d/camera.hpp"
 #include "handcentric/sim/insert3d/scenes.hpp"
 

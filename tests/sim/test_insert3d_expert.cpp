@@ -8,7 +8,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/so3.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
 #include "handcentric/sim/scenes.hpp"
 

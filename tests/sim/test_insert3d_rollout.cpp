@@ -5,7 +5,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/props/catch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
 #include "handcentric/sim/insert3d/rollout.hpp"
 

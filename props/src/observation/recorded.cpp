@@ -6,7 +6,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "../transport/wire_arrays.hpp"
+#include "../wire_arrays.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "npz.hpp"

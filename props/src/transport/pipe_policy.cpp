@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "wire_arrays.hpp"
+#include "../wire_arrays.hpp"
 
 namespace handcentric::props {
 

@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "handcentric/core/format.hpp"
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/tolerance.hpp"
-#include "wire_arrays.hpp"
+#include "../wire_arrays.hpp"
 
 namespace handcentric::props {
 namespace {
@@ -186,7 +186,12 @@ void require_finite(const double* values, std::size_t count, const std::string& 
 wire::Array read_encoded(const nlohmann::json& value, const std::string& field, std::size_t rank,
                          const std::string& form, const std::string& answered) {
   const std::string where = answered + " with \"" + field + "\"";
-  wire::Array array = wire::read_array(value, where);
+  wire::Array array;
+  try {
+    array = wire::read_array(value, where);
+  } catch (const wire::FormatError& e) {
+    throw PluginError(e.what());  // the plug-in's answer, not a file, is at fault
+  }
   if (array.dtype != wire::Dtype::float64) {
     throw PluginError(where + " of dtype " + wire::dtype_name(array.dtype) +
                       "; the protocol's numbers are float64 (NumPy: array.astype('<f8'), exact "
@@ -331,16 +336,6 @@ Scene with_named_extras(Scene scene, const std::vector<std::string>& pose_names,
     if (!has(scene.scalars, name)) scene.scalars.emplace_back(name, 0.0);
   }
   return scene;
-}
-
-std::string one_line(std::string text, std::size_t limit) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' '))
-    text.pop_back();
-  for (char& c : text) {
-    if (c == '\n' || c == '\r') c = '|';
-  }
-  if (text.size() > limit) text = text.substr(0, limit) + "...";
-  return text;
 }
 
 std::string encode_request_body(const Scene& scene, const std::optional<FlowQuery>& flow,

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "handcentric/experiments/document.hpp"
-#include "handcentric/props/classifier.hpp"
+#include "handcentric/props/checks/classifier.hpp"
 
 namespace handcentric::experiments {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "handcentric/policy/learned_policy.hpp"
-#include "handcentric/props/classifier.hpp"
+#include "handcentric/props/checks/classifier.hpp"
 #include "handcentric/props/group.hpp"
 
 namespace handcentric::experiments {

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "handcentric/props/profile.hpp"
+#include "handcentric/props/checks/profile.hpp"
 #include "handcentric/sim/draw.hpp"
 
 namespace handcentric::experiments {

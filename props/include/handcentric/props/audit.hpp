@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "handcentric/props/classifier.hpp"
+#include "handcentric/props/checks/classifier.hpp"
 #include "handcentric/props/observation/recorded.hpp"
-#include "handcentric/props/workspace.hpp"
+#include "handcentric/props/observation/workspace.hpp"
 
 namespace handcentric::props {
 

@@ -9,7 +9,7 @@
 
 #include "handcentric/core/camera.hpp"
 #include "handcentric/props/observation/camera_rig.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/noisy_policy.hpp"
 
 namespace handcentric::props {
 

@@ -34,7 +34,7 @@
 #include <vector>
 
 #include "handcentric/core/scene.hpp"
-#include "handcentric/props/workspace.hpp"
+#include "handcentric/props/observation/workspace.hpp"
 
 namespace handcentric::props {
 

@@ -15,9 +15,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/transport/plugin_connection.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/noisy_policy.hpp"
 
 namespace handcentric::props {
 

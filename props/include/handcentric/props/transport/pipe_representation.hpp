@@ -36,7 +36,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representation.hpp"
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/transport/plugin_connection.hpp"
 #include "handcentric/props/transport/plugin_protocol.hpp"
 

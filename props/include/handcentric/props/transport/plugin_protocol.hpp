@@ -131,7 +131,4 @@ std::vector<std::string> merged_names(std::vector<std::string> first,
 Scene with_named_extras(Scene scene, const std::vector<std::string>& pose_names,
                         const std::vector<std::string>& scalar_names);
 
-/// `text` as one line (newlines -> '|'), cut at `limit` characters.
-std::string one_line(std::string text, std::size_t limit = 200);
-
 }  // namespace handcentric::props

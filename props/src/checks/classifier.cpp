@@ -1,4 +1,4 @@
-#include "handcentric/props/classifier.hpp"
+#include "handcentric/props/checks/classifier.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "handcentric/props/preflight.hpp"
+#include "handcentric/props/checks/preflight.hpp"
 
 #include <rapidcheck.h>
 
@@ -6,8 +6,9 @@
 #include <cstdio>
 #include <numeric>
 
-#include "handcentric/props/batch.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/prefetch.hpp"
+#include "handcentric/props/scene_key.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 #include "check_runner.hpp"
 
 namespace handcentric::props {

@@ -1,4 +1,4 @@
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
 
 #include <cmath>
 #include <limits>

@@ -31,7 +31,8 @@
 #include "handcentric/core/chunk_policy.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representation.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/observation/generators.hpp"
+#include "handcentric/props/noisy_policy.hpp"
 #include "handcentric/props/run.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "handcentric/props/verdict.hpp"
@@ -107,9 +108,6 @@ SceneFunction flow_input_of(std::shared_ptr<const FlowTarget> target, std::uint6
                             double t);
 SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed,
                              double t);
-
-/// The first `n` standard normals of mt19937_64(seed) (core/sampling.hpp).
-Eigen::VectorXd fixed_noise(Eigen::Index n, std::uint64_t seed);
 
 /// f(g * s) = f(s) within pointwise_tolerance for g in `group`. `component` only labels the
 /// verdict.

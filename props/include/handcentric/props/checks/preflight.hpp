@@ -37,7 +37,7 @@
 #include <vector>
 
 #include "handcentric/core/errors.hpp"
-#include "handcentric/props/check.hpp"
+#include "handcentric/props/checks/check.hpp"
 
 namespace handcentric::props {
 

@@ -1,4 +1,4 @@
-#include "handcentric/props/workspace.hpp"
+#include "handcentric/props/observation/workspace.hpp"
 
 #include <algorithm>
 #include <cmath>

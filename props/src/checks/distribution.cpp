@@ -1,4 +1,4 @@
-#include "handcentric/props/distribution.hpp"
+#include "handcentric/props/checks/distribution.hpp"
 
 #include <algorithm>
 #include <array>
@@ -13,7 +13,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/core/sampling.hpp"
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/prefetch.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 

@@ -55,8 +55,8 @@
 #include <vector>
 
 #include "handcentric/core/flow_target.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 
 namespace handcentric::props {
 

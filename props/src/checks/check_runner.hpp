@@ -7,9 +7,9 @@
 
 #include <string>
 
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/distribution.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/checks/distribution.hpp"
+#include "handcentric/props/checks/policy_audit.hpp"
 
 namespace handcentric::props::detail {
 

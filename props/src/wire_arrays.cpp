@@ -6,8 +6,7 @@
 #include <cstring>
 #include <limits>
 
-#include "handcentric/props/transport/plugin_protocol.hpp"
-#include "handcentric/props/transport/subprocess.hpp"
+#include "handcentric/core/format.hpp"
 
 namespace handcentric::props::wire {
 namespace {
@@ -78,7 +77,7 @@ std::vector<unsigned char> decode_base64(const std::string& text, const std::str
       "; \"data\" is standard base64 (A-Z a-z 0-9 + /, padded with = to a multiple of 4 "
       "characters), e.g. Python's base64.b64encode(array.astype('<f8').tobytes())";
   if (text.size() % 4 != 0) {
-    throw PluginError(where + " whose \"data\" is not base64: " + std::to_string(text.size()) +
+    throw FormatError(where + " whose \"data\" is not base64: " + std::to_string(text.size()) +
                       " characters, not a multiple of 4" + fix);
   }
   std::vector<unsigned char> out;
@@ -92,7 +91,7 @@ std::vector<unsigned char> decode_base64(const std::string& text, const std::str
       const char c = text[i + static_cast<std::size_t>(j)];
       const int value = j >= 4 - pad ? 0 : kValues[static_cast<unsigned char>(c)];
       if (value < 0) {
-        throw PluginError(where + " whose \"data\" is not base64: " + shown(c) + " at character " +
+        throw FormatError(where + " whose \"data\" is not base64: " + shown(c) + " at character " +
                           std::to_string(i + static_cast<std::size_t>(j)) + fix);
       }
       v = (v << 6) | static_cast<std::uint32_t>(value);
@@ -168,7 +167,7 @@ void append_float32_array(std::string& out, const std::vector<std::size_t>& shap
 Array read_array(const nlohmann::json& value, const std::string& where) {
   if (!value.is_object() || value.size() != 3 || !value.contains("dtype") ||
       !value.contains("shape") || !value.contains("data")) {
-    throw PluginError(where + " = " + one_line(value.dump(), 60) + ", not an encoded array" +
+    throw FormatError(where + " = " + one_line(value.dump(), 60) + ", not an encoded array" +
                       kForm);
   }
   Array array;
@@ -180,7 +179,7 @@ Array read_array(const nlohmann::json& value, const std::string& where) {
   } else if (dtype == "uint8") {
     array.dtype = Dtype::uint8;
   } else {
-    throw PluginError(where + " of dtype " + one_line(dtype.dump(), 40) +
+    throw FormatError(where + " of dtype " + one_line(dtype.dump(), 40) +
                       "; an encoded array's dtype is \"float64\", \"float32\" or \"uint8\" "
                       "(little-endian)");
   }
@@ -191,7 +190,7 @@ Array read_array(const nlohmann::json& value, const std::string& where) {
     sizes = shape[i].is_number_unsigned() ||
             (shape[i].is_number_integer() && shape[i].get<long long>() >= 0);
   if (!sizes) {
-    throw PluginError(where + " of shape " + one_line(shape.dump(), 40) +
+    throw FormatError(where + " of shape " + one_line(shape.dump(), 40) +
                       ", not a list of at most 8 sizes (integers >= 0)" + kForm);
   }
   std::size_t count = 1;
@@ -205,11 +204,11 @@ Array read_array(const nlohmann::json& value, const std::string& where) {
       count *= static_cast<std::size_t>(size);
   }
   if (!value["data"].is_string())
-    throw PluginError(where + " whose \"data\" is not a string" + kForm);
+    throw FormatError(where + " whose \"data\" is not a string" + kForm);
   const std::vector<unsigned char> bytes = decode_base64(value["data"].get<std::string>(), where);
   const std::size_t size = item_size(array.dtype);
   if (overflow || bytes.size() != count * size) {
-    throw PluginError(where + " of shape " + shape_text(array.shape) + " and dtype " +
+    throw FormatError(where + " of shape " + shape_text(array.shape) + " and dtype " +
                       dtype_name(array.dtype) + ", which needs " +
                       (overflow ? std::string("more") : std::to_string(count * size)) +
                       " bytes, but \"data\" holding " + std::to_string(bytes.size()) +

@@ -36,7 +36,7 @@
 #include <vector>
 
 #include "handcentric/core/representation.hpp"
-#include "handcentric/props/check.hpp"
+#include "handcentric/props/checks/check.hpp"
 
 namespace handcentric::props {
 

@@ -1,4 +1,4 @@
-#include "handcentric/props/check.hpp"
+#include "handcentric/props/checks/check.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,7 +12,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/core/sampling.hpp"
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/prefetch.hpp"
 #include "handcentric/props/observation/recorded.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
@@ -480,20 +480,6 @@ CheckOptions options_for(View view) {
 
 CheckOptions eye_in_hand_options() {
   return options_for(View::eye_in_hand);
-}
-
-Eigen::VectorXd fixed_noise(Eigen::Index n, std::uint64_t seed) {
-  // The first n normals of one stream: cache a long prefix per thread (seeding a Mersenne
-  // twister costs more than the checks that use it).
-  thread_local std::uint64_t cached_seed = 0;
-  thread_local Eigen::VectorXd cached;
-  if (cached.size() < n || cached_seed != seed) {
-    std::mt19937_64 rng(seed);
-    cached.resize(std::max<Eigen::Index>(n, 256));
-    for (Eigen::Index i = 0; i < cached.size(); ++i) cached(i) = standard_normal(rng);
-    cached_seed = seed;
-  }
-  return cached.head(n);
 }
 
 SceneFunction actions_of(std::shared_ptr<const Representation> representation) {

@@ -29,81 +29,15 @@
 #include "handcentric/core/representation.hpp"
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/core/scene.hpp"
-#include "handcentric/props/policy_audit.hpp"
+#include "handcentric/props/noisy_policy.hpp"
+#include "handcentric/props/prefetch.hpp"
+#include "handcentric/props/scene_key.hpp"
 
 namespace handcentric::props {
 
 /// The largest batch_size a batched map takes (one batch of a policy holds batch_size noise
 /// vectors, up to kMaxPolicyNoise numbers each).
 inline constexpr int kMaxBatchSize = 1 << 16;
-
-/// Thrown, during a prefetch pass only, by a batched map asked for an input it has not evaluated
-/// yet (the input is recorded). Deliberately not a std::exception: only the check runner and
-/// prefetch() catch it.
-struct PendingEvaluation {};
-
-/// Something that records inputs during a prefetch pass and then evaluates them together.
-class Prefetcher {
- public:
-  virtual ~Prefetcher() = default;
-  /// Evaluates the recorded inputs; returns how many it evaluated.
-  virtual std::size_t flush() = 0;
-};
-
-/// True while a prefetch pass runs on this thread.
-bool prefetching();
-
-/// During a prefetch pass, calls ask(input) for every input, catching PendingEvaluation, so that
-/// a case records every question it will ask before it needs the first answer. Outside a
-/// prefetch pass it does nothing (the questions are asked when the case gets to them).
-template <class Input, class Ask>
-void prefetch(const std::vector<Input>& inputs, const Ask& ask) {
-  if (!prefetching()) return;
-  for (const Input& input : inputs) {
-    try {
-      (void)ask(input);
-    } catch (const PendingEvaluation&) {
-    }
-  }
-}
-
-namespace detail {
-
-/// Called by a prefetcher for each input it records in this thread's current prefetch pass.
-void enlist(Prefetcher& prefetcher);
-
-/// The prefetch passes of one check (check_runner.hpp): while alive, prefetching() is true
-/// during pass(); flush() evaluates what the pass recorded. Nested checks keep their own state.
-class PrefetchPasses {
- public:
-  PrefetchPasses();
-  ~PrefetchPasses();
-  PrefetchPasses(const PrefetchPasses&) = delete;
-  PrefetchPasses& operator=(const PrefetchPasses&) = delete;
-  /// Runs one prefetch pass.
-  void pass(const std::function<void()>& body);
-  /// Evaluates the inputs the last pass recorded; returns how many.
-  std::size_t flush();
-  /// Inputs recorded since the last flush.
-  std::size_t recorded() const { return recorded_; }
-
- private:
-  bool prefetching_ = false;
-  std::size_t recorded_ = 0;
-  std::vector<Prefetcher*> enlisted_;
-  PrefetchPasses* outer_ = nullptr;
-  friend bool props::prefetching();
-  friend void enlist(Prefetcher& prefetcher);
-};
-
-/// The bytes of a scene's observation (its chunk too when `with_chunk`): a cache key.
-std::string scene_key(const Scene& scene, bool with_chunk);
-
-/// What must agree for scenes to be stacked in one batch: the history and chunk lengths and the
-/// numbers of points (extra poses and scalars are the audit's, the same for every scene).
-std::string shape_key(const Scene& scene, bool with_chunk);
-
-}  // namespace detail
 
 /// A policy that answers many observations at once (a Python callable on stacked arrays, a
 /// plug-in over the pipe).

@@ -10,7 +10,16 @@
 #include <string>
 #include <vector>
 
+#include "handcentric/core/errors.hpp"
+
 namespace handcentric::props::wire {
+
+/// An encoded array that cannot be read. The transports report it as the plug-in's fault
+/// (PluginError), the recorded observations as the file's (InvalidArgument).
+class FormatError : public Error {
+ public:
+  using Error::Error;
+};
 
 enum class Dtype { float64, float32, uint8 };
 
@@ -34,7 +43,7 @@ struct Array {
 };
 
 /// Reads `value` as an encoded array. `where` begins each message and names the field, e.g.
-/// `plug-in 'x' answered batched request 3 (item 1 of 4) with "actions"`. Throws PluginError
+/// `plug-in 'x' answered batched request 3 (item 1 of 4) with "actions"`. Throws FormatError
 /// for an object that is not {"dtype", "shape", "data"}, a dtype other than the three, a shape
 /// that is not a list of sizes, data that is not standard base64, or data whose length is not
 /// the shape's. Non-finite elements are returned as they are: the caller says which are

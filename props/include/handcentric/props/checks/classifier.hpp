@@ -17,10 +17,10 @@
 
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representation.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/distribution.hpp"
-#include "handcentric/props/injectivity.hpp"
-#include "handcentric/props/preflight.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/checks/distribution.hpp"
+#include "handcentric/props/checks/injectivity.hpp"
+#include "handcentric/props/checks/preflight.hpp"
 #include "handcentric/props/verdict.hpp"
 
 namespace handcentric::props {

@@ -1,4 +1,4 @@
-#include "handcentric/props/batch.hpp"
+#include "handcentric/props/transport/batch.hpp"
 
 #include <algorithm>
 #include <map>
@@ -8,23 +8,12 @@
 namespace handcentric::props {
 namespace {
 
-thread_local detail::PrefetchPasses* current_passes = nullptr;
-
 void require_batch_size(int batch_size) {
   if (batch_size < 1 || batch_size > kMaxBatchSize) {
     throw InvalidArgument("batch_size=" + std::to_string(batch_size) + " is outside [1, " +
                           std::to_string(kMaxBatchSize) +
                           "]; 32 to 1024 suits a network on a CPU or GPU");
   }
-}
-
-void append(std::string& key, const RigidTransform& T) {
-  key.append(reinterpret_cast<const char*>(T.rotation().matrix().data()), 9 * sizeof(double));
-  key.append(reinterpret_cast<const char*>(T.translation().data()), 3 * sizeof(double));
-}
-
-void append_count(std::string& key, std::size_t n) {
-  key.append(reinterpret_cast<const char*>(&n), sizeof(n));
 }
 
 // The pending inputs in groups of one shape and at most batch_size each, in the order they were
@@ -55,89 +44,6 @@ std::vector<std::vector<const Pending*>> batches_of(const std::vector<Pending>& 
 }
 
 }  // namespace
-
-bool prefetching() {
-  return current_passes != nullptr && current_passes->prefetching_;
-}
-
-namespace detail {
-
-void enlist(Prefetcher& prefetcher) {
-  if (current_passes == nullptr) return;
-  ++current_passes->recorded_;
-  auto& enlisted = current_passes->enlisted_;
-  if (std::find(enlisted.begin(), enlisted.end(), &prefetcher) == enlisted.end())
-    enlisted.push_back(&prefetcher);
-}
-
-PrefetchPasses::PrefetchPasses() : outer_(current_passes) {
-  current_passes = this;
-}
-
-PrefetchPasses::~PrefetchPasses() {
-  current_passes = outer_;
-}
-
-void PrefetchPasses::pass(const std::function<void()>& body) {
-  prefetching_ = true;
-  try {
-    body();
-  } catch (...) {
-    prefetching_ = false;
-    throw;
-  }
-  prefetching_ = false;
-}
-
-std::size_t PrefetchPasses::flush() {
-  std::vector<Prefetcher*> enlisted;
-  enlisted.swap(enlisted_);
-  recorded_ = 0;
-  std::size_t evaluated = 0;
-  for (Prefetcher* p : enlisted) evaluated += p->flush();
-  return evaluated;
-}
-
-std::string scene_key(const Scene& scene, bool with_chunk) {
-  std::string key;
-  key.reserve(96 * (scene.world_T_hand_history.size() + scene.world_T_hand_chunk.size()) + 64);
-  append_count(key, scene.world_T_hand_history.size());
-  for (const RigidTransform& T : scene.world_T_hand_history) append(key, T);
-  append_count(key, with_chunk ? scene.world_T_hand_chunk.size() : 0);
-  if (with_chunk)
-    for (const RigidTransform& T : scene.world_T_hand_chunk) append(key, T);
-  for (const auto* points : {&scene.hand_points, &scene.world_points}) {
-    append_count(key, points->size());
-    for (const Eigen::Vector3d& q : *points)
-      key.append(reinterpret_cast<const char*>(q.data()), 3 * sizeof(double));
-  }
-  for (const auto& [name, T] : scene.extra_poses) append(key, T);
-  for (const auto& [name, x] : scene.scalars)
-    key.append(reinterpret_cast<const char*>(&x), sizeof(x));
-  // Held arrays are shared and never changed: the same array is the same object.
-  for (const auto& [name, array] : scene.held) {
-    const HeldArray* address = array.get();
-    key.append(reinterpret_cast<const char*>(&address), sizeof(address));
-  }
-  return key;
-}
-
-std::string shape_key(const Scene& scene, bool with_chunk) {
-  std::string key;
-  append_count(key, scene.world_T_hand_history.size());
-  append_count(key, with_chunk ? scene.world_T_hand_chunk.size() : 0);
-  append_count(key, scene.hand_points.size());
-  append_count(key, scene.world_points.size());
-  // Held arrays stack into one array per name: their shapes must agree within a batch.
-  for (const auto& [name, array] : scene.held) {
-    append_count(key, array->shape.size());
-    for (const std::int64_t size : array->shape) append_count(key, static_cast<std::size_t>(size));
-    key += array->float32 ? 'f' : 'd';
-  }
-  return key;
-}
-
-}  // namespace detail
 
 std::vector<RigidTransform> BatchRepresentation::decode_in_scene(const Eigen::VectorXd&,
                                                                  const Scene&) const {

@@ -16,7 +16,7 @@
 #include "handcentric/core/rotation.hpp"
 #include "handcentric/core/scene.hpp"
 #include "handcentric/props/group.hpp"
-#include "handcentric/props/workspace.hpp"
+#include "handcentric/props/observation/workspace.hpp"
 
 namespace handcentric::props {
 

@@ -1,10 +1,8 @@
-#include "handcentric/props/policy_audit.hpp"
-
-#include <cstring>
+#include "handcentric/props/checks/policy_audit.hpp"
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
-#include "handcentric/props/preflight.hpp"
+#include "handcentric/props/checks/preflight.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 
@@ -89,33 +87,6 @@ void agree_on_the_evidence(const NoisyPolicy& policy, Group group, const CheckOp
 }
 
 }  // namespace
-
-std::vector<std::vector<RigidTransform>> NoisyPolicy::act_fresh(
-    const std::vector<const Scene*>& observations,
-    const std::vector<const Eigen::VectorXd*>& noises) const {
-  std::vector<std::vector<RigidTransform>> out;
-  out.reserve(observations.size());
-  for (std::size_t i = 0; i < observations.size(); ++i)
-    out.push_back(act(*observations[i], *noises[i]));
-  return out;
-}
-
-SeededPolicy::SeededPolicy(std::shared_ptr<const ChunkPolicy> policy) : policy_(std::move(policy)) {
-  if (!policy_) throw InvalidArgument("SeededPolicy needs a policy, got null");
-}
-
-std::vector<RigidTransform> SeededPolicy::act(const Scene& observation,
-                                              const Eigen::VectorXd& noise) const {
-  // FNV-1a over the noise's bytes: the same vector, the same seed.
-  std::uint64_t seed = 1469598103934665603ULL;
-  for (Eigen::Index i = 0; i < noise.size(); ++i) {
-    std::uint64_t bits = 0;
-    const double x = noise(i);
-    std::memcpy(&bits, &x, sizeof(bits));
-    for (int b = 0; b < 8; ++b) seed = (seed ^ ((bits >> (8 * b)) & 0xffU)) * 1099511628211ULL;
-  }
-  return policy_->act(observation, seed);
-}
 
 Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options) {

@@ -21,52 +21,12 @@
 #include <string>
 #include <vector>
 
-#include "handcentric/core/chunk_policy.hpp"
-#include "handcentric/props/check.hpp"
-#include "handcentric/props/classifier.hpp"
-#include "handcentric/props/distribution.hpp"
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/checks/classifier.hpp"
+#include "handcentric/props/checks/distribution.hpp"
+#include "handcentric/props/noisy_policy.hpp"
 
 namespace handcentric::props {
-
-/// A policy under audit: an observation and a noise vector in, the world chunk out.
-class NoisyPolicy {
- public:
-  virtual ~NoisyPolicy() = default;
-  virtual std::string name() const = 0;
-  /// The length of the noise vector act() reads.
-  virtual Eigen::Index noise_dimension() const = 0;
-  /// T_1..T_K for `observation` (its history, points, extras; its chunk is ignored).
-  virtual std::vector<RigidTransform> act(const Scene& observation,
-                                          const Eigen::VectorXd& noise) const = 0;
-  /// The chunks for (observations[i], noises[i]) asked afresh, past any cache, in ONE call when
-  /// batched(): the questions of the preflight (preflight.hpp), which asks the same observation
-  /// several times and compares rows across batches. Default: act() on each.
-  virtual std::vector<std::vector<RigidTransform>> act_fresh(
-      const std::vector<const Scene*>& observations,
-      const std::vector<const Eigen::VectorXd*>& noises) const;
-  /// True when act_fresh asks its observations as the rows of one batch.
-  virtual bool batched() const { return false; }
-  /// The global random generators the last act_fresh call drew from (e.g. "torch's CPU
-  /// generator"), empty when none; nullopt when the policy cannot tell (a C++ policy, a plug-in).
-  virtual std::optional<std::vector<std::string>> last_draws() const { return std::nullopt; }
-};
-
-/// A ChunkPolicy, whose noise comes from a seed, as a NoisyPolicy: the noise vector's bits are
-/// hashed into the seed, so one vector gives one chunk, and different vectors independent
-/// chunks. Its output is not affine in that vector, so in distribution it is decided by the
-/// tests.
-class SeededPolicy final : public NoisyPolicy {
- public:
-  /// Throws InvalidArgument for a null policy.
-  explicit SeededPolicy(std::shared_ptr<const ChunkPolicy> policy);
-  std::string name() const override { return policy_->name(); }
-  Eigen::Index noise_dimension() const override { return 4; }
-  std::vector<RigidTransform> act(const Scene& observation,
-                                  const Eigen::VectorXd& noise) const override;
-
- private:
-  std::shared_ptr<const ChunkPolicy> policy_;
-};
 
 /// eq. (4) pointwise: a(g o, n) = g a(o, n) with n the first noise_dimension() normals of
 /// mt19937_64(options.noise_seed). The witness's before/after are g a(o) and a(g o), each pose

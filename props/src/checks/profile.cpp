@@ -1,4 +1,4 @@
-#include "handcentric/props/profile.hpp"
+#include "handcentric/props/checks/profile.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +11,8 @@
 #include "check_runner.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
-#include "handcentric/props/batch.hpp"
-#include "handcentric/props/distribution.hpp"
+#include "handcentric/props/prefetch.hpp"
+#include "handcentric/props/checks/distribution.hpp"
 #include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {

@@ -38,7 +38,7 @@
 #include <vector>
 
 #include "handcentric/core/flow_target.hpp"
-#include "handcentric/props/check.hpp"
+#include "handcentric/props/checks/check.hpp"
 
 namespace handcentric::props {
 

@@ -1,4 +1,4 @@
-#include "handcentric/props/injectivity.hpp"
+#include "handcentric/props/checks/injectivity.hpp"
 
 #include <algorithm>
 #include <array>
@@ -13,8 +13,8 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
-#include "handcentric/props/batch.hpp"
-#include "handcentric/props/generators.hpp"
+#include "handcentric/props/prefetch.hpp"
+#include "handcentric/props/observation/generators.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "check_runner.hpp"
 
