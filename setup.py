@@ -1,6 +1,7 @@
 """`pip install .`: the package handcentric (python/handcentric/), its extension handcentric._core
 built by the project's own CMake build (target handcentric_python, python/CMakeLists.txt) for
-the Python running pip, and the plug-in helper handcentric_plugin (python/handcentric_plugin.py).
+the Python running pip, and the plug-in helper, the package handcentric_plugin
+(python/handcentric_plugin/).
 
     python3 -m venv --system-site-packages venv           # Debian's NumPy and setuptools
     venv/bin/pip install --no-build-isolation .           # offline
@@ -106,8 +107,7 @@ os.makedirs(os.path.join(ROOT, BUILD_BASE), exist_ok=True)
 setup(
     version=cmake_version(),
     package_dir={"": "python"},
-    packages=["handcentric"],
-    py_modules=["handcentric_plugin"],
+    packages=["handcentric", "handcentric_plugin"],
     ext_modules=[Extension("handcentric._core", sources=[])],
     cmdclass={"build": FreshBuild, "build_ext": CMakeBuild},
     # setuptools' own files under build/ (the CMake build's folder, ignored by git), not in the

@@ -25,10 +25,10 @@ import sys
 
 
 def _find_helper():
-    """Put the folder holding handcentric_plugin.py first on sys.path.
+    """Put the folder holding the helper package handcentric_plugin/ first on sys.path.
 
     In order: $HANDCENTRIC_PYTHON (a folder, to override); the source tree (this file is
-    examples/python_representation/repr.py, the helper python/handcentric_plugin.py); an install
+    examples/python_representation/repr.py, the helper python/handcentric_plugin/); an install
     (<prefix>/share/handcentric/python, with <prefix> found from the `handcentric` program on
     PATH, or /usr/local, /usr). Symbolic links to this file are resolved first, so a link to it
     from elsewhere still finds its source tree. Failing all of them, a plain import (PYTHONPATH).
@@ -41,7 +41,7 @@ def _find_helper():
     candidates += [os.path.join(p, "share", "handcentric", "python")
                    for p in prefixes + ["/usr/local", "/usr"]]
     for folder in candidates:
-        if folder and os.path.isfile(os.path.join(folder, "handcentric_plugin.py")):
+        if folder and os.path.isfile(os.path.join(folder, "handcentric_plugin", "__init__.py")):
             sys.path.insert(0, os.path.abspath(folder))
             return
     # Not found: leave sys.path alone; the import below then tries PYTHONPATH.
@@ -53,7 +53,7 @@ try:
     import handcentric_plugin as hp
 except ImportError as error:  # one clear line: the audit quotes our stderr
     sys.exit("repr.py: %s (with %s). It needs NumPy (Debian: python3-numpy) and "
-             "handcentric_plugin.py (the source tree's python/ folder, an install's "
+             "the package handcentric_plugin (the source tree's python/ folder, an install's "
              "share/handcentric/python, or $HANDCENTRIC_PYTHON)." % (error, sys.executable))
 
 

@@ -5,10 +5,15 @@ function of (o, n) on both sides. A policy that draws from torch's, NumPy's or P
 generator inside (Diffusion Policy's predict_action draws torch.randn) is not; with rng= the
 audit seeds the generator alike before each call (seed_before_call), and without it the preflight
 watches which generators a call advanced (snapshot, advanced) to say why answers differ.
+
+The seeding itself is the plug-in helper's (handcentric_plugin.seeding): one implementation for
+the audit in process and over the pipe (serve_policy(rng=...)), kept in the helper because a
+plug-in runs without the compiled extension that this package needs.
 """
 import sys
 
-RNG_MODES = ("torch", "numpy", "generator")
+# seed_before_call is called by the extension (callables.cpp), not here.
+from handcentric_plugin.seeding import RNG_MODES, seed_before_call  # noqa: F401
 
 
 def _torch():
@@ -71,21 +76,3 @@ def check_mode(rng):
             raise ImportError('rng="%s" needs torch, which %s cannot import: %s'
                               % (rng, sys.executable, e)) from None
     return rng
-
-
-def seed_before_call(rng, seed, device):
-    """Seeds the generator of mode `rng` with `seed` (0 <= seed < 2**63); returns the keywords
-    the call gets ({"generator": g} for "generator", else {})."""
-    if rng == "torch":
-        _torch().manual_seed(seed)  # the CPU generator and every CUDA device's
-        return {}
-    if rng == "numpy":
-        import numpy
-        numpy.random.seed(seed % (1 << 32))
-        return {}
-    if rng == "generator":
-        torch = _torch()
-        generator = torch.Generator(device=device if device is not None else "cpu")
-        generator.manual_seed(seed)
-        return {"generator": generator}
-    return {}

@@ -64,7 +64,7 @@ def test_the_package_is_imported_from_the_venvs_site_packages(venv):
         "    'all': handcentric.__all__}))")
     assert found["package"] == os.path.join(venv.site, "handcentric", "__init__.py")
     assert os.path.dirname(found["core"]) == os.path.join(venv.site, "handcentric")
-    assert found["helper"] == os.path.join(venv.site, "handcentric_plugin.py")
+    assert found["helper"] == os.path.join(venv.site, "handcentric_plugin", "__init__.py")
     assert found["version"] == found["metadata"]  # the wheel's version is the module's (CMake's)
     for name in ("audit", "audit_policy", "assert_invariant", "assert_equivariant", "decode",
                  "encode_actions", "encode_observation", "so3_exp", "so3_log", "se3_exp",

@@ -57,14 +57,14 @@ def test_a_batch_is_answered_in_order_with_the_unbatched_answers():
 
 
 def test_mutant_helper_that_reverses_the_rows_is_caught(monkeypatch):
-    rows = hp._encoded_rows
-    monkeypatch.setattr(hp, "_encoded_rows", lambda result, B: rows(result, B)[::-1])
+    rows = hp.loop._encoded_rows
+    monkeypatch.setattr(hp.loop, "_encoded_rows", lambda result, B: rows(result, B)[::-1])
     assert not framing_holds()
 
 
 def test_mutant_helper_that_drops_the_last_answer_is_caught(monkeypatch):
-    rows = hp._encoded_rows
-    monkeypatch.setattr(hp, "_encoded_rows", lambda result, B: rows(result, B)[:-1])
+    rows = hp.loop._encoded_rows
+    monkeypatch.setattr(hp.loop, "_encoded_rows", lambda result, B: rows(result, B)[:-1])
     assert not framing_holds()
 
 
@@ -120,7 +120,7 @@ def test_a_batched_request_to_an_unbatched_plugin_says_so():
 
 
 def test_batched_mode_without_numpy_says_it_needs_numpy(monkeypatch):
-    monkeypatch.setattr(hp, "np", None)
+    monkeypatch.setattr(hp.loop, "np", None)  # where serve() looks for NumPy
     _, status, err = run_serve([PROBE], lambda *a: None, batched=True)
     assert status == 1 and "needs NumPy" in err
 
@@ -199,14 +199,14 @@ def test_mutant_that_answers_a_mixed_batch_in_shape_order_is_caught(monkeypatch)
     single = [run_serve([request(s, 7)], repr_py.encode)[0][0] for s in mixed]
     for a in single:
         del a["id"]
-    rows = hp._encoded_rows
+    rows = hp.loop._encoded_rows
     order = []
 
     def grouped(result, B):
         out = rows(result, B)
         order.extend(out)
         return out
-    monkeypatch.setattr(hp, "_encoded_rows", grouped)
+    monkeypatch.setattr(hp.loop, "_encoded_rows", grouped)
     answers, status, _ = run_serve([PROBE, batched(1, mixed)], repr_py.encode_batch, batched=True)
     assert answers[1]["batch"] == single           # the helper itself puts them back in order
     assert order != single                         # which the shape order alone would not

@@ -97,15 +97,15 @@ def test_an_encoded_line_is_answered_with_the_text_answers_bit_for_bit():
 
 
 def test_mutant_helper_that_rounds_its_encoded_answers_to_float32_is_caught(monkeypatch):
-    exact = hp._encode_array
-    monkeypatch.setattr(hp, "_encode_array",
+    exact = hp.codec._encode_array
+    monkeypatch.setattr(hp.codec, "_encode_array",
                         lambda a: exact(a.astype(np.float32).astype(np.float64)))
     assert not encoded_equals_text()
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")  # the garbage numbers it reads
 def test_mutant_helper_that_reads_the_bytes_big_endian_is_caught(monkeypatch):
-    monkeypatch.setitem(hp._DTYPES, "float64", ">f8")
+    monkeypatch.setitem(hp.codec._DTYPES, "float64", ">f8")
     assert not encoded_equals_text()
 
 
@@ -172,12 +172,13 @@ def test_encoded_arrays_carry_float32_and_uint8_images_too():
     images = [rng.integers(0, 256, size=(48, 64, 3)).astype(np.uint8),
               rng.normal(size=(48, 64)).astype(np.float32)]
     for image in images:
-        value = hp._encode_array(image)
+        value = hp.codec._encode_array(image)
         assert value == encode_array(image, value["dtype"])
-        back = hp._decode_array(value, "'image'", dtypes=("float32", "uint8"))
+        back = hp.codec._decode_array(value, "'image'", dtypes=("float32", "uint8"))
         assert back.dtype == image.dtype and np.array_equal(back, image)
-    with pytest.raises(hp._Malformed, match="'image' has dtype float64; it must be uint8"):
-        hp._decode_array(encode_array(np.zeros((2, 2))), "'image'", dtypes=("uint8",))
+    malformed = hp.protocol._Malformed
+    with pytest.raises(malformed, match="'image' has dtype float64; it must be uint8"):
+        hp.codec._decode_array(encode_array(np.zeros((2, 2))), "'image'", dtypes=("uint8",))
 
 
 def spoiled(field="history", **change):

@@ -1,4 +1,5 @@
-"""Tests of python/handcentric_plugin.py and of the plug-ins built on it (protocol v2, Python side).
+"""Tests of the helper (the package python/handcentric_plugin/) and of the plug-ins built on it
+(protocol v2, Python side).
 
 serve() runs in-process on hand-written request lines (run_serve) or, where pipes, flushing and
 exit statuses matter, as a subprocess driven by a tiny fake audit (FakeAudit), which waits for
@@ -27,6 +28,7 @@ import pytest
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
 PYTHON_DIR = os.path.join(ROOT, "python")
+HELPER_DIR = os.path.join(PYTHON_DIR, "handcentric_plugin")  # the helper, a package
 PLUGINS = os.path.join(ROOT, "tests", "props", "plugins")
 REPR = os.path.join(ROOT, "examples", "python_representation", "repr.py")
 PY = sys.executable  # the interpreter running pytest (/usr/bin/python3 under ctest): has NumPy
@@ -87,7 +89,8 @@ def encoded(encode, scene, **kwargs):
     """encode's (actions, observation) on a scene, flattened, as serve() would send them."""
     actions, observation = encode(scene["history"], scene["chunk"], scene["hand_points"],
                                   scene["world_points"], **kwargs)
-    return np.array(hp._flatten(actions, "actions")), np.array(hp._flatten(observation, "o"))
+    flatten = hp.protocol._flatten
+    return np.array(flatten(actions, "actions")), np.array(flatten(observation, "o"))
 
 
 def change(encode, scene, g):
@@ -189,10 +192,22 @@ def test_encode_gets_numpy_arrays_newest_first_row_major():
     assert seen["hand"].shape == (0, 3) and seen["world"].shape == (1, 3)
 
 
+def load_helper(name, monkeypatch):
+    """A fresh copy of the helper package under another name: its modules import each other
+    relatively, so the copy's modules are its own (they stay in sys.modules under that name,
+    where nothing else looks; the package itself is registered until undo)."""
+    spec = importlib.util.spec_from_file_location(name, os.path.join(HELPER_DIR, "__init__.py"),
+                                                  submodule_search_locations=[HELPER_DIR])
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, name, module)  # the relative imports find it there
+    spec.loader.exec_module(module)
+    return module
+
+
 def test_list_path_without_numpy(monkeypatch):
     monkeypatch.setitem(sys.modules, "numpy", None)  # `import numpy` now raises ImportError
-    lists = load(os.path.join(PYTHON_DIR, "handcentric_plugin.py"), "handcentric_plugin_lists")
-    assert lists.np is None  # else this test would prove nothing
+    lists = load_helper("handcentric_plugin_lists", monkeypatch)
+    assert lists._numpy.np is None  # else this test would prove nothing
     seen = {}
 
     def encode(history, chunk, hand_points, world_points):
@@ -207,7 +222,7 @@ def test_list_path_without_numpy(monkeypatch):
                                 [12.0, 13.0, 14.0, 15.0]]]
     assert seen["hand"] == [[1.0, 2.0, 3.0]] and seen["world"] == []
     monkeypatch.undo()
-    assert hp.np is np  # the module the other tests use still has NumPy
+    assert hp._numpy.np is np  # the package the other tests use still has NumPy
 
 
 @pytest.mark.parametrize("result, actions, observation", [
@@ -248,7 +263,8 @@ def test_non_finite_results_are_rejected_naming_field_and_index(result, field, i
 
 
 def test_mutant_helper_without_the_finiteness_check_is_caught(monkeypatch):
-    monkeypatch.setattr(hp, "math", types.SimpleNamespace(isfinite=lambda x: True))  # planted
+    # planted: the answers' writer (protocol._flatten) takes every number for finite
+    monkeypatch.setattr(hp.protocol, "math", types.SimpleNamespace(isfinite=lambda x: True))
     assert not rejects_non_finite([0.0, 1.0, 2.0, 3.0, float("nan")], "actions", 4)
 
 
@@ -734,9 +750,8 @@ def test_actionflow_target_is_rotation_invariant_in_distribution_only():
 
 def test_repr_finds_the_helper_in_an_install_and_says_so_when_it_cannot(tmp_path):
     prefix = tmp_path / "prefix"
-    (prefix / "share" / "handcentric" / "python").mkdir(parents=True)
-    shutil.copy(os.path.join(PYTHON_DIR, "handcentric_plugin.py"),
-                prefix / "share" / "handcentric" / "python")
+    shutil.copytree(HELPER_DIR, prefix / "share" / "handcentric" / "python" / "handcentric_plugin",
+                    ignore=shutil.ignore_patterns("__pycache__"))
     (prefix / "bin").mkdir()
     program = prefix / "bin" / "handcentric"
     program.write_text("#!/bin/sh\n")
@@ -756,7 +771,7 @@ def test_repr_finds_the_helper_in_an_install_and_says_so_when_it_cannot(tmp_path
     assert found.returncode == 0 and json.loads(found.stdout)["id"] == 0
     installed = prefix / "share" / "handcentric" / "python"
     assert run({"HANDCENTRIC_PYTHON": str(installed)}).returncode == 0
-    system = [os.path.join(p, "share", "handcentric", "python", "handcentric_plugin.py")
+    system = [os.path.join(p, "share", "handcentric", "python", "handcentric_plugin", "__init__.py")
               for p in ("/usr/local", "/usr")]
     if not any(map(os.path.exists, system)):  # else repr.py would (rightly) find that one
         lost = run({})
@@ -775,5 +790,8 @@ def test_cmake_installs_the_helper_into_share_handcentric_python(tmp_path):
     for argv in (["cmake", "-S", str(tmp_path / "src"), "-B", str(build)],
                  ["cmake", "--install", str(build), "--prefix", str(prefix)]):
         subprocess.run(argv, check=True, capture_output=True, timeout=120)
-    installed = prefix / "share" / "handcentric" / "python" / "handcentric_plugin.py"
-    assert installed.read_text() == open(os.path.join(PYTHON_DIR, "handcentric_plugin.py")).read()
+    installed = prefix / "share" / "handcentric" / "python" / "handcentric_plugin"
+    sources = sorted(name for name in os.listdir(HELPER_DIR) if name.endswith(".py"))
+    assert sorted(os.listdir(installed)) == sources  # every module, and nothing else
+    for name in sources:
+        assert (installed / name).read_text() == open(os.path.join(HELPER_DIR, name)).read()

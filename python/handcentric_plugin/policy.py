@@ -1,0 +1,104 @@
+"""serve_policy(): a whole policy behind `handcentric audit --policy-exec`, and its rng=/reset=.
+
+A policy plug-in is served by the same loop as a representation (loop.serve), with the policy in
+place of encode; what is particular to policies is here: the cameras of the hello, and the
+wrapper that calls reset() and seeds the policy's own generator before each observation's call
+(seeding.seed_before_call, the implementation the in-process audit uses too).
+"""
+import struct
+import sys
+
+from ._numpy import np
+from .protocol import _die
+from .seeding import RNG_MODES, seed_before_call
+from .loop import serve
+
+
+def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, batched=False,
+                 batch_size=256, encoding="base64", cameras=None, rng=None, device=None,
+                 reset=None, stdin=None, stdout=None):
+    """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
+
+    policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
+    noise: the standard normals the request carries (256 unless `noise=n` asks for n); use them
+        as the policy's only randomness, so that one noise vector gives one chunk.
+    batched: policy(history (B,H+1,4,4), hand_points (B,n,3), world_points (B,m,3), noise (B,d))
+        -> (B,K,4,4), on up to batch_size observations of one shape per call (needs NumPy).
+    cameras: what the policy sees, e.g. ("eye_in_hand",) or {"views": ["eye_in_hand"],
+        "image_size": [64, 48], "channels": "rgbd", "floor": False} (the defaults but views):
+        the audit renders each observation's images and the policy gets images={view: (C,h,w)}
+        float32 as a keyword ((B,C,h,w) batched), as audit_policy(..., cameras=...) passes them
+        (docs/AUDIT_YOUR_POLICY.md). Needs NumPy.
+    rng: None, "torch", "numpy" or "generator": the policy draws random numbers of its own
+        (torch.randn inside, a DDPM sampler's per-step noise). Each observation is then asked in
+        a call of its own, after seeding that generator from the observation's noise vector
+        ("generator": a seeded torch.Generator passed as generator=), so that o and g o, which
+        the audit asks with the same noise, get the same draws. Without it the audit's
+        preflight finds answers that differ on the same observation and gives no verdict.
+        "torch" seeds torch's CPU generator and every CUDA device's, as the in-process audit does.
+    device: the torch device the policy draws on (e.g. "cuda"; None: the CPU), as
+        audit_policy's device=: rng="generator" makes its torch.Generator there (torch refuses
+        a CPU generator for a draw on a GPU). The other modes do not need it.
+    reset: a function of no arguments called before every call (e.g. LeRobot's policy.reset),
+        for a policy that keeps state between calls (an action queue, a history).
+    extra_poses, scalars, hello, encoding, stdin, stdout: as for serve().
+    """
+    if rng is not None or reset is not None:
+        policy = _paired_policy(policy, rng, reset, batched, device)
+    if cameras is not None:
+        if np is None:
+            _die(1, "handcentric_plugin: serve_policy(..., cameras=...) needs NumPy, which does "
+                    "not import in %s (Debian: python3-numpy)" % sys.executable)
+        cameras = dict(cameras) if isinstance(cameras, dict) else {
+            "views": [cameras] if isinstance(cameras, str) else list(cameras)}
+        if not cameras.get("views") or not all(isinstance(v, str) for v in cameras["views"]):
+            raise ValueError("cameras needs at least one view name, e.g. ('eye_in_hand',), "
+                             "got %r" % (cameras,))
+        hello = True
+    serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, batched=batched,
+          batch_size=batch_size, encoding=encoding, stdin=stdin, stdout=stdout, _policy=policy,
+          _noise=noise, _cameras=cameras)
+
+
+def _noise_seed(noise):
+    """A seed below 2**63 from the bytes of one noise vector (the same vector, the same seed)."""
+    import hashlib
+    values = noise.tolist() if hasattr(noise, "tolist") else list(noise)
+    digest = hashlib.sha256(struct.pack("<%dd" % len(values), *values)).digest()
+    return int.from_bytes(digest[:8], "little") >> 1
+
+
+def _paired_policy(policy, rng, reset, batched, device=None):
+    """policy called after reset() and, with rng, one observation per call with its generator
+    seeded from that observation's noise (serve_policy's rng=, device= and reset=)."""
+    if rng is not None and rng not in RNG_MODES:
+        raise ValueError('rng=%r is not a mode; use "torch", "numpy", "generator" or None' % (rng,))
+    if rng == "numpy" and np is None:
+        raise ValueError('rng="numpy" needs NumPy, which does not import in %s' % sys.executable)
+    if reset is not None and not callable(reset):
+        raise TypeError("reset must be a function of no arguments (e.g. policy.reset), got %r"
+                        % (reset,))
+
+    def one_call(history, hand_points, world_points, noise, kwargs, seed_noise):
+        if reset is not None:
+            reset()
+        extra = (seed_before_call(rng, _noise_seed(seed_noise), device)
+                 if rng is not None else {})
+        return policy(history, hand_points, world_points, noise, **dict(kwargs, **extra))
+
+    def call(history, hand_points, world_points, noise, **kwargs):
+        if rng is None or not batched:
+            return one_call(history, hand_points, world_points, noise, kwargs, noise)
+
+        def row(value, i):
+            return {k: row(v, i) for k, v in value.items()} if isinstance(value, dict) \
+                else value[i:i + 1]
+
+        def as_numpy(x):  # a torch result, on any device, with or without grad
+            return x.detach().cpu().numpy() if hasattr(x, "detach") else np.asarray(x)
+        chunks = [as_numpy(one_call(history[i:i + 1], hand_points[i:i + 1],
+                                      world_points[i:i + 1], noise[i:i + 1],
+                                      {k: row(v, i) for k, v in kwargs.items()}, noise[i]))
+                  for i in range(len(noise))]
+        return np.concatenate(chunks, axis=0)
+    return call
