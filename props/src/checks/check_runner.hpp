@@ -13,12 +13,30 @@
 
 namespace handcentric::props::detail {
 
+/// What in-distribution cases saw, for the verdict: whether a case was tested whole (energy) or
+/// split into exact and tested coordinates (partial), and, over the cases that reached the
+/// tests, the largest number of coordinates tested and spread (for the detectable shift) and
+/// the largest detectable scale ratio. One case's, or merged over a check's (merge()).
+struct LawStatistics {
+  bool any_energy = false;
+  bool any_partial = false;
+  int partial_cases = 0;
+  std::string exact_coordinates;  ///< which coordinates the first partial case decided exactly
+  Eigen::Index largest_dimension = 0;
+  double largest_spread = 0.0;
+  double largest_scale_ratio = 0.0;  ///< 0: no scale test ran
+};
+
+/// Folds one case's statistics into a check's: flags or-ed, counts added, largest values kept,
+/// the first case's exact coordinates named.
+void merge(LawStatistics& into, const LawStatistics& one);
+
 struct CaseOutcome {
   Witness witness;  ///< scene, g, outputs, error, tolerance, p-value of this case
   bool holds = true;
   bool discontinuity = false;  ///< held only because the difference sat on a discontinuity
-  /// Decided in a prefetch pass without its statistical tests (batch.hpp): to be run again.
-  bool provisional = false;
+  /// An in-distribution case's statistics (run_check merges them over the cases it decides).
+  LawStatistics statistics;
 };
 
 /// The two sides of a pointwise case, for the decision of check.hpp.
@@ -42,11 +60,13 @@ using CaseFunction = std::function<CaseOutcome(const Scene& scene, const RigidTr
 
 /// Runs `cases` cases; after the first failure, RapidCheck shrinks for at most `shrink_budget`
 /// evaluations (then every further candidate passes, and the last failure is the witness).
-/// With options.prefetch, the prefetch passes of batch.hpp run first; `before_real_pass` then
-/// resets what run_case accumulates across cases (they ran it too).
+/// With options.prefetch, the prefetch passes of prefetch.hpp run first and keep the outcome of
+/// each case they decide, so a case is decided once whether batched or not. `statistics`, when
+/// given, receives the merged statistics of every case the verdict rests on (the search, the
+/// shrinking, the extra cases), in the order an unbatched check decides them.
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget,
-                  const std::function<void()>& before_real_pass = nullptr);
+                  LawStatistics* statistics = nullptr);
 
 /// Two functions of the noise whose laws (eps ~ N(0, I)) a distribution check compares:
 /// f(s, .) and f(g s, .) for a flow; g * a(o, .) and a(g o, .) for a policy.
@@ -56,25 +76,11 @@ struct NoisePair {
   std::string name;  ///< for errors: what changed length
 };
 
-/// What a check's cases saw, for its verdict: whether any case was tested whole (energy) or
-/// split into exact and tested coordinates (partial), and, over the cases that reached the
-/// tests, the largest number of coordinates tested and spread (for the detectable shift) and
-/// the largest detectable scale ratio.
-struct LawStatistics {
-  bool any_energy = false;
-  bool any_partial = false;
-  int partial_cases = 0;
-  std::string exact_coordinates;  ///< which coordinates the first partial case decided exactly
-  Eigen::Index largest_dimension = 0;
-  double largest_spread = 0.0;
-  double largest_scale_ratio = 0.0;  ///< 0: no scale test ran
-};
-
 /// One in-distribution case: exact Gaussian laws for the coordinates affine in eps on both
 /// sides, the tests for the others (distribution.hpp). The witness's scene and g are left for the
-/// caller.
+/// caller; the outcome carries the case's statistics.
 CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOptions& options,
-                         const DistributionOptions& distribution, LawStatistics& statistics);
+                         const DistributionOptions& distribution);
 
 /// Sets the verdict's method and, for a "yes" by tests, its detectable shift and scale ratio.
 void finish_distribution_verdict(Verdict& verdict, const LawStatistics& statistics,
@@ -112,5 +118,19 @@ std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& 
 /// nothing: the caller records what it needs from inside the property.
 void run_silently(const std::function<void()>& property, const std::string& description,
                   std::uint64_t seed, int cases);
+
+/// For a batched map (`batched`), the questions of unit(0), ..., unit(units - 1) asked ahead: the
+/// units run in prefetch passes (prefetch.hpp), each again until it runs to its end or raises,
+/// with what they asked evaluated in batches between passes. What the units compute there is
+/// dropped: the caller then runs them itself, in its order, and finds every answer cached.
+/// Without `batched`, nothing.
+void answer_units_ahead(bool batched, std::size_t units,
+                        const std::function<void(std::size_t)>& unit);
+
+/// The same for a RapidCheck property run as run_silently runs it; `reset` then undoes what the
+/// property accumulated in its captures (after every pass).
+void answer_property_ahead(bool batched, const std::function<void()>& property,
+                           const std::function<void()>& reset, const std::string& description,
+                           std::uint64_t seed, int cases);
 
 }  // namespace handcentric::props::detail

@@ -221,12 +221,12 @@ std::optional<PartlyAffineLaw> partly_affine_law(
     for (Eigen::Index j = 0; j < n; ++j) v(j) = standard_normal(rng);
     return v;
   };
-  // Every input of a phase is drawn before the first is evaluated, so that a prefetch pass
-  // (batch.hpp) asks for them together; the draws are in the same order either way.
+  // Every input of a phase is drawn before the first is evaluated, so that a batched map can
+  // answer them together (prefetch.hpp); the draws are in the same order either way.
   const Eigen::VectorXd u = normals(), v = normals();
   std::vector<Eigen::VectorXd> checked;
   for (int c = 0; c < checks; ++c) checked.push_back(normals());
-  prefetch(std::vector<Eigen::VectorXd>{eps, u, v, u + v}, f);
+  ask_ahead([&] { return std::vector<Eigen::VectorXd>{eps, u, v, u + v}; }, f);
   law.mean = f(eps);
   const Eigen::Index width = law.mean.size();
   out.affine.assign(static_cast<std::size_t>(width), true);
@@ -248,11 +248,13 @@ std::optional<PartlyAffineLaw> partly_affine_law(
   law.noise_map = Eigen::MatrixXd::Zero(width, n);
   if (width > 0 && std::none_of(out.affine.begin(), out.affine.end(), [](bool a) { return a; }))
     return out;
-  if (prefetching()) {
-    std::vector<Eigen::VectorXd> probes = checked;
-    for (Eigen::Index j = 0; j < n; ++j) probes.push_back(Eigen::VectorXd::Unit(n, j));
-    prefetch(probes, f);
-  }
+  ask_ahead(
+      [&] {
+        std::vector<Eigen::VectorXd> probes = checked;
+        for (Eigen::Index j = 0; j < n; ++j) probes.push_back(Eigen::VectorXd::Unit(n, j));
+        return probes;
+      },
+      f);
   for (Eigen::Index j = 0; j < n; ++j) {
     eps(j) = 1.0;
     const Eigen::VectorXd column = f(eps);
@@ -607,11 +609,22 @@ std::string describe(const ExactComparison& c, double tolerance) {
 
 }  // namespace
 
+void merge(LawStatistics& into, const LawStatistics& one) {
+  into.any_energy = into.any_energy || one.any_energy;
+  into.any_partial = into.any_partial || one.any_partial;
+  into.partial_cases += one.partial_cases;
+  if (into.exact_coordinates.empty()) into.exact_coordinates = one.exact_coordinates;
+  into.largest_dimension = std::max(into.largest_dimension, one.largest_dimension);
+  into.largest_spread = std::max(into.largest_spread, one.largest_spread);
+  into.largest_scale_ratio = std::max(into.largest_scale_ratio, one.largest_scale_ratio);
+}
+
 CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOptions& options,
-                         const DistributionOptions& distribution, LawStatistics& statistics) {
+                         const DistributionOptions& distribution) {
   const double alpha = distribution.family_alpha / distribution.cases;  // Bonferroni
   const double level = alpha / 3.0;                                     // each of the three tests
   CaseOutcome outcome;
+  LawStatistics& statistics = outcome.statistics;
   const std::optional<PartlyAffineLaw> law =
       partly_affine_law(pair.before, pair.noise_dimension, tolerance, options.noise_seed,
                         distribution.affinity_checks);
@@ -669,8 +682,6 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
     statistics.any_energy = true;
   }
   const Eigen::Index noise = pair.noise_dimension;
-  // A prefetch pass (batch.hpp) only gathers the draws; the tests run once, in the real pass.
-  const bool gathering = prefetching();
   std::mt19937_64 shared(options.noise_seed), fresh(options.noise_seed ^ 0x9e3779b97f4a7c15ULL);
   auto draw = [noise](std::mt19937_64& rng) {
     Eigen::VectorXd eps(noise);
@@ -682,8 +693,8 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   auto draw_shared = [&](int from, int to) {
     std::vector<Eigen::VectorXd> drawn;
     for (int i = from; i < to; ++i) drawn.push_back(draw(shared));
-    prefetch(drawn, pair.before);
-    prefetch(drawn, pair.after);
+    ask_ahead([&] { return drawn; }, pair.before);
+    ask_ahead([&] { return drawn; }, pair.after);
     for (int i = from; i < to; ++i) {
       const Eigen::VectorXd& eps = drawn[static_cast<std::size_t>(i - from)];
       const Eigen::VectorXd u = pair.before(eps);
@@ -718,7 +729,6 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
     return outcome;
   }
   const auto dimension = static_cast<Eigen::Index>(tested.size());
-  outcome.provisional = gathering;
   // The draws the tests need: enough for the scale test to find scale_ratio with 90% power.
   const int scale_permutations = scale_test_permutations(level);
   const double scale_level = permutation_level(level, scale_permutations);
@@ -744,7 +754,7 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
           : samples;
   statistics.largest_dimension = std::max(statistics.largest_dimension, dimension);
   const Eigen::MatrixXd x_tested = columns_of(x, tested);
-  if (dimension > 0 && !gathering) {
+  if (dimension > 0) {
     const Eigen::RowVectorXd mean = x_tested.colwise().mean();
     const double variance = (x_tested.rowwise() - mean).squaredNorm() /
                             (static_cast<double>(samples - 1) * static_cast<double>(dimension));
@@ -758,9 +768,7 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   }
   const double pointwise =
       dimension > 0 ? (x_tested - columns_of(same_eps, tested)).lpNorm<Eigen::Infinity>() : 0.0;
-  outcome.provisional = gathering;
   if (pointwise <= tolerance) {
-    if (gathering) return outcome;
     // The same value on every shared draw: the two distributions are the same one, no test needed.
     outcome.witness.after = same_eps.row(0).transpose();
     outcome.witness.error =
@@ -784,10 +792,9 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   Eigen::MatrixXd y(draws, same_eps.cols());
   std::vector<Eigen::VectorXd> fresh_draws;
   for (int i = 0; i < draws; ++i) fresh_draws.push_back(draw(fresh));
-  prefetch(fresh_draws, pair.after);
+  ask_ahead([&] { return fresh_draws; }, pair.after);
   for (int i = 0; i < draws; ++i)
     y.row(i) = pair.after(fresh_draws[static_cast<std::size_t>(i)]).transpose();
-  if (gathering) return outcome;
   const Eigen::MatrixXd before = columns_of(x, tested), after = columns_of(y, tested);
   const TwoSampleResult test = energy_test(before.topRows(samples), after.topRows(samples),
                                            permutations_for(level), options.seed, level);
@@ -866,7 +873,6 @@ Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, 
                           to_string(component));
   }
   detail::require_distribution_options(distribution);
-  detail::LawStatistics statistics;
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
     const Scene moved = g * scene;
     auto part_of = [&](const Scene& s) {
@@ -877,16 +883,15 @@ Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, 
     };
     const detail::NoisePair pair{part_of(scene), part_of(moved), target->noise_dimension(scene),
                                  target->name() + ": the " + to_string(component)};
-    detail::CaseOutcome outcome =
-        detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance),
-                             options, distribution, statistics);
+    detail::CaseOutcome outcome = detail::compare_laws(
+        pair, pointwise_tolerance(scene, moved, options.relative_tolerance), options, distribution);
     outcome.witness.scene = scene;
     outcome.witness.g = g;
     return outcome;
   };
-  Verdict verdict =
-      detail::run_check(run_case, component, group, Mode::distribution, options, distribution.cases,
-                        distribution.shrink_budget, [&statistics] { statistics = {}; });
+  detail::LawStatistics statistics;
+  Verdict verdict = detail::run_check(run_case, component, group, Mode::distribution, options,
+                                      distribution.cases, distribution.shrink_budget, &statistics);
   detail::finish_distribution_verdict(verdict, statistics, distribution);
   return verdict;
 }

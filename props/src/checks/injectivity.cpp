@@ -36,21 +36,6 @@ constexpr double kGrowth = 1.333521432163324;
 
 enum class Change { one_translation, one_rotation, whole_chunk, other_chunk };
 
-// With CheckOptions::prefetch (a batched representation, batch.hpp): runs `property` in
-// prefetch passes, each followed by `reset` (a pass's cases stop at their first unanswered
-// question, so what they accumulated is not the check's) and by the evaluation of the scenes it
-// recorded, until a pass records nothing new; the real run then asks the same questions in the
-// same order and finds them answered. At most 64 passes, as for the other checks.
-void run_prefetch_passes(const std::function<void()>& property, const std::function<void()>& reset,
-                         const std::string& description, std::uint64_t seed, int cases) {
-  detail::PrefetchPasses passes;
-  for (int p = 0; p < 64; ++p) {
-    passes.pass([&] { detail::run_silently(property, description, seed, cases); });
-    reset();
-    if (passes.flush() == 0) return;
-  }
-}
-
 const char* describe(Change change) {
   switch (change) {
     case Change::one_translation:
@@ -212,8 +197,8 @@ Scan scan_resolution(const Representation& representation, const CheckOptions& o
   auto property = [&] {
     if (error) return;
     const Scene first = *shaped_scene(options.shape);
-    // Every pair's draws first, in the order of the loop below, so that a prefetch pass can ask
-    // for all the pairs' scenes at once.
+    // Every pair's draws first, in the order of the loop below, so that a batched map can be
+    // asked for all the pairs' scenes at once.
     std::vector<Pair> pairs;
     for (std::size_t i = 0; i < decades.size(); ++i) {
       for (int c = 0; c < kScanChanges; ++c) {
@@ -225,19 +210,21 @@ Scan scan_resolution(const Representation& representation, const CheckOptions& o
         pairs.push_back({change, unit, size, k, u});
       }
     }
+    ask_ahead(
+        [&] {
+          std::vector<Scene> asked = {first};
+          for (const Pair& pair : pairs) {
+            Scene second = first;
+            second.world_T_hand_chunk =
+                scaled_change(first.world_T_hand_chunk, pair.change, pair.k, pair.u, pair.size);
+            if (pair.size >
+                kPairMargin * pointwise_tolerance(first, second, options.relative_tolerance))
+              asked.push_back(std::move(second));
+          }
+          return asked;
+        },
+        [&](const Scene& s) { return representation.encode_actions(s); });
     try {
-      if (prefetching()) {
-        std::vector<Scene> asked = {first};
-        for (const Pair& pair : pairs) {
-          Scene second = first;
-          second.world_T_hand_chunk =
-              scaled_change(first.world_T_hand_chunk, pair.change, pair.k, pair.u, pair.size);
-          if (pair.size >
-              kPairMargin * pointwise_tolerance(first, second, options.relative_tolerance))
-            asked.push_back(std::move(second));
-        }
-        prefetch(asked, [&](const Scene& s) { return representation.encode_actions(s); });
-      }
       const Eigen::VectorXd a = representation.encode_actions(first);
       for (std::size_t p = 0; p < pairs.size(); ++p) {
         const Pair& pair = pairs[p];
@@ -264,22 +251,18 @@ Scan scan_resolution(const Representation& representation, const CheckOptions& o
           out.at_largest[pair.unit] = std::move(collision);
         }
       }
-    } catch (const PendingEvaluation&) {
-      // A prefetch pass: this scene's next question is recorded; the next pass goes on.
     } catch (const Error&) {
       error = std::current_exception();
     }
   };
   const std::string description = "resolution of " + representation.name();
-  if (options.prefetch) {
-    run_prefetch_passes(
-        property,
-        [&] {
-          out = fresh();
-          error = nullptr;
-        },
-        description, options.seed, scenes);
-  }
+  detail::answer_property_ahead(
+      options.prefetch, property,
+      [&] {
+        out = fresh();
+        error = nullptr;
+      },
+      description, options.seed, scenes);
   detail::run_silently(property, description, options.seed, scenes);
   if (error) std::rethrow_exception(error);
   return out;
@@ -315,22 +298,19 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
     const Rotation R = *rotation();
     Scene second = first;
     second.world_T_hand_chunk = changed_chunk(first, change, index, v, w, R);
-    if (prefetching()) {
-      // Both scenes the case asks for (the second only if it is a pair, as below); the decode
-      // round trip is asked one at a time.
-      const double apart = chunk_distance(first.world_T_hand_chunk, second.world_T_hand_chunk);
-      const double scale = 1.0 + std::max(length_scale(first), length_scale(second));
-      std::vector<Scene> asked = {first};
-      if (apart >=
-          std::max(1e-6 * scale, kPairMargin * pointwise_tolerance(first, second, relative)))
-        asked.push_back(second);
-      try {
-        prefetch(asked, [&](const Scene& s) { return representation->encode_actions(s); });
-      } catch (const Error&) {
-        // the real run meets it again and reports it
-      }
-      return;
-    }
+    // Both scenes the case asks for (the second only if it is a pair, as below), named ahead
+    // for a batched map; the decode round trip is asked one at a time.
+    ask_ahead(
+        [&] {
+          const double apart = chunk_distance(first.world_T_hand_chunk, second.world_T_hand_chunk);
+          const double scale = 1.0 + std::max(length_scale(first), length_scale(second));
+          std::vector<Scene> asked = {first};
+          if (apart >=
+              std::max(1e-6 * scale, kPairMargin * pointwise_tolerance(first, second, relative)))
+            asked.push_back(second);
+          return asked;
+        },
+        [&](const Scene& s) { return representation->encode_actions(s); });
     try {
       const Eigen::VectorXd a = representation->encode_actions(first);
       if (searching && decodes && !result.round_trip_failure) {
@@ -360,9 +340,15 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
     }
   };
   const std::string description = "injectivity of " + representation->name();
-  if (options.prefetch)
-    run_prefetch_passes(
-        property, [] {}, description, options.seed, options.cases);
+  detail::answer_property_ahead(
+      options.prefetch, property,
+      [&] {
+        result = Injectivity{};
+        searching = true;
+        shrink_evaluations = 0;
+        error = nullptr;
+      },
+      description, options.seed, options.cases);
   detail::run_silently(property, description, options.seed, options.cases);
   if (error) std::rethrow_exception(error);
 

@@ -120,7 +120,6 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
   detail::require_distribution_options(distribution);
   const double poses = output_pose_tolerance(
       options.output_unit_roundoff > 0.0 ? options.output_unit_roundoff : options.unit_roundoff);
-  detail::LawStatistics statistics;
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
     const Scene moved = g * scene;
     detail::NoisePair pair;
@@ -133,16 +132,16 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
     };
     pair.noise_dimension = policy.noise_dimension();
     pair.name = policy.name() + ": the chunk";
-    detail::CaseOutcome outcome =
-        detail::compare_laws(pair, pointwise_tolerance(scene, moved, options.relative_tolerance),
-                             options, distribution, statistics);
+    detail::CaseOutcome outcome = detail::compare_laws(
+        pair, pointwise_tolerance(scene, moved, options.relative_tolerance), options, distribution);
     outcome.witness.scene = scene;
     outcome.witness.g = g;
     return outcome;
   };
-  Verdict verdict = detail::run_check(run_case, Component::policy, group, Mode::distribution,
-                                      options, distribution.cases, distribution.shrink_budget,
-                                      [&statistics] { statistics = {}; });
+  detail::LawStatistics statistics;
+  Verdict verdict =
+      detail::run_check(run_case, Component::policy, group, Mode::distribution, options,
+                        distribution.cases, distribution.shrink_budget, &statistics);
   detail::finish_distribution_verdict(verdict, statistics, distribution);
   return verdict;
 }

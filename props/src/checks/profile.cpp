@@ -22,8 +22,6 @@ namespace {
 constexpr double kScaleFloor = 1e-3;
 constexpr int kMaxProfileScenes = 10'000;
 constexpr int kMaxProfileSamples = 10'000;
-// Rounds of prefetching before the real pass (each answers the next question of every scene).
-constexpr int kPrefetchRounds = 16;
 
 void require_options(const ProfileOptions& options, Group group) {
   if (options.scenes < 1 || options.scenes > kMaxProfileScenes)
@@ -117,7 +115,7 @@ std::vector<Eigen::VectorXd> normal_draws(Eigen::Index n, int count, std::uint64
 
 Eigen::MatrixXd sample_rows(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& f,
                             const std::vector<Eigen::VectorXd>& draws, const std::string& name) {
-  prefetch(draws, f);
+  ask_ahead([&] { return draws; }, f);
   Eigen::MatrixXd rows;
   for (std::size_t i = 0; i < draws.size(); ++i) {
     const Eigen::VectorXd y = f(draws[i]);
@@ -208,25 +206,12 @@ Profile run_profile(const ProfiledMap& map, const std::string& name, Component c
   const auto scene_seed = [&](std::size_t i) {
     return options.noise_seed * 1000003ULL + static_cast<std::uint64_t>(i);
   };
-  if (options.prefetch) {
-    // A batched map records what each scene asks and answers it in batches; each round gets
-    // every scene one question further (batch.hpp). The real pass below then finds the answers.
-    detail::PrefetchPasses passes;
-    for (int round = 0; round < kPrefetchRounds; ++round) {
-      passes.pass([&] {
-        for (std::size_t i = 0; i < cases.size(); ++i) {
-          try {
-            (void)profile_scene(map, cases[i], group, sizes, options, scene_seed(i));
-          } catch (const PendingEvaluation&) {
-          }
-        }
-      });
-      if (passes.flush() == 0) break;
-    }
-  }
+  const auto row = [&](std::size_t i) {
+    return profile_scene(map, cases[i], group, sizes, options, scene_seed(i));
+  };
+  detail::answer_units_ahead(options.prefetch, cases.size(), [&](std::size_t i) { (void)row(i); });
   std::vector<SceneRow> rows;
-  for (std::size_t i = 0; i < cases.size(); ++i)
-    rows.push_back(profile_scene(map, cases[i], group, sizes, options, scene_seed(i)));
+  for (std::size_t i = 0; i < cases.size(); ++i) rows.push_back(row(i));
 
   Profile profile;
   profile.name = name;

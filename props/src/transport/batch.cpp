@@ -247,7 +247,11 @@ std::vector<RigidTransform> BatchedRepresentation::decode_actions(
 
 std::vector<RigidTransform> BatchedRepresentation::decode_in_scene(const Eigen::VectorXd& actions,
                                                                    const Scene& observation) const {
-  return representation_->decode_in_scene(actions, observation);
+  std::string key = detail::scene_key(observation, false);
+  key.append(reinterpret_cast<const char*>(actions.data()),
+             sizeof(double) * static_cast<std::size_t>(actions.size()));
+  if (const auto* hit = decoded_.find(key)) return *hit;
+  return decoded_.put(std::move(key), representation_->decode_in_scene(actions, observation));
 }
 
 }  // namespace handcentric::props

@@ -3,7 +3,7 @@
 // cases as it always does; during a prefetch pass, a batched map asked for an input it has no
 // answer for records it and throws PendingEvaluation, which ends that case only; the runner
 // (check_runner.hpp) then has the recorded inputs evaluated together and starts the next pass.
-// Checks name their upcoming questions with prefetch(), which does nothing outside a pass.
+// Checks name their upcoming questions with ask_ahead(), which does nothing outside a pass.
 // batch.hpp says why the verdicts stay those of an unbatched check, bit for bit.
 #include <cstddef>
 #include <functional>
@@ -13,7 +13,7 @@ namespace handcentric::props {
 
 /// Thrown, during a prefetch pass only, by a batched map asked for an input it has not evaluated
 /// yet (the input is recorded). Deliberately not a std::exception: only the check runner and
-/// prefetch() catch it.
+/// ask_ahead() catch it.
 struct PendingEvaluation {};
 
 /// Something that records inputs during a prefetch pass and then evaluates them together.
@@ -27,13 +27,15 @@ class Prefetcher {
 /// True while a prefetch pass runs on this thread.
 bool prefetching();
 
-/// During a prefetch pass, calls ask(input) for every input, catching PendingEvaluation, so that
-/// a case records every question it will ask before it needs the first answer. Outside a
-/// prefetch pass it does nothing (the questions are asked when the case gets to them).
-template <class Input, class Ask>
-void prefetch(const std::vector<Input>& inputs, const Ask& ask) {
+/// A check names the questions it is about to ask, so that a batched map can answer them
+/// together: `inputs()` gives them and ask(input) asks one. The check then asks each input
+/// itself, in its own order, and finds the answer cached. inputs() is called only while a
+/// batched map is collecting questions (a prefetch pass); otherwise this does nothing, and the
+/// questions are asked when the check gets to them.
+template <class MakeInputs, class Ask>
+void ask_ahead(const MakeInputs& inputs, const Ask& ask) {
   if (!prefetching()) return;
-  for (const Input& input : inputs) {
+  for (const auto& input : inputs()) {
     try {
       (void)ask(input);
     } catch (const PendingEvaluation&) {

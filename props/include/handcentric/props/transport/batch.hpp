@@ -8,7 +8,7 @@
 // affine probes, then the draws). So with CheckOptions::prefetch, run_check first runs prefetch
 // passes over its cases: in such a pass a BatchedPolicy or BatchedRepresentation asked for an input
 // it has no answer for records it and throws PendingEvaluation, which stops that case only (cases
-// where several questions are known at once ask them all first: prefetch()). The recorded inputs
+// where several questions are known at once ask them all first: ask_ahead()). The recorded inputs
 // are then evaluated together, in batches of at most batch_size inputs (of one shape unless the map
 // takes mixed shapes), and the next pass goes a question further. When a pass records nothing new,
 // the real pass runs: it asks the same questions in the same order as an unbatched check and finds
@@ -203,6 +203,8 @@ class BatchedRepresentation final : public Representation, public Prefetcher {
   std::shared_ptr<const BatchRepresentation> representation_;
   int batch_size_;
   Side actions_, observation_;
+  /// Round trips already asked: a check that runs its cases in prefetch passes asks again.
+  mutable AnswerCache<std::vector<RigidTransform>> decoded_;
   mutable std::size_t batches_ = 0, evaluations_ = 0;
 };
 
