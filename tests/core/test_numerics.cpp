@@ -13,6 +13,7 @@
 #include <catch2/catch.hpp>
 
 #include <Eigen/LU>  // determinant
+#include <algorithm>
 #include <cfloat>
 #include <cmath>
 #include <cstdlib>
@@ -21,6 +22,7 @@
 #include <numbers>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
@@ -30,6 +32,7 @@
 #include "handcentric/core/so3.hpp"
 #include "handcentric/props/catch.hpp"
 #include "mutants.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 
@@ -508,4 +511,47 @@ TEST_CASE("format_shortest_reads_back_exactly_and_is_as_short_as_typed", "[unit]
   char six_digits[32];
   std::snprintf(six_digits, sizeof six_digits, "%g", 0.1 + 0.2);
   CHECK(std::strtod(six_digits, nullptr) != 0.1 + 0.2);
+}
+
+namespace {
+
+// The tests' tolerance checks accumulate errors from 0 and then CHECK(worst <= tolerance); a NaN
+// error (a kernel or a policy gone wrong) must fail that check. Errors of 1e-12 to 3e-10 against
+// a tolerance of 1e-9, with a NaN planted at `nan_at` (none when it is past the end).
+std::vector<double> errors_with_nan_at(std::size_t nan_at) {
+  std::vector<double> errors = {1e-12, 3e-10, 0.0, 2e-11};
+  if (nan_at < errors.size()) errors[nan_at] = kNan;
+  return errors;
+}
+
+double worst_error_by(double (*accumulate)(double, double), const std::vector<double>& errors) {
+  double worst = 0.0;
+  for (const double error : errors) worst = accumulate(worst, error);
+  return worst;
+}
+
+double worst_by_std_max(double worst, double error) {
+  return std::max(worst, error);
+}
+
+}  // namespace
+
+TEST_CASE("worst_of_fails_the_tolerance_check_on_a_nan_among_finite_errors", "[unit]") {
+  CHECK(worst_error_by(test::worst_of, errors_with_nan_at(4)) == 3e-10);
+  for (std::size_t nan_at = 0; nan_at < 4; ++nan_at) {
+    INFO("NaN at " << nan_at);
+    const double worst = worst_error_by(test::worst_of, errors_with_nan_at(nan_at));
+    CHECK(std::isnan(worst));
+    CHECK_FALSE(worst <= 1e-9);
+  }
+}
+
+TEST_CASE("mutant_std_max_passes_the_tolerance_check_on_a_nan_among_finite_errors", "[unit]") {
+  // The planted fault is the accumulation worst_of replaced: std::max(worst, NaN) is worst.
+  for (std::size_t nan_at = 0; nan_at < 4; ++nan_at) {
+    INFO("NaN at " << nan_at);
+    const double worst = worst_error_by(worst_by_std_max, errors_with_nan_at(nan_at));
+    CHECK(worst == (nan_at == 1 ? 2e-11 : 3e-10));  // the largest finite error left
+    CHECK(worst <= 1e-9);
+  }
 }

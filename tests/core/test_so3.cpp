@@ -14,6 +14,7 @@
 #include "handcentric/props/observation/generators.hpp"
 #include "handcentric/props/show.hpp"
 #include "mutants.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using LogFn = Eigen::Vector3d (*)(const Eigen::Matrix3d&);
@@ -28,7 +29,7 @@ double max_exp_log_error(LogFn log_fn, int n, std::uint64_t seed, Draw draw) {
   double worst = 0.0;
   for (int i = 0; i < n; ++i) {
     const Eigen::Matrix3d R = draw(rng).matrix();
-    worst = std::max(worst, (so3::exp(log_fn(R)) - R).norm());
+    worst = test::worst_of(worst, (so3::exp(log_fn(R)) - R).norm());
   }
   return worst;
 }

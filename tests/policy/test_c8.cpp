@@ -10,6 +10,7 @@
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/props/catch.hpp"
 #include "handcentric/props/observation/generators.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::policy;
@@ -75,12 +76,12 @@ TEST_CASE("c8_velocity_push_forward_matches_finite_differences", "[unit]") {
         (c8::act_on_actions(R, a + h * v) - c8::act_on_actions(R, a - h * v)) / (2 * h);
     if (a.segment<3>(3).norm() > 3.0 || a.segment<3>(9).norm() > 3.0)
       continue;  // keep away from |r| = pi
-    worst = std::max(worst, (numeric - c8::push_velocity(R, a, v)).cwiseAbs().maxCoeff());
+    worst = test::worst_of(worst, (numeric - c8::push_velocity(R, a, v)).cwiseAbs().maxCoeff());
     // Planted fault: rotating the rotation-vector velocity like a translation.
     Eigen::VectorXd naive = v;
     for (int i = 0; i < 12; i += 3) naive.segment<3>(i) = R * v.segment<3>(i);
     worst_without_jacobians =
-        std::max(worst_without_jacobians, (numeric - naive).cwiseAbs().maxCoeff());
+        test::worst_of(worst_without_jacobians, (numeric - naive).cwiseAbs().maxCoeff());
   }
   CHECK(worst < 1e-6);
   CHECK(worst_without_jacobians > 1e-2);

@@ -20,6 +20,7 @@
 #include "handcentric/policy/head.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "throws.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::policy;
@@ -80,10 +81,10 @@ double worst_scene_mismatch(const Act& act) {
               .cwiseAbs()
               .maxCoeff();
         };
-        worst = std::max(worst, mismatch(absolute.encode_actions(moved),
-                                         absolute.encode_actions(scene), kActions));
-        worst = std::max(worst, mismatch(absolute.encode_observation(moved),
-                                         absolute.encode_observation(scene), kObservations));
+        worst = test::worst_of(worst, mismatch(absolute.encode_actions(moved),
+                                               absolute.encode_actions(scene), kActions));
+        worst = test::worst_of(worst, mismatch(absolute.encode_observation(moved),
+                                               absolute.encode_observation(scene), kObservations));
       }
     }
   }

@@ -30,6 +30,7 @@
 #include "handcentric/policy/normalizer.hpp"
 #include "kernels/kernel_set.hpp"
 #include "throws.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::policy;
@@ -220,7 +221,7 @@ Run run_on(ConvEncoder& encoder, const kernels::KernelSet& set, const Eigen::Mat
 
 struct Errors {
   double features, gradient, d_images;
-  double worst() const { return std::max({features, gradient, d_images}); }
+  double worst() const { return test::worst_of(test::worst_of(features, gradient), d_images); }
 };
 
 Errors errors_of(const Run& run, const Eigen::MatrixXd& features, const Eigen::VectorXd& gradient,
@@ -457,7 +458,7 @@ TEST_CASE("the_reference_backward_matches_central_differences", "[unit]") {
     const double plus = loss(r, images);
     r.parameters[i] -= 2 * h;
     const double minus = loss(r, images);
-    worst_p = std::max(worst_p, std::abs((plus - minus) / (2 * h) - gradient[i]));
+    worst_p = test::worst_of(worst_p, std::abs((plus - minus) / (2 * h) - gradient[i]));
   }
   for (Eigen::Index i = 0; i < images.size(); i += 5) {
     Reference r = reference;
@@ -467,8 +468,8 @@ TEST_CASE("the_reference_backward_matches_central_differences", "[unit]") {
     x(i) -= 2 * h;
     const double minus = loss(r, x);
     const double numeric = (plus - minus) / (2 * h);
-    worst_x = std::max(worst_x, std::abs(numeric - d_images(i)));
-    wrong_x = std::max(wrong_x, std::abs(numeric - wrong_d_images(i)));
+    worst_x = test::worst_of(worst_x, std::abs(numeric - d_images(i)));
+    wrong_x = test::worst_of(wrong_x, std::abs(numeric - wrong_d_images(i)));
   }
   CHECK(worst_p < 1e-6);
   CHECK(worst_x < 1e-6);

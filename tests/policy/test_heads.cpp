@@ -13,6 +13,7 @@
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "throws.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::policy;
@@ -101,7 +102,7 @@ double worst_distance_to_demo(const LearnedPolicy& policy) {
     for (std::uint64_t seed = 0; seed < 5; ++seed) {
       const auto chunk = policy.act(scene, seed);
       for (std::size_t k = 0; k < chunk.size(); ++k) {
-        worst = std::max(worst, distance(chunk[k], scene.world_T_hand_chunk[k]));
+        worst = test::worst_of(worst, distance(chunk[k], scene.world_T_hand_chunk[k]));
       }
     }
   }

@@ -27,6 +27,7 @@
 #include "kernels/asan_lanes.hpp"
 #include "kernels/kernel_set.hpp"
 #include "throws.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::policy;
@@ -109,7 +110,7 @@ double gemm_error(const GemmProblem& problem, bool skip_last_term = false) {
         magnitude += std::abs(term);
       }
       const double bound = 4.0 * std::max(problem.k, 1) * 6e-8 * magnitude + 1e-30;
-      worst = std::max(worst, std::abs(problem.c[i + j * problem.ldc] - sum) / bound);
+      worst = test::worst_of(worst, std::abs(problem.c[i + j * problem.ldc] - sum) / bound);
     }
   }
   return worst;
@@ -214,7 +215,7 @@ double row_sums_error(const GemmProblem& problem, const std::vector<float>& sums
       magnitude += std::abs(problem.A(i, p));
     }
     const double bound = 4.0 * std::max(problem.k, 1) * 6e-8 * magnitude + 1e-30;
-    worst = std::max(worst, std::abs(sums[i] - sum) / bound);
+    worst = test::worst_of(worst, std::abs(sums[i] - sum) / bound);
   }
   return worst;
 }
@@ -493,10 +494,10 @@ TEST_CASE("pixel_weight_gradients_are_the_sums_of_the_double_reference", "[unit]
           // The worst error against the reference, in units of float rounding of the terms.
           double worst = 0;
           for (std::size_t i = 0; i < weights.size(); ++i) {
-            worst = std::max(worst, std::abs(d_weights[i] - weights[i]) / weight_scale[i]);
+            worst = test::worst_of(worst, std::abs(d_weights[i] - weights[i]) / weight_scale[i]);
           }
           for (int f = 0; f < kFilters; ++f) {
-            worst = std::max(worst, std::abs(d_bias[f] - bias[f]) / bias_scale[f]);
+            worst = test::worst_of(worst, std::abs(d_bias[f] - bias[f]) / bias_scale[f]);
           }
           return worst;
         };
@@ -662,7 +663,7 @@ double epilogue_error(const GemmProblem& problem, const ReferenceProduct& refere
         bound = bound * 1.1 + 1e-6 * std::abs(expected) +
                 1e-30;  // SiLU' <= 1.1, plus the sigmoid's error
         if (!s_out.empty())
-          worst = std::max(worst, std::abs(s_out[at_s] - sigmoid) / (bound + 1e-6 * sigmoid));
+          worst = test::worst_of(worst, std::abs(s_out[at_s] - sigmoid) / (bound + 1e-6 * sigmoid));
       } else if (!skip_epilogue && epilogue == kernels::Epilogue::silu_derivative) {
         const double derivative = s_in[at_s] + a_in[at_s] * (1.0 - s_in[at_s]);
         const double terms =
@@ -671,7 +672,7 @@ double epilogue_error(const GemmProblem& problem, const ReferenceProduct& refere
         bound = bound * std::abs(derivative) +
                 4.0 * 6e-8 * (std::abs(z) * terms + std::abs(expected)) + 1e-30;
       }
-      worst = std::max(worst, std::abs(problem.c[at] - expected) / bound);
+      worst = test::worst_of(worst, std::abs(problem.c[at] - expected) / bound);
     }
   }
   return worst;
@@ -752,8 +753,8 @@ TEST_CASE("narrow_products_read_columns_at_every_offset_from_a_cache_line", "[un
               sum += static_cast<double>(a[i + p * lda]) * x[p + j * k];
               magnitude += std::abs(static_cast<double>(a[i + p * lda]) * x[p + j * k]);
             }
-            worst =
-                std::max(worst, std::abs(y[16 + i + j * ldc] - sum) / (4.0 * k * 6e-8 * magnitude));
+            worst = test::worst_of(
+                worst, std::abs(y[16 + i + j * ldc] - sum) / (4.0 * k * 6e-8 * magnitude));
           }
           // Nothing written outside C: the masked lanes stay untouched.
           for (int i = 0; i < 16; ++i) CHECK(y[i + j * ldc] == 7.0f);

@@ -15,6 +15,7 @@
 #include "handcentric/policy/mlp.hpp"
 #include "handcentric/policy/time_embedding.hpp"
 #include "throws.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::policy;
@@ -137,7 +138,7 @@ TEST_CASE("mse_and_kl_gradients_match_finite_differences", "[unit]") {
     const double numeric =
         (mse_loss<double>(plus, target, scratch_a) - mse_loss<double>(minus, target, scratch_a)) /
         (2 * h);
-    worst = std::max(worst, std::abs(numeric - d_pred(i)));
+    worst = test::worst_of(worst, std::abs(numeric - d_pred(i)));
   }
   for (Eigen::Index i = 0; i < mu.size(); ++i) {
     Eigen::MatrixXd plus = mu, minus = mu;
@@ -146,7 +147,7 @@ TEST_CASE("mse_and_kl_gradients_match_finite_differences", "[unit]") {
     double numeric = (gaussian_kl_loss<double>(plus, log_var, 0.3, scratch_a, scratch_b) -
                       gaussian_kl_loss<double>(minus, log_var, 0.3, scratch_a, scratch_b)) /
                      (2 * h);
-    worst = std::max(worst, std::abs(numeric - d_mu(i)));
+    worst = test::worst_of(worst, std::abs(numeric - d_mu(i)));
     plus = log_var;
     minus = log_var;
     plus(i) += h;
@@ -154,7 +155,7 @@ TEST_CASE("mse_and_kl_gradients_match_finite_differences", "[unit]") {
     numeric = (gaussian_kl_loss<double>(mu, plus, 0.3, scratch_a, scratch_b) -
                gaussian_kl_loss<double>(mu, minus, 0.3, scratch_a, scratch_b)) /
               (2 * h);
-    worst = std::max(worst, std::abs(numeric - d_log_var(i)));
+    worst = test::worst_of(worst, std::abs(numeric - d_log_var(i)));
   }
   CHECK(worst < kGradientTolerance);
   // Planted fault: the gradient of the mean absolute error is not that of the MSE.
@@ -236,7 +237,7 @@ TEST_CASE("cvae_loss_gradients_match_finite_differences_through_the_reparameteri
       const double minus = loss(encoder, decoder);
       net.parameters()[i] = saved;
       const double numeric = (plus - minus) / (2 * h);
-      worst = std::max(worst, std::abs(analytic[i] - numeric) / (1.0 + std::abs(numeric)));
+      worst = test::worst_of(worst, std::abs(analytic[i] - numeric) / (1.0 + std::abs(numeric)));
     }
     return worst;
   };

@@ -16,6 +16,7 @@
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/policy/spatial_softmax.hpp"
 #include "throws.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::policy;
@@ -170,8 +171,8 @@ TEST_CASE("the_soft_argmax_reference_backward_matches_central_differences", "[un
     const double plus = loss(z);
     z(i) -= 2 * h;
     const double numeric = (plus - loss(z)) / (2 * h);
-    worst = std::max(worst, std::abs(numeric - exact(i)));
-    worst_wrong = std::max(worst_wrong, std::abs(numeric - wrong(i)));
+    worst = test::worst_of(worst, std::abs(numeric - exact(i)));
+    worst_wrong = test::worst_of(worst_wrong, std::abs(numeric - wrong(i)));
   }
   CHECK(worst < 1e-8);
   CHECK(worst_wrong > 1e-3);  // planted fault: the expectation not subtracted

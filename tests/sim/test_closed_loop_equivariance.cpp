@@ -11,6 +11,7 @@
 #include "handcentric/sim/expert.hpp"
 #include "handcentric/sim/rollout.hpp"
 #include "handcentric/sim/scenes.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 
@@ -38,7 +39,7 @@ double trajectory_gap(const sim::Rollout& original, const sim::Rollout& moved,
   double worst = 0.0;
   const std::size_t n = std::min(original.world_T_hand.size(), moved.world_T_hand.size());
   for (std::size_t t = 0; t < n; ++t) {
-    worst = std::max(worst, distance(g * original.world_T_hand[t], moved.world_T_hand[t]));
+    worst = test::worst_of(worst, distance(g * original.world_T_hand[t], moved.world_T_hand[t]));
   }
   return worst;
 }
@@ -55,7 +56,7 @@ double worst_gap(const ChunkPolicy& policy, bool& same_outcomes) {
     const sim::Rollout moved = sim::rollout(policy, g * scenes[i], checker, 3 + i);
     same_outcomes =
         same_outcomes && original.outcome == moved.outcome && original.steps == moved.steps;
-    worst = std::max(worst, trajectory_gap(original, moved, g));
+    worst = test::worst_of(worst, trajectory_gap(original, moved, g));
   }
   return worst;
 }

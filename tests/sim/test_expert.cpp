@@ -10,6 +10,7 @@
 #include "handcentric//core/sampling.hpp"
 #include "handcentric/sim/expert.hpp"
 #include "handcentric/sim/rollout.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::sim;
@@ -54,7 +55,7 @@ double equivariance_error(DemoMaker make, int n) {
         make(g * scenes[static_cast<std::size_t>(i)], static_cast<std::uint64_t>(i), checker);
     if (demo.size() != moved.size()) return INFINITY;
     for (std::size_t t = 0; t < demo.size(); ++t)
-      worst = std::max(worst, distance(moved[t], g * demo[t]));
+      worst = test::worst_of(worst, distance(moved[t], g * demo[t]));
   }
   return worst;
 }

@@ -11,6 +11,7 @@
 #include "handcentric/props/observation/generators.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
 #include "handcentric/sim/scenes.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::sim::insert3d;
@@ -60,7 +61,7 @@ auto expert_is_equivariant(Planner planner) {
     RC_ASSERT(original.size() == moved.size());
     double worst = 0.0;
     for (std::size_t t = 0; t < original.size(); ++t)
-      worst = std::max(worst, distance(moved[t], g * original[t]));
+      worst = test::worst_of(worst, distance(moved[t], g * original[t]));
     RC_ASSERT(worst <= kEquivarianceTolerance);
   };
 }

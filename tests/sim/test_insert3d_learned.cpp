@@ -15,6 +15,7 @@
 #include "handcentric/sim/insert3d/expert.hpp"
 #include "handcentric/sim/insert3d/rollout.hpp"
 #include "handcentric/sim/insert3d/scenes.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 namespace insert3d = sim::insert3d;
@@ -63,7 +64,8 @@ double worst_gap_3d(const ChunkPolicy& policy, bool& same_outcomes) {
                       original.world_T_hand.size() == moved.world_T_hand.size();
       const std::size_t n = std::min(original.world_T_hand.size(), moved.world_T_hand.size());
       for (std::size_t t = 0; t < n; ++t) {
-        worst = std::max(worst, distance(g * original.world_T_hand[t], moved.world_T_hand[t]));
+        worst =
+            test::worst_of(worst, distance(g * original.world_T_hand[t], moved.world_T_hand[t]));
       }
     }
   }

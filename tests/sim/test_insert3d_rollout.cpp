@@ -8,6 +8,7 @@
 #include "handcentric/props/observation/generators.hpp"
 #include "handcentric/sim/insert3d/expert.hpp"
 #include "handcentric/sim/insert3d/rollout.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::sim::insert3d;
@@ -52,7 +53,7 @@ auto rollouts_are_equivariant(std::shared_ptr<const ChunkPolicy> policy) {
     RC_ASSERT(original.world_T_hand.size() == moved.world_T_hand.size());
     double worst = 0.0;
     for (std::size_t t = 0; t < original.world_T_hand.size(); ++t) {
-      worst = std::max(worst, distance(moved.world_T_hand[t], g * original.world_T_hand[t]));
+      worst = test::worst_of(worst, distance(moved.world_T_hand[t], g * original.world_T_hand[t]));
     }
     RC_ASSERT(worst <= 1e-9);
   };

@@ -6,6 +6,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/insert3d/scenes.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::sim::insert3d;
@@ -44,8 +45,8 @@ double is_a_global_transform_of_train(Sampler sample, const SceneDistribution& d
     const TaskScene other = sample(distribution, 7, static_cast<std::uint64_t>(i));
     const RigidTransform g = other.world_T_slot * train.world_T_slot.inverse();
     const TaskScene moved = g * train;
-    worst = std::max({worst, distance(moved.world_T_slot, other.world_T_slot),
-                      distance(moved.world_T_hand_start, other.world_T_hand_start)});
+    worst = test::worst_of(worst, distance(moved.world_T_slot, other.world_T_slot));
+    worst = test::worst_of(worst, distance(moved.world_T_hand_start, other.world_T_hand_start));
   }
   return worst;
 }

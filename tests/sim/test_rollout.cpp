@@ -9,6 +9,7 @@
 #include "handcentric//core/sampling.hpp"
 #include "handcentric/sim/policies.hpp"
 #include "handcentric/sim/rollout.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::sim;
@@ -71,7 +72,7 @@ double policy_equivariance_error(const ChunkPolicy& policy, int n) {
     const auto moved = policy.act(g * o, 5);
     if (chunk.size() != moved.size()) return INFINITY;
     for (std::size_t k = 0; k < chunk.size(); ++k)
-      worst = std::max(worst, distance(moved[k], g * chunk[k]));
+      worst = test::worst_of(worst, distance(moved[k], g * chunk[k]));
   }
   return worst;
 }

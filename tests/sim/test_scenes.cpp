@@ -8,6 +8,7 @@
 #include "handcentric/sim/difficulty.hpp"
 #include "handcentric/sim/geometry.hpp"
 #include "handcentric/sim/scenes.hpp"
+#include "worst_error.hpp"  // tests/support
 
 using namespace handcentric;
 using namespace handcentric::sim;
@@ -46,8 +47,8 @@ double ood_is_a_global_transform_of_train(Sampler sample, int n) {
     const TaskScene ood = sample(SceneDistribution::ood(), 5, static_cast<std::uint64_t>(i));
     const RigidTransform g = ood.world_T_hole * train.world_T_hole.inverse();
     const TaskScene moved = g * train;
-    worst = std::max({worst, distance(moved.world_T_hole, ood.world_T_hole),
-                      distance(moved.world_T_hand_start, ood.world_T_hand_start)});
+    worst = test::worst_of(worst, distance(moved.world_T_hole, ood.world_T_hole));
+    worst = test::worst_of(worst, distance(moved.world_T_hand_start, ood.world_T_hand_start));
   }
   return worst;
 }
@@ -146,7 +147,7 @@ double widest_opening(const SceneDistribution& distribution, int n) {
   double widest = 0.0;
   for (const auto& scene : sample_scenes(distribution, n, 3)) {
     const Eigen::Vector3d hole = planar_coordinates(scene.world_T_hole);
-    widest = std::max({widest, std::abs(hole(1)), std::abs(hole(2))});
+    widest = test::worst_of(test::worst_of(widest, std::abs(hole(1))), std::abs(hole(2)));
   }
   return widest;
 }
