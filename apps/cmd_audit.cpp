@@ -381,7 +381,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
                   "cases per pointwise check, at most 10^7 (in distribution: max(10, cases/100))")
       ->capture_default_str();
   cmd->add_option("--seed", options->seed,
-                  "RapidCheck seed: the same seed gives the same cases and witnesses")
+                  "seeds all the audit draws (the cases, a policy's fixed noise, the "
+                  "in-distribution draws): the same seed gives the same verdicts and witnesses")
       ->capture_default_str();
   cmd->add_option("--tolerance", options->tolerance,
                   "REL in the pointwise tolerance REL * (1 + L); default 1e-9 (float64 rounding)");

@@ -134,6 +134,7 @@ int run_audit_profile(const ProfileCommand& command) {
                           "'; use eye_in_hand or third_person with --profile");
   props::ProfileOptions options;
   options.seed = command.seed;
+  options.noise_seed = command.seed;  // the policy's fixed noise and the laws' draws too
   options.scenes = command.scenes;
   options.sizes = command.sizes;
   options.shape = props::shape_for(command.view == "third_person" ? props::View::third_person

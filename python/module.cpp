@@ -347,14 +347,17 @@ own random numbers without rng= raises OwnRandomnessError for "pointwise" and "b
           .c_str());
   m.def(
       "equivariance_profile",
-      [](py::object what, const std::string& group, const std::string& component, py::handle noise,
-         py::object observation, py::handle sizes, int scenes, std::uint64_t seed, int samples,
-         const std::string& view, HANDCENTRIC_SETUP_PARAMETERS) {
-        return equivariance_profile(std::move(what), group, component, noise,
-                                    std::move(observation), sizes, scenes, seed, samples, view,
-                                    HANDCENTRIC_SETUP_VALUE);
+      [](py::object either, py::object group, py::object policy, py::object representation,
+         const std::string& component, py::handle noise, py::object observation, py::handle sizes,
+         int scenes, std::uint64_t seed, int samples, const std::string& view,
+         HANDCENTRIC_SETUP_PARAMETERS) {
+        return equivariance_profile(
+            {std::move(either), std::move(policy), std::move(representation)}, std::move(group),
+            component, noise, std::move(observation), sizes, scenes, seed, samples, view,
+            HANDCENTRIC_SETUP_VALUE);
       },
-      py::arg("policy_or_representation"), py::arg("group"), py::kw_only(),
+      py::arg("policy_or_representation") = py::none(), py::arg("group") = py::none(),
+      py::kw_only(), py::arg("policy") = py::none(), py::arg("representation") = py::none(),
       py::arg("component") = "actions", py::arg("noise") = py::none(),
       py::arg("observation") = py::none(), py::arg("sizes") = py::none(), py::arg("scenes") = 16,
       py::arg("seed") = 1, py::arg("samples") = 32, py::arg("view") = "eye_in_hand",
@@ -365,11 +368,14 @@ Returns one profile of `handcentric audit --profile` (docs/AUDIT.md, "Profiles")
 sizes (rad for rotation and c8, m for translation, both at once for se2 and se3), in_group,
 pointwise {median, max} and distribution (None, or {method, median, max, floor}) per size, each
 divided by the chunk's scale, and lie_derivative {median, max, step, method} (the slope at the
-identity, Gruver et al. 2023). policy_or_representation: a built-in's name (REPRESENTATIONS or
-"actionflow"), a policy(history, hand_points, world_points, noise) -> (K, 4, 4) when noise= (its
-length) is given, else a representation's actions function (component="observation" profiles
-observation= instead). sizes=None: the group's grid; scenes: 1 to 10**4 per size; samples: draws
-per side of the energy distance. Deterministic given seed.
+identity, Gruver et al. 2023). Pass one map: policy=, a policy(history, hand_points,
+world_points, noise) -> (K, 4, 4), with noise= (the length of its noise vector); or
+representation=, a built-in's name (REPRESENTATIONS or "actionflow") or a representation's
+actions function (component="observation" profiles observation= instead). The positional
+policy_or_representation (a policy when noise= is given) still works, with a
+DeprecationWarning. sizes=None: the group's grid; scenes: 1 to 10**4 per size; samples: draws
+per side of the energy distance. Deterministic given seed, which draws the scenes, the
+policy's fixed noise and the laws' samples.
 )doc") +
        kSetupDoc)
           .c_str());

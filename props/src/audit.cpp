@@ -133,6 +133,8 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
   classifier.views = options.views;
   classifier.check.cases = options.cases;
   classifier.check.seed = options.seed;
+  // One seed for everything the audit draws: the cases, a policy's fixed noise, the laws' draws.
+  classifier.check.noise_seed = options.seed;
   classifier.check.relative_tolerance = audit_relative_tolerance(options);
   classifier.check.unit_roundoff = probe_unit_roundoff(options.precision);
   classifier.check.output_unit_roundoff = unit_roundoff(options.precision);

@@ -85,3 +85,13 @@ def wrong_order_actions(history, chunk, hand_points, world_points):
 
 def absolute_actions(history, chunk, hand_points, world_points):
     return np.concatenate([pose_vector(T) for T in chunk])
+
+
+def noise_recording_policy(seen, fault=None):
+    """make_policy(fault) that adds noise[0] of every row it is asked with to the set `seen`."""
+    base = make_policy(fault)
+
+    def recording(history, hand_points, world_points, noise):
+        seen.add(float(noise[0]))
+        return base(history, hand_points, world_points, noise)
+    return recording

@@ -11,7 +11,7 @@ import pytest
 
 import handcentric
 import policies
-from policies import make_policy
+from policies import make_policy, noise_recording_policy
 
 CASES = 200  # per pointwise cell: enough for every planted fault, fast enough for CI
 HERE = os.path.dirname(os.path.realpath(__file__))
@@ -146,6 +146,18 @@ def test_same_seed_same_witness():
                               cases=CASES, seed=5) for _ in range(2)]
     assert runs[0] == runs[1]
     assert runs[0]["checks"][0]["witness"] is not None
+
+
+def test_the_seed_draws_the_noise_a_policy_is_asked_with():
+    # seed= used to seed the cases only: every seed asked the policy with one fixed noise.
+    def noises_seen(seed):
+        seen = set()
+        handcentric.audit_policy(noise_recording_policy(seen), noise=20, groups="translation",
+                                 views="eye_in_hand", cases=10, seed=seed)
+        return seen
+    assert noises_seen(3) == noises_seen(3)
+    # Only the affine probes (the zero vector and the unit vectors) are the same for every seed.
+    assert not (noises_seen(3) & noises_seen(4)) - {0.0, 1.0}
 
 
 # ---------------------------------------------------------------------------------------------

@@ -45,6 +45,7 @@ struct AuditOptions {
   std::vector<Group> groups = all_groups();
   std::vector<View> views = {View::eye_in_hand, View::third_person};
   int cases = kDefaultCases;  ///< pointwise cases per cell
+  /// Seeds everything the audit draws: the cases, a policy's fixed noise, the laws' draws.
   std::uint64_t seed = 1;
   Precision precision = Precision::float64;
   /// REL of the tolerance REL * (1 + L); 0 = from `precision` (precision_relative_tolerance).
