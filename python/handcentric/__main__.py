@@ -2,7 +2,7 @@
 Python, from the shell.
 
     python -m handcentric audit my_repr.py:actions --observation my_repr.py:observation
-    python -m handcentric audit-policy my_package.policies:policy --groups se3 --cases 500
+    python -m handcentric audit-policy my_package.policies:policy --group se3 --cases 500
 
 MODULE:FUNCTION names the callable: MODULE is a dotted module name (importable from the current
 directory or sys.path) or the path of a .py file (its folder is put on sys.path, so that it
@@ -10,7 +10,8 @@ imports its neighbours); FUNCTION may be dotted (Class.method). The callables ta
 handcentric.audit and handcentric.audit_policy pass them (help(handcentric.audit)).
 
 Prints one line per verdict (view, component, mode, group, yes/NO, largest error) and exits 0;
---json FILE also writes the full result (the dict handcentric.audit / audit_policy returns).
+--json prints the full result instead (the dict handcentric.audit / audit_policy returns, as
+JSON). The options are spelled as `handcentric audit` spells them (--group, --view, --json).
 Bad arguments: one line on stderr, exit 2. An exception raised by the callable under audit
 propagates with its traceback (exit 1)."""
 import argparse
@@ -34,6 +35,20 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):
         # One line, as the C++ command's usage errors (README.md: "a usage error exits 2").
         self.exit(2, "%s: error: %s (see --help)\n" % (self.prog, message))
+
+
+class _Deprecated(argparse.Action):
+    """An old spelling, kept for one release: it works as the new one and says so on stderr."""
+
+    def __init__(self, option_strings, dest, new, **kwargs):
+        self.new = new
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print("%s: %s is deprecated: use %s (the same values, as `handcentric audit` spells it); "
+              "the old name goes in the next release" % (PROG, option_string, self.new),
+              file=sys.stderr)
+        setattr(namespace, self.dest, values)
 
 
 def _bounded(low, high):
@@ -100,13 +115,24 @@ def make_parser():
 
     def common(sub, what):
         sub.add_argument("target", metavar="MODULE:FUNCTION", help=what)
-        sub.add_argument("--groups", nargs="+", choices=handcentric.GROUPS, metavar="GROUP",
-                         help="among %s (default: all)" % ", ".join(handcentric.GROUPS))
-        sub.add_argument("--views", nargs="+", choices=handcentric.VIEWS, metavar="VIEW",
-                         help="among %s (default: both)" % ", ".join(handcentric.VIEWS))
+        # Spelled as `handcentric audit` spells them; --groups and --views are the old names.
+        sub.add_argument("--group", nargs="+", choices=handcentric.GROUPS + ("all",),
+                         metavar="GROUP", dest="groups",
+                         help="one or more of %s, or all (the default)"
+                              % ", ".join(handcentric.GROUPS))
+        sub.add_argument("--view", nargs="+", choices=handcentric.VIEWS + ("all",),
+                         metavar="VIEW", dest="views",
+                         help="one or both of %s, or all (the default)"
+                              % ", ".join(handcentric.VIEWS))
+        for old, new, names in (("--groups", "--group", handcentric.GROUPS),
+                                ("--views", "--view", handcentric.VIEWS)):
+            sub.add_argument(old, nargs="+", dest=old[2:], choices=names + ("all",),
+                             action=_Deprecated, new=new, help=argparse.SUPPRESS)
         sub.add_argument("--cases", type=_bounded(1, handcentric.MAX_CASES), metavar="N",
                          help="cases per check, 1 to %d" % handcentric.MAX_CASES)
-        sub.add_argument("--seed", type=int, metavar="S", help="RapidCheck's seed (default 1)")
+        sub.add_argument("--seed", type=int, metavar="S",
+                         help="seeds all the audit draws: the cases, a policy's noise, the "
+                              "in-distribution draws (default 1)")
         sub.add_argument("--precision", choices=("float64", "float32", "bfloat16", "float16"),
                          help="the arithmetic of the callable, for the tolerance "
                               "(default float64)")
@@ -125,8 +151,10 @@ def make_parser():
                              help="fix the number of %s (default: drawn per case)" % what)
         sub.add_argument("--quiet", action="store_true", default=None,
                          help="no progress line on stderr")
-        sub.add_argument("--json", metavar="FILE",
-                         help="also write the whole result as JSON to FILE")
+        sub.add_argument("--json", nargs="?", const="-", metavar="FILE",
+                         help="print the whole result as JSON instead of the lines, as "
+                              "`handcentric audit --json` does (--json FILE, which also wrote "
+                              "FILE, is the old form)")
 
     audit = commands.add_parser(
         "audit", help="audit a representation (handcentric.audit)",
@@ -163,6 +191,8 @@ def _keywords(args):
                    "array", "device", "history", "hand_points", "world_points", "chunk",
                    "quiet", "rng"):
         value = getattr(args, option, None)
+        if option in ("groups", "views") and value and "all" in value:
+            value = None  # all: the module's default
         if value is not None:
             out[option] = tuple(value) if isinstance(value, list) else value
     return out
@@ -221,11 +251,21 @@ def main(argv=None):
         # Wrong shapes, bad tolerances and the like: the module's message is the diagnosis.
         print("%s: %s" % (PROG, e), file=sys.stderr)
         return 1
+    if args.json == "-":
+        try:
+            sys.stdout.write(json.dumps(result, indent=1) + "\n")
+            sys.stdout.flush()
+        except BrokenPipeError:  # `| head`: the reader has what it wanted
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     name = result.get("name", args.target)
     print("%s %s (%s)" % (args.command, name, args.target))
     for line in summary_lines(result):
         print("  " + line)
     if args.json:
+        print("%s: --json FILE is deprecated: use --json > FILE (the JSON on stdout, as "
+              "`handcentric audit --json`); the FILE form goes in the next release" % PROG,
+              file=sys.stderr)
         with open(args.json, "w") as out:
             json.dump(result, out, indent=1)
             out.write("\n")

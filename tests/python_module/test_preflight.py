@@ -215,7 +215,7 @@ def test_the_command_line_takes_rng_and_reset_and_prints_the_preflight(tmp_path,
         "stateful = HistoryBuffer()\n"
         "reset = stateful.reset\n" % str(__import__("os").path.dirname(__file__)))
     target = str(tmp_path / "shipped.py")
-    common = ["--groups", "se3", "--views", "eye_in_hand", "--cases", "20", "--quiet"]
+    common = ["--group", "se3", "--view", "eye_in_hand", "--cases", "20", "--quiet"]
     assert cli.main(["audit-policy", target + ":noisy"] + common) == 0
     out = capsys.readouterr().out
     assert "no pointwise verdict:" in out and "pointwise" not in out.split("no pointwise")[0]

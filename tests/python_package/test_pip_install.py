@@ -91,16 +91,15 @@ def test_the_plugin_helper_and_the_pytest_helpers_work_from_the_venv(venv):
     assert result["caught"] and "translation" in result["caught"]
 
 
-def test_python_m_handcentric_audits_a_representation_file(venv, tmp_path):
-    report = tmp_path / "audit.json"
-    out = venv.run(venv.python, "-m", "handcentric", "audit",
-                   POLICIES + ":absolute_actions", "--groups", "translation", "rotation",
-                   "--views", "eye_in_hand", "--cases", "50", "--json", str(report))
+def test_python_m_handcentric_audits_a_representation_file(venv):
+    command = [venv.python, "-m", "handcentric", "audit", POLICIES + ":absolute_actions",
+               "--group", "translation", "rotation", "--view", "eye_in_hand", "--cases", "50"]
+    out = venv.run(*command)
     lines = out.stdout.splitlines()
     assert "absolute_actions" in lines[0]
     # Absolute actions: invariant under nothing; one line per verdict, each a NO.
     verdicts = [line.split() for line in lines if line.split()[:1] == ["eye_in_hand"]]
-    checks = json.loads(report.read_text())["checks"]
+    checks = json.loads(venv.run(*command, "--json").stdout)["checks"]
     assert len(verdicts) == len(checks) > 0
     assert {(v[1], v[2], v[3], v[4]) for v in verdicts} == {
         (c["component"], c["mode"], c["group"], "yes" if c["invariant"] else "NO")
