@@ -124,13 +124,6 @@ std::vector<props::Group> parse_groups(const std::string& name) {
   return {props::parse_group(name)};  // throws InvalidArgument naming the valid names
 }
 
-std::vector<props::View> parse_views(const std::string& name) {
-  if (name == "all") return {props::View::eye_in_hand, props::View::third_person};
-  if (name == "eye_in_hand") return {props::View::eye_in_hand};
-  if (name == "third_person") return {props::View::third_person};
-  throw InvalidArgument("unknown --view '" + name + "'; use eye_in_hand, third_person or all");
-}
-
 // One --expect item: GROUP (every component) or COMPONENT:GROUP.
 struct Expectation {
   std::optional<props::Component> component;
@@ -237,7 +230,7 @@ void require_recorded_names(const props::AuditOptions& audit,
 int run_audit(const AuditCommandOptions& options) {
   props::AuditOptions audit;
   audit.groups = parse_groups(options.group);
-  audit.views = parse_views(options.view);
+  audit.views = props::parse_views({options.view}, "view");
   audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
   audit.seed = options.seed;
   audit.precision = props::parse_precision(options.precision);

@@ -129,16 +129,14 @@ int run_audit_profile(const ProfileCommand& command) {
         "--profile all: a profile is drawn for one group; use --profile translation, rotation, "
         "se2, se3 or c8");
   const props::Group group = props::parse_group(command.group);
-  if (command.view != "all" && command.view != "eye_in_hand" && command.view != "third_person")
-    throw InvalidArgument("unknown --view '" + command.view +
-                          "'; use eye_in_hand or third_person with --profile");
+  // A profile is of one view: "all" (the audit's default) draws the eye-in-hand one.
+  const props::View view = props::parse_views({command.view}, "view").front();
   props::ProfileOptions options;
   options.seed = command.seed;
   options.noise_seed = command.seed;  // the policy's fixed noise and the laws' draws too
   options.scenes = command.scenes;
   options.sizes = command.sizes;
-  options.shape = props::shape_for(command.view == "third_person" ? props::View::third_person
-                                                                  : props::View::eye_in_hand);
+  options.shape = props::shape_for(view);
   std::vector<props::Profile> profiles;
   if (!command.exec.empty()) {
     profiles = exec_profiles(command, group, options);

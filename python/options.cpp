@@ -37,19 +37,7 @@ std::vector<props::Group> groups_of(py::handle value) {
 }
 
 std::vector<props::View> views_of(py::handle value) {
-  std::vector<props::View> out;
-  for (const std::string& name : names_of(value, "views")) {
-    if (name == "all") return {props::View::eye_in_hand, props::View::third_person};
-    if (name == "eye_in_hand") {
-      out.push_back(props::View::eye_in_hand);
-    } else if (name == "third_person") {
-      out.push_back(props::View::third_person);
-    } else {
-      throw InvalidArgument("unknown view '" + name + "'; use eye_in_hand, third_person or all");
-    }
-  }
-  if (out.empty()) throw InvalidArgument("views is empty; name eye_in_hand, third_person or both");
-  return out;
+  return props::parse_views(names_of(value, "views"), "view", props::kPythonSpelling);
 }
 
 /// `value` (a Python int of any size, or anything with __index__ such as a NumPy integer) in
@@ -223,8 +211,8 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
   o.audit.groups = groups_of(groups);
   o.audit.views = views_of(views);
   o.audit.seed = seed;
-  o.audit.precision = props::parse_precision(precision, "precision");
-  o.audit.tolerance_option = "tolerance";
+  o.audit.spelling = props::kPythonSpelling;
+  o.audit.precision = props::parse_precision(precision, props::kPythonSpelling);
   if (tolerance) {
     if (!(*tolerance > 0.0)) {
       throw InvalidArgument("tolerance must be in (0, 1), got " + std::to_string(*tolerance) +
@@ -255,9 +243,6 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
 
 props::ClassifierOptions classifier_for(const CommonOptions& o) {
   props::ClassifierOptions c = props::classifier_options(o.audit);
-  c.precision_advice = [](const std::string& precision) {
-    return "pass precision=\"" + precision + "\"";
-  };
   props::SceneShape& shape = c.check.shape;
   shape.extra_pose_names = o.extra_poses;
   shape.scalar_names = o.scalars;

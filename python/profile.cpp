@@ -82,11 +82,12 @@ py::dict equivariance_profile(const Profiled& what, py::object group_object,
     throw py::error_already_set();  // warnings turned into errors
   require_numpy("equivariance_profile");
   const props::Group parsed_group = props::parse_group(group);
-  if (view != "eye_in_hand" && view != "third_person")
-    throw InvalidArgument("view '" + view +
-                          "' is not one; use \"eye_in_hand\" or \"third_person\"");
+  if (view == "all")
+    throw InvalidArgument(
+        "view 'all': a profile is of one view; use \"eye_in_hand\" or "
+        "\"third_person\"");
   const props::View parsed_view =
-      view == "third_person" ? props::View::third_person : props::View::eye_in_hand;
+      props::parse_views({view}, "view", props::kPythonSpelling).front();
   const CommonOptions o =
       common_options(py::make_tuple(group), py::make_tuple(view), py::int_(1), seed, std::nullopt,
                      "float64", py::tuple(), py::tuple(), setup);

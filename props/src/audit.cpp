@@ -62,12 +62,12 @@ std::vector<std::string> auditable_names() {
   return names;
 }
 
-Precision parse_precision(const std::string& name, const std::string& option) {
+Precision parse_precision(const std::string& name, const Spelling& spelling) {
   if (name == "float64") return Precision::float64;
   if (name == "float32") return Precision::float32;
   if (name == "bfloat16") return Precision::bfloat16;
   if (name == "float16") return Precision::float16;
-  throw InvalidArgument("unknown " + option + " '" + name +
+  throw InvalidArgument("unknown " + spelling.option("precision") + " '" + name +
                         "'; use float64 (the default), float32, bfloat16 or float16: the "
                         "arithmetic the policy or representation is computed in");
 }
@@ -103,11 +103,13 @@ double precision_relative_tolerance(Precision precision) {
   return kRelativeTolerance;
 }
 
-int checked_cases(long long cases) {
-  if (cases < 1) throw InvalidArgument("--cases must be at least 1, got " + std::to_string(cases));
+int checked_cases(long long cases, const Spelling& spelling) {
+  if (cases < 1)
+    throw InvalidArgument(spelling.option("cases") + " must be at least 1, got " +
+                          std::to_string(cases));
   if (cases > kMaxCases) {
-    throw InvalidArgument("--cases " + std::to_string(cases) + " is above the bound " +
-                          std::to_string(kMaxCases) +
+    throw InvalidArgument(spelling.with_value("cases", std::to_string(cases), false) +
+                          " is above the bound " + std::to_string(kMaxCases) +
                           " (10^7 cases already take hours per cell through a plug-in)");
   }
   return static_cast<int>(cases);
@@ -116,15 +118,16 @@ int checked_cases(long long cases) {
 double audit_relative_tolerance(const AuditOptions& options) {
   const double relative = options.relative_tolerance;
   if (!(relative >= 0.0 && relative < 1.0)) {
-    throw InvalidArgument(options.tolerance_option + " must be a number in (0, 1), got " +
-                          format_number(relative) + "; e.g. 1e-6, or a lower precision");
+    throw InvalidArgument(options.spelling.option("tolerance") +
+                          " must be a number in (0, 1), got " + format_number(relative) +
+                          "; e.g. 1e-6, or a lower precision");
   }
   if (relative > 0.0) return relative;
   return precision_relative_tolerance(options.precision);
 }
 
 ClassifierOptions classifier_options(const AuditOptions& options) {
-  (void)checked_cases(options.cases);
+  (void)checked_cases(options.cases, options.spelling);
   if (options.views.empty() || options.groups.empty()) {
     throw InvalidArgument("an audit needs at least one view and one group");
   }
@@ -132,6 +135,10 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
   classifier.groups = options.groups;
   classifier.views = options.views;
   classifier.check.cases = options.cases;
+  classifier.precision_advice = [spelling = options.spelling](const std::string& precision) {
+    return (spelling.command_line ? "rerun with " : "pass ") +
+           spelling.with_value("precision", precision);
+  };
   classifier.check.seed = options.seed;
   // One seed for everything the audit draws: the cases, a policy's fixed noise, the laws' draws.
   classifier.check.noise_seed = options.seed;

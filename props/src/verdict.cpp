@@ -51,6 +51,24 @@ std::string to_string(View view) {
   return view == View::eye_in_hand ? "eye_in_hand" : "third_person";
 }
 
+std::vector<View> parse_views(const std::vector<std::string>& names, const std::string& option,
+                              const Spelling& spelling) {
+  std::vector<View> out;
+  for (const std::string& name : names) {
+    if (name == "all") return {View::eye_in_hand, View::third_person};
+    if (name == "eye_in_hand" || name == "third_person") {
+      out.push_back(name == "eye_in_hand" ? View::eye_in_hand : View::third_person);
+    } else {
+      throw InvalidArgument("unknown " + spelling.option(option) + " '" + name +
+                            "'; use eye_in_hand, third_person or all");
+    }
+  }
+  if (out.empty())
+    throw InvalidArgument(spelling.option(option) +
+                          " is empty; name eye_in_hand, third_person or both");
+  return out;
+}
+
 std::string to_string(Method method) {
   switch (method) {
     case Method::compared:

@@ -233,7 +233,7 @@ TEST_CASE("float32_rounding_gets_a_note_and_passes_at_float32_tolerance", "[prop
                     Catch::Matchers::Contains("--tolerance"));
   CHECK_THROWS_WITH(props::parse_precision("float8"),
                     Catch::Matchers::Contains("unknown --precision 'float8'"));
-  CHECK_THROWS_WITH(props::parse_precision("half", "precision"),
+  CHECK_THROWS_WITH(props::parse_precision("half", props::kPythonSpelling),
                     Catch::Matchers::Contains("unknown precision 'half'"));
 }
 

@@ -91,7 +91,7 @@ double Workspace::room_for(Group group) const {
       throw InvalidArgument("the workspace " + describe() +
                             " does not contain the origin, about which the rotation group turns "
                             "the scene: give a box around the origin, or leave rotation out "
-                            "(e.g. --group se3)");
+                            "(e.g. audit se3 alone)");
     }
     return room;
   }
@@ -100,7 +100,7 @@ double Workspace::room_for(Group group) const {
     if (!(room > 0.0)) {
       throw InvalidArgument("the workspace " + describe() +
                             " does not contain the z axis, about which c8 turns the scene: give a "
-                            "box around x = y = 0, or leave c8 out (e.g. --group se2)");
+                            "box around x = y = 0, or leave c8 out (e.g. audit se2 alone)");
     }
     return room;
   }

@@ -22,7 +22,7 @@ enum class Precision { float64, float32, bfloat16, float16 };
 /// "float64", "float32", "bfloat16" or "float16"; throws InvalidArgument naming the value, the
 /// option as the caller spells it (`option`: "--precision" on the command line, "precision" in
 /// Python) and the names otherwise.
-Precision parse_precision(const std::string& name, const std::string& option = "--precision");
+Precision parse_precision(const std::string& name, const Spelling& spelling = kCommandLineSpelling);
 
 /// The unit roundoff of a precision: 2^-53, 2^-24, 2^-8 (bfloat16), 2^-11 (float16).
 double unit_roundoff(Precision precision);
@@ -50,8 +50,8 @@ struct AuditOptions {
   Precision precision = Precision::float64;
   /// REL of the tolerance REL * (1 + L); 0 = from `precision` (precision_relative_tolerance).
   double relative_tolerance = 0.0;
-  /// How the caller spells the tolerance option in messages ("--tolerance", "tolerance=").
-  std::string tolerance_option = "--tolerance";
+  /// How the caller names the options in messages (spelling.hpp).
+  Spelling spelling = kCommandLineSpelling;
   /// Draw every case inside this box, g * scene included (workspace.hpp); none: anywhere.
   std::optional<Workspace> workspace;
   /// Draw every scene from these (observation/recorded.hpp); none: random scenes.
@@ -60,7 +60,7 @@ struct AuditOptions {
 
 /// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value
 /// and the bound, in one line. Wide enough to take an unchecked command-line number.
-int checked_cases(long long cases);
+int checked_cases(long long cases, const Spelling& spelling = kCommandLineSpelling);
 
 /// The REL an audit uses: options.relative_tolerance if set, else the precision's. Throws
 /// InvalidArgument for a negative, non-finite or >= 1 tolerance.

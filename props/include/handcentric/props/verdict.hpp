@@ -10,10 +10,12 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/core/scene.hpp"
 #include "handcentric/props/group.hpp"
+#include "handcentric/props/spelling.hpp"
 
 namespace handcentric::props {
 
@@ -47,6 +49,11 @@ std::string to_string(Component component);
 std::string to_string(Mode mode);
 /// "eye_in_hand", "third_person".
 std::string to_string(View view);
+/// The views `names` name, each "eye_in_hand" or "third_person", or "all" for both; InvalidArgument
+/// naming the option `option` ("views", "view") in the caller's spelling for an unknown name or
+/// none.
+std::vector<View> parse_views(const std::vector<std::string>& names, const std::string& option,
+                              const Spelling& spelling = kCommandLineSpelling);
 /// "compared", "exact_gaussian", "energy_test", "partly_exact".
 std::string to_string(Method method);
 
