@@ -26,7 +26,7 @@
 //   distribution: (flow targets and policies; a deterministic component has none) a distance
 //                 between the law of the left side and the law of the right side, eps ~ N(0, I),
 //                 divided by c:
-//                 exact_gaussian where both sides are affine in eps (distribution.hpp's
+//                 exact_gaussian where both sides are affine in eps (affine_law.hpp's
 //                 affine_law; every rectified flow, ActionFlow's target): the larger of
 //                 |mean_a - mean_b|_inf and |Sigma_a - Sigma_b|_inf / (2 s), s the largest
 //                 standard deviation of either law (the change of a standard deviation of size
