@@ -197,7 +197,8 @@ PythonPolicy::PythonPolicy(py::object policy, Eigen::Index noise, CallOptions op
       noise_(noise),
       options_(std::move(options)),
       name_("python: " + callable_name(policy_)) {
-  if (!options_.rng.empty()) rng_module_ = py::module_::import("handcentric._rng");
+  // The preflight watches the global generators of every policy; rng= seeds them per call.
+  rng_module_ = py::module_::import("handcentric._rng");
 }
 
 void PythonPolicy::watch_draws(bool on) const {
@@ -257,10 +258,10 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
     for (auto item : extra) seeded[item.first] = item.second;
   }
   py::object before;
-  if (watching_) before = py::module_::import("handcentric._rng").attr("snapshot")();
+  if (watching_) before = rng_module_.attr("snapshot")();
   const auto watched = [&](py::object result) {
     if (watching_) {
-      for (auto name : py::module_::import("handcentric._rng").attr("advanced")(before)) {
+      for (auto name : rng_module_.attr("advanced")(before)) {
         const std::string n = py::str(name);
         if (std::find(draws_.begin(), draws_.end(), n) == draws_.end()) draws_.push_back(n);
       }

@@ -93,7 +93,7 @@ class PythonPolicy final : public props::BatchPolicy {
   Eigen::Index noise_;
   CallOptions options_;
   std::string name_;
-  py::object rng_module_;  ///< handcentric._rng, imported when first needed
+  py::object rng_module_;  ///< handcentric._rng: the generators' snapshots and seeding
   mutable bool watching_ = false;
   mutable std::vector<std::string> draws_;  ///< generators advanced since watch_draws(true)
 };

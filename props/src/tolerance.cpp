@@ -125,7 +125,7 @@ std::string pose_defect(const Eigen::Matrix4d& M, double tolerance) {
   }
   const Eigen::Matrix3d R = M.topLeftCorner<3, 3>();
   const double orthonormality =
-      (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+      (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
   const double determinant = R.determinant();
   if (!(orthonormality <= tolerance) || !(std::abs(determinant - 1.0) <= tolerance)) {
     return "its rotation block is not a rotation: |R^T R - I|_max = " +

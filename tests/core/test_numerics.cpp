@@ -174,7 +174,7 @@ Eigen::Vector3d translation() {
 Eigen::Vector4d quaternion() {
   Eigen::Vector4d q;
   for (int i = 0; i < 4; ++i) q(i) = 2.0 * unit() - 1.0;
-  if (!(q.cwiseAbs().maxCoeff() > 0.0)) q(0) = 1.0;
+  if (!(q.cwiseAbs().maxCoeff<Eigen::PropagateNaN>() > 0.0)) q(0) = 1.0;
   return decade(-300, 300) * q;
 }
 
@@ -307,7 +307,7 @@ Rotation real_from_matrix(const Eigen::Matrix3d& M) {
 // Certainly not orthonormal, also where R^T R is not computable (entries near 1e300 give inf -
 // inf = nan): an orthonormal matrix has no entry above 1.
 bool certainly_not_orthonormal(const Eigen::Matrix3d& M) {
-  return M.cwiseAbs().maxCoeff() > 2.0 || orthonormality_error(M) > 1e-8;
+  return M.cwiseAbs().maxCoeff<Eigen::PropagateNaN>() > 2.0 || orthonormality_error(M) > 1e-8;
 }
 
 enum class Kind { rotation, rounded_rotation, non_finite, non_orthonormal, reflection };

@@ -36,7 +36,7 @@ void exercise(const Rotation& R) {
 // two stay far from overflow); beyond that only the matrix itself is checked.
 void exercise(const RigidTransform& T) {
   require_finite(T.matrix());
-  if (T.translation().cwiseAbs().maxCoeff() > 1e150) return;
+  if (T.translation().cwiseAbs().maxCoeff<Eigen::PropagateNaN>() > 1e150) return;
   require_finite(T.log());
   require_finite(T.inverse().matrix());
   require_finite((T * T.inverse()).matrix());

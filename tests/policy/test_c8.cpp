@@ -34,11 +34,11 @@ auto action_matches_scene_transform(int hand_points) {
     RC_ASSERT(
         (absolute.encode_actions(g * scene) - c8::act_on_actions(R, absolute.encode_actions(scene)))
             .cwiseAbs()
-            .maxCoeff() < 1e-9);
+            .maxCoeff<Eigen::PropagateNaN>() < 1e-9);
     RC_ASSERT((absolute.encode_observation(g * scene) -
                c8::act_on_observation(R, absolute.encode_observation(scene), 2, hand_points))
                   .cwiseAbs()
-                  .maxCoeff() < 1e-9);
+                  .maxCoeff<Eigen::PropagateNaN>() < 1e-9);
   };
 }
 
@@ -54,8 +54,9 @@ TEST_CASE("c8_action_on_absolute_vectors_is_the_scene_transform", "[property]") 
 TEST_CASE("c8_rotations_compose_exactly", "[unit]") {
   for (int j = 0; j < 8; ++j) {
     for (int k = 0; k < 8; ++k) {
-      CHECK((c8::rotation(j) * c8::rotation(k) - c8::rotation(j + k)).cwiseAbs().maxCoeff() <
-            1e-15);
+      CHECK((c8::rotation(j) * c8::rotation(k) - c8::rotation(j + k))
+                .cwiseAbs()
+                .maxCoeff<Eigen::PropagateNaN>() < 1e-15);
     }
   }
 }
@@ -76,12 +77,13 @@ TEST_CASE("c8_velocity_push_forward_matches_finite_differences", "[unit]") {
         (c8::act_on_actions(R, a + h * v) - c8::act_on_actions(R, a - h * v)) / (2 * h);
     if (a.segment<3>(3).norm() > 3.0 || a.segment<3>(9).norm() > 3.0)
       continue;  // keep away from |r| = pi
-    worst = test::worst_of(worst, (numeric - c8::push_velocity(R, a, v)).cwiseAbs().maxCoeff());
+    worst = test::worst_of(
+        worst, (numeric - c8::push_velocity(R, a, v)).cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
     // Planted fault: rotating the rotation-vector velocity like a translation.
     Eigen::VectorXd naive = v;
     for (int i = 0; i < 12; i += 3) naive.segment<3>(i) = R * v.segment<3>(i);
-    worst_without_jacobians =
-        test::worst_of(worst_without_jacobians, (numeric - naive).cwiseAbs().maxCoeff());
+    worst_without_jacobians = test::worst_of(
+        worst_without_jacobians, (numeric - naive).cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
   }
   CHECK(worst < 1e-6);
   CHECK(worst_without_jacobians > 1e-2);
@@ -112,7 +114,8 @@ auto field_equivariant(std::shared_ptr<const LearnedPolicy> policy, props::Group
     const Eigen::VectorXd F_moved = c8_velocity(policy->head(), x_moved, o_moved, t, symmetrized);
     // g_* for a rigid g = [R | p]: the translation part of a velocity only rotates.
     const Eigen::VectorXd expected = c8::push_velocity(g.rotation().matrix(), x, F);
-    RC_ASSERT((F_moved - expected).cwiseAbs().maxCoeff() <= 1e-4 * (1.0 + F.cwiseAbs().maxCoeff()));
+    RC_ASSERT((F_moved - expected).cwiseAbs().maxCoeff<Eigen::PropagateNaN>() <=
+              1e-4 * (1.0 + F.cwiseAbs().maxCoeff<Eigen::PropagateNaN>()));
   };
 }
 

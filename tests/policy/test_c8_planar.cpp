@@ -79,7 +79,7 @@ double worst_scene_mismatch(const Act& act) {
           const Eigen::VectorXd expected = c8::encode_planar(of_moved, layout);
           return (expected - act(k, centre, c8::encode_planar(of_scene, layout), layout))
               .cwiseAbs()
-              .maxCoeff();
+              .maxCoeff<Eigen::PropagateNaN>();
         };
         worst = test::worst_of(worst, mismatch(absolute.encode_actions(moved),
                                                absolute.encode_actions(scene), kActions));
@@ -143,8 +143,9 @@ TEST_CASE("c8_planar_action_is_a_group_action", "[unit]") {
       for (int k = 0; k < 8; ++k) {
         const Eigen::VectorXd two_steps =
             c8::act_planar(j, centre, c8::act_planar(k, centre, x, kObservations), kObservations);
-        CHECK((two_steps - c8::act_planar(j + k, centre, x, kObservations)).cwiseAbs().maxCoeff() <
-              1e-10);
+        CHECK((two_steps - c8::act_planar(j + k, centre, x, kObservations))
+                  .cwiseAbs()
+                  .maxCoeff<Eigen::PropagateNaN>() < 1e-10);
       }
     }
   }
@@ -155,10 +156,11 @@ TEST_CASE("c8_planar_encoding_round_trips_without_a_wrap", "[unit]") {
   for (std::uint64_t seed = 0; seed < 10; ++seed) {
     const Eigen::VectorXd a = absolute.encode_actions(planar_scene(seed));
     const Eigen::VectorXd planar = c8::encode_planar(a, kActions);
-    CHECK((c8::decode_planar(planar, kActions) - a).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK((c8::decode_planar(planar, kActions) - a).cwiseAbs().maxCoeff<Eigen::PropagateNaN>() <
+          1e-12);
     CHECK((c8::encode_planar(c8::decode_planar(planar, kActions), kActions) - planar)
               .cwiseAbs()
-              .maxCoeff() < 1e-12);
+              .maxCoeff<Eigen::PropagateNaN>() < 1e-12);
     // The network's (cos, sin) need not be unit length: the heading is its direction.
     Eigen::VectorXd scaled = planar;
     scaled.segment<2>(3) *= 0.3;
@@ -199,7 +201,8 @@ TEST_CASE("c8_augmented_data_is_c8_invariant", "[unit]") {
     for (int i = 0; i < 5; ++i) {
       for (int k = 0; k < 8; ++k) {
         const Eigen::VectorXd moved = c8::act_planar(j, centre, orbit.col(8 * i + k), kActions);
-        CHECK((moved - orbit.col(8 * i + (k + j) % 8)).cwiseAbs().maxCoeff() < 1e-10);
+        CHECK((moved - orbit.col(8 * i + (k + j) % 8)).cwiseAbs().maxCoeff<Eigen::PropagateNaN>() <
+              1e-10);
       }
     }
   }

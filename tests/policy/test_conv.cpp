@@ -176,7 +176,8 @@ struct Reference {
 };
 
 double relative_error(const Eigen::MatrixXd& x, const Eigen::MatrixXd& reference) {
-  return (x - reference).cwiseAbs().maxCoeff() / (1.0 + reference.cwiseAbs().maxCoeff());
+  return (x - reference).cwiseAbs().maxCoeff<Eigen::PropagateNaN>() /
+         (1.0 + reference.cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
 }
 
 struct Case {

@@ -34,7 +34,7 @@ float encoder_change(const LearnedPolicy& a, const LearnedPolicy& b) {
   const ConvEncoder* after = image_encoder(b.head());
   REQUIRE(before != nullptr);
   REQUIRE(after != nullptr);
-  return (before->parameters() - after->parameters()).cwiseAbs().maxCoeff();
+  return (before->parameters() - after->parameters()).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
 }
 
 // `count` training samples of config's shape: actions uniform in [-0.5, 0.5), observations

@@ -856,8 +856,8 @@ TEST_CASE("mlp_on_every_kernel_set_matches_the_double_network", "[unit]") {
       const Eigen::MatrixXf out = net.forward(input.cast<float>());
       const Eigen::MatrixXf din = net.backward(d_output.cast<float>());
       const auto relative = [](const auto& x, const Eigen::MatrixXd& y) {
-        return (x.template cast<double>() - y).cwiseAbs().maxCoeff() /
-               (1.0 + y.cwiseAbs().maxCoeff());
+        return (x.template cast<double>() - y).cwiseAbs().template maxCoeff<Eigen::PropagateNaN>() /
+               (1.0 + y.cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
       };
       CHECK(relative(out, output) < 1e-5);
       CHECK(relative(din, d_input) < 1e-5);

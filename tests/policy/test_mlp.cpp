@@ -161,7 +161,7 @@ TEST_CASE("mse_and_kl_gradients_match_finite_differences", "[unit]") {
   // Planted fault: the gradient of the mean absolute error is not that of the MSE.
   CHECK((d_pred - (pred - target).cwiseSign() / static_cast<double>(pred.size()))
             .cwiseAbs()
-            .maxCoeff() > 1e-3);
+            .maxCoeff<Eigen::PropagateNaN>() > 1e-3);
 }
 
 TEST_CASE("adam_minimizes_a_quadratic_and_clipping_bounds_the_norm", "[unit]") {
@@ -171,7 +171,9 @@ TEST_CASE("adam_minimizes_a_quadratic_and_clipping_bounds_the_norm", "[unit]") {
     Eigen::VectorXf gradient = 2.0f * (x - Eigen::VectorXf::LinSpaced(4, -1.0f, 1.0f));
     adam.step(x, gradient);
   }
-  CHECK((x - Eigen::VectorXf::LinSpaced(4, -1.0f, 1.0f)).cwiseAbs().maxCoeff() < 1e-3f);
+  CHECK(
+      (x - Eigen::VectorXf::LinSpaced(4, -1.0f, 1.0f)).cwiseAbs().maxCoeff<Eigen::PropagateNaN>() <
+      1e-3f);
   Eigen::VectorXf g = Eigen::VectorXf::Constant(4, 10.0f);
   CHECK(clip_gradient_norm(g, 1.0) == Approx(20.0));
   CHECK(g.norm() == Approx(1.0f));
@@ -192,7 +194,7 @@ TEST_CASE("sinusoidal_time_features_are_bounded_and_distinguish_times", "[unit]"
   Eigen::VectorXf a(16), b(16);
   time_features(0.3, 16, a);
   time_features(0.31, 16, b);
-  CHECK(a.cwiseAbs().maxCoeff() <= 1.0f);
+  CHECK(a.cwiseAbs().maxCoeff<Eigen::PropagateNaN>() <= 1.0f);
   CHECK((a - b).norm() > 1e-2f);
   Eigen::VectorXf raw(1);
   time_features(0.3, 0, raw);

@@ -105,7 +105,8 @@ Eigen::MatrixXd uniform_matrix(Eigen::Index rows, Eigen::Index cols, double scal
 }
 
 double largest_relative_error(const Eigen::MatrixXd& got, const Eigen::MatrixXd& want) {
-  return (got - want).cwiseAbs().maxCoeff() / (1.0 + want.cwiseAbs().maxCoeff());
+  return (got - want).cwiseAbs().maxCoeff<Eigen::PropagateNaN>() /
+         (1.0 + want.cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
 }
 
 struct SoftmaxCase {

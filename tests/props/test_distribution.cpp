@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 #include <Eigen/Geometry>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <random>
 
@@ -164,6 +165,20 @@ TEST_CASE("affine_law_reads_mean_and_noise_map_and_refuses_a_curved_map", "[unit
   props::GaussianLaw stretched = *law;
   stretched.noise_map *= 2.0;
   CHECK(props::law_difference(*law, stretched).covariance > 1.0);
+}
+
+// Mutant seen failing: with Eigen's default maxCoeff() (NaN dropped unless first) the NaN mean
+// coordinate below gave a difference of 0, "equal laws".
+TEST_CASE("a_nan_in_a_laws_mean_or_covariance_is_a_difference_not_a_match", "[unit]") {
+  props::GaussianLaw a;
+  a.mean = Eigen::Vector3d(1.0, 2.0, 3.0);
+  a.noise_map = Eigen::Matrix3d::Identity();
+  props::GaussianLaw b = a;
+  b.mean(1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(props::law_difference(a, b).mean <= 1e-9);
+  props::GaussianLaw c = a;
+  c.noise_map(2, 1) = std::numeric_limits<double>::quiet_NaN();
+  CHECK_FALSE(props::law_difference(a, c).covariance <= 1e-9);
 }
 
 TEST_CASE("the_world_delta_mode_is_never_called_invariant_in_distribution_under_rotations",

@@ -112,17 +112,18 @@ LawDifference law_difference(const GaussianLaw& a, const GaussianLaw& b) {
     return difference;
   }
   if (a.mean.size() == 0) return difference;
-  difference.mean = (a.mean - b.mean).cwiseAbs().maxCoeff();
+  difference.mean = (a.mean - b.mean).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
   // Equal noise maps give equal covariances, the common case (a rectified flow's J is the same
   // for every scene): skip the two products then.
   const bool same_map = a.noise_map.cols() == b.noise_map.cols() && a.noise_map == b.noise_map;
   const Eigen::MatrixXd covariance_a = a.noise_map * a.noise_map.transpose();
-  difference.covariance_scale = std::max(1.0, covariance_a.cwiseAbs().maxCoeff());
+  difference.covariance_scale =
+      std::max(1.0, covariance_a.cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
   if (same_map) return difference;
   const Eigen::MatrixXd covariance_b = b.noise_map * b.noise_map.transpose();
-  difference.covariance_scale =
-      std::max(difference.covariance_scale, covariance_b.cwiseAbs().maxCoeff());
-  difference.covariance = (covariance_a - covariance_b).cwiseAbs().maxCoeff();
+  difference.covariance_scale = std::max(difference.covariance_scale,
+                                         covariance_b.cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
+  difference.covariance = (covariance_a - covariance_b).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
   return difference;
 }
 

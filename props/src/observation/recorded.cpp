@@ -81,7 +81,8 @@ RigidTransform pose_of(const double* m, const std::string& where) {
   Eigen::Matrix4d M;
   for (int r = 0; r < 4; ++r)
     for (int c = 0; c < 4; ++c) M(r, c) = m[4 * r + c];
-  const double row = (M.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff();
+  const double row =
+      (M.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
   if (!(row <= 1e-6))
     throw InvalidArgument(where + " is not a rigid transform: its last row is " +
                           format_matrix(Eigen::MatrixXd(M.row(3))) + ", expected 0 0 0 1");
