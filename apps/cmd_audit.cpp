@@ -204,29 +204,6 @@ int gate(const std::vector<props::Classification>& results,
   return failed == 0 ? 0 : 1;
 }
 
-// A plug-in's declared extra poses and scalars must be in recorded observations: the pipe would
-// otherwise fill the missing ones with placeholders the data never had.
-void require_recorded_names(const props::AuditOptions& audit,
-                            const props::PluginCapabilities& capabilities) {
-  if (!audit.observations) return;
-  const Scene& first = audit.observations->scenes.front();
-  auto has = [](const auto& named, const std::string& name) {
-    return std::any_of(named.begin(), named.end(), [&](const auto& n) { return n.first == name; });
-  };
-  for (const std::string& name : capabilities.extra_pose_names) {
-    if (!has(first.extra_poses, name))
-      throw InvalidArgument("the plug-in asks for extra pose '" + name +
-                            "', which the observations of " + audit.observations->source +
-                            " do not record: add it under \"extra_poses\"");
-  }
-  for (const std::string& name : capabilities.scalar_names) {
-    if (!has(first.scalars, name))
-      throw InvalidArgument("the plug-in asks for scalar '" + name +
-                            "', which the observations of " + audit.observations->source +
-                            " do not record: add it under \"scalars\"");
-  }
-}
-
 int run_audit(const AuditCommandOptions& options) {
   props::AuditOptions audit;
   audit.groups = parse_groups(options.group);
@@ -253,35 +230,25 @@ int run_audit(const AuditCommandOptions& options) {
                                                               options.extra_poses, options.scalars);
     if (audit.observations) plugin->use_probe(audit.observations->scenes.front());
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
-    require_recorded_names(audit, capabilities);
-    props::ClassifierOptions classifier = props::classifier_options(audit);
+    props::ClassifierOptions classifier = props::plugin_classifier_options(audit, capabilities);
     classifier.observation = plugin->provides_observation();
-    classifier.check.shape.extra_pose_names = capabilities.extra_pose_names;
-    classifier.check.shape.scalar_names = capabilities.scalar_names;
     std::shared_ptr<const FlowTarget> flow;
     if (capabilities.flow) flow = std::make_shared<props::PipeFlowTarget>(plugin);
     std::shared_ptr<const Representation> audited = plugin;
-    if (capabilities.batch > 0) {
-      // Prefetch passes gather each check's scenes so that they go in batched requests; the
-      // verdicts and the JSON are those of the audit one scene at a time (batch.hpp).
+    // Batched requests, with the verdicts and JSON of one scene at a time (batch.hpp).
+    if (capabilities.batch > 0)
       audited = std::make_shared<props::BatchedRepresentation>(plugin, capabilities.batch);
-      classifier.check.prefetch = true;
-    }
     results.push_back(props::classify_representation(audited, classifier, flow));
   } else if (!options.policy_exec.empty()) {
     auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout,
                                                       options.extra_poses, options.scalars);
     if (audit.observations) plugin->use_probe(audit.observations->scenes.front());
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
-    require_recorded_names(audit, capabilities);
-    props::ClassifierOptions classifier = props::classifier_options(audit);
-    classifier.check.shape.extra_pose_names = capabilities.extra_pose_names;
-    classifier.check.shape.scalar_names = capabilities.scalar_names;
+    const props::ClassifierOptions classifier =
+        props::plugin_classifier_options(audit, capabilities);
     std::shared_ptr<const props::NoisyPolicy> audited = plugin;
-    if (capabilities.batch > 0) {  // as for --exec
+    if (capabilities.batch > 0)  // as for --exec
       audited = std::make_shared<props::BatchedPolicy>(plugin, capabilities.batch);
-      classifier.check.prefetch = true;
-    }
     results.push_back(props::classify_policy(audited, classifier));
     policies = true;
     if (!options.witness_dir.empty()) {

@@ -157,6 +157,43 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
   return classifier;
 }
 
+namespace {
+
+// A plug-in's declared extra poses and scalars must be in recorded observations: the pipe would
+// otherwise fill the missing ones with placeholders the data never had.
+void require_recorded_names(const AuditOptions& audit, const PluginCapabilities& capabilities) {
+  if (!audit.observations) return;
+  const Scene& first = audit.observations->scenes.front();
+  auto has = [](const auto& named, const std::string& name) {
+    return std::any_of(named.begin(), named.end(), [&](const auto& n) { return n.first == name; });
+  };
+  for (const std::string& name : capabilities.extra_pose_names) {
+    if (!has(first.extra_poses, name))
+      throw InvalidArgument("the plug-in asks for extra pose '" + name +
+                            "', which the observations of " + audit.observations->source +
+                            " do not record: add it under \"extra_poses\"");
+  }
+  for (const std::string& name : capabilities.scalar_names) {
+    if (!has(first.scalars, name))
+      throw InvalidArgument("the plug-in asks for scalar '" + name +
+                            "', which the observations of " + audit.observations->source +
+                            " do not record: add it under \"scalars\"");
+  }
+}
+
+}  // namespace
+
+ClassifierOptions plugin_classifier_options(const AuditOptions& options,
+                                            const PluginCapabilities& capabilities) {
+  require_recorded_names(options, capabilities);
+  ClassifierOptions classifier = classifier_options(options);
+  classifier.check.shape.extra_pose_names = capabilities.extra_pose_names;
+  classifier.check.shape.scalar_names = capabilities.scalar_names;
+  // Prefetch passes gather each check's questions so that they go in batched requests.
+  classifier.check.prefetch = capabilities.batch > 0;
+  return classifier;
+}
+
 std::vector<Classification> audit_builtins(const std::vector<std::string>& names,
                                            const AuditOptions& options) {
   const ClassifierOptions classifier = classifier_options(options);

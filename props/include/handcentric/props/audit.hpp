@@ -12,6 +12,7 @@
 #include "handcentric/props/checks/classifier.hpp"
 #include "handcentric/props/observation/recorded.hpp"
 #include "handcentric/props/observation/workspace.hpp"
+#include "handcentric/props/transport/plugin_protocol.hpp"
 
 namespace handcentric::props {
 
@@ -74,6 +75,14 @@ std::vector<std::string> auditable_names();
 /// max(10, ceil(cases / 100)), injectivity max(100, cases / 5) chunk pairs and a resolution
 /// scan on max(10, pairs / 8) scenes.
 ClassifierOptions classifier_options(const AuditOptions& options);
+
+/// classifier_options for a plug-in after its hello: the extra poses and scalars it asked for,
+/// and prefetch passes when it answers batches (capabilities.batch > 0; the caller then wraps it
+/// in a BatchedRepresentation or BatchedPolicy of that size). Throws InvalidArgument for a name
+/// the recorded observations (options.observations) do not record: the pipe would fill it with
+/// a placeholder the data never had.
+ClassifierOptions plugin_classifier_options(const AuditOptions& options,
+                                            const PluginCapabilities& capabilities);
 
 /// Audits the named built-ins (empty = all of auditable_names()). Throws InvalidArgument
 /// naming an unknown name and the valid ones.
