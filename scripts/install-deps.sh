@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   ca-certificates cmake g++ make pkg-config python3
   libeigen3-dev catch2 librapidcheck-dev libbox2d-dev libfcl-dev libopencv-dev libginac-dev
-  libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev zlib1g-dev
+  libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev zlib1g-dev libzip-dev
   python3-numpy python3-pytest time
   # tests/python_package: `pip install --no-build-isolation .` into a venv of Debian's Python
   python3-venv python3-pip python3-setuptools python3-wheel
