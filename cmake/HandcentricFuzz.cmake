@@ -17,13 +17,14 @@ option(HANDCENTRIC_FUZZ "Build the libFuzzer targets of tests/fuzz (needs clang)
 set(HANDCENTRIC_FUZZ_COVERAGE "all" CACHE STRING
     "Where the fuzz targets get coverage feedback: all (every target) or parsers")
 set_property(CACHE HANDCENTRIC_FUZZ_COVERAGE PROPERTY STRINGS all parsers)
-# What the four fuzz targets parse: demo files, model files, plug-in replies and their arrays,
-# and the geometry's validating constructors.
+# What the five fuzz targets parse: demo files, model files, plug-in replies and their arrays,
+# the geometry's validating constructors, and recorded observations (.npz and JSON Lines).
 set(HANDCENTRIC_FUZZ_PARSER_SOURCES
   sim/src/demos.cpp sim/src/demo_file.cpp
   policy/src/model_file.cpp policy/src/binary_io.cpp
   props/src/transport/plugin_protocol.cpp props/src/wire_arrays.cpp
-  core/src/rigid_transform.cpp core/src/rotation.cpp)
+  core/src/rigid_transform.cpp core/src/rotation.cpp
+  props/src/observation/npz.cpp props/src/observation/recorded.cpp)
 
 if(HANDCENTRIC_FUZZ)
   if(NOT CMAKE_CXX_COMPILER_ID STREQUAL "Clang")

@@ -19,7 +19,7 @@ command -v "$cxx" >/dev/null || {
   echo "fuzz.sh: $cxx not found: bash scripts/install-deps.sh (clang, libfuzzer-14-dev)" >&2
   exit 2
 }
-targets=(fuzz_demo_file fuzz_model_file fuzz_plugin_reply fuzz_geometry)
+targets=(fuzz_demo_file fuzz_model_file fuzz_plugin_reply fuzz_geometry fuzz_observations)
 
 start=$(date +%s)
 # A tree configured for fuzzing already (scripts/sanitize.sh's, with the tests) is used as it is.

@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   ca-certificates cmake g++ make pkg-config python3
   libeigen3-dev catch2 librapidcheck-dev libbox2d-dev libfcl-dev libopencv-dev libginac-dev
-  libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev zlib1g-dev
+  libcli11-dev nlohmann-json3-dev libbenchmark-dev libhwy-dev zlib1g-dev libzip-dev
   # props/src/checks/special_functions.cpp: Boost.Math's distributions (header-only, private)
   libboost-math-dev
   python3-numpy python3-pytest time

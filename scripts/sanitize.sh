@@ -61,6 +61,9 @@ built=$(date +%s)
 #    (table1_audits_every_model..., float32_rounding_is_named...): 48 s under ASan; the audit
 #    of a saved model runs here through the table2 and sim CLI audits, the float32 note in
 #    float32_rounding_gets_a_note_and_passes_at_float32_tolerance;
+#  - the 300 mutated .npz files: their bound on the peak memory reads the RSS, which ASan's shadow
+#    and quarantine inflate; the readers run here under the fuzz target fuzz_observations and in
+#    the other .npz tests;
 #  - three simulations of the in-distribution tests' power (the tabulated detectable shift, the
 #    scale test on curved world noise and without the exact split): 196 s under ASan; the same
 #    code paths run in the shorter anisotropic-noise and scale-test-level tests.
@@ -82,7 +85,7 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^table1_cli_writes_the_table_beside_the_papers|^table1_cli_an_existing_run_needs_resume|'\
 '^table2_cli_image_rows_beside_the_key_point_rows|^table1_audits_every_model_and_shows|'\
 '^float32_rounding_is_named_and_precision_float32|^a_plugin_that_draws_its_own_noise|'\
-'^policy_exec_hands_a_plugin_the_images'
+'^policy_exec_hands_a_plugin_the_images|^300_mutated_npz_files'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 

@@ -1,11 +1,11 @@
 #include "npz.hpp"
 
-#include <zlib.h>
+#include <zip.h>
 
 #include <algorithm>
 #include <cstring>
 #include <fstream>
-#include <limits>
+#include <memory>
 #include <sstream>
 
 #include "handcentric/core/errors.hpp"
@@ -13,7 +13,7 @@
 namespace handcentric::props::npz {
 namespace {
 
-// Little-endian reads from a byte buffer, bounds-checked by the caller's `need`.
+// Little-endian reads from a byte buffer, bounds-checked by the caller.
 std::uint64_t read_le(const std::string& bytes, std::size_t at, int width) {
   std::uint64_t v = 0;
   for (int i = width - 1; i >= 0; --i)
@@ -21,162 +21,146 @@ std::uint64_t read_le(const std::string& bytes, std::size_t at, int width) {
   return v;
 }
 
+// A member is read in pieces of this size, never past the size the archive declares for it.
+constexpr std::uint64_t kChunk = std::uint64_t{1} << 20;
+// Deflate gives at most 1032 bytes for one compressed byte (zlib's maximum ratio), stored
+// members one: a member that claims more is refused before anything is allocated for it.
+constexpr std::uint64_t kDeflateRatio = 1032;
+
+struct ZipDiscard {
+  void operator()(zip_t* archive) const { zip_discard(archive); }
+};
+struct ZipFileClose {
+  void operator()(zip_file_t* file) const { zip_fclose(file); }
+};
+
 class Reader {
  public:
-  Reader(std::string path, std::uint64_t max_bytes) : path_(std::move(path)), max_(max_bytes) {}
+  Reader(std::string source, std::uint64_t max_bytes)
+      : source_(std::move(source)), max_(max_bytes) {}
+
+  // The archive's size, checked against the limit before libzip reads it.
+  void set_size(std::uint64_t size) {
+    if (size > max_)
+      fail("it is " + std::to_string(size) + " bytes, above the limit of " + std::to_string(max_));
+    size_ = size;
+  }
+
+  // Takes `source` (freed here on failure): libzip's checks of the zip structure on open
+  // (ZIP_CHECKCONS: the local headers against the central directory).
+  void open(zip_source_t* source) {
+    zip_error_t error;
+    zip_error_init(&error);
+    archive_.reset(zip_open_from_source(source, ZIP_RDONLY | ZIP_CHECKCONS, &error));
+    if (!archive_) {
+      zip_source_free(source);
+      const int code = zip_error_code_zip(&error);
+      const std::string detail = zip_error_strerror(&error);
+      zip_error_fini(&error);
+      fail_zip(code, detail, "");
+    }
+    zip_error_fini(&error);
+  }
 
   std::map<std::string, Array> read() {
-    load();
     std::map<std::string, Array> out;
-    for (const Member& m : members()) {
-      std::string name = m.name;
+    const zip_int64_t entries = zip_get_num_entries(archive_.get(), 0);
+    for (zip_int64_t i = 0; i < entries; ++i) {
+      zip_stat_t st;
+      zip_stat_init(&st);
+      if (zip_stat_index(archive_.get(), static_cast<zip_uint64_t>(i), 0, &st) != 0)
+        fail_zip(zip_get_error(archive_.get()), "");
+      std::string name = (st.valid & ZIP_STAT_NAME) != 0 ? st.name : "";
       if (name.size() < 4 || name.compare(name.size() - 4, 4, ".npy") != 0)
         fail("member '" + name + "' is not a .npy array");
+      const std::string npy = member(static_cast<zip_uint64_t>(i), st, name);
       name.resize(name.size() - 4);
-      out[name] = parse_npy(inflate(m), name);
+      out[name] = parse_npy(npy, name);
     }
     return out;
   }
 
- private:
-  struct Member {
-    std::string name;
-    int method = 0;
-    std::uint32_t crc = 0;
-    std::uint64_t compressed = 0, size = 0, local_offset = 0;
-  };
-
   [[noreturn]] void fail(const std::string& what) const {
-    throw FileError("observations file '" + path_ + "': " + what +
+    throw FileError("observations file '" + source_ + "': " + what +
                     "; write it with np.savez or np.savez_compressed (docs/AUDIT.md, \"Your own "
                     "observations\")");
   }
 
-  void need(std::uint64_t at, std::uint64_t count, const char* what) const {
-    if (at > bytes_.size() || count > bytes_.size() - at) fail(std::string("truncated ") + what);
+ private:
+  // libzip's error in our words, for the archive (`member` empty) or one member. The archive's
+  // and a member's errors are freed with them.
+  [[noreturn]] void fail_zip(zip_error_t* error, const std::string& member) const {
+    fail_zip(zip_error_code_zip(error), zip_error_strerror(error), member);
+  }
+  [[noreturn]] void fail_zip(int code, const std::string& detail, const std::string& member) const {
+    const std::string which = member.empty() ? "it" : "member '" + member + "'";
+    switch (code) {
+      case ZIP_ER_NOZIP:
+        fail("it is not a zip archive");
+      case ZIP_ER_CRC:
+        fail(which + " fails its CRC check (a corrupt file)");
+      case ZIP_ER_EOF:
+      case ZIP_ER_READ:
+      case ZIP_ER_SEEK:
+        fail(which + " is truncated (" + detail + ")");
+      case ZIP_ER_INCONS:
+        fail((member.empty() ? "it is a damaged zip archive" : which + " is damaged") + " (" +
+             detail + ")");
+      case ZIP_ER_ZLIB:
+      case ZIP_ER_COMPRESSED_DATA:
+        fail(which + " does not inflate (" + detail + ")");
+      case ZIP_ER_ENCRNOTSUPP:
+      case ZIP_ER_NOPASSWD:
+      case ZIP_ER_WRONGPASSWD:
+        fail(which + " is encrypted");
+      case ZIP_ER_COMPNOTSUPP:
+        fail(which + " uses a zip compression method other than stored and deflate");
+      default:
+        fail(which + " cannot be read as a zip archive (libzip: " + detail + ")");
+    }
   }
 
-  void load() {
-    std::ifstream in(path_, std::ios::binary);
-    if (!in) throw FileError("cannot open observations file '" + path_ + "': check the path");
-    in.seekg(0, std::ios::end);
-    const std::streamoff size = in.tellg();
-    if (size < 0) throw FileError("cannot read observations file '" + path_ + "'");
-    if (static_cast<std::uint64_t>(size) > max_)
-      fail("it is " + std::to_string(size) + " bytes, above the limit of " + std::to_string(max_));
-    in.seekg(0);
-    bytes_.resize(static_cast<std::size_t>(size));
-    if (!in.read(bytes_.data(), size))
-      throw FileError("cannot read observations file '" + path_ + "'");
-  }
-
-  std::vector<Member> members() const {
-    // The end of central directory record: the last one within 64 KiB + 22 bytes of the end.
-    if (bytes_.size() < 22) fail("it is not a zip archive (too short)");
-    std::size_t eocd = std::string::npos;
-    const std::size_t lowest = bytes_.size() > 65557 ? bytes_.size() - 65557 : 0;
-    for (std::size_t at = bytes_.size() - 22 + 1; at-- > lowest;) {
-      if (read_le(bytes_, at, 4) == 0x06054b50U) {
-        eocd = at;
-        break;
-      }
-    }
-    if (eocd == std::string::npos) fail("it is not a zip archive (no end of central directory)");
-    std::uint64_t entries = read_le(bytes_, eocd + 10, 2);
-    std::uint64_t cd_offset = read_le(bytes_, eocd + 16, 4);
-    if (entries == 0xFFFFU || cd_offset == 0xFFFFFFFFU) {  // zip64: the locator comes first
-      if (eocd < 20 || read_le(bytes_, eocd - 20, 4) != 0x07064b50U)
-        fail("a zip64 archive without its locator");
-      const std::uint64_t z64 = read_le(bytes_, eocd - 20 + 8, 8);
-      need(z64, 56, "zip64 end of central directory");
-      if (read_le(bytes_, z64, 4) != 0x06064b50U) fail("a bad zip64 end of central directory");
-      entries = read_le(bytes_, z64 + 32, 8);
-      cd_offset = read_le(bytes_, z64 + 48, 8);
-    }
-    if (entries > bytes_.size() / 46)
-      fail("a central directory of " + std::to_string(entries) + " entries");
-    std::vector<Member> out;
-    std::uint64_t at = cd_offset;
-    for (std::uint64_t e = 0; e < entries; ++e) {
-      need(at, 46, "central directory");
-      if (read_le(bytes_, at, 4) != 0x02014b50U) fail("a bad central directory entry");
-      Member m;
-      const std::uint64_t flags = read_le(bytes_, at + 8, 2);
-      if ((flags & 1U) != 0) fail("an encrypted member");
-      m.method = static_cast<int>(read_le(bytes_, at + 10, 2));
-      m.crc = static_cast<std::uint32_t>(read_le(bytes_, at + 16, 4));
-      m.compressed = read_le(bytes_, at + 20, 4);
-      m.size = read_le(bytes_, at + 24, 4);
-      const std::uint64_t name_length = read_le(bytes_, at + 28, 2);
-      const std::uint64_t extra_length = read_le(bytes_, at + 30, 2);
-      const std::uint64_t comment_length = read_le(bytes_, at + 32, 2);
-      m.local_offset = read_le(bytes_, at + 42, 4);
-      need(at + 46, name_length + extra_length + comment_length, "central directory entry");
-      m.name =
-          bytes_.substr(static_cast<std::size_t>(at + 46), static_cast<std::size_t>(name_length));
-      // The zip64 extra field holds, in this order, the sizes and offset whose 32-bit fields are
-      // all ones.
-      std::uint64_t x = at + 46 + name_length;
-      const std::uint64_t x_end = x + extra_length;
-      while (x + 4 <= x_end) {
-        const std::uint64_t id = read_le(bytes_, x, 2), length = read_le(bytes_, x + 2, 2);
-        if (x + 4 + length > x_end) fail("a bad extra field");
-        if (id == 1) {
-          std::uint64_t y = x + 4;
-          auto take = [&](std::uint64_t& field) {
-            if (field != 0xFFFFFFFFU) return;
-            if (y + 8 > x + 4 + length) fail("a short zip64 extra field");
-            field = read_le(bytes_, y, 8);
-            y += 8;
-          };
-          take(m.size);
-          take(m.compressed);
-          take(m.local_offset);
-        }
-        x += 4 + length;
-      }
-      out.push_back(std::move(m));
-      at = x_end + comment_length;
-    }
-    return out;
-  }
-
-  std::string inflate(const Member& m) const {
-    if (m.size > max_)
-      fail("member '" + m.name + "' is " + std::to_string(m.size) + " bytes, above the limit");
-    need(m.local_offset, 30, "local header");
-    if (read_le(bytes_, m.local_offset, 4) != 0x04034b50U) fail("a bad local header");
-    const std::uint64_t data = m.local_offset + 30 + read_le(bytes_, m.local_offset + 26, 2) +
-                               read_le(bytes_, m.local_offset + 28, 2);
-    need(data, m.compressed, "member data");
-    std::string out;
-    if (m.method == 0) {
-      if (m.compressed != m.size) fail("member '" + m.name + "' has two sizes");
-      out = bytes_.substr(static_cast<std::size_t>(data), static_cast<std::size_t>(m.size));
-    } else if (m.method == 8) {
-      out.resize(static_cast<std::size_t>(m.size));
-      z_stream stream{};
-      if (inflateInit2(&stream, -MAX_WBITS) != Z_OK) fail("zlib could not start");
-      stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(bytes_.data() + data));
-      stream.avail_in = static_cast<uInt>(
-          std::min<std::uint64_t>(m.compressed, std::numeric_limits<uInt>::max()));
-      stream.next_out = reinterpret_cast<Bytef*>(out.data());
-      stream.avail_out =
-          static_cast<uInt>(std::min<std::uint64_t>(m.size, std::numeric_limits<uInt>::max()));
-      const int status = ::inflate(&stream, Z_FINISH);
-      const std::uint64_t produced = stream.total_out;
-      inflateEnd(&stream);
-      if (status != Z_STREAM_END || produced != m.size)
-        fail("member '" + m.name + "' does not inflate to its " + std::to_string(m.size) +
-             " bytes");
-    } else {
-      fail("member '" + m.name + "' uses zip compression method " + std::to_string(m.method) +
+  // One member's bytes, its sizes checked first and its CRC by libzip once read to the end.
+  std::string member(zip_uint64_t index, const zip_stat_t& st, const std::string& name) const {
+    const zip_uint64_t needed =
+        ZIP_STAT_SIZE | ZIP_STAT_COMP_SIZE | ZIP_STAT_COMP_METHOD | ZIP_STAT_ENCRYPTION_METHOD;
+    if ((st.valid & needed) != needed) fail("member '" + name + "' has no sizes");
+    if (st.encryption_method != ZIP_EM_NONE) fail("member '" + name + "' is encrypted");
+    if (st.comp_method != ZIP_CM_STORE && st.comp_method != ZIP_CM_DEFLATE)
+      fail("member '" + name + "' uses zip compression method " + std::to_string(st.comp_method) +
            " (only stored and deflate are read)");
+    if (st.size > max_)
+      fail("member '" + name + "' is " + std::to_string(st.size) + " bytes, above the limit");
+    if (st.comp_method == ZIP_CM_STORE && st.size != st.comp_size)
+      fail("member '" + name + "' has two sizes");
+    // What its compressed bytes, at most the whole file, can hold: the bound of the allocation.
+    const std::uint64_t compressed = std::min<std::uint64_t>(st.comp_size, size_);
+    const std::uint64_t can_hold =
+        st.comp_method == ZIP_CM_STORE ? compressed : (compressed + 1) * kDeflateRatio;
+    if (st.size > can_hold)
+      fail("member '" + name + "' claims " + std::to_string(st.size) + " bytes from " +
+           std::to_string(st.comp_size) + " compressed in a file of " + std::to_string(size_) +
+           " (a corrupt file)");
+    std::unique_ptr<zip_file_t, ZipFileClose> file(zip_fopen_index(archive_.get(), index, 0));
+    if (!file) fail_zip(zip_get_error(archive_.get()), name);
+    std::string out(static_cast<std::size_t>(st.size), '\0');
+    std::uint64_t got = 0;
+    for (;;) {
+      // One byte past the declared size: libzip checks the CRC and the size when it reaches the
+      // member's end, and a member longer than it says is refused here.
+      char past = 0;
+      const std::uint64_t want = std::min(kChunk, st.size - got);
+      const zip_int64_t n = want > 0 ? zip_fread(file.get(), out.data() + got, want)
+                                     : zip_fread(file.get(), &past, 1);
+      if (n < 0) fail_zip(zip_file_get_error(file.get()), name);
+      if (n == 0) break;
+      if (want == 0)
+        fail("member '" + name + "' is longer than its " + std::to_string(st.size) + " bytes");
+      got += static_cast<std::uint64_t>(n);
     }
-    if (out.size() <= std::numeric_limits<uInt>::max() &&
-        crc32(0L, reinterpret_cast<const Bytef*>(out.data()), static_cast<uInt>(out.size())) !=
-            m.crc)
-      fail("member '" + m.name + "' fails its CRC check (a corrupt file)");
+    if (got != st.size)
+      fail("member '" + name + "' is " + std::to_string(got) + " bytes, not its " +
+           std::to_string(st.size));
     return out;
   }
 
@@ -212,7 +196,9 @@ class Reader {
     if (close == std::string::npos) fail(where + " has a bad 'descr'");
     out.dtype = header.substr(open + 1, close - open - 1);
     at = value_after("fortran_order");
-    if (header.compare(header.find_first_not_of(' ', at), 4, "True") == 0)
+    const std::size_t order = header.find_first_not_of(' ', at);
+    if (order == std::string::npos) fail(where + " has a bad 'fortran_order'");
+    if (header.compare(order, 4, "True") == 0)
       fail(where + " is in Fortran order: save np.ascontiguousarray(x)");
     at = value_after("shape");
     const std::size_t paren = header.find('(', at), end = header.find(')', at);
@@ -276,15 +262,48 @@ class Reader {
     return out;
   }
 
-  std::string path_;
+  std::string source_;
   std::uint64_t max_;
-  std::string bytes_;
+  std::uint64_t size_ = 0;
+  std::unique_ptr<zip_t, ZipDiscard> archive_;
 };
 
 }  // namespace
 
 std::map<std::string, Array> read(const std::string& path, std::uint64_t max_bytes) {
-  return Reader(path, max_bytes).read();
+  Reader reader(path, max_bytes);
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw FileError("cannot open observations file '" + path + "': check the path");
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    if (size < 0) throw FileError("cannot read observations file '" + path + "'");
+    reader.set_size(static_cast<std::uint64_t>(size));
+  }
+  zip_error_t error;
+  zip_error_init(&error);
+  zip_source_t* source = zip_source_file_create(path.c_str(), 0, -1, &error);
+  if (source == nullptr) {
+    zip_error_fini(&error);
+    throw FileError("cannot read observations file '" + path + "'");
+  }
+  reader.open(source);
+  return reader.read();
+}
+
+std::map<std::string, Array> read_bytes(std::string_view bytes, const std::string& source,
+                                        std::uint64_t max_bytes) {
+  Reader reader(source, max_bytes);
+  reader.set_size(bytes.size());
+  zip_error_t error;
+  zip_error_init(&error);
+  zip_source_t* buffer = zip_source_buffer_create(bytes.data(), bytes.size(), 0, &error);
+  if (buffer == nullptr) {
+    zip_error_fini(&error);
+    reader.fail("libzip could not take its bytes");
+  }
+  reader.open(buffer);
+  return reader.read();
 }
 
 }  // namespace handcentric::props::npz

@@ -191,13 +191,19 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-std::vector<Scene> from_npz(const std::string& path) {
-  std::map<std::string, npz::Array> arrays = npz::read(path, kMaxRecordedBytes);
+std::vector<Scene> from_npz(const std::map<std::string, npz::Array>& arrays,
+                            const std::string& path) {
   const auto history = arrays.find("history");
   if (history == arrays.end() || history->second.shape.empty())
     throw InvalidArgument("observations file '" + path +
                           "' has no array 'history' of shape (N, H+1, 4, 4)");
   const std::int64_t n = history->second.shape[0];
+  // Each observation has at least one pose of 16 numbers: bounds N before one map per
+  // observation is made (a shape such as (10**12, 0, 4, 4) holds no numbers at all).
+  if (history->second.values.size() / 16 < static_cast<std::uint64_t>(n))
+    throw InvalidArgument("observations file '" + path + "': array 'history' has shape " +
+                          shape_text(history->second.shape) +
+                          "; expected (N, H+1, 4, 4) with H+1 >= 1");
   std::vector<std::map<std::string, Part>> per(static_cast<std::size_t>(n));
   for (const auto& [name, a] : arrays) {
     if (a.shape.empty() || a.shape[0] != n)
@@ -312,8 +318,14 @@ RecordedObservations observations_from_json_lines(std::istream& in, const std::s
   return recorded_observations(std::move(scenes), source);
 }
 
+RecordedObservations observations_from_npz(std::string_view bytes, const std::string& source) {
+  return recorded_observations(from_npz(npz::read_bytes(bytes, source, kMaxRecordedBytes), source),
+                               source);
+}
+
 RecordedObservations read_observations(const std::string& path) {
-  if (ends_with(path, ".npz")) return recorded_observations(from_npz(path), path);
+  if (ends_with(path, ".npz"))
+    return recorded_observations(from_npz(npz::read(path, kMaxRecordedBytes), path), path);
   if (!ends_with(path, ".jsonl") && !ends_with(path, ".json-lines") && !ends_with(path, ".ndjson"))
     throw InvalidArgument("observations file '" + path +
                           "' is neither .jsonl nor .npz: name it by its format");
