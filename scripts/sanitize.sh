@@ -3,9 +3,9 @@
 # LeakSanitizer) and UndefinedBehaviorSanitizer into ${ASAN_BUILD_DIR:-build-asan} (-O1 with line
 # tables, no benchmarks, the libFuzzer targets too, with coverage feedback on the parsers of
 # outside data only: on every file it made the tests 1.5-2.8x slower), runs the ctest labels
-# unit, property and proofs there, then every fuzz target for ${FUZZ_SECONDS:-15} s
+# unit, property and proofs there, then every fuzz target for ${FUZZ_SECONDS:-10} s
 # (scripts/fuzz.sh, same tree;
-# 15 s in CI for its 25 minutes: the longer runs of docs/RELIABILITY.md, 60 s and 240 s per
+# 10 s in CI for its 25 minutes: the longer runs of docs/RELIABILITY.md, 60 s and 240 s per
 # target, found nothing).
 # A report aborts the test or fuzz run that caused it, so any report fails this script and CI.
 # Prints the build, test and fuzz times last. docs/RELIABILITY.md has the measured figures.
@@ -61,6 +61,9 @@ built=$(date +%s)
 #    (table1_audits_every_model..., float32_rounding_is_named...): 48 s under ASan; the audit
 #    of a saved model runs here through the table2 and sim CLI audits, the float32 note in
 #    float32_rounding_gets_a_note_and_passes_at_float32_tolerance;
+#  - the two audits of every built-in against the paper's table (builtin_representations_are_...,
+#    every_builtin_cell_matches_...): 25 s under ASan; the same classifier runs here in the
+#    batched representation audit's comparison and the planted-fault audits;
 #  - the 300 mutated .npz files: their bound on the peak memory reads the RSS, which ASan's shadow
 #    and quarantine inflate; the readers run here under the fuzz target fuzz_observations and in
 #    the other .npz tests;
@@ -85,11 +88,12 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^table1_cli_writes_the_table_beside_the_papers|^table1_cli_an_existing_run_needs_resume|'\
 '^table2_cli_image_rows_beside_the_key_point_rows|^table1_audits_every_model_and_shows|'\
 '^float32_rounding_is_named_and_precision_float32|^a_plugin_that_draws_its_own_noise|'\
-'^policy_exec_hands_a_plugin_the_images|^300_mutated_npz_files'
+'^policy_exec_hands_a_plugin_the_images|^300_mutated_npz_files|'\
+'^builtin_representations_are_classified_as_the_paper|^every_builtin_cell_matches_its_exp'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 
-FUZZ_BUILD_DIR="$build_dir" FUZZ_CXX="$cxx" bash "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-15}"
+FUZZ_BUILD_DIR="$build_dir" FUZZ_CXX="$cxx" bash "$root/scripts/fuzz.sh" "${FUZZ_SECONDS:-10}"
 fuzzed=$(date +%s)
 echo "sanitize: build $((built - start)) s, tests $((tested - built)) s" \
      "(labels unit, property, proofs)," \

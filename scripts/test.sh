@@ -3,7 +3,7 @@
 # ctest suite, then installs the package into a staging prefix and builds and tests
 # examples/downstream against it with find_package(handcentric); last, the sanitizer run
 # (scripts/sanitize.sh: a second tree built by clang with ASan + UBSan, labels unit, property,
-# proofs, then each libFuzzer target for 15 s). SANITIZE=0 leaves the sanitizer run out (a quick
+# proofs, then each libFuzzer target for 10 s). SANITIZE=0 leaves the sanitizer run out (a quick
 # local check); CI runs it. Each phase prints its start time; docs/BENCHMARKS.md ("CI") has the
 # measured phases.
 set -euo pipefail
