@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 
 namespace handcentric::props {
