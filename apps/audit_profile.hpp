@@ -22,12 +22,6 @@ struct ProfileCommand {
   double timeout = 10.0;
 };
 
-/// The profile of a trained model file under `group`, on scenes of its own task (planar for
-/// peg2d; a planar C8 head's rotations about its centre), named "model FILE (NAME)". Throws
-/// InvalidArgument for a group that tilts a peg2d model's plane.
-props::Profile profile_model(const std::string& path, props::Group group,
-                             props::ProfileOptions options);
-
 /// Runs the profiles, then writes DIR/profile.json and DIR/profile.png (each atomically, both
 /// computed before either is written) and prints one line per profile. Returns 0; throws
 /// InvalidArgument for bad input.

@@ -202,9 +202,9 @@ void add_eval_command(CLI::App& app, int& exit_code) {
 
 // Main-report section: the sim's own bar (sim/expert_check.hpp) on seeded scenes.
 int run_sim_section(std::ostream& out, const ReportOptions&) {
-  constexpr int kScenes = kSimBarScenes;
-  constexpr int kRollouts = kSimBarRollouts;
-  constexpr std::uint64_t kSeed = kSimBarSeed;
+  constexpr int kScenes = sim::kExpertBarScenes;
+  constexpr int kRollouts = sim::kExpertBarRollouts;
+  constexpr std::uint64_t kSeed = sim::kExpertBarSeed;
   out << "sim: 2D peg-in-hole (Sec. 4.2), expert demos on " << kScenes
       << " scenes and closed-loop expert rollouts on " << kRollouts
       << " scenes per distribution, seed " << kSeed << "\n";

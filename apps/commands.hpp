@@ -13,12 +13,6 @@
 
 namespace handcentric::apps {
 
-/// The 2D sim's bar in the report (run_sim_section and the page): the expert's demos on this many
-/// scenes per distribution and its closed-loop rollouts on this many, from this seed.
-inline constexpr int kSimBarScenes = 200;
-inline constexpr int kSimBarRollouts = 50;
-inline constexpr std::uint64_t kSimBarSeed = 1;
-
 /// What `handcentric report` lets a user set (plain `handcentric` uses the defaults).
 struct ReportOptions {
   long long cases = 1000;  ///< cases per pointwise cell of the audit section (1 to 10^7)
