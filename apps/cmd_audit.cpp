@@ -25,7 +25,7 @@
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/transport/batch.hpp"
+#include "handcentric/props/gate.hpp"
 #include "handcentric/props/transport/pipe_policy.hpp"
 #include "handcentric/props/transport/pipe_representation.hpp"
 #include "handcentric/props/checks/policy_audit.hpp"
@@ -124,84 +124,14 @@ std::vector<props::Group> parse_groups(const std::string& name) {
   return {props::parse_group(name)};  // throws InvalidArgument naming the valid names
 }
 
-// One --expect item: GROUP (every component) or COMPONENT:GROUP.
-struct Expectation {
-  std::optional<props::Component> component;
-  props::Group group;
-};
-
-props::Component parse_component(const std::string& name) {
-  for (props::Component c :
-       {props::Component::actions, props::Component::observation, props::Component::flow_input,
-        props::Component::flow_target, props::Component::policy}) {
-    if (props::to_string(c) == name) return c;
-  }
-  throw InvalidArgument(
-      "unknown component '" + name +
-      "' in --expect; use actions, observation, flow_input, flow_target or policy, e.g. "
-      "--expect actions:se3");
-}
-
-std::vector<Expectation> parse_expectations(const std::vector<std::string>& items) {
-  std::vector<Expectation> out;
-  for (const std::string& item : items) {
-    const std::size_t colon = item.find(':');
-    Expectation e{std::nullopt,
-                  props::parse_group(colon == std::string::npos ? item : item.substr(colon + 1))};
-    if (colon != std::string::npos) e.component = parse_component(item.substr(0, colon));
-    out.push_back(e);
-  }
-  return out;
-}
-
-// The verdicts an --expect list asks to hold that do not; each failing one with its witness on
-// stderr. A group nothing was checked under is an error: an empty gate must not pass.
+// The gate (props/gate.hpp): each expected symmetry that does not hold, with its witness, on
+// stderr, and exit 1.
 int gate(const std::vector<props::Classification>& results,
-         const std::vector<Expectation>& expectations) {
-  int failed = 0;
-  for (const Expectation& e : expectations) {
-    int checked = 0;
-    for (const props::Classification& c : results) {
-      for (const props::Verdict& v : c.verdicts) {
-        if (v.group != e.group || (e.component && v.component != *e.component)) continue;
-        ++checked;
-        if (v.invariant) continue;
-        ++failed;
-        std::cerr << "handcentric audit: expected "
-                  << (v.component == props::Component::policy ? "equivariance" : "invariance")
-                  << " does not hold: " << c.name << ", " << props::to_string(v.component) << " ("
-                  << props::to_string(v.mode) << ", " << props::to_string(v.view) << ") under "
-                  << props::to_string(v.group) << (v.note.empty() ? "" : "; note: " + v.note)
-                  << "\n";
-        if (v.witness) std::cerr << props::format_witness(*v.witness) << "\n";
-      }
-    }
-    if (checked == 0) {
-      const std::string item =
-          "--expect " + std::string(e.component ? props::to_string(*e.component) + ":" : "") +
-          props::to_string(e.group);
-      // Say which part of the item matched nothing: the component, or the group and view.
-      bool component_ran = !e.component.has_value();
-      std::string components_ran;
-      for (const props::Classification& c : results) {
-        for (const props::Verdict& v : c.verdicts) {
-          const std::string name = props::to_string(v.component);
-          if (components_ran.find(name) == std::string::npos)
-            components_ran += (components_ran.empty() ? "" : ", ") + name;
-          if (e.component && v.component == *e.component) component_ran = true;
-        }
-      }
-      if (!component_ran) {
-        throw InvalidArgument(item + " names the component '" + props::to_string(*e.component) +
-                              "', which this audit does not check (it checks " + components_ran +
-                              "); e.g. --expect " +
-                              components_ran.substr(0, components_ran.find(',')) + ":" +
-                              props::to_string(e.group));
-      }
-      throw InvalidArgument(item + " matches no check that ran; widen --group or --view");
-    }
-  }
-  return failed == 0 ? 0 : 1;
+         const std::vector<props::ExpectedSymmetry>& expectations) {
+  const std::vector<props::GateFailure> failures = props::gate_failures(results, expectations);
+  for (const props::GateFailure& failure : failures)
+    std::cerr << "handcentric audit: " << props::gate_failure_text(failure);
+  return failures.empty() ? 0 : 1;
 }
 
 int run_audit(const AuditCommandOptions& options) {
@@ -221,7 +151,8 @@ int run_audit(const AuditCommandOptions& options) {
       audit.views = {props::View::eye_in_hand};
   }
   const double relative = props::audit_relative_tolerance(audit);  // validates --tolerance
-  const std::vector<Expectation> expectations = parse_expectations(options.expect);
+  const std::vector<props::ExpectedSymmetry> expectations =
+      props::parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
   std::vector<props::Classification> results;
   bool policies = false, planar_model = false;
