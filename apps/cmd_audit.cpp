@@ -165,11 +165,8 @@ int run_audit(const AuditCommandOptions& options) {
     classifier.observation = plugin->provides_observation();
     std::shared_ptr<const FlowTarget> flow;
     if (capabilities.flow) flow = std::make_shared<props::PipeFlowTarget>(plugin);
-    std::shared_ptr<const Representation> audited = plugin;
     // Batched requests, with the verdicts and JSON of one scene at a time (batch.hpp).
-    if (capabilities.batch > 0)
-      audited = std::make_shared<props::BatchedRepresentation>(plugin, capabilities.batch);
-    results.push_back(props::classify_representation(audited, classifier, flow));
+    results.push_back(props::classify_representation(props::as_checked(plugin), classifier, flow));
   } else if (!options.policy_exec.empty()) {
     auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout,
                                                       options.extra_poses, options.scalars);
@@ -177,10 +174,7 @@ int run_audit(const AuditCommandOptions& options) {
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
     const props::ClassifierOptions classifier =
         props::plugin_classifier_options(audit, capabilities);
-    std::shared_ptr<const props::NoisyPolicy> audited = plugin;
-    if (capabilities.batch > 0)  // as for --exec
-      audited = std::make_shared<props::BatchedPolicy>(plugin, capabilities.batch);
-    results.push_back(props::classify_policy(audited, classifier));
+    results.push_back(props::classify_policy(props::as_checked(plugin), classifier));  // as --exec
     policies = true;
     if (!options.witness_dir.empty()) {
       if (!capabilities.cameras) {

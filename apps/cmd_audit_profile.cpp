@@ -24,10 +24,7 @@ namespace {
 std::vector<props::Profile> builtin_profiles(const ProfileCommand& command, props::Group group,
                                              const props::ProfileOptions& options) {
   std::vector<std::string> names = command.representations;
-  if (names.empty()) {
-    names = builtin_representation_names();
-    names.push_back("actionflow");
-  }
+  if (names.empty()) names = props::auditable_names();
   std::vector<props::Profile> profiles;
   for (const std::string& name : names) {
     if (name == "actionflow") {
@@ -42,18 +39,16 @@ std::vector<props::Profile> builtin_profiles(const ProfileCommand& command, prop
   return profiles;
 }
 
-std::vector<props::Profile> exec_profiles(const ProfileCommand& command, props::Group group,
+// A plug-in's profile is set up as its audit is (props/audit.hpp): the extra poses and scalars
+// its hello asks for, and batched requests with prefetch passes when it answers batches.
+std::vector<props::Profile> exec_profiles(const ProfileCommand& command,
+                                          const props::AuditOptions& audit, props::Group group,
                                           props::ProfileOptions options) {
   auto plugin = std::make_shared<props::PipeRepresentation>(
       command.exec, command.timeout, std::vector<std::string>{}, std::vector<std::string>{});
-  const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
-  options.shape.extra_pose_names = capabilities.extra_pose_names;
-  options.shape.scalar_names = capabilities.scalar_names;
-  std::shared_ptr<const Representation> profiled = plugin;
-  if (capabilities.batch > 0) {  // each size's scenes in batched requests (batch.hpp)
-    profiled = std::make_shared<props::BatchedRepresentation>(plugin, capabilities.batch);
-    options.prefetch = true;
-  }
+  options = props::with_audit_setup(
+      options, props::plugin_classifier_options(audit, plugin->capabilities()), audit.views[0]);
+  const std::shared_ptr<const Representation> profiled = props::as_checked(plugin);
   std::vector<props::Profile> profiles;
   profiles.push_back(props::profile_function(props::actions_of(profiled), plugin->name(),
                                              props::Component::actions, group, options));
@@ -63,19 +58,15 @@ std::vector<props::Profile> exec_profiles(const ProfileCommand& command, props::
   return profiles;
 }
 
-std::vector<props::Profile> policy_exec_profiles(const ProfileCommand& command, props::Group group,
+std::vector<props::Profile> policy_exec_profiles(const ProfileCommand& command,
+                                                 const props::AuditOptions& audit,
+                                                 props::Group group,
                                                  props::ProfileOptions options) {
   auto plugin = std::make_shared<props::PipePolicy>(
       command.policy_exec, command.timeout, std::vector<std::string>{}, std::vector<std::string>{});
-  const props::PluginCapabilities& capabilities = plugin->capabilities();
-  options.shape.extra_pose_names = capabilities.extra_pose_names;
-  options.shape.scalar_names = capabilities.scalar_names;
-  std::shared_ptr<const props::NoisyPolicy> profiled = plugin;
-  if (capabilities.batch > 0) {
-    profiled = std::make_shared<props::BatchedPolicy>(plugin, capabilities.batch);
-    options.prefetch = true;
-  }
-  return {props::profile_policy(*profiled, group, options)};
+  options = props::with_audit_setup(
+      options, props::plugin_classifier_options(audit, plugin->capabilities()), audit.views[0]);
+  return {props::profile_policy(*props::as_checked(plugin), group, options)};
 }
 
 std::vector<props::Profile> model_profiles(const ProfileCommand& command, props::Group group,
@@ -99,17 +90,21 @@ int run_audit_profile(const ProfileCommand& command) {
   const props::Group group = props::parse_group(command.group);
   // A profile is of one view: "all" (the audit's default) draws the eye-in-hand one.
   const props::View view = props::parse_views({command.view}, "view").front();
+  // The audit's setup of these scenes (props/audit.hpp): its seed, for the scenes, the policy's
+  // fixed noise and the laws' draws.
+  props::AuditOptions audit;
+  audit.groups = {group};
+  audit.views = {view};
+  audit.seed = command.seed;
   props::ProfileOptions options;
-  options.seed = command.seed;
-  options.noise_seed = command.seed;  // the policy's fixed noise and the laws' draws too
   options.scenes = command.scenes;
   options.sizes = command.sizes;
-  options.shape = props::shape_for(view);
+  options = props::with_audit_setup(options, props::classifier_options(audit), view);
   std::vector<props::Profile> profiles;
   if (!command.exec.empty()) {
-    profiles = exec_profiles(command, group, options);
+    profiles = exec_profiles(command, audit, group, options);
   } else if (!command.policy_exec.empty()) {
-    profiles = policy_exec_profiles(command, group, options);
+    profiles = policy_exec_profiles(command, audit, group, options);
   } else if (!command.model.empty()) {
     profiles = model_profiles(command, group, options);
   } else {
