@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "handcentric/props/checks/profile.hpp"
+#include "handcentric/props/transport/plugin_connection.hpp"
 
 namespace handcentric::apps {
 
@@ -16,10 +17,10 @@ struct ProfileCommand {
   std::string out;    ///< the folder to write
   std::vector<std::string> representations;  ///< built-ins; empty: all, and ActionFlow's target
   std::string exec, policy_exec, model;
-  std::uint64_t seed = 1;
-  int scenes = 16;
+  std::uint64_t seed = props::ProfileOptions{}.seed;
+  int scenes = props::ProfileOptions{}.scenes;
   std::vector<double> sizes;  ///< empty: the group's defaults
-  double timeout = 10.0;
+  double timeout = props::kDefaultPluginTimeout;
 };
 
 /// Runs the profiles, then writes DIR/profile.json and DIR/profile.png (each atomically, both

@@ -39,8 +39,8 @@ struct AuditCommandOptions {
   std::string group = "all";
   std::string view = "all";
   long long cases = props::kDefaultCases;  // wide: a value past the bound is named, not wrapped
-  std::uint64_t seed = 1;
-  double timeout = 10.0;
+  std::uint64_t seed = props::AuditOptions{}.seed;
+  double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
   std::string precision = "float64";
   std::string workspace, witness_dir, observations;
@@ -50,7 +50,7 @@ struct AuditCommandOptions {
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
   std::string profile, out;  // --profile GROUP --out DIR (audit_profile.hpp)
-  int profile_scenes = 16;
+  int profile_scenes = props::ProfileOptions{}.scenes;
   std::vector<double> profile_sizes;
 };
 

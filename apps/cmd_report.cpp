@@ -46,7 +46,9 @@ void add_report_command(CLI::App& app, int& exit_code) {
                   "write the report as a page: DIR/index.html and index.md, with a quick Table 1 "
                   "and Table 2 and Figs. 3 and 5");
   cmd->add_flag("--full", page->full,
-                "with --out: the paper's whole grid (7 demo counts, 100 trials)");
+                "with --out: the paper's whole grid (" +
+                    std::to_string(experiments::kPaperDemoCounts.size()) + " demo counts, " +
+                    std::to_string(experiments::EvalSettings{}.trials) + " trials)");
   cmd->add_option("--demos", page->demos, "with --out: the quick Table 1's demo counts")
       ->capture_default_str();
   cmd->add_option("--trials", page->trials,
@@ -60,7 +62,8 @@ void add_report_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--steps", page->steps,
                   "with --out: Adam steps per cell and Table 2 policy (0: the library's budget; "
-                  "the quick Table 2: 15000)")
+                  "the quick Table 2: " +
+                      std::to_string(experiments::kQuickTable2Steps) + ")")
       ->capture_default_str();
   cmd->add_option("--jobs", page->jobs, "with --out: trainings at once (0: one per core)")
       ->capture_default_str();

@@ -307,7 +307,7 @@ int write_report_page(const ReportPageOptions& page) {
   const std::vector<int> demo_counts =
       page.full ? std::vector<int>(kPaperDemoCounts.begin(), kPaperDemoCounts.end())
                 : parse_int_list(page.demos, "--demos");
-  const int trials = page.full ? 100 : page.trials;
+  const int trials = page.full ? EvalSettings{}.trials : page.trials;
   std::fprintf(stderr, "report: Table 1 (%zu demo counts, %d trials per scene set)\n",
                demo_counts.size(), trials);
   std::vector<Cell> table1_cells;

@@ -17,7 +17,7 @@ struct ReportPageOptions {
   std::string out;  ///< the folder of the page
   /// The audit's cases per pointwise cell (1 to props::kMaxCases) and seed.
   long long cases = props::kDefaultCases;
-  std::uint64_t seed = 1;
+  std::uint64_t seed = props::AuditOptions{}.seed;
   bool full = false;  ///< the paper's whole grid instead of the quick one
   // The quick page's defaults keep it within 5 minutes on two cores: Table 1 at the paper's
   // headline count (100 demos, where its OOD column is), Fig. 5 at 10 demos (with 40 the page
