@@ -13,8 +13,9 @@ namespace handcentric::apps {
 
 struct ProfileCommand {
   std::string group;  ///< one group's name ("all" is refused: one plot per group)
-  std::string view;   ///< "eye_in_hand", "third_person"; "all" means eye_in_hand
-  std::string out;    ///< the folder to write
+  /// --view as given: one of "eye_in_hand", "third_person"; "all" means eye_in_hand
+  std::vector<std::string> views;
+  std::string out;                           ///< the folder to write
   std::vector<std::string> representations;  ///< built-ins; empty: all, and ActionFlow's target
   std::string exec, policy_exec, model;
   std::uint64_t seed = props::ProfileOptions{}.seed;

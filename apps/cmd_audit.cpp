@@ -36,8 +36,9 @@ namespace {
 
 struct AuditCommandOptions {
   std::vector<std::string> representations;
-  std::string group = "all";
-  std::string view = "all";
+  // One or more names each, or "all" (props::parse_groups, props::parse_views).
+  std::vector<std::string> groups = {"all"};
+  std::vector<std::string> views = {"all"};
   long long cases = props::kDefaultCases;  // wide: a value past the bound is named, not wrapped
   std::uint64_t seed = props::AuditOptions{}.seed;
   double timeout = props::kDefaultPluginTimeout;
@@ -60,7 +61,7 @@ ProfileCommand profile_command(const AuditCommandOptions& options) {
     throw InvalidArgument(
         "--profile draws g by its size and writes --out; leave out --workspace, --witness-dir, "
         "--expect, --extra-poses, --scalars and --observations");
-  return {options.profile,        options.view,          options.out,    options.representations,
+  return {options.profile,        options.views,         options.out,    options.representations,
           options.exec,           options.policy_exec,   options.model,  options.seed,
           options.profile_scenes, options.profile_sizes, options.timeout};
 }
@@ -119,11 +120,6 @@ void write_witness_images(const std::string& dir, const props::Classification& r
             << " (colour beside depth, of o and of g o)\n";
 }
 
-std::vector<props::Group> parse_groups(const std::string& name) {
-  if (name == "all") return props::all_groups();
-  return {props::parse_group(name)};  // throws InvalidArgument naming the valid names
-}
-
 // The gate (props/gate.hpp): each expected symmetry that does not hold, with its witness, on
 // stderr, and exit 1.
 int gate(const std::vector<props::Classification>& results,
@@ -136,8 +132,13 @@ int gate(const std::vector<props::Classification>& results,
 
 int run_audit(const AuditCommandOptions& options) {
   props::AuditOptions audit;
-  audit.groups = parse_groups(options.group);
-  audit.views = props::parse_views({options.view}, "view");
+  audit.groups = props::parse_groups(options.groups, "group");
+  audit.views = props::parse_views(options.views, "view");
+  // "all" (the default), as against groups and views named one by one.
+  auto has_all = [](const std::vector<std::string>& names) {
+    return std::find(names.begin(), names.end(), "all") != names.end();
+  };
+  const bool all_groups = has_all(options.groups), all_views = has_all(options.views);
   audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
   audit.seed = options.seed;
   audit.precision = props::parse_precision(options.precision);
@@ -147,7 +148,7 @@ int run_audit(const AuditCommandOptions& options) {
     audit.observations = std::make_shared<props::RecordedObservations>(
         props::read_observations(options.observations));
     // Data without world points show the third-person view nothing to move: one view only.
-    if (options.view == "all" && !audit.observations->has_world_points())
+    if (all_views && !audit.observations->has_world_points())
       audit.views = {props::View::eye_in_hand};
   }
   const double relative = props::audit_relative_tolerance(audit);  // validates --tolerance
@@ -192,7 +193,7 @@ int run_audit(const AuditCommandOptions& options) {
     auto model = experiments::load_audited_model(options.model, options.floor);
     planar_model = model->config().task == policy::kTaskPeg2d;
     audit.groups =
-        experiments::model_groups(model->config(), audit.groups, options.group, options.model);
+        experiments::model_groups(model->config(), audit.groups, !all_groups, options.model);
     props::ClassifierOptions classifier =
         experiments::model_classifier_options(model->config(), props::classifier_options(audit));
     classifier.in_distribution = !options.pointwise;
@@ -237,7 +238,7 @@ int run_audit(const AuditCommandOptions& options) {
       << " per cell) the energy distance of the tested coordinates (a statistic, not a length). "
          "Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
-  if (planar_model && options.group == "all") {
+  if (planar_model && all_groups) {
     std::cout << "\nA model of the 2D task (peg2d) is audited on planar scenes (poses rotating "
                  "about z, everything at z = 0) under the groups that keep them planar; rotation "
                  "and se3 tilt the plane and are not checked.\n";
@@ -255,12 +256,13 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       "--repr", options->representations,
       "a built-in to audit (absolute, relative, relative_diff, hand_centric, actionflow); "
       "repeatable; default: all");
-  cmd->add_option("--group", options->group, "translation|rotation|se2|se3|c8|all")
+  cmd->add_option("--group", options->groups,
+                  "one or more of translation, rotation, se2, se3, c8, or all, e.g. --group "
+                  "rotation se3")
       ->capture_default_str();
-  cmd->add_option(
-         "--view", options->view,
-         "eye_in_hand (no world points: Theorem 1's setting), third_person (1-8 world points that "
-         "move with g) or all")
+  cmd->add_option("--view", options->views,
+                  "one or both of eye_in_hand (no world points: Theorem 1's setting) and "
+                  "third_person (1-8 world points that move with g), or all")
       ->capture_default_str();
   cmd->add_option("--cases", options->cases,
                   "cases per pointwise check, at most 10^7 (in distribution: max(10, cases/100))")

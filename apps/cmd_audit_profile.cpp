@@ -89,7 +89,9 @@ int run_audit_profile(const ProfileCommand& command) {
         "se2, se3 or c8");
   const props::Group group = props::parse_group(command.group);
   // A profile is of one view: "all" (the audit's default) draws the eye-in-hand one.
-  const props::View view = props::parse_views({command.view}, "view").front();
+  if (command.views.size() > 1)
+    throw InvalidArgument("--profile draws one view; give --view eye_in_hand or third_person");
+  const props::View view = props::parse_views(command.views, "view").front();
   // The audit's setup of these scenes (props/audit.hpp): its seed, for the scenes, the policy's
   // fixed noise and the laws' draws.
   props::AuditOptions audit;

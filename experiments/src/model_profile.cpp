@@ -19,7 +19,7 @@ props::Profile profile_model(const std::string& path, props::Group group,
   const policy::PolicyConfig& config = model->config();
   // A peg2d model is profiled on planar scenes, under the groups that keep them planar
   // (model_audit.hpp).
-  if (model_groups(config, {group}, "all", path).empty())
+  if (model_groups(config, {group}, false, path).empty())
     throw InvalidArgument("--profile " + props::to_string(group) + ": " + path +
                           " is a model of the 2D task (peg2d), whose scenes lie in a plane that " +
                           props::to_string(group) +
