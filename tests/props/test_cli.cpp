@@ -55,12 +55,12 @@ TEST_CASE("audit_takes_several_groups_and_views_like_the_python_cli", "[unit]") 
   // The (group, view) pairs the JSON's checks cover, sorted.
   auto cells = [](const std::string& args) {
     const auto result =
-        test::run_command(test::cli() + " audit --repr relative --cases 10 " + "--json " + args);
+        test::run_command(test::cli() + " audit --repr relative --cases 10 --json " + args);
     INFO(args << "\n" << result.err);
     REQUIRE(result.exit_code == 0);
+    const auto json = nlohmann::json::parse(result.out);
     std::set<std::pair<std::string, std::string>> out;
-    for (const auto& check :
-         nlohmann::json::parse(result.out).at("representations").at(0).at("checks"))
+    for (const auto& check : json.at("representations").at(0).at("checks"))
       out.insert({check.at("group").get<std::string>(), check.at("view").get<std::string>()});
     return out;
   };
