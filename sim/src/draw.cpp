@@ -1,4 +1,4 @@
-// OpenCV drawings of scenes, demos and rollouts (draw.hpp), written as PNG by png.hpp.
+// OpenCV drawings of scenes, demos and rollouts (draw.hpp).
 #include "handcentric/sim/draw.hpp"
 
 #include <algorithm>
@@ -7,9 +7,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
-#include "png.hpp"
 
 namespace handcentric::sim {
 namespace {
@@ -124,17 +122,6 @@ std::string fmt(const char* format, double a) {
 
 }  // namespace
 
-int Image::count_pixels(std::uint8_t r, std::uint8_t g, std::uint8_t b, int tolerance) const {
-  int count = 0;
-  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) {
-    if (std::abs(rgb[i] - r) <= tolerance && std::abs(rgb[i + 1] - g) <= tolerance &&
-        std::abs(rgb[i + 2] - b) <= tolerance) {
-      ++count;
-    }
-  }
-  return count;
-}
-
 Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry, int size) {
   check_size(size);
   cv::Mat canvas = blank(size);
@@ -213,15 +200,6 @@ Image draw_rollout(const TaskScene& scene, const Rollout& rollout, const PegHole
                       " steps, " + std::to_string(rollout.replans) + " replans, " +
                       std::to_string(rollout.clipped) + " clipped");
   return to_image(canvas);
-}
-
-void write_png(const std::string& path, const Image& image) {
-  if (image.width <= 0 || image.height <= 0 ||
-      image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3) {
-    throw InvalidArgument("write_png: the image is empty or its pixel buffer has the wrong size");
-  }
-  write_file_atomically(path,
-                        encode_png(image.rgb.data(), image.rgb.size(), image.width, image.height));
 }
 
 }  // namespace handcentric::sim
