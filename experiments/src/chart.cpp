@@ -1,28 +1,28 @@
 #include "handcentric/experiments/chart.hpp"
 
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <functional>
-#include <memory>
 #include <numbers>
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/sim/canvas.hpp"
 
 namespace handcentric::experiments {
 namespace {
 
 using Box = ChartLayout::Box;
+using sim::Align;
+using sim::lines_of;
+using sim::set_grey;
+using sim::text;
+using sim::text_width;
+using sim::white_page;
 
-// DejaVu Sans (Debian's fonts-dejavu-core, which fontconfig also falls back to): a real outline
-// font, whose glyphs the SVG surface writes as paths, so the SVG reads the same everywhere.
-constexpr const char* kFont = "DejaVu Sans";
 constexpr double kMarker = 4.5;      // marker half size, px
 constexpr double kCurveShift = 1.5;  // px between curves at one x, so their bars stay apart
 constexpr double kLegendText = 12.0, kNoteText = 11.0;  // px
@@ -30,19 +30,6 @@ constexpr double kLegendText = 12.0, kNoteText = 11.0;  // px
 struct Frame {
   double x0, y0, x1, y1;
 };
-
-// The advance of `s` in the chart's font at `size` px, from a scratch surface.
-double text_width(const std::string& s, double size) {
-  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1);
-  cairo_t* cr = cairo_create(surface);
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t extents;
-  cairo_text_extents(cr, s.c_str(), &extents);
-  cairo_destroy(cr);
-  cairo_surface_destroy(surface);
-  return extents.x_advance;
-}
 
 // The axes' frame, leaving room on the right for the widest legend line (a 40 px key before a
 // label; notes start at the key).
@@ -254,39 +241,6 @@ void set_colour(cairo_t* cr, int index) {
   cairo_set_source_rgb(cr, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
 }
 
-void set_grey(cairo_t* cr, double level) {
-  cairo_set_source_rgb(cr, level, level, level);
-}
-
-enum class Align { left, centre, right };
-
-// Text with its baseline at y; `size` in px; returns its width.
-double text(cairo_t* cr, const std::string& s, double x, double y, double size,
-            Align align = Align::left, bool bold = false) {
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL,
-                         bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t extents;
-  cairo_text_extents(cr, s.c_str(), &extents);
-  const double dx = align == Align::left     ? 0.0
-                    : align == Align::centre ? -0.5 * extents.x_advance
-                                             : -extents.x_advance;
-  cairo_move_to(cr, x + dx, y);
-  cairo_show_text(cr, s.c_str());
-  return extents.x_advance;
-}
-
-std::vector<std::string> lines_of(const std::string& s) {
-  std::vector<std::string> lines;
-  std::size_t start = 0;
-  for (std::size_t at = s.find('\n'); at != std::string::npos; at = s.find('\n', start)) {
-    lines.push_back(s.substr(start, at - start));
-    start = at + 1;
-  }
-  lines.push_back(s.substr(start));
-  return lines;
-}
-
 void marker(cairo_t* cr, Marker shape, double x, double y, int colour, bool hollow) {
   cairo_new_path(cr);
   switch (shape) {
@@ -313,12 +267,6 @@ void marker(cairo_t* cr, Marker shape, double x, double y, int colour, bool holl
     set_colour(cr, colour);
     cairo_fill(cr);
   }
-}
-
-void white_page(cairo_t* cr, int width, int height) {
-  cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
-  cairo_rectangle(cr, 0, 0, width, height);
-  cairo_fill(cr);
 }
 
 // The frame, horizontal grid lines and y ticks every 0.2 (of [lo, hi]), the y label and title.
@@ -505,79 +453,25 @@ void draw(cairo_t* cr, const BarChart& chart, int width, int height) {
 
 // --- Surfaces -------------------------------------------------------------------------------
 
-using Surface = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
-using Context = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
-
-cairo_status_t append(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
-
-void check(cairo_status_t status, const std::string& what) {
-  if (status != CAIRO_STATUS_SUCCESS)
-    throw Error("chart: " + what + " failed in Cairo: " + cairo_status_to_string(status));
-}
-
 template <class Chart>
 sim::Image render(const Chart& chart, int width, int height) {
   check_size(width, height);
   validate(chart);
-  Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height),
-                  &cairo_surface_destroy);
-  check(cairo_surface_status(surface.get()), "an image surface");
-  {
-    Context cr(cairo_create(surface.get()), &cairo_destroy);
-    draw(cr.get(), chart, width, height);
-    check(cairo_status(cr.get()), "drawing");
-  }
-  cairo_surface_flush(surface.get());
-  sim::Image image;
-  image.width = width;
-  image.height = height;
-  image.rgb.resize(static_cast<std::size_t>(width) * height * 3);
-  const unsigned char* data = cairo_image_surface_get_data(surface.get());
-  const int stride = cairo_image_surface_get_stride(surface.get());
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      // RGB24: one native-endian 32-bit word per pixel, 0x00RRGGBB.
-      std::uint32_t word;
-      std::memcpy(&word, data + static_cast<std::ptrdiff_t>(y) * stride + 4 * x, 4);
-      std::uint8_t* out = &image.rgb[(static_cast<std::size_t>(y) * width + x) * 3];
-      out[0] = static_cast<std::uint8_t>(word >> 16);
-      out[1] = static_cast<std::uint8_t>(word >> 8);
-      out[2] = static_cast<std::uint8_t>(word);
-    }
-  }
-  return image;
+  const sim::Canvas canvas(width, height);
+  draw(canvas.cr(), chart, width, height);
+  return canvas.image();
 }
 
 template <class Chart>
 void write(const Chart& chart, const std::string& stem, int width, int height) {
   check_size(width, height);
   validate(chart);
-  std::string png;
-  {
-    Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, 2 * width, 2 * height),
-                    &cairo_surface_destroy);
-    Context cr(cairo_create(surface.get()), &cairo_destroy);
-    cairo_scale(cr.get(), 2.0, 2.0);
-    draw(cr.get(), chart, width, height);
-    check(cairo_status(cr.get()), "drawing " + stem + ".png");
-    check(cairo_surface_write_to_png_stream(surface.get(), append, &png), "PNG encoding");
-  }
-  std::string svg;
-  {
-    Surface surface(cairo_svg_surface_create_for_stream(append, &svg, width, height),
-                    &cairo_surface_destroy);
-    check(cairo_surface_status(surface.get()), "an SVG surface");
-    {
-      Context cr(cairo_create(surface.get()), &cairo_destroy);
-      draw(cr.get(), chart, width, height);
-      check(cairo_status(cr.get()), "drawing " + stem + ".svg");
-    }
-    cairo_surface_finish(surface.get());
-    check(cairo_surface_status(surface.get()), "SVG encoding");
-  }
+  const sim::Canvas canvas(2 * width, 2 * height);  // twice the pixels, for sharp text
+  cairo_scale(canvas.cr(), 2.0, 2.0);
+  draw(canvas.cr(), chart, width, height);
+  const std::string png = canvas.png();
+  const std::string svg =
+      sim::svg_drawing(width, height, [&](cairo_t* cr) { draw(cr, chart, width, height); });
   write_file_atomically(stem + ".png", png);
   write_file_atomically(stem + ".svg", svg);
 }

@@ -163,11 +163,13 @@ std::string png_of(cairo_surface_t* surface) {
   return png;
 }
 
-std::string svg_drawing(int width, int height, const std::function<void(cairo_t*)>& draw) {
+std::string svg_drawing(int width, int height, const std::function<void(cairo_t*)>& draw,
+                        SvgUnit unit) {
   std::string svg;
   std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> surface(
       cairo_svg_surface_create_for_stream(append, &svg, width, height), &cairo_surface_destroy);
   check_cairo(cairo_surface_status(surface.get()), "an SVG surface");
+  if (unit == SvgUnit::px) cairo_svg_surface_set_document_unit(surface.get(), CAIRO_SVG_UNIT_PX);
   {
     std::unique_ptr<cairo_t, decltype(&cairo_destroy)> cr(cairo_create(surface.get()),
                                                           &cairo_destroy);

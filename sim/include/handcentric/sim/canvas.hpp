@@ -76,7 +76,11 @@ void white_page(cairo_t* cr, int width, int height);
 void check_cairo(cairo_status_t status, const std::string& what);
 /// A surface's pixels encoded as PNG (RGB24: 8-bit RGB).
 std::string png_of(cairo_surface_t* surface);
+/// The unit of an SVG document's width and height (its drawing is in user units either way):
+/// Cairo's default, points, or pixels, for a picture shown at the size it was drawn.
+enum class SvgUnit { pt, px };
 /// The SVG document of a width x height drawing made by `draw` (text as glyph outlines).
-std::string svg_drawing(int width, int height, const std::function<void(cairo_t*)>& draw);
+std::string svg_drawing(int width, int height, const std::function<void(cairo_t*)>& draw,
+                        SvgUnit unit = SvgUnit::pt);
 
 }  // namespace handcentric::sim

@@ -1,5 +1,5 @@
 #pragma once
-// Drawings of the 2D task (OpenCV imgproc; image.hpp writes them as PNG), meant to be read at a
+// Drawings of the 2D task (OpenCV imgproc, captions in Cairo text), meant to be read at a
 // glance:
 //   scene   : the hole (grey walls, orange opening corners = the eye-in-hand key points), the peg
 //             at its start (blue outline), the hole's +y axis (thin line out of the opening);
