@@ -21,6 +21,7 @@
 #include "commands.hpp"
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/flow_figure.hpp"
 #include "handcentric/experiments/audit_page.hpp"
 #include "handcentric/experiments/claims_page.hpp"
@@ -149,12 +150,6 @@ Section section(std::string id, std::string title) {
   return out;
 }
 
-std::string fixed(double value, const char* format) {
-  char text[32];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 // The audit: the built-ins' grids, how to read them, and whether they match App. A; their
 // witnesses go to `witnesses`, an appendix of the page.
 std::vector<Section> audit_sections(const ReportOptions& options,
@@ -270,8 +265,8 @@ Section sim_section(bool& passes) {
     passes = passes && check.passes();
     table.rows.push_back(
         {experiments::text_cell(distribution.name),
-         experiments::text_cell(fixed(100.0 * check.solved_rate, "%.1f%%")),
-         experiments::text_cell(fixed(check.discard_rate, "%.3f")),
+         experiments::text_cell(format_fixed(100.0 * check.solved_rate, 1) + "%"),
+         experiments::text_cell(format_fixed(check.discard_rate, 3)),
          experiments::text_cell(std::to_string(check.rollout_success) + "/" +
                                 std::to_string(check.rollouts)),
          experiments::verdict_cell(check.passes(), check.passes() ? "met" : "below the bar", "",
@@ -486,7 +481,7 @@ int write_report_page(const ReportOptions& options, const PageOptions& page) {
 
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::string took = "made in " + fixed(seconds, "%.0f") + " s of wall time";
+  const std::string took = "made in " + format_fixed(seconds, 0) + " s of wall time";
   doc.intro.push_back(Paragraph{
       {plain("What this library checks of \"Guaranteed SE(3)-Equivariant Control via "
              "Hand-Centric Behavior Cloning\", run on this machine (" +

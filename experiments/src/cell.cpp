@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "handcentric/core/format.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/rollout.hpp"
@@ -46,9 +47,7 @@ std::string digest(const std::string& bytes) {
     h ^= c;
     h *= 1099511628211ull;
   }
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
-  return text;
+  return format_hex(h, 16);
 }
 
 std::string cell_hash(const Cell& cell) {

@@ -4,12 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <functional>
 #include <numbers>
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/sim/canvas.hpp"
 
 namespace handcentric::experiments {
@@ -216,8 +216,7 @@ ValueLabel value_label(const BarGeometry& g, const BarChart& chart, std::size_t 
     // The label's box spans top - 4 - 9 .. top - 4, the line r +- 1.25.
     if (r > top - 18.0 && r < top + 2.0) top = r - 2.0;
   }
-  char text[16];
-  std::snprintf(text, sizeof text, "%.2f", v.value);
+  const std::string text = format_fixed(v.value, 2);
   const double centre = g.bar_x0(group, series, chart.series.size()) + 0.5 * g.bar_width;
   const double half = 0.5 * text_width(text, kValueText);
   return {text,
@@ -279,9 +278,7 @@ void axes(cairo_t* cr, const Frame& f, const std::function<double(double)>& py, 
     cairo_line_to(cr, f.x1, std::round(py(y)) + 0.5);
     cairo_stroke(cr);
     set_grey(cr, 0.15);
-    char label[16];
-    std::snprintf(label, sizeof label, "%.1f", y);
-    text(cr, label, f.x0 - 8.0, py(y) + 4.0, 11.0, Align::right);
+    text(cr, format_fixed(y, 1), f.x0 - 8.0, py(y) + 4.0, 11.0, Align::right);
   }
   set_grey(cr, 0.15);
   cairo_rectangle(cr, f.x0 + 0.5, f.y0 + 0.5, f.x1 - f.x0 - 1.0, f.y1 - f.y0 - 1.0);
@@ -315,9 +312,7 @@ void notes(cairo_t* cr, const std::vector<std::string>& lines, double x, double 
 }
 
 std::string tick_text(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", x);
-  return text;
+  return format_significant(x, 6);
 }
 
 void draw(cairo_t* cr, const LineChart& chart, int width, int height) {
@@ -476,6 +471,19 @@ void write(const Chart& chart, const std::string& stem, int width, int height) {
   write_file_atomically(stem + ".svg", svg);
 }
 
+// "(x0, y0)-(x1, y1)", one decimal.
+std::string box_text(const Box& b) {
+  std::string text = "(";  // appends: GCC 12 warns, falsely, on "(" + std::string&&
+  text += format_fixed(b.x0, 1);
+  text += ", ";
+  text += format_fixed(b.y0, 1);
+  text += ")-(";
+  text += format_fixed(b.x1, 1);
+  text += ", ";
+  text += format_fixed(b.y1, 1);
+  return text + ")";
+}
+
 template <class Geometry>
 Box frame_box(const Geometry& g) {
   return {g.frame.x0, g.frame.y0, g.frame.x1, g.frame.y1, "the axes"};
@@ -546,10 +554,7 @@ std::string label_under_line(const ChartLayout& layout) {
     for (const Box& line : layout.lines) {
       if (label.x1 <= line.x0 || line.x1 <= label.x0 || label.y1 <= line.y0 || line.y1 <= label.y0)
         continue;
-      char text[160];
-      std::snprintf(text, sizeof text, " at (%.1f, %.1f)-(%.1f, %.1f) is crossed by ", label.x0,
-                    label.y0, label.x1, label.y1);
-      return label.what + text + line.what;
+      return label.what + " at " + box_text(label) + " is crossed by " + line.what;
     }
   }
   return "";
@@ -559,11 +564,7 @@ std::string mark_outside_axes(const ChartLayout& layout) {
   const Box& f = layout.frame;
   for (const Box& m : layout.marks) {
     if (m.x0 >= f.x0 && m.x1 <= f.x1 && m.y0 >= f.y0 && m.y1 <= f.y1) continue;
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  " at (%.1f, %.1f)-(%.1f, %.1f) outside the axes (%.1f, %.1f)-(%.1f, %.1f)", m.x0,
-                  m.y0, m.x1, m.y1, f.x0, f.y0, f.x1, f.y1);
-    return m.what + text;
+    return m.what + " at " + box_text(m) + " outside the axes " + box_text(f);
   }
   return "";
 }

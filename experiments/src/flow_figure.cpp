@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <random>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/sim/collision.hpp"
@@ -192,12 +192,12 @@ sim::Image draw_flow_figure(const FlowFigure& figure, int panel_size) {
       ink();
       if (row == 0) text(cr, column.representation, x0 + 5, y0 - 8, 15.0);
     }
-    char line[128];
     const PanelBox bottom = flow_panel_box(c, 1, panel_size);
     const int y_caption = bottom.y + panel_size + 22;
-    std::snprintf(line, sizeof line, "|a_1(g*chunk) - a_1(chunk)| = %.2g", column.a1_change);
     ink();
-    text(cr, line, bottom.x, y_caption, 13.0);
+    std::string change = "|a_1(g*chunk) - a_1(chunk)| = ";  // appends (GCC 12 -Wrestrict)
+    change += format_significant(column.a1_change, 2);
+    text(cr, change, bottom.x, y_caption, 13.0);
     if (column.a1_change < 1e-9) {
       set_rgb(cr, 40, 150, 60);
     } else {

@@ -3,16 +3,11 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/methods.hpp"
 
 namespace handcentric::experiments {
 namespace {
-
-std::string two(double value) {
-  char text[16];
-  std::snprintf(text, sizeof text, "%.2f", value);
-  return text;
-}
 
 // "26/30: 0.87 [0.70, 0.95]"
 std::string counts_text(int successes, int trials) {
@@ -26,8 +21,9 @@ std::string counts_text(int successes, int trials) {
 
 std::string rate_text(const std::optional<double>& rate, const std::optional<Interval>& interval) {
   if (!rate) return "-";
-  std::string text = two(*rate);
-  if (interval) text += " [" + two(interval->lo) + ", " + two(interval->hi) + "]";
+  std::string text = format_fixed(*rate, 2);
+  if (interval)
+    text += " [" + format_fixed(interval->lo, 2) + ", " + format_fixed(interval->hi, 2) + "]";
   return text;
 }
 
@@ -52,8 +48,9 @@ Table table1_table(const std::vector<Row>& rows, const std::string& id,
     if (paper) {
       const auto at = std::find(kPaperDemoCounts.begin(), kPaperDemoCounts.end(), row.demos);
       if (at != kPaperDemoCounts.end())
-        paper_id = two(paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())]);
-      if (row.demos == 100) paper_ood = two(paper->ood_at_100);
+        paper_id = format_fixed(
+            paper->success[static_cast<std::size_t>(at - kPaperDemoCounts.begin())], 2);
+      if (row.demos == 100) paper_ood = format_fixed(paper->ood_at_100, 2);
       paper_id += " (" + paper->label + ")";
     }
     table.rows.push_back(

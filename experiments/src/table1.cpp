@@ -177,9 +177,7 @@ std::string cell_text(const std::string& value) {
 
 std::string rate(const std::optional<double>& value) {
   if (!value) return "-";
-  char text[16];
-  std::snprintf(text, sizeof text, "%.2f", *value);
-  return text;
+  return format_fixed(*value, 2);
 }
 
 // `data` with the perturbation seed of `reference`: the recipe without the per-cell seed.
@@ -602,10 +600,8 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
     }
     std::string text;
     for (const SymmetryVerdict& v : merged) {
-      char number[32];
-      std::snprintf(number, sizeof number, "%.1e", v.max_error);
       text += (text.empty() ? "" : ", ") + v.group + (v.equivariant ? " yes" : " no") + " (" +
-              number + ")";
+              format_scientific(v.max_error, 1) + ")";
     }
     if (with_audit < models) {
       text += (text.empty() ? "" : "; ") + std::to_string(with_audit) + " of " +
@@ -614,34 +610,30 @@ std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& ev
     return text;
   };
   std::string text = "# Table 1 on this library\n\n";
-  char line[1024];
-  std::snprintf(
-      line, sizeof line,
-      "Success over %d closed-loop rollouts per cell (mean over %zu training seed%s). Scenes: `id` "
-      "= train distribution, eval seed %llu; `ood` = bottom-up holes, their own seed %llu; `ood "
-      "paired` = the global transforms of the id scenes (same seed, same noise: equal to id "
-      "exactly when the policy is equivariant). Demos: the first N of `demos --n 100 --dist "
-      "train --seed %llu`.\n\n",
-      eval.trials, seeds.size(), seeds.size() == 1 ? "" : "s",
-      static_cast<unsigned long long>(eval.eval_seed),
-      static_cast<unsigned long long>(eval.ood_seed), static_cast<unsigned long long>(demo_seed));
-  text += line;
+  text += "Success over " + std::to_string(eval.trials) +
+          " closed-loop rollouts per cell (mean over " + std::to_string(seeds.size()) +
+          " training seed" + (seeds.size() == 1 ? "" : "s") +
+          "). Scenes: `id` = train distribution, eval seed " + std::to_string(eval.eval_seed) +
+          "; `ood` = bottom-up holes, their own seed " + std::to_string(eval.ood_seed) +
+          "; `ood paired` = the global transforms of the id scenes (same seed, same noise: equal "
+          "to id exactly when the policy is equivariant). Demos: the first N of `demos --n 100 "
+          "--dist train --seed " +
+          std::to_string(demo_seed) + "`.\n\n";
   if (!difficulty.is_default()) {
     text += "Task: " + difficulty.describe() +
             " (the paper's task: workspace 100 cm, clearance 0.1 cm).\n\n";
   }
   if (!training.empty()) text += "Training data of every cell: " + training + ".\n\n";
   if (audited) {
-    std::snprintf(line, sizeof line,
-                  "`audited symmetry`: each model's pointwise audit, eq. (4) with the same noise "
-                  "on both sides (`handcentric audit --model M --view eye_in_hand --pointwise`, "
-                  "%d cases per group, planar scenes for the 2D task): per group yes when every "
-                  "model of the row is equivariant, and the largest error over them (the task's "
-                  "units). A `no`'s number is the error of the first failing case, and the audit "
-                  "draws small g first: it shows the group is broken, not by how much "
-                  "(`handcentric audit --profile` measures that).\n\n",
-                  eval.audit_cases);
-    text += line;
+    text +=
+        "`audited symmetry`: each model's pointwise audit, eq. (4) with the same noise on both "
+        "sides (`handcentric audit --model M --view eye_in_hand --pointwise`, " +
+        std::to_string(eval.audit_cases) +
+        " cases per group, planar scenes for the 2D task): per group yes when every model of "
+        "the row is equivariant, and the largest error over them (the task's units). A "
+        "`no`'s number is the error of the first failing case, and the audit draws small g "
+        "first: it shows the group is broken, not by how much (`handcentric audit --profile` "
+        "measures that).\n\n";
   }
   text += header + "\n" + rule + "\n";
   for (std::size_t i = 0; i < series.size(); ++i) {

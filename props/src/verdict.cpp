@@ -146,9 +146,12 @@ double detectable_frequency(int cases) {
 std::string pose_summary(const RigidTransform& T) {
   // 4 significant digits: enough to recognise a scene; the seed replays it exactly.
   const auto short_vector = [](const Eigen::Vector3d& v) {
-    char buffer[96];
-    std::snprintf(buffer, sizeof buffer, "[%.4g, %.4g, %.4g]", v.x(), v.y(), v.z());
-    return std::string(buffer);
+    std::string text = "[";  // appends: GCC 12 warns, falsely, on "[" + std::string&&
+    for (int i = 0; i < 3; ++i) {
+      if (i > 0) text += ", ";
+      text += format_significant(v[i], 4);
+    }
+    return text + "]";
   };
   return "(p = " + short_vector(T.translation()) + " m, r = " + short_vector(T.rotation().log()) +
          ")";

@@ -3,11 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/sim/canvas.hpp"
 
 namespace handcentric::sim {
@@ -111,12 +111,6 @@ cv::Mat blank(int size) {
   return cv::Mat(size, size, CV_8UC3, cv::Scalar(255, 255, 255));
 }
 
-std::string fmt(const char* format, double a) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, a);
-  return buffer;
-}
-
 }  // namespace
 
 Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry, int size) {
@@ -129,8 +123,9 @@ Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry, int si
   cv::circle(canvas, view.px(scene.world_T_hand_start * Eigen::Vector3d::Zero()), 3,
              rgb(30, 90, 220), cv::FILLED);
   const Eigen::Vector3d q = planar_coordinates(scene.world_T_hole);
-  return captioned(canvas, "scene: hole at (" + fmt("%.1f", q(1)) + ", " + fmt("%.1f", q(2)) +
-                               ") cm, angle " + fmt("%.1f", q(0) * 180.0 / 3.14159265358979) +
+  return captioned(canvas, "scene: hole at (" + format_fixed(q(1), 1) + ", " +
+                               format_fixed(q(2), 1) + ") cm, angle " +
+                               format_fixed(q(0) * 180.0 / 3.14159265358979, 1) +
                                " deg; peg start in blue");
 }
 
