@@ -48,10 +48,6 @@ std::string to_string(Mode mode) {
   return mode == Mode::pointwise ? "pointwise" : "distribution";
 }
 
-std::string to_string(View view) {
-  return view == View::eye_in_hand ? "eye_in_hand" : "third_person";
-}
-
 std::vector<View> parse_views(const std::vector<std::string>& names, const std::string& option,
                               const Spelling& spelling) {
   std::vector<View> out;
