@@ -1,8 +1,7 @@
 #include "handcentric/experiments/cell.hpp"
 
 #include <algorithm>
-
-#include <cstdio>
+#include <filesystem>
 
 #include "handcentric/core/format.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -23,6 +22,11 @@ std::string to_string(SceneSet set) {
   return "?";
 }
 
+sim::SceneDistribution scene_distribution(SceneSet set, const sim::Difficulty& difficulty) {
+  return difficulty.apply(set == SceneSet::id ? sim::SceneDistribution::train()
+                                              : sim::SceneDistribution::ood());
+}
+
 std::string Cell::describe() const {
   return method + "/" + head + ", " + std::to_string(demos) + " demos, train seed " +
          std::to_string(train_seed);
@@ -39,6 +43,14 @@ std::string Cell::result_path(SceneSet set, const EvalSettings& eval) const {
 
 std::string Cell::audit_path(const EvalSettings& eval) const {
   return "results/" + hash + ".audit-pointwise-n" + std::to_string(eval.audit_cases) + ".json";
+}
+
+bool Cell::done(const EvalSettings& eval, const std::string& dir) const {
+  const std::filesystem::path root = dir;
+  for (const SceneSet set : kSceneSets) {
+    if (!std::filesystem::exists(root / result_path(set, eval))) return false;
+  }
+  return eval.audit_cases == 0 || std::filesystem::exists(root / audit_path(eval));
 }
 
 std::string digest(const std::string& bytes) {
