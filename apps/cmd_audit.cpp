@@ -9,8 +9,6 @@
 //   handcentric audit --policy-exec 'python3 my_policy.py' --expect se3
 //   handcentric audit --model hc.model
 //   handcentric audit --model image.model --floor   # the hand camera sees the table too
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -22,6 +20,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/experiments/model_audit.hpp"
+#include "handcentric/experiments/witness_panel.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
@@ -29,7 +28,7 @@
 #include "handcentric/props/transport/pipe_policy.hpp"
 #include "handcentric/props/transport/pipe_representation.hpp"
 #include "handcentric/props/checks/policy_audit.hpp"
-#include "handcentric/sim/draw.hpp"
+#include "handcentric/sim/image.hpp"
 
 namespace handcentric::apps {
 namespace {
@@ -66,34 +65,6 @@ ProfileCommand profile_command(const AuditCommandOptions& options) {
           options.profile_scenes, options.profile_sizes, options.timeout};
 }
 
-// One camera image as a PNG: the colour image beside its depth (near bright, black at the
-// camera's range), each pixel 4 x 4, so that a 64 x 48 image reads at a glance.
-sim::Image witness_panel(const CameraImage& image, double max_range) {
-  constexpr int kScale = 4;
-  sim::Image out;
-  out.width = 2 * image.width * kScale + kScale;
-  out.height = image.height * kScale;
-  out.rgb.assign(static_cast<std::size_t>(out.width) * out.height * 3, 255);
-  for (int y = 0; y < out.height; ++y) {
-    for (int x = 0; x < out.width; ++x) {
-      const int col = x / kScale, row = y / kScale;
-      const std::size_t pixel = static_cast<std::size_t>(row) * image.width;
-      std::uint8_t* to = &out.rgb[3 * (static_cast<std::size_t>(y) * out.width + x)];
-      if (col < image.width) {
-        for (int c = 0; c < 3; ++c)
-          to[c] = static_cast<std::uint8_t>(
-              std::lround(255.0 * std::clamp(image.rgb[3 * (pixel + col) + c], 0.0, 1.0)));
-      } else if (col > image.width) {
-        const double depth = image.depth[pixel + static_cast<std::size_t>(col - image.width - 1)];
-        const auto shade = static_cast<std::uint8_t>(
-            std::lround(255.0 * std::clamp(1.0 - depth / max_range, 0.0, 1.0)));
-        to[0] = to[1] = to[2] = shade;
-      }
-    }
-  }
-  return out;
-}
-
 // --witness-dir: for each failing check of a policy that sees cameras, the images it was shown
 // of the witness's o and of g o (what the policy saw differ), one PNG per camera and side.
 void write_witness_images(const std::string& dir, const props::Classification& result,
@@ -111,8 +82,10 @@ void write_witness_images(const std::string& dir, const props::Classification& r
     const std::vector<CameraImage> after = props::render_views(moved, rig);
     for (std::size_t v = 0; v < rig.views.size(); ++v) {
       const std::string camera = props::to_string(rig.views[v]);
-      sim::write_png(stem + camera + "_o.png", witness_panel(before[v], rig.camera.max_range));
-      sim::write_png(stem + camera + "_g_o.png", witness_panel(after[v], rig.camera.max_range));
+      sim::write_png(stem + camera + "_o.png",
+                     experiments::witness_panel(before[v], rig.camera.max_range));
+      sim::write_png(stem + camera + "_g_o.png",
+                     experiments::witness_panel(after[v], rig.camera.max_range));
       written += 2;
     }
   }

@@ -8,6 +8,7 @@
 #include "audit_profile.hpp"
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/experiments/model_profile.hpp"
@@ -74,12 +75,6 @@ std::vector<props::Profile> model_profiles(const ProfileCommand& command, props:
   return {experiments::profile_model(command.model, group, options)};
 }
 
-std::string two_digits(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.2g", x);
-  return buffer;
-}
-
 }  // namespace
 
 int run_audit_profile(const ProfileCommand& command) {
@@ -128,16 +123,16 @@ int run_audit_profile(const ProfileCommand& command) {
             << "; error / chunk scale, median (max) over the scenes (docs/AUDIT.md, Profiles)\n";
   for (const props::Profile& p : profiles) {
     std::cout << "  " << p.name << " " << props::to_string(p.component) << ": pointwise "
-              << two_digits(p.points.front().pointwise.median) << " at "
-              << two_digits(p.points.front().size) << " .. "
-              << two_digits(p.points.back().pointwise.median) << " at "
-              << two_digits(p.points.back().size);
+              << format_significant(p.points.front().pointwise.median, 2) << " at "
+              << format_significant(p.points.front().size, 2) << " .. "
+              << format_significant(p.points.back().pointwise.median, 2) << " at "
+              << format_significant(p.points.back().size, 2);
     if (p.points.back().distribution)
       std::cout << "; in distribution (" << p.distribution_method << ") "
-                << two_digits(p.points.front().distribution->median) << " .. "
-                << two_digits(p.points.back().distribution->median);
-    std::cout << "; Lie derivative " << two_digits(p.slope.median) << " ("
-              << two_digits(p.slope.max) << ")\n";
+                << format_significant(p.points.front().distribution->median, 2) << " .. "
+                << format_significant(p.points.back().distribution->median, 2);
+    std::cout << "; Lie derivative " << format_significant(p.slope.median, 2) << " ("
+              << format_significant(p.slope.max, 2) << ")\n";
   }
   std::cout << "wrote " << (std::filesystem::path(command.out) / "profile.json").string()
             << " and profile.png\n";

@@ -9,8 +9,9 @@
 // insert3d --policy expert; a --task that contradicts the model file is an error naming both.
 #include <cmath>
 #include <cstdio>
-#include <limits>
+#include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -21,6 +22,7 @@
 #include "insert3d_options.hpp"
 #include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/results.hpp"
 #include "handcentric/experiments/table2.hpp"
 #include "handcentric/sim/collision.hpp"
@@ -212,13 +214,10 @@ int run_sim_section(std::ostream& out, const ReportOptions&) {
   for (const auto& distribution :
        {sim::SceneDistribution::train(), sim::SceneDistribution::ood()}) {
     const sim::ExpertCheck check = sim::check_expert(distribution, kScenes, kRollouts, kSeed);
-    char line[200];
-    std::snprintf(
-        line, sizeof(line),
-        "  %-5s expert solved %5.1f%% (discard rate %.3f), closed loop %d/%d success  %s\n",
-        distribution.name.c_str(), 100.0 * check.solved_rate, check.discard_rate,
-        check.rollout_success, check.rollouts, check.passes() ? "ok" : "BELOW THE 99% BAR");
-    out << line;
+    out << "  " << std::left << std::setw(5) << distribution.name << std::right << " expert solved "
+        << std::setw(5) << format_fixed(100.0 * check.solved_rate, 1) << "% (discard rate "
+        << format_fixed(check.discard_rate, 3) << "), closed loop " << check.rollout_success << "/"
+        << check.rollouts << " success  " << (check.passes() ? "ok" : "BELOW THE 99% BAR") << "\n";
     if (!check.passes()) status = 1;
   }
   out << "  (handcentric demos / eval --policy expert reproduce these; docs/SIM.md)\n";

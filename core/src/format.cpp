@@ -22,6 +22,41 @@ std::string format_shortest(double value) {
   return std::string(buffer, result.ptr);
 }
 
+namespace {
+
+// One printf conversion of one value (the only printf of the library's numbers).
+template <class T>
+std::string printed(const char* format, int precision, T value) {
+  char buffer[400];  // %.Nf of 1e308 with N <= 17 fits
+  std::snprintf(buffer, sizeof(buffer), format, precision, value);
+  return buffer;
+}
+
+}  // namespace
+
+std::string format_fixed(double value, int decimals) {
+  return printed("%.*f", decimals, value);
+}
+
+std::string format_significant(double value, int digits) {
+  return printed("%.*g", digits, value);
+}
+
+std::string format_scientific(double value, int decimals) {
+  return printed("%.*e", decimals, value);
+}
+
+std::string format_hex(std::uint64_t value, int digits) {
+  return printed("%0*llx", digits, static_cast<unsigned long long>(value));
+}
+
+std::string format_clock(double seconds) {
+  const long s = static_cast<long>(seconds + 0.5);
+  const std::string ss = printed("%0*ld", 2, s % 60);
+  if (s < 3600) return std::to_string(s / 60) + ":" + ss;
+  return std::to_string(s / 3600) + ":" + printed("%0*ld", 2, (s / 60) % 60) + ":" + ss;
+}
+
 std::string format_matrix(const Eigen::Ref<const Eigen::MatrixXd>& matrix) {
   auto row_text = [&](Eigen::Index r) {
     std::string text = "[";

@@ -10,6 +10,7 @@
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/audit_page.hpp"
 #include "handcentric/experiments/claims_page.hpp"
 #include "handcentric/experiments/document_html.hpp"
@@ -70,12 +71,6 @@ Section section(std::string id, std::string title) {
   out.id = std::move(id);
   out.title = std::move(title);
   return out;
-}
-
-std::string fixed(double value, const char* format) {
-  char text[32];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
 }
 
 // The audit: the built-ins' grids, how to read them, and whether they match App. A; their
@@ -179,8 +174,8 @@ Section sim_section(bool& passes) {
                                                      sim::kExpertBarRollouts, sim::kExpertBarSeed);
     passes = passes && check.passes();
     table.rows.push_back(
-        {text_cell(distribution.name), text_cell(fixed(100.0 * check.solved_rate, "%.1f%%")),
-         text_cell(fixed(check.discard_rate, "%.3f")),
+        {text_cell(distribution.name), text_cell(format_fixed(100.0 * check.solved_rate, 1) + "%"),
+         text_cell(format_fixed(check.discard_rate, 3)),
          text_cell(std::to_string(check.rollout_success) + "/" + std::to_string(check.rollouts)),
          verdict_cell(check.passes(), check.passes() ? "met" : "below the bar", "",
                       check.passes() ? "" : "#sim")});
@@ -392,7 +387,7 @@ int write_report_page(const ReportPageOptions& page) {
 
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::string took = "made in " + fixed(seconds, "%.0f") + " s of wall time";
+  const std::string took = "made in " + format_fixed(seconds, 0) + " s of wall time";
   doc.intro.push_back(Paragraph{
       {plain("What this library checks of \"Guaranteed SE(3)-Equivariant Control via "
              "Hand-Centric Behavior Cloning\", run on this machine (" +

@@ -48,10 +48,6 @@ std::string to_string(Mode mode) {
   return mode == Mode::pointwise ? "pointwise" : "distribution";
 }
 
-std::string to_string(View view) {
-  return view == View::eye_in_hand ? "eye_in_hand" : "third_person";
-}
-
 std::vector<View> parse_views(const std::vector<std::string>& names, const std::string& option,
                               const Spelling& spelling) {
   std::vector<View> out;
@@ -146,9 +142,12 @@ double detectable_frequency(int cases) {
 std::string pose_summary(const RigidTransform& T) {
   // 4 significant digits: enough to recognise a scene; the seed replays it exactly.
   const auto short_vector = [](const Eigen::Vector3d& v) {
-    char buffer[96];
-    std::snprintf(buffer, sizeof buffer, "[%.4g, %.4g, %.4g]", v.x(), v.y(), v.z());
-    return std::string(buffer);
+    std::string text = "[";  // appends: GCC 12 warns, falsely, on "[" + std::string&&
+    for (int i = 0; i < 3; ++i) {
+      if (i > 0) text += ", ";
+      text += format_significant(v[i], 4);
+    }
+    return text + "]";
   };
   return "(p = " + short_vector(T.translation()) + " m, r = " + short_vector(T.rotation().log()) +
          ")";

@@ -412,9 +412,8 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
 }
 
 std::string format_resolution(double value, const std::string& unit) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.1e", value);
-  std::string text = buffer;  // e.g. 7.8e-03: drop the exponent's leading zeros
+  std::string text =
+      format_scientific(value, 1);  // e.g. 7.8e-03: drop the exponent's leading zeros
   const std::size_t e = text.find('e');
   if (e != std::string::npos && e + 2 < text.size()) {
     std::size_t digits = e + 2;
