@@ -1,6 +1,7 @@
 #include "handcentric/props/observation/generators.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <type_traits>
@@ -21,10 +22,16 @@ rc::Gen<double> unit_interval() {
                       [](int k) { return static_cast<double>(k) / kResolution; });
 }
 
-// A uniform number in [-max_abs, max_abs].
+// A uniform number in [-max_abs, max_abs] that shrinks toward 0 (RapidCheck shrinks an integer
+// toward the low end of its range, which would be -max_abs: a half turn for an angle). The
+// integer k in [0, 2^31] is taken to 0, 1, -1, 2, -2, ..., 2^30, -2^30, one value each, so the
+// law is the uniform one on the grid and a smaller k is a smaller |value|.
 rc::Gen<double> symmetric(double max_abs) {
-  return rc::gen::map(rc::gen::inRange(-kResolution, kResolution + 1),
-                      [max_abs](int k) { return max_abs * static_cast<double>(k) / kResolution; });
+  return rc::gen::map(rc::gen::inRange<std::int64_t>(0, 2 * std::int64_t{kResolution} + 1),
+                      [max_abs](std::int64_t k) {
+                        const std::int64_t signed_k = k % 2 == 1 ? (k + 1) / 2 : -(k / 2);
+                        return max_abs * static_cast<double>(signed_k) / kResolution;
+                      });
 }
 
 // A Haar-uniform unit axis (the axis of a Haar rotation is uniform on the sphere).
@@ -143,10 +150,11 @@ rc::Gen<Eigen::Vector3d> planar_axis() {
 }  // namespace
 
 rc::Gen<Rotation> haar_rotation() {
-  return rc::gen::map(rc::gen::tuple(unit_interval(), unit_interval(), unit_interval()),
-                      [](const auto& u) {
-                        return shoemake_rotation(std::get<0>(u), std::get<1>(u), std::get<2>(u));
-                      });
+  // A uniform axis and an angle by the inverse CDF of Haar's angle law (haar_angle): exactly
+  // Haar, and the number behind the angle shrinks to 0, the identity, so that a failure shrinks
+  // to the smallest turn that still fails. (Shoemake's map of three uniform numbers is Haar
+  // too, but maps their zeros to a half turn, where rotation vectors jump.)
+  return axis_angle(rc::gen::map(unit_interval(), [](double u) { return haar_angle(u); }));
 }
 
 rc::Gen<Rotation> rotation_near_pi() {

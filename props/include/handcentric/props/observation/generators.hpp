@@ -1,9 +1,10 @@
 #pragma once
 // RapidCheck generators for rotations, rigid transforms and scenes.
 //
-// Rotations are Haar-uniform (Shoemake's method from three uniform numbers), mixed with the
-// edge cases where SO(3) code breaks: the identity, angles of 1e-12, angles within 1e-9 of pi
-// and exactly pi. Every generator shrinks toward simpler values (smaller numbers, fewer poses).
+// Rotations are Haar-uniform (a uniform axis and an angle by the inverse CDF of Haar's angle
+// law), mixed with the edge cases where SO(3) code breaks: the identity, angles of 1e-12, angles
+// within 1e-9 of pi and exactly pi. Every generator shrinks toward simpler values (smaller
+// numbers, fewer poses); rotations toward the identity, the smallest angle that still fails.
 #include <rapidcheck.h>
 
 #include <memory>
@@ -22,7 +23,7 @@ namespace handcentric::props {
 
 struct RecordedObservations;  // observation/recorded.hpp
 
-/// A Haar-uniform rotation (no edge cases).
+/// A Haar-uniform rotation (no edge cases); shrinks toward the identity.
 rc::Gen<Rotation> haar_rotation();
 
 /// Haar-uniform rotations mixed with edge cases (identity, 1e-12, pi - 1e-9, pi): 1 in 5 is an edge
