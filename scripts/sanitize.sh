@@ -64,6 +64,12 @@ built=$(date +%s)
 #  - the two audits of every built-in against the paper's table (builtin_representations_are_...,
 #    every_builtin_cell_matches_...): 25 s under ASan; the same classifier runs here in the
 #    batched representation audit's comparison and the planted-fault audits;
+#  - three more whole audits: six audits of one built-in through the command's several-name
+#    --group and --view (audit_takes_several_groups_...), the image model's audit with the table
+#    in view (sim_cli_audit_with_the_table_...), and the world-delta map in law on 50 seeds x 4
+#    groups (the_world_delta_mode_is_never_called_...): 44 s under ASan; the flag parsing runs
+#    here in the command's refusals, the image audit in the other sim_cli_audit tests, the exact
+#    Gaussian test in the world-delta map's translation test;
 #  - the 300 mutated .npz files: their bound on the peak memory reads the RSS, which ASan's shadow
 #    and quarantine inflate; the readers run here under the fuzz target fuzz_observations and in
 #    the other .npz tests;
@@ -89,7 +95,9 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^table2_cli_image_rows_beside_the_key_point_rows|^table1_audits_every_model_and_shows|'\
 '^float32_rounding_is_named_and_precision_float32|^a_plugin_that_draws_its_own_noise|'\
 '^policy_exec_hands_a_plugin_the_images|^300_mutated_npz_files|'\
-'^builtin_representations_are_classified_as_the_paper|^every_builtin_cell_matches_its_exp'
+'^builtin_representations_are_classified_as_the_paper|^every_builtin_cell_matches_its_exp|'\
+'^audit_takes_several_groups_and_views|^sim_cli_audit_with_the_table_in_view_loses_se3|'\
+'^the_world_delta_mode_is_never_called_invariant'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 
