@@ -52,9 +52,7 @@ std::string shell_quoted(const std::string& path) {
 // audit (below 1e-9): the printed witness is then the same on any machine that gets the same
 // doubles up to their last bits.
 std::string rounded(double value) {
-  if (!std::isfinite(value)) return value > 0 ? "inf" : (value < 0 ? "-inf" : "nan");
-  if (std::abs(value) < 1e-9) value = 0.0;
-  return format_significant(value, 3);
+  return format_significant(std::abs(value) < 1e-9 ? 0.0 : value, 3);
 }
 
 std::string rounded_vector(const Eigen::Vector3d& v) {
