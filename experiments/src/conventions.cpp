@@ -11,6 +11,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/experiments/document_markdown.hpp"
+#include "handcentric/experiments/shell_quote.hpp"
 #include "handcentric/props/audit.hpp"
 #include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/transport/pipe_representation.hpp"
@@ -39,13 +40,6 @@ std::string read_plugin_text(const std::string& path) {
   std::ostringstream out;
   out << file.rdbuf();
   return out.str();
-}
-
-// `path` quoted for /bin/sh: the plug-in's command line.
-std::string shell_quoted(const std::string& path) {
-  std::string out = "'";
-  for (char c : path) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
 }
 
 // Three significant digits, and exact zeros for what is rounding noise at the scale of the
@@ -431,7 +425,7 @@ std::vector<ConventionAudit> audit_conventions(const ConventionsOptions& options
       options.progress(c.name, static_cast<int>(i) + 1, static_cast<int>(plugins.size()));
     // As `handcentric audit --exec` does (apps/cmd_audit.cpp): batched, with prefetch passes.
     auto plugin = std::make_shared<props::PipeRepresentation>(
-        options.python + " " + shell_quoted(plugins[i]), options.timeout);
+        options.python + " " + shell_quote(plugins[i]), options.timeout);
     props::ClassifierOptions classifier = props::classifier_options(audit);
     classifier.observation = plugin->provides_observation();
     std::shared_ptr<const Representation> audited = plugin;
