@@ -13,8 +13,7 @@
 #include "handcentric/experiments/document_markdown.hpp"
 #include "handcentric/experiments/shell_quote.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/transport/batch.hpp"
-#include "handcentric/props/transport/pipe_representation.hpp"
+#include "handcentric/props/plugin_audit.hpp"
 
 namespace handcentric::experiments {
 namespace {
@@ -423,17 +422,11 @@ std::vector<ConventionAudit> audit_conventions(const ConventionsOptions& options
     (void)expected_groups(plugins[i], c.description, props::Component::observation);
     if (options.progress)
       options.progress(c.name, static_cast<int>(i) + 1, static_cast<int>(plugins.size()));
-    // As `handcentric audit --exec` does (apps/cmd_audit.cpp): batched, with prefetch passes.
-    auto plugin = std::make_shared<props::PipeRepresentation>(
-        options.python + " " + shell_quote(plugins[i]), options.timeout);
-    props::ClassifierOptions classifier = props::classifier_options(audit);
-    classifier.observation = plugin->provides_observation();
-    std::shared_ptr<const Representation> audited = plugin;
-    if (plugin->batch_size() > 0) {
-      audited = std::make_shared<props::BatchedRepresentation>(plugin, plugin->batch_size());
-      classifier.check.prefetch = true;
-    }
-    c.result = props::classify_representation(audited, classifier);
+    // As `handcentric audit --exec` runs it: batched, with prefetch passes.
+    props::PluginAuditSetup setup;
+    setup.timeout = options.timeout;
+    c.result = props::audit_representation_plugin(options.python + " " + shell_quote(plugins[i]),
+                                                  audit, setup);
     c.result.name = c.name;
     c.mismatches = expectation_mismatches(plugins[i], c.description, c.result);
     out.push_back(std::move(c));
