@@ -24,10 +24,10 @@
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/gate.hpp"
-#include "handcentric/props/transport/pipe_policy.hpp"
-#include "handcentric/props/transport/pipe_representation.hpp"
+#include "handcentric/props/audit_header.hpp"
 #include "handcentric/props/checks/policy_audit.hpp"
+#include "handcentric/props/gate.hpp"
+#include "handcentric/props/plugin_audit.hpp"
 #include "handcentric/sim/image.hpp"
 
 namespace handcentric::apps {
@@ -124,56 +124,36 @@ int run_audit(const AuditCommandOptions& options) {
     if (all_views && !audit.observations->has_world_points())
       audit.views = {props::View::eye_in_hand};
   }
-  const double relative = props::audit_relative_tolerance(audit);  // validates --tolerance
+  (void)props::audit_relative_tolerance(audit);  // validates --tolerance before anything runs
   const std::vector<props::ExpectedSymmetry> expectations =
       props::parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
+  const props::PluginAuditSetup plugin{options.timeout, options.extra_poses, options.scalars};
   std::vector<props::Classification> results;
   bool policies = false, planar_model = false;
   if (!options.exec.empty()) {
-    auto plugin = std::make_shared<props::PipeRepresentation>(options.exec, options.timeout,
-                                                              options.extra_poses, options.scalars);
-    if (audit.observations) plugin->use_probe(audit.observations->scenes.front());
-    const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
-    props::ClassifierOptions classifier = props::plugin_classifier_options(audit, capabilities);
-    classifier.observation = plugin->provides_observation();
-    std::shared_ptr<const FlowTarget> flow;
-    if (capabilities.flow) flow = std::make_shared<props::PipeFlowTarget>(plugin);
-    // Batched requests, with the verdicts and JSON of one scene at a time (batch.hpp).
-    results.push_back(props::classify_representation(props::as_checked(plugin), classifier, flow));
+    results.push_back(props::audit_representation_plugin(options.exec, audit, plugin));
   } else if (!options.policy_exec.empty()) {
-    auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout,
-                                                      options.extra_poses, options.scalars);
-    if (audit.observations) plugin->use_probe(audit.observations->scenes.front());
-    const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
-    const props::ClassifierOptions classifier =
-        props::plugin_classifier_options(audit, capabilities);
-    results.push_back(props::classify_policy(props::as_checked(plugin), classifier));  // as --exec
+    const props::PolicyPluginAudit audited =
+        props::audit_policy_plugin(options.policy_exec, audit, plugin);
+    results.push_back(audited.result);
     policies = true;
     if (!options.witness_dir.empty()) {
-      if (!capabilities.cameras) {
+      if (!audited.cameras) {
         throw InvalidArgument(
             "--witness-dir saves the images of a failing check, but the plug-in's "
             "hello declares no \"cameras\"; declare them, or leave --witness-dir "
             "out");
       }
-      write_witness_images(options.witness_dir, results.back(), *capabilities.cameras);
+      write_witness_images(options.witness_dir, results.back(), *audited.cameras);
     }
   } else if (!options.model.empty()) {
     if (plugin_names)
       throw InvalidArgument("--extra-poses and --scalars are for plug-ins; a model reads neither");
-    // An image model sees every scene through its hand camera (and the table with --floor).
-    auto model = experiments::load_audited_model(options.model, options.floor);
-    planar_model = model->config().task == policy::kTaskPeg2d;
-    audit.groups =
-        experiments::model_groups(model->config(), audit.groups, !all_groups, options.model);
-    props::ClassifierOptions classifier =
-        experiments::model_classifier_options(model->config(), props::classifier_options(audit));
-    classifier.in_distribution = !options.pointwise;
-    audit.views = classifier.views;
-    results.push_back(
-        props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier));
-    results.back().name = experiments::audited_model_name(options.model, *model);
+    const experiments::ModelAudit audited = experiments::audit_model(
+        options.model, options.model, audit, !all_groups, options.pointwise, options.floor);
+    results.push_back(audited.result);
+    planar_model = audited.planar;
     policies = true;
   } else {
     if (plugin_names)
@@ -185,37 +165,9 @@ int run_audit(const AuditCommandOptions& options) {
     std::cout << (policies ? props::policy_audit_json(results) : props::audit_json(results));
     return gate(results, expectations);
   }
-  const props::ClassifierOptions used = props::classifier_options(audit);
-  std::cout
-      << "handcentric audit: " << audit.cases << " (scene, g) cases per pointwise cell, "
-      << used.distribution.cases << " per in-distribution cell, seed " << audit.seed
-      << "; tolerance " << relative << " (1 + L)"
-      << (options.tolerance > 0.0                        ? " (--tolerance)"
-          : audit.precision != props::Precision::float64 ? " (" + options.precision + " rounding)"
-                                                         : std::string())
-      << (audit.workspace ? "; every case inside the workspace " + audit.workspace->describe() +
-                                ", g * scene too (--workspace)"
-                          : std::string())
-      << (audit.observations ? "; " + audit.observations->verdict_note() + " (--observations)"
-                             : std::string())
-      << "\n"
-      << (policies ? "'yes' = equivariant, a(g o, n) = g a(o, n) (eq. 4); pointwise with the same "
-                     "noise n, in distribution with n ~ N(0, I). "
-                   : "'yes' = invariant. ")
-      << "The number is the largest error seen: pointwise the largest difference between the "
-         "two sides, in the component's units (m, rad or the map's own numbers); in "
-         "distribution, exactly for maps affine in the noise, the larger difference of the two "
-         "Gaussian laws' means and covariances, else (marked ~: decided wholly or partly by the "
-         "energy, paired mean and scale tests at level "
-      << used.distribution.family_alpha
-      << " per cell) the energy distance of the tested coordinates (a statistic, not a length). "
-         "Rules: docs/AUDIT.md\n\n";
+  props::print_audit_header(std::cout, audit, policies);
   props::print_audit(std::cout, results, audit);
-  if (planar_model && all_groups) {
-    std::cout << "\nA model of the 2D task (peg2d) is audited on planar scenes (poses rotating "
-                 "about z, everything at z = 0) under the groups that keep them planar; rotation "
-                 "and se3 tilt the plane and are not checked.\n";
-  }
+  if (planar_model && all_groups) std::cout << "\n" << experiments::kPlanarModelNote << "\n";
   return gate(results, expectations);
 }
 

@@ -24,8 +24,8 @@ int run_flow_figure(const FigureOptions& options) {
             << ": how far a global transform g moves a_1 (all six numbers)\n";
   for (const auto& column : figure.columns) {
     std::printf("  %-13s %-9.3g %s\n", column.representation.c_str(), column.a1_change,
-                column.a1_change < 1e-9 ? "(invariant: the flow problem is the same)"
-                                        : "(the flow problem moved)");
+                column.invariant() ? "(invariant: the flow problem is the same)"
+                                   : "(the flow problem moved)");
   }
   return 0;
 }

@@ -34,8 +34,8 @@ struct RenderOptions {
   std::string dist = "train";
   std::uint64_t seed = 1;
   std::uint64_t index = 0;
-  int max_demos = 20;
-  int size = 800;
+  int max_demos = sim::kDrawnDemos;
+  int size = sim::kDrawingSize;
   std::string out;
   std::string camera_frames;  ///< 3D rollouts: also the hand camera's images along it, as a PNG
 };
@@ -85,11 +85,12 @@ int run_insert3d_render(const RenderOptions& options) {
   std::cout << "wrote " << what << " to " << options.out << "\n";
   if (!options.camera_frames.empty()) {
     sim::write_png(options.camera_frames, experiments::draw_insert3d_camera_frames(
-                                              scene, rollout, 4, 8, {}, rig, normals));
+                                              scene, rollout, experiments::kCameraFrameEvery,
+                                              experiments::kCameraFrameColumns, {}, rig, normals));
     std::cout << "wrote the hand " << (rig.size() == 2 ? "cameras' " : "camera's ")
               << (normals ? "depth and normals" : "depth") << " images of "
-              << rollout.world_T_hand.size() << " poses (every 4th and the last) to "
-              << options.camera_frames << "\n";
+              << rollout.world_T_hand.size() << " poses (every " << experiments::kCameraFrameEvery
+              << "th and the last) to " << options.camera_frames << "\n";
   }
   return 0;
 }
@@ -178,7 +179,9 @@ void add_render_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--out", options->out, "output PNG (written atomically)")->required();
   cmd->add_option("--camera-frames", options->camera_frames,
                   "insert3d: also a PNG of the hand camera's depth images along the rollout "
-                  "(every 4th pose and the last), what an image policy sees");
+                  "(every " +
+                      std::to_string(experiments::kCameraFrameEvery) +
+                      "th pose and the last), what an image policy sees");
   cmd->callback([options, &exit_code] {
     if (!options->scene && options->demos.empty() && !options->rollout)
       throw CLI::RequiredError("--scene, --demos or --rollout");

@@ -40,7 +40,10 @@ std::string format_fixed(double value, int decimals) {
 }
 
 std::string format_significant(double value, int digits) {
-  return printed("%.*g", digits, value);
+  if (std::isnan(value)) return "nan";
+  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  if (value == 0.0) return "0";  // and not "-0"
+  return printed("%.*g", std::clamp(digits, 1, 17), value);
 }
 
 std::string format_scientific(double value, int decimals) {
@@ -58,13 +61,6 @@ std::string format_clock(double seconds) {
   return std::to_string(s / 3600) + ":" + printed("%0*ld", 2, (s / 60) % 60) + ":" + ss;
 }
 
-std::string format_digits(double value, int digits) {
-  if (std::isnan(value)) return "nan";
-  if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
-  if (value == 0.0) return "0";  // and not "-0"
-  return format_significant(value, std::clamp(digits, 1, 17));
-}
-
 double largest_magnitude(const Eigen::Ref<const Eigen::VectorXd>& vector) {
   return vector.size() > 0 ? vector.cwiseAbs().maxCoeff<Eigen::PropagateNaN>() : 0.0;
 }
@@ -74,7 +70,7 @@ std::string format_readable(const Eigen::Ref<const Eigen::VectorXd>& vector, int
   std::string text = "[";
   for (Eigen::Index i = 0; i < vector.size(); ++i) {
     if (i > 0) text += ", ";
-    text += format_digits(std::abs(vector(i)) < noise ? 0.0 : vector(i), digits);
+    text += format_significant(std::abs(vector(i)) < noise ? 0.0 : vector(i), digits);
   }
   return text + "]";
 }
@@ -85,7 +81,8 @@ std::string format_readable(const Eigen::Ref<const Eigen::VectorXd>& vector) {
 
 int digits_to_tell_apart(double a, double b, int at_least) {
   int digits = std::clamp(at_least, 1, 17);
-  while (digits < 17 && a != b && format_digits(a, digits) == format_digits(b, digits)) ++digits;
+  while (digits < 17 && a != b && format_significant(a, digits) == format_significant(b, digits))
+    ++digits;
   return digits;
 }
 

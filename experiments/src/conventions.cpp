@@ -11,9 +11,9 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/experiments/document_markdown.hpp"
+#include "handcentric/experiments/shell_quote.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/transport/batch.hpp"
-#include "handcentric/props/transport/pipe_representation.hpp"
+#include "handcentric/props/plugin_audit.hpp"
 
 namespace handcentric::experiments {
 namespace {
@@ -41,20 +41,11 @@ std::string read_plugin_text(const std::string& path) {
   return out.str();
 }
 
-// `path` quoted for /bin/sh: the plug-in's command line.
-std::string shell_quoted(const std::string& path) {
-  std::string out = "'";
-  for (char c : path) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 // Three significant digits, and exact zeros for what is rounding noise at the scale of the
 // audit (below 1e-9): the printed witness is then the same on any machine that gets the same
 // doubles up to their last bits.
 std::string rounded(double value) {
-  if (!std::isfinite(value)) return value > 0 ? "inf" : (value < 0 ? "-inf" : "nan");
-  if (std::abs(value) < 1e-9) value = 0.0;
-  return format_significant(value, 3);
+  return format_significant(std::abs(value) < 1e-9 ? 0.0 : value, 3);
 }
 
 std::string rounded_vector(const Eigen::Vector3d& v) {
@@ -431,17 +422,11 @@ std::vector<ConventionAudit> audit_conventions(const ConventionsOptions& options
     (void)expected_groups(plugins[i], c.description, props::Component::observation);
     if (options.progress)
       options.progress(c.name, static_cast<int>(i) + 1, static_cast<int>(plugins.size()));
-    // As `handcentric audit --exec` does (apps/cmd_audit.cpp): batched, with prefetch passes.
-    auto plugin = std::make_shared<props::PipeRepresentation>(
-        options.python + " " + shell_quoted(plugins[i]), options.timeout);
-    props::ClassifierOptions classifier = props::classifier_options(audit);
-    classifier.observation = plugin->provides_observation();
-    std::shared_ptr<const Representation> audited = plugin;
-    if (plugin->batch_size() > 0) {
-      audited = std::make_shared<props::BatchedRepresentation>(plugin, plugin->batch_size());
-      classifier.check.prefetch = true;
-    }
-    c.result = props::classify_representation(audited, classifier);
+    // As `handcentric audit --exec` runs it: batched, with prefetch passes.
+    props::PluginAuditSetup setup;
+    setup.timeout = options.timeout;
+    c.result = props::audit_representation_plugin(options.python + " " + shell_quote(plugins[i]),
+                                                  audit, setup);
     c.result.name = c.name;
     c.mismatches = expectation_mismatches(plugins[i], c.description, c.result);
     out.push_back(std::move(c));

@@ -198,12 +198,12 @@ sim::Image draw_flow_figure(const FlowFigure& figure, int panel_size) {
     std::string change = "|a_1(g*chunk) - a_1(chunk)| = ";  // appends (GCC 12 -Wrestrict)
     change += format_significant(column.a1_change, 2);
     text(cr, change, bottom.x, y_caption, 13.0);
-    if (column.a1_change < 1e-9) {
+    if (column.invariant()) {
       set_rgb(cr, 40, 150, 60);
     } else {
       set_rgb(cr, 200, 40, 40);
     }
-    text(cr, column.a1_change < 1e-9 ? "flow unchanged by g" : "flow moved by g", bottom.x,
+    text(cr, column.invariant() ? "flow unchanged by g" : "flow moved by g", bottom.x,
          y_caption + 20, 13.0);
   }
   return canvas.image();

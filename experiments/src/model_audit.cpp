@@ -72,23 +72,32 @@ std::string audited_model_name(const std::string& path, const policy::LearnedPol
          (model.camera() ? ", " + model.camera()->name() : std::string()) + ")";
 }
 
+ModelAudit audit_model(const std::string& file, const std::string& name, props::AuditOptions& audit,
+                       bool named_groups, bool pointwise, bool floor) {
+  // An image model sees every scene through its hand camera (and the table with `floor`).
+  auto model = load_audited_model(file, floor);
+  audit.groups = model_groups(model->config(), audit.groups, named_groups, name);
+  props::ClassifierOptions classifier =
+      model_classifier_options(model->config(), props::classifier_options(audit));
+  classifier.in_distribution = !pointwise;
+  audit.views = classifier.views;
+  ModelAudit out;
+  out.result = props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier);
+  out.result.name = audited_model_name(name, *model);
+  out.planar = model->config().task == policy::kTaskPeg2d;
+  return out;
+}
+
 std::string table1_model_audit_json(const std::string& dir, const std::string& path, int cases) {
   // RapidCheck's search keeps process-wide state: Table 1's trainings run on several threads,
   // their audits one at a time.
   static std::mutex one_at_a_time;
   const std::lock_guard lock(one_at_a_time);
-  auto model = load_audited_model(dir + "/" + path);
   props::AuditOptions audit;
-  audit.groups = model_groups(model->config(), props::all_groups(), false, path);
+  audit.groups = props::all_groups();
   audit.views = {props::View::eye_in_hand};
   audit.cases = cases;
-  props::ClassifierOptions classifier =
-      model_classifier_options(model->config(), props::classifier_options(audit));
-  classifier.in_distribution = false;
-  props::Classification result =
-      props::classify_policy(std::make_shared<props::SeededPolicy>(model), classifier);
-  result.name = audited_model_name(path, *model);
-  return props::policy_audit_json({result});
+  return props::policy_audit_json({audit_model(dir + "/" + path, path, audit, false, true).result});
 }
 
 }  // namespace handcentric::experiments

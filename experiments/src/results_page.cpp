@@ -86,7 +86,8 @@ Table table2_table(const std::vector<Table2Row>& rows, const std::string& id) {
   table.caption = "Table 2's analogue: success, counts and [Wilson 95%]";
   table.columns = {"method", "demos", "steps", "train", "ood (slot on its side)", "random-se3"};
   for (const Table2Row& row : rows) {
-    table.rows.push_back({text_cell("flow / " + row.method), text_cell(std::to_string(row.demos)),
+    table.rows.push_back({text_cell("flow / " + table2_row_label(row)),
+                          text_cell(std::to_string(row.demos)),
                           text_cell(std::to_string(row.steps)),
                           text_cell(counts_text(row.train.success, row.train.trials)),
                           text_cell(counts_text(row.ood.success, row.ood.trials)),

@@ -5,6 +5,7 @@
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/format.hpp"
+#include "handcentric/experiments/shell_quote.hpp"
 
 namespace handcentric::experiments {
 namespace fs = std::filesystem;
@@ -16,12 +17,6 @@ std::string c8_centre_options(const policy::PolicyConfig& config) {
   // "=": a negative coordinate is the option's value, not an option of its own.
   return " --c8-centre-x=" + format_number(config.c8_centre_x) +
          " --c8-centre-y=" + format_number(config.c8_centre_y);
-}
-
-std::string shell_quote(const std::string& text) {
-  std::string quoted = "'";
-  for (const char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return quoted + "'";
 }
 
 }  // namespace

@@ -229,17 +229,11 @@ Table2Row run_method(const Table2Options& options, const std::string& method,
   return row;
 }
 
-std::string row_label(const Table2Row& row) {
+}  // namespace
+
+std::string table2_row_label(const Table2Row& row) {
   return row.observation == policy::ObservationKind::image ? row.method + " (image)" : row.method;
 }
-
-std::string rate_with_interval(const Insert3dCounts& counts) {
-  const Interval ci = wilson_interval(counts.success, counts.trials);
-  return format_fixed(counts.success_rate(), 2) + " [" + format_fixed(ci.lo, 2) + ", " +
-         format_fixed(ci.hi, 2) + "]";
-}
-
-}  // namespace
 
 std::string table2_model_file(const std::string& method, policy::ObservationKind observation) {
   return observation == policy::ObservationKind::image ? method + "_image.hcm" : method + ".hcm";
@@ -279,7 +273,7 @@ std::vector<Table2Row> run_table2(const Table2Options& options) {
                            options.observations[o], scenes[o], threads);
       if (!options.quiet) {
         const std::lock_guard<std::mutex> lock(print);
-        std::cerr << "table2: " << row_label(rows[m]) << " (trained in "
+        std::cerr << "table2: " << table2_row_label(rows[m]) << " (trained in "
                   << static_cast<long>(rows[m].train_seconds) << " s) train "
                   << rows[m].train.success_rate() << " ood " << rows[m].ood.success_rate()
                   << " random-se3 " << rows[m].random_se3.success_rate() << "\n";
@@ -357,59 +351,6 @@ std::string table2_json(const std::vector<Table2Row>& rows) {
   return out.dump(2);
 }
 
-std::string table2_markdown(const std::vector<Table2Row>& rows) {
-  std::ostringstream md;
-  md << "# Table 2 (3D blade insertion), simulated\n\n";
-  if (!rows.empty()) {
-    md << "Flow policies trained on " << rows.front().demos
-       << " expert demos of train scenes (seed " << rows.front().seed << "), each evaluated on "
-       << rows.front().train.trials << " closed-loop rollouts per scene set (scenes of seed "
-       << rows.front().seed + 1
-       << "; ood and random-se3 scene i is a global transform of train scene i). Success rate "
-          "[Wilson 95%].\n\n";
-  }
-  // The noise injection of each kind of row, once per kind.
-  for (const policy::ObservationKind kind :
-       {policy::ObservationKind::key_points, policy::ObservationKind::image}) {
-    const auto row = std::find_if(rows.begin(), rows.end(),
-                                  [kind](const Table2Row& r) { return r.observation == kind; });
-    if (row == rows.end()) continue;
-    md << (kind == policy::ObservationKind::image ? "Image rows" : "Key-point rows")
-       << " train on the demos' scenes";
-    if (row->perturbation.copies > 0) {
-      md << " and " << row->perturbation.copies
-         << " noise-injected copies of each (the hand moved by up to " << row->perturbation.max_cm
-         << " cm and turned by up to " << row->perturbation.max_deg
-         << " deg per axis, in its own frame)";
-    }
-    md << ".\n\n";
-  }
-  for (const Table2Row& row : rows) {
-    if (row.observation != policy::ObservationKind::image) continue;
-    md << "Rows marked (image) see no key points: "
-       << (row.image.find("2 cameras") != std::string::npos
-               ? "the images of two cameras on the hand ("
-               : "the hand camera's image (")
-       << row.image
-       << ") through a small CNN trained end to end with the flow head "
-          "(experiments/insert3d_image.hpp).\n\n";
-    break;
-  }
-  md << "| method | demos | steps | train | ood (slot on its side) | random-se3 |\n";
-  md << "|---|---|---|---|---|---|\n";
-  for (const Table2Row& row : rows) {
-    md << "| flow / " << row_label(row) << " | " << row.demos << " | " << row.steps << " | "
-       << rate_with_interval(row.train) << " | " << rate_with_interval(row.ood) << " | "
-       << rate_with_interval(row.random_se3) << " |\n";
-  }
-  md << "\nThe paper's Table 2 for reference (a real robot, blade insertion, 35 trials; not "
-        "rerunnable here):\n\n"
-        "| method | in distribution | out of distribution (horizontal stacks) |\n"
-        "|---|---|---|\n"
-        "| hand-centric (paper) | 26/30 (0.87) | 5/5 (1.00) |\n";
-  return md.str();
-}
-
 BarChart table2_chart(const std::vector<Table2Row>& rows) {
   if (rows.empty()) throw InvalidArgument("draw_table2: no rows to draw");
   BarChart chart;
@@ -417,7 +358,7 @@ BarChart table2_chart(const std::vector<Table2Row>& rows) {
   chart.series = {"train", "ood", "random-se3"};
   chart.reference_label = "the paper (real robot)";
   for (const Table2Row& row : rows) {
-    chart.groups.push_back("flow\n" + row_label(row));
+    chart.groups.push_back("flow\n" + table2_row_label(row));
     std::vector<std::optional<ChartValue>> values;
     for (int set = 0; set < 3; ++set) {
       const Insert3dCounts& c = set_counts(row, set);

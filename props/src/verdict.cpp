@@ -119,7 +119,7 @@ std::string format_witness(const Witness& witness) {
   for (const auto& [name, T] : s.extra_poses)
     out << "  extra pose '" << name << "': " << pose_text(T) << "\n";
   for (const auto& [name, value] : s.scalars)
-    out << "  scalar '" << name << "': " << format_digits(value) << "\n";
+    out << "  scalar '" << name << "': " << format_significant(value) << "\n";
   for (const auto& [name, array] : s.held)
     out << "  held array '" << name << "': " << array->describe() << " (unchanged by g)\n";
   const bool law = !witness.detail.empty();
@@ -136,18 +136,20 @@ std::string format_witness(const Witness& witness) {
   if (law) out << witness.detail << "\n";
   if (witness.p_value < 1.0) {
     const int p_digits = digits_to_tell_apart(witness.p_value, witness.tolerance);
-    out << "energy distance " << format_digits(witness.error)
-        << " (unitless statistic), permutation p = " << format_digits(witness.p_value, p_digits)
-        << " < level " << format_digits(witness.tolerance, p_digits);
+    out << "energy distance " << format_significant(witness.error)
+        << " (unitless statistic), permutation p = "
+        << format_significant(witness.p_value, p_digits) << " < level "
+        << format_significant(witness.tolerance, p_digits);
     return out.str();
   }
-  out << "error " << format_digits(witness.error, compared)
+  out << "error " << format_significant(witness.error, compared)
       << " (largest difference; m, rad or the component's units) > tolerance "
-      << format_digits(witness.tolerance, compared);
+      << format_significant(witness.tolerance, compared);
   if (witness.length_scale > 0.0)
-    out << " = REL (1 + L) with L = " << format_digits(witness.length_scale) << " m";
+    out << " = REL (1 + L) with L = " << format_significant(witness.length_scale) << " m";
   if (witness.rounding_response > 0.0) {
-    out << "\nthe map's own rounding response here: " << format_digits(witness.rounding_response)
+    out << "\nthe map's own rounding response here: "
+        << format_significant(witness.rounding_response)
         << " (its outputs' change when the inputs move by a few units of rounding)";
   }
   // Off the case the difference persisted (check.cpp, decide_pointwise); whether that rules out

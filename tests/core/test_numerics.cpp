@@ -569,8 +569,15 @@ TEST_CASE("format_readable_prints_rounding_noise_as_0_and_keeps_the_rest", "[uni
   CHECK(format_readable(Eigen::Vector3d(0.1 + 0.2, 1.0 / 3.0, kNan), 3, 1.0) == "[0, 0, nan]");
   CHECK(format_readable(Eigen::Vector3d(0.1 + 0.2, 1.0 / 3.0, 2.0), 3, 0.0) == "[0.3, 0.333, 2]");
   CHECK(std::isnan(largest_magnitude(Eigen::Vector3d(1.0, kNan, 0.0))));
-  CHECK(format_digits(-0.0) == "0");
-  CHECK(format_digits(INFINITY) == "inf");
+  CHECK(format_significant(-0.0) == "0");
+  CHECK(format_significant(INFINITY) == "inf");
+  CHECK(format_significant(-INFINITY, 3) == "-inf");
+  CHECK(format_significant(-kNan, 3) == "nan");  // printf's %g would write "-nan"
+  // printf's %.Ng, with the digits clamped to [1, 17].
+  CHECK(format_significant(0.000123456, 2) == "0.00012");
+  CHECK(format_significant(1e-7, 2) == "1e-07");
+  CHECK(format_significant(2.0 / 3.0, 0) == "0.7");
+  CHECK(format_significant(0.1, 40) == "0.10000000000000001");
   // The planted fault, the same digits with no noise, reads the rounding as values.
   CHECK(format_readable(half_turn, 6, 0.0) == "[-2.3e-10, -3.14159, 9.7e-10]");
 }
@@ -578,7 +585,7 @@ TEST_CASE("format_readable_prints_rounding_noise_as_0_and_keeps_the_rest", "[uni
 TEST_CASE("digits_to_tell_apart_shows_the_difference_an_error_names", "[unit]") {
   CHECK(digits_to_tell_apart(1.0, 2.0) == 6);
   CHECK(digits_to_tell_apart(1.0, 1.0 + 1e-9) == 10);
-  CHECK(format_digits(1.0, 10) != format_digits(1.0 + 1e-9, 10));
+  CHECK(format_significant(1.0, 10) != format_significant(1.0 + 1e-9, 10));
   CHECK(digits_to_tell_apart(0.5, 0.5) == 6);
   CHECK(digits_to_tell_apart(1.0, std::nextafter(1.0, 2.0)) == 17);
 }

@@ -87,11 +87,23 @@ TEST_CASE("mutant_table2_schema_check_fails_on_a_row_without_random_se3_success"
 
 TEST_CASE("table2_markdown_sits_beside_the_papers_real_robot_numbers", "[unit]") {
   const std::string md = table2_markdown({sample_row("hand_centric", 19, 18, 19)});
-  CHECK_THAT(md, Contains("| flow / hand_centric | 10 | 3000 | 0.95 ["));
-  CHECK_THAT(md, Contains("| hand-centric (paper) | 26/30 (0.87) | 5/5 (1.00) |"));
+  // table2_table's columns and rows, through the page's Markdown renderer ('_', '[' escaped).
+  CHECK_THAT(md, Contains("| method | demos | steps | train | ood (slot on its side) | "
+                          "random-se3 |"));
+  CHECK_THAT(md, Contains("| flow / hand\\_centric | 10 | 3000 | 19/20: 0.95 \\["));
+  CHECK_THAT(md, Contains("| hand-centric (paper, real robot) | - | - | 26/30: 0.87 \\[0.70, "
+                          "0.95\\] | 5/5: 1.00 \\["));
   CHECK_THAT(md, Contains("real robot"));
   CHECK_THAT(md, Contains("Key-point rows train on the demos' scenes and 2 noise-injected copies "
                           "of each (the hand moved by up to 0.15 cm and turned by up to 1 deg"));
+  // An image row is named as such, and its camera described.
+  Table2Row image = sample_row("hand_centric", 20, 20, 20);
+  image.observation = policy::ObservationKind::image;
+  image.image = "depth, 32 x 24, 70 deg";
+  const std::string both = table2_markdown({sample_row("hand_centric", 19, 18, 19), image});
+  CHECK_THAT(both, Contains("| flow / hand\\_centric (image) | 10 | 3000 | 20/20: 1.00 \\["));
+  CHECK_THAT(both, Contains("Rows marked (image) see no key points: the hand camera's image "
+                            "(depth, 32 x 24, 70 deg)"));
 }
 
 TEST_CASE("table2_figure_draws_one_bar_per_method_and_set", "[unit]") {

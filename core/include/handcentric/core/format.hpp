@@ -21,9 +21,11 @@ std::string format_shortest(double value);
 /// `decimals` digits after the point, as printf's %.Nf: format_fixed(0.875, 2) is "0.88".
 std::string format_fixed(double value, int decimals);
 
-/// `digits` significant digits, as printf's %.Ng: format_significant(0.000123456, 2) is
-/// "0.00012", format_significant(1e-7, 2) is "1e-07".
-std::string format_significant(double value, int digits);
+/// `digits` significant digits (clamped to [1, 17]), as printf's %.Ng:
+/// format_significant(0.000123456, 2) is "0.00012", format_significant(1e-7, 2) is "1e-07";
+/// "nan", "inf" and "-inf" spelled out whatever the sign bit of a NaN, and -0 as "0" (a sign
+/// on nothing reads as a difference that is not there).
+std::string format_significant(double value, int digits = 6);
 
 /// One digit before the point and `decimals` after it, times a power of ten, as printf's %.Ne:
 /// format_scientific(0.00123, 1) is "1.2e-03".
@@ -34,10 +36,6 @@ std::string format_hex(std::uint64_t value, int digits);
 
 /// A duration rounded to the second: "m:ss" under an hour, "h:mm:ss" from an hour on.
 std::string format_clock(double seconds);
-
-/// `value` with `digits` significant digits, clamped to [1, 17] ("nan", "inf" spelled out;
-/// -0 as "0").
-std::string format_digits(double value, int digits = 6);
 
 /// `vector` as [a, b, c] with `digits` significant digits, each entry of magnitude below `noise`
 /// printed as 0 (a NaN never is).
@@ -53,8 +51,8 @@ std::string format_readable(const Eigen::Ref<const Eigen::VectorXd>& vector);
 /// The largest magnitude of `vector`'s entries (NaN when one is NaN, 0 when it is empty).
 double largest_magnitude(const Eigen::Ref<const Eigen::VectorXd>& vector);
 
-/// The fewest significant digits, from `at_least` up to 17, at which format_digits prints `a`
-/// and `b` apart (`at_least` when they are equal, 17 when even 17 does not).
+/// The fewest significant digits, from `at_least` up to 17, at which format_significant prints
+/// `a` and `b` apart (`at_least` when they are equal, 17 when even 17 does not).
 int digits_to_tell_apart(double a, double b, int at_least = 6);
 
 /// A matrix as [[a, b, c], [d, e, f], ...]; a column vector as [a, b, c].

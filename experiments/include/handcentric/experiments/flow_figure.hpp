@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "handcentric/core/rigid_transform.hpp"
+#include "handcentric/props/tolerance.hpp"
 #include "handcentric/sim/draw.hpp"
 
 namespace handcentric::experiments {
@@ -42,6 +43,9 @@ struct FlowColumn {
   /// |a_1(g * scene) - a_1(scene)| over all six numbers of a_1: 0 when a_1's flow problem is
   /// invariant under g (up to rounding).
   double a1_change = 0.0;
+  /// a1_change below the audit's float64 floor REL (props::kRelativeTolerance): what is left is
+  /// rounding, and the figure calls the column invariant where the audit would.
+  bool invariant() const { return a1_change < props::kRelativeTolerance; }
 };
 
 struct FlowFigure {

@@ -27,6 +27,11 @@ sim::Image draw_insert3d_rollout(const sim::insert3d::TaskScene& scene,
                                  const sim::insert3d::BladeSlotGeometry& geometry = {},
                                  const sim::insert3d::DepthCamera& camera = {});
 
+/// The camera-frame sheet's defaults, every 4th pose in rows of 8 panels: here once for the
+/// drawing's default arguments and for what `render --camera-frames` says it draws.
+inline constexpr int kCameraFrameEvery = 4;
+inline constexpr int kCameraFrameColumns = 8;
+
 /// The hand cameras' depth images along `rollout`, every `every`-th pose and the last, in rows of
 /// `columns` panels (4x enlarged, near bright, each labelled with its step): what an image
 /// policy saw. Each panel holds one image per camera of `rig`, the first on top. With `normals`,
@@ -35,8 +40,9 @@ sim::Image draw_insert3d_rollout(const sim::insert3d::TaskScene& scene,
 /// black where nothing is seen. Throws InvalidArgument for an empty rollout, every < 1, columns < 1
 /// or an empty rig.
 sim::Image draw_insert3d_camera_frames(
-    const sim::insert3d::TaskScene& scene, const sim::insert3d::Rollout& rollout, int every = 4,
-    int columns = 8, const sim::insert3d::BladeSlotGeometry& geometry = {},
+    const sim::insert3d::TaskScene& scene, const sim::insert3d::Rollout& rollout,
+    int every = kCameraFrameEvery, int columns = kCameraFrameColumns,
+    const sim::insert3d::BladeSlotGeometry& geometry = {},
     const std::vector<sim::insert3d::DepthCamera>& rig = {sim::insert3d::DepthCamera{}},
     bool normals = false);
 

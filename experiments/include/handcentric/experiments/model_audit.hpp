@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "handcentric/policy/learned_policy.hpp"
+#include "handcentric/props/audit.hpp"
 #include "handcentric/props/checks/classifier.hpp"
 #include "handcentric/props/group.hpp"
 
@@ -39,6 +40,26 @@ std::shared_ptr<policy::LearnedPolicy> load_audited_model(const std::string& pat
 
 /// "model PATH (head/representation)", and the camera an image model looks through.
 std::string audited_model_name(const std::string& path, const policy::LearnedPolicy& model);
+
+/// A model's audit, and whether it ran on planar scenes (a model of the 2D task).
+struct ModelAudit {
+  props::Classification result;
+  bool planar = false;
+};
+
+/// The audit of the model file `file` (load_audited_model, with `floor`) under `audit` narrowed
+/// to the model: the groups of its task (model_groups; `named_groups`: the caller named them one
+/// by one) and the view it sees (model_classifier_options), which `audit` is left holding for the
+/// header that describes the run; in-distribution cells too unless `pointwise`. `name` is the
+/// model in errors and, through audited_model_name, the result's name.
+ModelAudit audit_model(const std::string& file, const std::string& name, props::AuditOptions& audit,
+                       bool named_groups, bool pointwise, bool floor = false);
+
+/// What `handcentric audit --model` says under the tables of a 2D model audited under all groups.
+inline constexpr const char* kPlanarModelNote =
+    "A model of the 2D task (peg2d) is audited on planar scenes (poses rotating about z, "
+    "everything at z = 0) under the groups that keep them planar; rotation and se3 tilt the "
+    "plane and are not checked.";
 
 /// The pointwise audit Table 1 records for the model file DIR/PATH: eye-in-hand view, the
 /// groups of its task, `cases` cases per group from RapidCheck seed 1, float64 tolerance, no

@@ -27,8 +27,10 @@ std::string rate_text(const std::optional<double>& rate, const std::optional<Int
 /// group: yes or no, and the model's largest error) when a row was audited.
 Table table1_table(const std::vector<Row>& rows, const std::string& id, const std::string& caption);
 
-/// One row per method: train, ood and random-se3 success with counts and Wilson intervals, and
-/// the paper's hand-centric row (with the Wilson intervals of its counts).
+/// Table 2's one rendering (the report page, and table2.md through table2_markdown): one row per
+/// row of `rows` (a method, "(image)" after an image row's), its demos and steps, and train, ood
+/// and random-se3 success with counts and Wilson intervals; then the paper's hand-centric row
+/// (with the Wilson intervals of its counts).
 Table table2_table(const std::vector<Table2Row>& rows, const std::string& id);
 
 }  // namespace handcentric::experiments

@@ -13,7 +13,7 @@
 //
 //   DIR/table2.json  {"rows": [{"method", "demos", "trials", "train_success", "ood_success",
 //                     "random_se3_success", "<set>_wilson95": [lo, hi], ...}], ...}
-//   DIR/table2.md    the table beside the paper's Table 2
+//   DIR/table2.md    the table beside the paper's Table 2 (table2_markdown)
 //   DIR/table2.png, table2.svg   success per method and scene set, Wilson 95% bars
 //   DIR/<method>.hcm, DIR/<method>_image.hcm   with save_models: each row's trained model, for
 //                     `eval`, `render --rollout` and `audit --model` on the very policy of the row
@@ -136,6 +136,9 @@ struct Table2Row {
   Insert3dCounts train, ood, random_se3;
 };
 
+/// A row's method as its tables and charts name it: "hand_centric", "hand_centric (image)".
+std::string table2_row_label(const Table2Row& row);
+
 /// The file name of a row's model in DIR with Table2Options::save_models: "<method>.hcm" for
 /// the key-point rows, "<method>_image.hcm" for the image rows.
 std::string table2_model_file(const std::string& method, policy::ObservationKind observation);
@@ -153,7 +156,8 @@ std::vector<Table2Row> run_table2(const Table2Options& options);
 
 /// The rows as the table2.json document.
 std::string table2_json(const std::vector<Table2Row>& rows);
-/// The rows as Markdown beside the paper's Table 2.
+/// table2.md: what the run was (demos, seeds, trials, each kind of row's noise injection and
+/// camera), then table2_table (results_page.hpp) through the page's Markdown renderer.
 std::string table2_markdown(const std::vector<Table2Row>& rows);
 /// Success per method and scene set as grouped bars with Wilson 95% intervals, the paper's
 /// hand-centric numbers as ticks (chart.hpp). Throws InvalidArgument for no rows.

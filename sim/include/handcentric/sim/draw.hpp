@@ -25,12 +25,17 @@ namespace handcentric::sim {
 constexpr std::uint8_t kSuccessRgb[3] = {40, 170, 60};
 constexpr std::uint8_t kCollisionRgb[3] = {220, 30, 30};
 
+/// A drawing's width and height in pixels unless the caller asks for others (`render --size`).
+constexpr int kDrawingSize = 800;
+/// The demos `render --demos` draws unless --max says otherwise.
+constexpr int kDrawnDemos = 20;
+
 /// Throws InvalidArgument for a size outside [64, 4096].
 Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry = PegHoleGeometry(),
-                 int size = 800);
+                 int size = kDrawingSize);
 Image draw_demos(const std::vector<Demo>& demos,
-                 const PegHoleGeometry& geometry = PegHoleGeometry(), int size = 800);
+                 const PegHoleGeometry& geometry = PegHoleGeometry(), int size = kDrawingSize);
 Image draw_rollout(const TaskScene& scene, const Rollout& rollout,
-                   const PegHoleGeometry& geometry = PegHoleGeometry(), int size = 800);
+                   const PegHoleGeometry& geometry = PegHoleGeometry(), int size = kDrawingSize);
 
 }  // namespace handcentric::sim
