@@ -281,6 +281,7 @@ int run_audit(const AuditCommandOptions& options) {
       throw InvalidArgument(
           "--extra-poses and --scalars are for plug-ins; the built-ins read neither");
     results = props::audit_builtins(options.representations, audit);
+    for (auto& c : results) { int n = 0; for (auto& v : c.verdicts) n += v.first_failure.has_value(); fprintf(stderr, "DBG apps %s %zu verdicts %d engaged sizeof %zu\n", c.name.c_str(), c.verdicts.size(), n, sizeof(props::Verdict)); }
   }
   if (options.json) {
     std::cout << (policies ? props::policy_audit_json(results) : props::audit_json(results));

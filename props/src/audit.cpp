@@ -211,6 +211,7 @@ std::vector<Classification> audit_builtins(const std::vector<std::string>& names
                             valid + " (or --exec 'COMMAND' for your own)");
     }
   }
+  for (auto& c : out) { int n = 0; for (auto& v : c.verdicts) n += v.first_failure.has_value(); fprintf(stderr, "DBG props %s %zu verdicts %d engaged sizeof %zu\n", c.name.c_str(), c.verdicts.size(), n, sizeof(Verdict)); }
   return out;
 }
 

@@ -114,6 +114,10 @@ std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& 
                                         const Eigen::VectorXd& noise,
                                         double pose_tolerance = kOutputPoseTolerance);
 
+/// One case as every check draws it, inside a RapidCheck property: (scene, g) from the recorded
+/// observations, else inside the workspace, else from the generators (scene first, then g).
+std::pair<Scene, RigidTransform> draw_case(const SceneShape& shape, Group group);
+
 /// Runs a RapidCheck property (it calls RC_FAIL to fail) for `cases` cases from `seed`, printing
 /// nothing: the caller records what it needs from inside the property.
 void run_silently(const std::function<void()>& property, const std::string& description,

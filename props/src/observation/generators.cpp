@@ -17,13 +17,13 @@ constexpr int kResolution = 1 << 30;  // uniform numbers are k / 2^30, k an inte
 
 // A uniform number in [0, 1).
 rc::Gen<double> unit_interval() {
-  return rc::gen::map(rc::gen::inRange(0, kResolution),
+  return rc::gen::map(uniform_integer(0, kResolution),
                       [](int k) { return static_cast<double>(k) / kResolution; });
 }
 
 // A uniform number in [-max_abs, max_abs].
 rc::Gen<double> symmetric(double max_abs) {
-  return rc::gen::map(rc::gen::inRange(-kResolution, kResolution + 1),
+  return rc::gen::map(uniform_integer(-kResolution, kResolution + 1),
                       [max_abs](int k) { return max_abs * static_cast<double>(k) / kResolution; });
 }
 
@@ -51,7 +51,7 @@ rc::Gen<Rotation> z_rotation_edge_cases() {
 }
 
 rc::Gen<Rotation> c8_rotation() {
-  return rc::gen::map(rc::gen::inRange(0, 8),
+  return rc::gen::map(uniform_integer(0, 8),
                       [](int i) { return Rotation::about_z(i * kPi / 4.0); });
 }
 
@@ -202,18 +202,15 @@ rc::Gen<Eigen::Vector3d> point(double max_abs, bool planar) {
   });
 }
 
-// Between min_count and max_count points; with min_count = 0, RapidCheck's sized container.
+// Between min_count and max_count points, the count uniform.
 rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, double max_abs,
                                              bool planar) {
-  if (min_count <= 0) {
-    return rc::gen::resize(
-        max_count, rc::gen::container<std::vector<Eigen::Vector3d>>(point(max_abs, planar)));
-  }
-  return rc::gen::mapcat(rc::gen::inRange(min_count, std::max(min_count, max_count) + 1),
-                         [max_abs, planar](int count) {
-                           return rc::gen::container<std::vector<Eigen::Vector3d>>(
-                               static_cast<std::size_t>(count), point(max_abs, planar));
-                         });
+  return rc::gen::mapcat(
+      uniform_integer(std::max(min_count, 0), std::max(min_count, max_count) + 1),
+      [max_abs, planar](int count) {
+        return rc::gen::container<std::vector<Eigen::Vector3d>>(static_cast<std::size_t>(count),
+                                                                point(max_abs, planar));
+      });
 }
 
 }  // namespace
@@ -249,8 +246,8 @@ rc::Gen<Scene> scene(SceneShape shape) {
         shape.planar ? planar_rotation() : rotation(), shape.planar ? planar_axis() : unit_axis(),
         rc::gen::just(scale), step_or_rest(0.01 * scale, 0.3, shape.planar),
         step_or_rest(0.01 * scale, 0.3, shape.planar),
-        rc::gen::inRange(shape.min_history, shape.max_history + 1),
-        rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
+        uniform_integer(shape.min_history, shape.max_history + 1),
+        uniform_integer(shape.min_chunk, shape.max_chunk + 1),
         points(shape.min_hand_points, shape.max_hand_points, 0.1 * scale, shape.planar),
         points(shape.min_world_points, shape.max_world_points, scale, shape.planar));
   });
@@ -434,7 +431,7 @@ rc::Gen<std::pair<Scene, RigidTransform>> recorded_case(const SceneShape& shape,
   if (!shape.recorded) throw InvalidArgument("recorded_case needs recorded observations");
   std::shared_ptr<const RecordedObservations> data = shape.recorded;
   const bool eye_in_hand = shape.max_world_points == 0;
-  const auto index = rc::gen::inRange<std::size_t>(0, data->scenes.size());
+  const auto index = uniform_integer<std::size_t>(0, data->scenes.size());
   const auto observation = rc::gen::map(index, [data, eye_in_hand](std::size_t i) {
     Scene s = data->scenes[i];
     if (eye_in_hand) s.world_points.clear();
