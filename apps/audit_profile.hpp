@@ -7,26 +7,22 @@
 #include <vector>
 
 #include "handcentric/props/checks/profile.hpp"
+#include "handcentric/props/transport/plugin_connection.hpp"
 
 namespace handcentric::apps {
 
 struct ProfileCommand {
   std::string group;  ///< one group's name ("all" is refused: one plot per group)
-  std::string view;   ///< "eye_in_hand", "third_person"; "all" means eye_in_hand
-  std::string out;    ///< the folder to write
+  /// --view as given: one of "eye_in_hand", "third_person"; "all" means eye_in_hand
+  std::vector<std::string> views;
+  std::string out;                           ///< the folder to write
   std::vector<std::string> representations;  ///< built-ins; empty: all, and ActionFlow's target
   std::string exec, policy_exec, model;
-  std::uint64_t seed = 1;
-  int scenes = 16;
+  std::uint64_t seed = props::ProfileOptions{}.seed;
+  int scenes = props::ProfileOptions{}.scenes;
   std::vector<double> sizes;  ///< empty: the group's defaults
-  double timeout = 10.0;
+  double timeout = props::kDefaultPluginTimeout;
 };
-
-/// The profile of a trained model file under `group`, on scenes of its own task (planar for
-/// peg2d; a planar C8 head's rotations about its centre), named "model FILE (NAME)". Throws
-/// InvalidArgument for a group that tilts a peg2d model's plane.
-props::Profile profile_model(const std::string& path, props::Group group,
-                             props::ProfileOptions options);
 
 /// Runs the profiles, then writes DIR/profile.json and DIR/profile.png (each atomically, both
 /// computed before either is written) and prints one line per profile. Returns 0; throws

@@ -9,8 +9,6 @@
 //   handcentric audit --policy-exec 'python3 my_policy.py' --expect se3
 //   handcentric audit --model hc.model
 //   handcentric audit --model image.model --floor   # the hand camera sees the table too
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -22,25 +20,27 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/experiments/model_audit.hpp"
+#include "handcentric/experiments/witness_panel.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/props/transport/batch.hpp"
+#include "handcentric/props/gate.hpp"
 #include "handcentric/props/transport/pipe_policy.hpp"
 #include "handcentric/props/transport/pipe_representation.hpp"
 #include "handcentric/props/checks/policy_audit.hpp"
-#include "handcentric/sim/draw.hpp"
+#include "handcentric/sim/image.hpp"
 
 namespace handcentric::apps {
 namespace {
 
 struct AuditCommandOptions {
   std::vector<std::string> representations;
-  std::string group = "all";
-  std::string view = "all";
+  // One or more names each, or "all" (props::parse_groups, props::parse_views).
+  std::vector<std::string> groups = {"all"};
+  std::vector<std::string> views = {"all"};
   long long cases = props::kDefaultCases;  // wide: a value past the bound is named, not wrapped
-  std::uint64_t seed = 1;
-  double timeout = 10.0;
+  std::uint64_t seed = props::AuditOptions{}.seed;
+  double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
   std::string precision = "float64";
   std::string workspace, witness_dir, observations;
@@ -50,7 +50,7 @@ struct AuditCommandOptions {
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
   std::string profile, out;  // --profile GROUP --out DIR (audit_profile.hpp)
-  int profile_scenes = 16;
+  int profile_scenes = props::ProfileOptions{}.scenes;
   std::vector<double> profile_sizes;
 };
 
@@ -60,37 +60,9 @@ ProfileCommand profile_command(const AuditCommandOptions& options) {
     throw InvalidArgument(
         "--profile draws g by its size and writes --out; leave out --workspace, --witness-dir, "
         "--expect, --extra-poses, --scalars and --observations");
-  return {options.profile,        options.view,          options.out,    options.representations,
+  return {options.profile,        options.views,         options.out,    options.representations,
           options.exec,           options.policy_exec,   options.model,  options.seed,
           options.profile_scenes, options.profile_sizes, options.timeout};
-}
-
-// One camera image as a PNG: the colour image beside its depth (near bright, black at the
-// camera's range), each pixel 4 x 4, so that a 64 x 48 image reads at a glance.
-sim::Image witness_panel(const CameraImage& image, double max_range) {
-  constexpr int kScale = 4;
-  sim::Image out;
-  out.width = 2 * image.width * kScale + kScale;
-  out.height = image.height * kScale;
-  out.rgb.assign(static_cast<std::size_t>(out.width) * out.height * 3, 255);
-  for (int y = 0; y < out.height; ++y) {
-    for (int x = 0; x < out.width; ++x) {
-      const int col = x / kScale, row = y / kScale;
-      const std::size_t pixel = static_cast<std::size_t>(row) * image.width;
-      std::uint8_t* to = &out.rgb[3 * (static_cast<std::size_t>(y) * out.width + x)];
-      if (col < image.width) {
-        for (int c = 0; c < 3; ++c)
-          to[c] = static_cast<std::uint8_t>(
-              std::lround(255.0 * std::clamp(image.rgb[3 * (pixel + col) + c], 0.0, 1.0)));
-      } else if (col > image.width) {
-        const double depth = image.depth[pixel + static_cast<std::size_t>(col - image.width - 1)];
-        const auto shade = static_cast<std::uint8_t>(
-            std::lround(255.0 * std::clamp(1.0 - depth / max_range, 0.0, 1.0)));
-        to[0] = to[1] = to[2] = shade;
-      }
-    }
-  }
-  return out;
 }
 
 // --witness-dir: for each failing check of a policy that sees cameras, the images it was shown
@@ -110,8 +82,10 @@ void write_witness_images(const std::string& dir, const props::Classification& r
     const std::vector<CameraImage> after = props::render_views(moved, rig);
     for (std::size_t v = 0; v < rig.views.size(); ++v) {
       const std::string camera = props::to_string(rig.views[v]);
-      sim::write_png(stem + camera + "_o.png", witness_panel(before[v], rig.camera.max_range));
-      sim::write_png(stem + camera + "_g_o.png", witness_panel(after[v], rig.camera.max_range));
+      sim::write_png(stem + camera + "_o.png",
+                     experiments::witness_panel(before[v], rig.camera.max_range));
+      sim::write_png(stem + camera + "_g_o.png",
+                     experiments::witness_panel(after[v], rig.camera.max_range));
       written += 2;
     }
   }
@@ -119,95 +93,25 @@ void write_witness_images(const std::string& dir, const props::Classification& r
             << " (colour beside depth, of o and of g o)\n";
 }
 
-std::vector<props::Group> parse_groups(const std::string& name) {
-  if (name == "all") return props::all_groups();
-  return {props::parse_group(name)};  // throws InvalidArgument naming the valid names
-}
-
-// One --expect item: GROUP (every component) or COMPONENT:GROUP.
-struct Expectation {
-  std::optional<props::Component> component;
-  props::Group group;
-};
-
-props::Component parse_component(const std::string& name) {
-  for (props::Component c :
-       {props::Component::actions, props::Component::observation, props::Component::flow_input,
-        props::Component::flow_target, props::Component::policy}) {
-    if (props::to_string(c) == name) return c;
-  }
-  throw InvalidArgument(
-      "unknown component '" + name +
-      "' in --expect; use actions, observation, flow_input, flow_target or policy, e.g. "
-      "--expect actions:se3");
-}
-
-std::vector<Expectation> parse_expectations(const std::vector<std::string>& items) {
-  std::vector<Expectation> out;
-  for (const std::string& item : items) {
-    const std::size_t colon = item.find(':');
-    Expectation e{std::nullopt,
-                  props::parse_group(colon == std::string::npos ? item : item.substr(colon + 1))};
-    if (colon != std::string::npos) e.component = parse_component(item.substr(0, colon));
-    out.push_back(e);
-  }
-  return out;
-}
-
-// The verdicts an --expect list asks to hold that do not; each failing one with its witness on
-// stderr. A group nothing was checked under is an error: an empty gate must not pass.
+// The gate (props/gate.hpp): each expected symmetry that does not hold, with its witness, on
+// stderr, and exit 1.
 int gate(const std::vector<props::Classification>& results,
-         const std::vector<Expectation>& expectations) {
-  int failed = 0;
-  for (const Expectation& e : expectations) {
-    int checked = 0;
-    for (const props::Classification& c : results) {
-      for (const props::Verdict& v : c.verdicts) {
-        if (v.group != e.group || (e.component && v.component != *e.component)) continue;
-        ++checked;
-        if (v.invariant) continue;
-        ++failed;
-        std::cerr << "handcentric audit: expected "
-                  << (v.component == props::Component::policy ? "equivariance" : "invariance")
-                  << " does not hold: " << c.name << ", " << props::to_string(v.component) << " ("
-                  << props::to_string(v.mode) << ", " << props::to_string(v.view) << ") under "
-                  << props::to_string(v.group) << (v.note.empty() ? "" : "; note: " + v.note)
-                  << "\n";
-        if (v.witness) std::cerr << props::format_witness(*v.witness) << "\n";
-      }
-    }
-    if (checked == 0) {
-      const std::string item =
-          "--expect " + std::string(e.component ? props::to_string(*e.component) + ":" : "") +
-          props::to_string(e.group);
-      // Say which part of the item matched nothing: the component, or the group and view.
-      bool component_ran = !e.component.has_value();
-      std::string components_ran;
-      for (const props::Classification& c : results) {
-        for (const props::Verdict& v : c.verdicts) {
-          const std::string name = props::to_string(v.component);
-          if (components_ran.find(name) == std::string::npos)
-            components_ran += (components_ran.empty() ? "" : ", ") + name;
-          if (e.component && v.component == *e.component) component_ran = true;
-        }
-      }
-      if (!component_ran) {
-        throw InvalidArgument(item + " names the component '" + props::to_string(*e.component) +
-                              "', which this audit does not check (it checks " + components_ran +
-                              "); e.g. --expect " +
-                              components_ran.substr(0, components_ran.find(',')) + ":" +
-                              props::to_string(e.group));
-      }
-      throw InvalidArgument(item + " matches no check that ran; widen --group or --view");
-    }
-  }
-  return failed == 0 ? 0 : 1;
+         const std::vector<props::ExpectedSymmetry>& expectations) {
+  const std::vector<props::GateFailure> failures = props::gate_failures(results, expectations);
+  for (const props::GateFailure& failure : failures)
+    std::cerr << "handcentric audit: " << props::gate_failure_text(failure);
+  return failures.empty() ? 0 : 1;
 }
 
 int run_audit(const AuditCommandOptions& options) {
   props::AuditOptions audit;
-  audit.groups = parse_groups(options.group);
-  audit.views = props::parse_views({options.view}, "view");
+  audit.groups = props::parse_groups(options.groups, "group");
+  audit.views = props::parse_views(options.views, "view");
+  // "all" (the default), as against groups and views named one by one.
+  auto has_all = [](const std::vector<std::string>& names) {
+    return std::find(names.begin(), names.end(), "all") != names.end();
+  };
+  const bool all_groups = has_all(options.groups), all_views = has_all(options.views);
   audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
   audit.seed = options.seed;
   audit.precision = props::parse_precision(options.precision);
@@ -217,11 +121,12 @@ int run_audit(const AuditCommandOptions& options) {
     audit.observations = std::make_shared<props::RecordedObservations>(
         props::read_observations(options.observations));
     // Data without world points show the third-person view nothing to move: one view only.
-    if (options.view == "all" && !audit.observations->has_world_points())
+    if (all_views && !audit.observations->has_world_points())
       audit.views = {props::View::eye_in_hand};
   }
   const double relative = props::audit_relative_tolerance(audit);  // validates --tolerance
-  const std::vector<Expectation> expectations = parse_expectations(options.expect);
+  const std::vector<props::ExpectedSymmetry> expectations =
+      props::parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
   std::vector<props::Classification> results;
   bool policies = false, planar_model = false;
@@ -234,11 +139,8 @@ int run_audit(const AuditCommandOptions& options) {
     classifier.observation = plugin->provides_observation();
     std::shared_ptr<const FlowTarget> flow;
     if (capabilities.flow) flow = std::make_shared<props::PipeFlowTarget>(plugin);
-    std::shared_ptr<const Representation> audited = plugin;
     // Batched requests, with the verdicts and JSON of one scene at a time (batch.hpp).
-    if (capabilities.batch > 0)
-      audited = std::make_shared<props::BatchedRepresentation>(plugin, capabilities.batch);
-    results.push_back(props::classify_representation(audited, classifier, flow));
+    results.push_back(props::classify_representation(props::as_checked(plugin), classifier, flow));
   } else if (!options.policy_exec.empty()) {
     auto plugin = std::make_shared<props::PipePolicy>(options.policy_exec, options.timeout,
                                                       options.extra_poses, options.scalars);
@@ -246,10 +148,7 @@ int run_audit(const AuditCommandOptions& options) {
     const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
     const props::ClassifierOptions classifier =
         props::plugin_classifier_options(audit, capabilities);
-    std::shared_ptr<const props::NoisyPolicy> audited = plugin;
-    if (capabilities.batch > 0)  // as for --exec
-      audited = std::make_shared<props::BatchedPolicy>(plugin, capabilities.batch);
-    results.push_back(props::classify_policy(audited, classifier));
+    results.push_back(props::classify_policy(props::as_checked(plugin), classifier));  // as --exec
     policies = true;
     if (!options.witness_dir.empty()) {
       if (!capabilities.cameras) {
@@ -267,7 +166,7 @@ int run_audit(const AuditCommandOptions& options) {
     auto model = experiments::load_audited_model(options.model, options.floor);
     planar_model = model->config().task == policy::kTaskPeg2d;
     audit.groups =
-        experiments::model_groups(model->config(), audit.groups, options.group, options.model);
+        experiments::model_groups(model->config(), audit.groups, !all_groups, options.model);
     props::ClassifierOptions classifier =
         experiments::model_classifier_options(model->config(), props::classifier_options(audit));
     classifier.in_distribution = !options.pointwise;
@@ -281,7 +180,6 @@ int run_audit(const AuditCommandOptions& options) {
       throw InvalidArgument(
           "--extra-poses and --scalars are for plug-ins; the built-ins read neither");
     results = props::audit_builtins(options.representations, audit);
-    for (auto& c : results) { int n = 0; for (auto& v : c.verdicts) n += v.first_failure.has_value(); fprintf(stderr, "DBG apps %s %zu verdicts %d engaged sizeof %zu\n", c.name.c_str(), c.verdicts.size(), n, sizeof(props::Verdict)); }
   }
   if (options.json) {
     std::cout << (policies ? props::policy_audit_json(results) : props::audit_json(results));
@@ -313,7 +211,7 @@ int run_audit(const AuditCommandOptions& options) {
       << " per cell) the energy distance of the tested coordinates (a statistic, not a length). "
          "Rules: docs/AUDIT.md\n\n";
   props::print_audit(std::cout, results, audit);
-  if (planar_model && options.group == "all") {
+  if (planar_model && all_groups) {
     std::cout << "\nA model of the 2D task (peg2d) is audited on planar scenes (poses rotating "
                  "about z, everything at z = 0) under the groups that keep them planar; rotation "
                  "and se3 tilt the plane and are not checked.\n";
@@ -331,12 +229,13 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       "--repr", options->representations,
       "a built-in to audit (absolute, relative, relative_diff, hand_centric, actionflow); "
       "repeatable; default: all");
-  cmd->add_option("--group", options->group, "translation|rotation|se2|se3|c8|all")
+  cmd->add_option("--group", options->groups,
+                  "one or more of translation, rotation, se2, se3, c8, or all, e.g. --group "
+                  "rotation se3")
       ->capture_default_str();
-  cmd->add_option(
-         "--view", options->view,
-         "eye_in_hand (no world points: Theorem 1's setting), third_person (1-8 world points that "
-         "move with g) or all")
+  cmd->add_option("--view", options->views,
+                  "one or both of eye_in_hand (no world points: Theorem 1's setting) and "
+                  "third_person (1-8 world points that move with g), or all")
       ->capture_default_str();
   cmd->add_option("--cases", options->cases,
                   "cases per pointwise check, at most 10^7 (in distribution: max(10, cases/100))")

@@ -8,13 +8,12 @@
 #include "audit_profile.hpp"
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/representations.hpp"
-#include "handcentric/experiments/model_audit.hpp"
+#include "handcentric/core/flow_target.hpp"
+#include "handcentric/experiments/model_profile.hpp"
 #include "handcentric/experiments/profile_plot.hpp"
-#include "handcentric/policy/c8_planar.hpp"
-#include "handcentric/policy/learned_policy.hpp"
-#include "handcentric/policy/model_file.hpp"
-#include "handcentric/props/transport/batch.hpp"
+#include "handcentric/props/audit.hpp"
 #include "handcentric/props/checks/classifier.hpp"
 #include "handcentric/props/checks/profile.hpp"
 #include "handcentric/props/transport/pipe_policy.hpp"
@@ -26,10 +25,7 @@ namespace {
 std::vector<props::Profile> builtin_profiles(const ProfileCommand& command, props::Group group,
                                              const props::ProfileOptions& options) {
   std::vector<std::string> names = command.representations;
-  if (names.empty()) {
-    names = builtin_representation_names();
-    names.push_back("actionflow");
-  }
+  if (names.empty()) names = props::auditable_names();
   std::vector<props::Profile> profiles;
   for (const std::string& name : names) {
     if (name == "actionflow") {
@@ -44,18 +40,16 @@ std::vector<props::Profile> builtin_profiles(const ProfileCommand& command, prop
   return profiles;
 }
 
-std::vector<props::Profile> exec_profiles(const ProfileCommand& command, props::Group group,
+// A plug-in's profile is set up as its audit is (props/audit.hpp): the extra poses and scalars
+// its hello asks for, and batched requests with prefetch passes when it answers batches.
+std::vector<props::Profile> exec_profiles(const ProfileCommand& command,
+                                          const props::AuditOptions& audit, props::Group group,
                                           props::ProfileOptions options) {
   auto plugin = std::make_shared<props::PipeRepresentation>(
       command.exec, command.timeout, std::vector<std::string>{}, std::vector<std::string>{});
-  const props::PluginCapabilities& capabilities = plugin->capabilities();  // the handshake
-  options.shape.extra_pose_names = capabilities.extra_pose_names;
-  options.shape.scalar_names = capabilities.scalar_names;
-  std::shared_ptr<const Representation> profiled = plugin;
-  if (capabilities.batch > 0) {  // each size's scenes in batched requests (batch.hpp)
-    profiled = std::make_shared<props::BatchedRepresentation>(plugin, capabilities.batch);
-    options.prefetch = true;
-  }
+  options = props::with_audit_setup(
+      options, props::plugin_classifier_options(audit, plugin->capabilities()), audit.views[0]);
+  const std::shared_ptr<const Representation> profiled = props::as_checked(plugin);
   std::vector<props::Profile> profiles;
   profiles.push_back(props::profile_function(props::actions_of(profiled), plugin->name(),
                                              props::Component::actions, group, options));
@@ -65,60 +59,20 @@ std::vector<props::Profile> exec_profiles(const ProfileCommand& command, props::
   return profiles;
 }
 
-std::vector<props::Profile> policy_exec_profiles(const ProfileCommand& command, props::Group group,
+std::vector<props::Profile> policy_exec_profiles(const ProfileCommand& command,
+                                                 const props::AuditOptions& audit,
+                                                 props::Group group,
                                                  props::ProfileOptions options) {
   auto plugin = std::make_shared<props::PipePolicy>(
       command.policy_exec, command.timeout, std::vector<std::string>{}, std::vector<std::string>{});
-  const props::PluginCapabilities& capabilities = plugin->capabilities();
-  options.shape.extra_pose_names = capabilities.extra_pose_names;
-  options.shape.scalar_names = capabilities.scalar_names;
-  std::shared_ptr<const props::NoisyPolicy> profiled = plugin;
-  if (capabilities.batch > 0) {
-    profiled = std::make_shared<props::BatchedPolicy>(plugin, capabilities.batch);
-    options.prefetch = true;
-  }
-  return {props::profile_policy(*profiled, group, options)};
+  options = props::with_audit_setup(
+      options, props::plugin_classifier_options(audit, plugin->capabilities()), audit.views[0]);
+  return {props::profile_policy(*props::as_checked(plugin), group, options)};
 }
-
-}  // namespace
-
-props::Profile profile_model(const std::string& path, props::Group group,
-                             props::ProfileOptions options) {
-  auto model = std::make_shared<policy::LearnedPolicy>(policy::load_model(path));
-  const policy::PolicyConfig& config = model->config();
-  // A peg2d model is profiled on planar scenes, under the groups that keep them planar
-  // (experiments/model_audit.hpp).
-  if (experiments::model_groups(config, {group}, "all", path).empty())
-    throw InvalidArgument("--profile " + props::to_string(group) + ": " + path +
-                          " is a model of the 2D task (peg2d), whose scenes lie in a plane that " +
-                          props::to_string(group) +
-                          " tilts; profile it under translation, se2 or c8");
-  // The model's own H, point counts and view (its world points or none), as `audit --model`.
-  props::ClassifierOptions classifier;
-  classifier.views = {props::View::eye_in_hand, props::View::third_person};
-  options.shape = experiments::model_classifier_options(config, classifier).check.shape;
-  // A planar C8 head is symmetric about its own centre, not the world origin.
-  if (policy::is_c8_planar(config.head)) {
-    const Eigen::Vector2d centre = policy::c8::centre_of(config);
-    options.centre = Eigen::Vector3d(centre.x(), centre.y(), 0.0);
-  }
-  props::Profile profile = props::profile_policy(props::SeededPolicy(model), group, options);
-  profile.name =
-      "model " + std::filesystem::path(path).filename().string() + " (" + model->name() + ")";
-  return profile;
-}
-
-namespace {
 
 std::vector<props::Profile> model_profiles(const ProfileCommand& command, props::Group group,
                                            const props::ProfileOptions& options) {
-  return {profile_model(command.model, group, options)};
-}
-
-std::string two_digits(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.2g", x);
-  return buffer;
+  return {experiments::profile_model(command.model, group, options)};
 }
 
 }  // namespace
@@ -130,18 +84,24 @@ int run_audit_profile(const ProfileCommand& command) {
         "se2, se3 or c8");
   const props::Group group = props::parse_group(command.group);
   // A profile is of one view: "all" (the audit's default) draws the eye-in-hand one.
-  const props::View view = props::parse_views({command.view}, "view").front();
+  if (command.views.size() > 1)
+    throw InvalidArgument("--profile draws one view; give --view eye_in_hand or third_person");
+  const props::View view = props::parse_views(command.views, "view").front();
+  // The audit's setup of these scenes (props/audit.hpp): its seed, for the scenes, the policy's
+  // fixed noise and the laws' draws.
+  props::AuditOptions audit;
+  audit.groups = {group};
+  audit.views = {view};
+  audit.seed = command.seed;
   props::ProfileOptions options;
-  options.seed = command.seed;
-  options.noise_seed = command.seed;  // the policy's fixed noise and the laws' draws too
   options.scenes = command.scenes;
   options.sizes = command.sizes;
-  options.shape = props::shape_for(view);
+  options = props::with_audit_setup(options, props::classifier_options(audit), view);
   std::vector<props::Profile> profiles;
   if (!command.exec.empty()) {
-    profiles = exec_profiles(command, group, options);
+    profiles = exec_profiles(command, audit, group, options);
   } else if (!command.policy_exec.empty()) {
-    profiles = policy_exec_profiles(command, group, options);
+    profiles = policy_exec_profiles(command, audit, group, options);
   } else if (!command.model.empty()) {
     profiles = model_profiles(command, group, options);
   } else {
@@ -163,16 +123,16 @@ int run_audit_profile(const ProfileCommand& command) {
             << "; error / chunk scale, median (max) over the scenes (docs/AUDIT.md, Profiles)\n";
   for (const props::Profile& p : profiles) {
     std::cout << "  " << p.name << " " << props::to_string(p.component) << ": pointwise "
-              << two_digits(p.points.front().pointwise.median) << " at "
-              << two_digits(p.points.front().size) << " .. "
-              << two_digits(p.points.back().pointwise.median) << " at "
-              << two_digits(p.points.back().size);
+              << format_significant(p.points.front().pointwise.median, 2) << " at "
+              << format_significant(p.points.front().size, 2) << " .. "
+              << format_significant(p.points.back().pointwise.median, 2) << " at "
+              << format_significant(p.points.back().size, 2);
     if (p.points.back().distribution)
       std::cout << "; in distribution (" << p.distribution_method << ") "
-                << two_digits(p.points.front().distribution->median) << " .. "
-                << two_digits(p.points.back().distribution->median);
-    std::cout << "; Lie derivative " << two_digits(p.slope.median) << " ("
-              << two_digits(p.slope.max) << ")\n";
+                << format_significant(p.points.front().distribution->median, 2) << " .. "
+                << format_significant(p.points.back().distribution->median, 2);
+    std::cout << "; Lie derivative " << format_significant(p.slope.median, 2) << " ("
+              << format_significant(p.slope.max, 2) << ")\n";
   }
   std::cout << "wrote " << (std::filesystem::path(command.out) / "profile.json").string()
             << " and profile.png\n";

@@ -9,8 +9,9 @@
 // insert3d --policy expert; a --task that contradicts the model file is an error naming both.
 #include <cmath>
 #include <cstdio>
-#include <limits>
+#include <iomanip>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -21,6 +22,7 @@
 #include "insert3d_options.hpp"
 #include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/results.hpp"
 #include "handcentric/experiments/table2.hpp"
 #include "handcentric/sim/collision.hpp"
@@ -202,9 +204,9 @@ void add_eval_command(CLI::App& app, int& exit_code) {
 
 // Main-report section: the sim's own bar (sim/expert_check.hpp) on seeded scenes.
 int run_sim_section(std::ostream& out, const ReportOptions&) {
-  constexpr int kScenes = kSimBarScenes;
-  constexpr int kRollouts = kSimBarRollouts;
-  constexpr std::uint64_t kSeed = kSimBarSeed;
+  constexpr int kScenes = sim::kExpertBarScenes;
+  constexpr int kRollouts = sim::kExpertBarRollouts;
+  constexpr std::uint64_t kSeed = sim::kExpertBarSeed;
   out << "sim: 2D peg-in-hole (Sec. 4.2), expert demos on " << kScenes
       << " scenes and closed-loop expert rollouts on " << kRollouts
       << " scenes per distribution, seed " << kSeed << "\n";
@@ -212,13 +214,10 @@ int run_sim_section(std::ostream& out, const ReportOptions&) {
   for (const auto& distribution :
        {sim::SceneDistribution::train(), sim::SceneDistribution::ood()}) {
     const sim::ExpertCheck check = sim::check_expert(distribution, kScenes, kRollouts, kSeed);
-    char line[200];
-    std::snprintf(
-        line, sizeof(line),
-        "  %-5s expert solved %5.1f%% (discard rate %.3f), closed loop %d/%d success  %s\n",
-        distribution.name.c_str(), 100.0 * check.solved_rate, check.discard_rate,
-        check.rollout_success, check.rollouts, check.passes() ? "ok" : "BELOW THE 99% BAR");
-    out << line;
+    out << "  " << std::left << std::setw(5) << distribution.name << std::right << " expert solved "
+        << std::setw(5) << format_fixed(100.0 * check.solved_rate, 1) << "% (discard rate "
+        << format_fixed(check.discard_rate, 3) << "), closed loop " << check.rollout_success << "/"
+        << check.rollouts << " success  " << (check.passes() ? "ok" : "BELOW THE 99% BAR") << "\n";
     if (!check.passes()) status = 1;
   }
   out << "  (handcentric demos / eval --policy expert reproduce these; docs/SIM.md)\n";

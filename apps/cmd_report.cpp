@@ -1,532 +1,43 @@
 // `handcentric report` (and plain `handcentric`): the main report, and its first section: the
 // audit summary of the built-ins (`handcentric audit` without witnesses), one compact table per
-// representation, compared cell by cell with what App. A of the paper says.
+// representation, compared cell by cell with what App. A of the paper says
+// (experiments/report_audit.hpp).
 //
-// `handcentric report --out DIR` writes the report as a page: the audit's verdict grids with
-// their witnesses, the certificates, the sim's bar, Fig. 3, a quick Table 1 and Table 2 (fewer
-// demo counts, trials and steps, said on the page; --full: the paper's grids) and Fig. 5. The
-// page is one document (experiments/document.hpp) rendered twice, DIR/index.html and
-// DIR/index.md, with its pictures and CLAIMS.md beside them.
-#include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <filesystem>
+// `handcentric report --out DIR` writes the report as a page (experiments/report_page.hpp).
 #include <iostream>
-#include <sstream>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "audit_profile.hpp"
 #include "commands.hpp"
-#include "handcentric/core/atomic_file.hpp"
-#include "handcentric/core/errors.hpp"
-#include "handcentric/experiments/flow_figure.hpp"
-#include "handcentric/experiments/audit_page.hpp"
-#include "handcentric/experiments/claims_page.hpp"
-#include "handcentric/experiments/conventions.hpp"
-#include "handcentric/experiments/document_html.hpp"
-#include "handcentric/experiments/document_markdown.hpp"
-#include "handcentric/experiments/results_page.hpp"
+#include "handcentric/experiments/cell.hpp"
 #include "handcentric/experiments/methods.hpp"
-#include "handcentric/experiments/profile_plot.hpp"
-#include "handcentric/experiments/table1.hpp"
-#include "handcentric/proofs/claims.hpp"
+#include "handcentric/experiments/report_audit.hpp"
+#include "handcentric/experiments/report_page.hpp"
 #include "handcentric/props/audit.hpp"
-#include "handcentric/sim/expert_check.hpp"
-#include "handcentric/sim/scenes.hpp"
 
 namespace handcentric::apps {
 
 int run_audit_section(std::ostream& out, const ReportOptions& options) {
-  props::AuditOptions audit;
-  audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
-  audit.seed = options.seed;
-  const props::ClassifierOptions used = props::classifier_options(audit);  // validates --cases
+  const experiments::ReportAudit run = experiments::run_report_audit(options.cases, options.seed);
   out << "1. Audit of the built-in representations (handcentric audit; witnesses there)\n"
-      << "   " << audit.cases << " cases per pointwise cell, " << used.distribution.cases
-      << " per in-distribution cell, seed " << audit.seed
+      << "   " << run.options.cases << " cases per pointwise cell, "
+      << run.classifier.distribution.cases << " per in-distribution cell, seed " << run.options.seed
       << "; 'yes' = invariant, the number = largest error seen\n\n";
-  const std::vector<props::Classification> results = props::audit_builtins({}, audit);
-  props::print_audit(out, results, audit, /*witnesses=*/false);
-  std::vector<std::string> mismatches;
-  for (const auto& classification : results) {
-    for (auto& line : props::mismatches_with_paper(classification))
-      mismatches.push_back(std::move(line));
-  }
-  if (mismatches.empty()) {
-    // One paragraph on the terminal: the literals are joined without line breaks.
-    out << "Every cell matches App. A of the paper in the eye-in-hand view: absolute - no "
-           "symmetry (eqs. 11, 13); relative and relative_diff - translation only (eq. 16); "
-           "hand_centric - all of SE(3) (eqs. 9, 23, 26); ActionFlow - pointwise none, in "
-           "distribution rotations only (eq. 29). The third-person cells match the same pattern, "
-           "on this library's rule for world points (copied raw by absolute, relative, "
-           "relative_diff and ActionFlow; taken into the hand frame by hand_centric).\n";
+  props::print_audit(out, run.results, run.options, /*witnesses=*/false);
+  if (run.mismatches.empty()) {
+    out << "Every cell matches App. A of the paper" << experiments::kPaperPattern << "\n";
     return 0;
   }
-  out << mismatches.size() << " cell(s) differ from the paper:\n";
-  for (const auto& line : mismatches) out << "  " << line << "\n";
+  out << run.mismatches.size() << " cell(s) differ from the paper:\n";
+  for (const auto& line : run.mismatches) out << "  " << line << "\n";
   return 1;
 }
 
-namespace {
-
-struct PageOptions {
-  std::string out;    ///< empty: print the report on stdout
-  bool full = false;  ///< the paper's whole grid instead of the quick one
-  // The quick page's defaults keep it within 5 minutes on two cores: Table 1 at the paper's
-  // headline count (100 demos, where its OOD column is), Fig. 5 at 10 demos (with 40 the page
-  // took 318 s on an idle machine; docs/BENCHMARKS.md), Table 2 at 100 demos with half its
-  // training budget (the CI experiment's setting).
-  std::string demos = "100";  ///< the quick Table 1's demo counts
-  int trials = 30;            ///< rollouts per scene set of the quick tables
-  // One C8 row (the workspace centre), as many rows as before the C8 baseline had two.
-  std::string methods = "hand_centric,relative,absolute,c8_centre";
-  std::string ablation_demos = "10";  ///< Fig. 5 (App. B): flow, ddpm and cvae heads
-  int table2_demos = 100;             ///< Table 2's analogue (3D insertion)
-  int steps = 0;                      ///< 0: the library's automatic training budget
-  int jobs = 0;
-  /// The public conventions' plug-ins (docs/CONVENTIONS.md): the source tree's by default.
-  std::string conventions = HANDCENTRIC_CONVENTIONS_DIR;
-  std::string python = experiments::ConventionsOptions{}.python;  ///< the interpreter of them
-};
-
-// Adam steps per Table 2 policy on the quick page: half the library's budget, with which
-// hand-centric scored 1.00 on all three sets (docs/EXPERIMENTS.md, Table 2).
-constexpr int kQuickTable2Steps = 15000;
-
-// Runs a Table 1 grid into `dir` (resuming what is there), writes its table1.md/.png, and
-// returns its rows, read back from the result files.
-std::vector<experiments::Row> table_into(const std::string& dir,
-                                         const std::vector<int>& demo_counts, int trials,
-                                         const std::vector<experiments::Method>& methods,
-                                         const std::vector<std::string>& heads,
-                                         const PageOptions& page,
-                                         std::vector<experiments::Cell>* cells = nullptr) {
-  experiments::Table1Options table;
-  table.demo_counts = demo_counts;
-  table.eval.trials = trials;
-  table.methods = methods;
-  table.heads = heads;
-  table.steps = page.steps;
-  table.jobs = page.jobs;
-  table.out = dir;
-  table.resume = true;
-  table.quiet = true;
-  table.validate();
-  const experiments::Table1Grid grid = experiments::prepare_table1(table);
-  experiments::run_table1(table, grid);
-  (void)experiments::collect_table1(grid.dir);
-  std::vector<experiments::Row> rows;
-  for (const experiments::Cell& cell : grid.cells)
-    rows.push_back(experiments::collect_row(cell, table.eval, grid.dir));
-  if (cells != nullptr) *cells = grid.cells;
-  return rows;
-}
-
-// What a Table 1 figure (experiments/plot.hpp) shows, up to its PNG link.
-std::string table1_figure_caption(std::size_t demo_counts) {
-  return std::string(demo_counts == 1
-                         ? "Success per method and head at one demo count: train scenes and "
-                           "independent OOD scenes, the paper's number as a black tick"
-                         : "Success against demos: train scenes solid, independent OOD scenes "
-                           "dashed") +
-         "; Wilson 95% bars (SVG; ";
-}
-
-using experiments::bold;
-using experiments::code;
-using experiments::Figure;
-using experiments::List;
-using experiments::Paragraph;
-using experiments::plain;
-using experiments::Section;
-
-Section section(std::string id, std::string title) {
-  Section out;
-  out.id = std::move(id);
-  out.title = std::move(title);
-  return out;
-}
-
-std::string fixed(double value, const char* format) {
-  char text[32];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
-// The audit: the built-ins' grids, how to read them, and whether they match App. A; their
-// witnesses go to `witnesses`, an appendix of the page.
-std::vector<Section> audit_sections(const ReportOptions& options,
-                                    std::vector<experiments::PageFile>& files,
-                                    std::vector<Section>& witnesses, bool& matches) {
-  props::AuditOptions audit;
-  audit.cases = props::checked_cases(options.cases);
-  audit.seed = options.seed;
-  const props::ClassifierOptions used = props::classifier_options(audit);
-  std::fprintf(stderr, "report: audit\n");
-  const std::vector<props::Classification> results = props::audit_builtins({}, audit);
-  std::vector<std::string> mismatches;
-  for (const auto& classification : results) {
-    for (auto& line : props::mismatches_with_paper(classification))
-      mismatches.push_back(std::move(line));
-  }
-  matches = mismatches.empty();
-  Section top = section("audit",
-                        "Audit: which global transforms each representation is "
-                        "invariant under");
-  top.blocks.push_back(Paragraph{
-      {plain("Each built-in representation (and ActionFlow's target) checked under each group "
-             "of global transforms g: " +
-             std::to_string(audit.cases) + " cases per pointwise cell, " +
-             std::to_string(used.distribution.cases) + " per in-distribution cell, seed " +
-             std::to_string(audit.seed) + " ("),
-       code("handcentric audit --cases " + std::to_string(audit.cases) + " --seed " +
-            std::to_string(audit.seed)),
-       plain(" prints the same on a terminal; docs/AUDIT.md says what each verdict means).")}});
-  top.blocks.push_back(List{{
-      {bold("✓ yes"), plain(": f(g·s) = f(s) on every case (in distribution: the laws agree).")},
-      {bold("✗ NO"),
-       plain(": a case where it does not; the cell links to that witness (the appendix).")},
-      {bold("m/1"), plain(": the largest error seen, in the component's units: metres for "
-                          "positions, no unit for rotation-matrix entries (one max-norm over "
-                          "both). In distribution: the largest difference of the laws' moments "
-                          "(exact), or the energy distance (test).")},
-      {bold("exact / test"),
-       plain(": how an in-distribution cell was decided: the laws compared exactly as "
-             "Gaussians, or by the energy, mean and scale tests (a 'yes' then means no difference "
-             "was found).")},
-  }});
-  if (matches) {
-    top.blocks.push_back(Paragraph{
-        {bold("Every cell matches App. A of the paper"),
-         plain(" in the eye-in-hand view: absolute - no symmetry (eqs. 11, 13); relative and "
-               "relative_diff - translation only (eq. 16); hand_centric - all of SE(3) (eqs. 9, "
-               "23, 26); ActionFlow - pointwise none, in distribution rotations only (eq. 29). "
-               "The third-person cells match the same pattern, on this library's rule for world "
-               "points (copied raw by absolute, relative, relative_diff and ActionFlow; taken "
-               "into the hand frame by hand_centric).")}});
-  } else {
-    List differ;
-    for (const std::string& line : mismatches) differ.items.push_back({plain(line)});
-    top.blocks.push_back(
-        Paragraph{{bold(std::to_string(mismatches.size()) + " cell(s) differ from the paper:")}});
-    top.blocks.push_back(std::move(differ));
-  }
-  std::vector<Section> out = {std::move(top)};
-  experiments::AuditPart part = experiments::audit_part(results, audit);
-  for (Section& s : part.grids) out.push_back(std::move(s));
-  if (!part.witnesses.empty()) {
-    Section appendix = section("witnesses", "Appendix: the witnesses of the audit's NO cells");
-    appendix.blocks.push_back(Paragraph{
-        {plain("Each NO cell of the grids links here: the scene s (its sizes and T_0), the "
-               "global transform g, the two outputs coordinate by coordinate and, projected on two "
-               "world axes, "
-               "the hand's path in s and in g s.")}});
-    witnesses.push_back(std::move(appendix));
-    for (Section& s : part.witnesses) witnesses.push_back(std::move(s));
-  }
-  for (experiments::PageFile& f : part.files) files.push_back(std::move(f));
-  return out;
-}
-
-Section certificates_section(std::vector<experiments::PageFile>& files, bool& all_verified) {
-  std::fprintf(stderr, "report: certificates\n");
-  const auto outcomes = proofs::certify_all(proofs::paper_claims());
-  experiments::ClaimsPart claims = experiments::claims_part(outcomes);
-  all_verified = claims.verified == static_cast<int>(outcomes.size());
-  Section out = section("certificates", "Certificates: the paper's claims, exactly");
-  out.blocks.push_back(Paragraph{
-      {plain(std::to_string(claims.verified) + "/" + std::to_string(outcomes.size()) +
-             " certificates verified. An identity is proved symbolically for generic inputs; a "
-             "counterexample is one exact input where the two sides differ ("),
-       code("handcentric prove"), plain("; each row links to its entry in "),
-       plain("docs/CLAIMS.md", "claims.html"), plain(").")}});
-  out.blocks.push_back(std::move(claims.table));
-  for (experiments::PageFile& f : claims.files) files.push_back(std::move(f));
-  return out;
-}
-
-Section sim_section(bool& passes) {
-  std::fprintf(stderr, "report: the sim's bar\n");
-  Section out = section("sim", "The 2D peg-in-hole task: the expert's bar");
-  out.blocks.push_back(Paragraph{
-      {plain("Sec. 4.2's task: expert demos on " + std::to_string(kSimBarScenes) +
-             " scenes and closed-loop expert rollouts on " + std::to_string(kSimBarRollouts) +
-             " scenes per distribution, seed " + std::to_string(kSimBarSeed) +
-             ". The bar: at least 99% solved and 99% inserted in closed loop (docs/SIM.md; "),
-       code("handcentric demos"), plain(" and "), code("handcentric eval --policy expert"),
-       plain(" reproduce these).")}});
-  experiments::Table table;
-  table.id = "sim-bar";
-  table.kind = "results";
-  table.caption = "The expert on the train and OOD scenes";
-  table.columns = {"distribution", "expert solved", "discard rate", "closed loop", "bar (99%)"};
-  passes = true;
-  for (const auto& distribution :
-       {sim::SceneDistribution::train(), sim::SceneDistribution::ood()}) {
-    const sim::ExpertCheck check =
-        sim::check_expert(distribution, kSimBarScenes, kSimBarRollouts, kSimBarSeed);
-    passes = passes && check.passes();
-    table.rows.push_back(
-        {experiments::text_cell(distribution.name),
-         experiments::text_cell(fixed(100.0 * check.solved_rate, "%.1f%%")),
-         experiments::text_cell(fixed(check.discard_rate, "%.3f")),
-         experiments::text_cell(std::to_string(check.rollout_success) + "/" +
-                                std::to_string(check.rollouts)),
-         experiments::verdict_cell(check.passes(), check.passes() ? "met" : "below the bar", "",
-                                   check.passes() ? "" : "#sim")});
-  }
-  out.blocks.push_back(std::move(table));
-  return out;
-}
-
-// The table of public conventions, audited afresh from their plug-ins as docs/CONVENTIONS.md is
-// (experiments/conventions.hpp), at its cases and seed; a note instead when there is no folder.
-std::vector<Section> conventions_page_sections(const PageOptions& page) {
-  experiments::ConventionsOptions options;
-  options.folder = page.conventions;
-  options.python = page.python;
-  if (!std::filesystem::is_directory(options.folder)) {
-    Section note = section("conventions", "Public pose conventions, audited");
-    note.blocks.push_back(
-        Paragraph{{plain("Not run: no folder of convention plug-ins at " + options.folder + " ("),
-                   code("--conventions DIR"), plain(": the source tree's conventions/).")}});
-    return {std::move(note)};
-  }
-  options.progress = [](const std::string& name, int index, int count) {
-    std::fprintf(stderr, "report: convention %s (%d/%d)\n", name.c_str(), index, count);
-  };
-  try {
-    return experiments::conventions_sections(experiments::audit_conventions(options), options);
-  } catch (const Error& error) {
-    // The rest of the page stands without this table; say why it is missing, there and here.
-    std::fprintf(stderr, "report: the conventions' table is left out: %s\n", error.what());
-    Section note = section("conventions", "Public pose conventions, audited");
-    note.blocks.push_back(Paragraph{{plain("Not run: " + std::string(error.what()) + " ("),
-                                     code("--conventions DIR --python PYTHON"), plain(").")}});
-    return {std::move(note)};
-  }
-}
-
-// How far from equivariant each Table 1 row's model is (props/profile.hpp), under the groups
-// that keep the 2D task's plane: one figure per group, the model of each method at the largest
-// demo count and the first training seed. Figures go to DIR/profiles/<group>.png.
-Section profiles_section(const std::filesystem::path& dir,
-                         const std::vector<experiments::Cell>& cells) {
-  Section out = section("profiles", "How far from equivariant: Table 1's models");
-  int demos = 0;
-  for (const experiments::Cell& cell : cells) demos = std::max(demos, cell.demos);
-  std::vector<const experiments::Cell*> models;  // one per method, in Table 1's order
-  for (const experiments::Cell& cell : cells) {
-    if (cell.demos != demos) continue;
-    bool seen = false;
-    for (const experiments::Cell*& m : models) {
-      if (m->method != cell.method) continue;
-      seen = true;
-      if (cell.train_seed < m->train_seed) m = &cell;
-    }
-    if (!seen) models.push_back(&cell);
-  }
-  out.blocks.push_back(Paragraph{
-      {plain("The normalized error of each model's chunk, |g a(o, n) - a(g o, n)| over the "
-             "chunk's reach, against the size of g (median over 8 scenes of the task's own "
-             "planar kind; in distribution too where the head is affine in its noise), as "),
-       code("handcentric audit --model M --profile GROUP"),
-       plain(" draws it; the models are Table 1's at " + std::to_string(demos) +
-             " demos. Theorem 1 makes the hand-centric model flat at rounding; an absolute model "
-             "grows with any g; a model made C8-equivariant by construction (c8_averaged, "
-             "with --methods) is zero at the multiples of 45 degrees about its centre only, "
-             "and the C8 stand-ins trained with rotated copies only as far as they learned it. "
-             "How a profile is made: docs/AUDIT.md, \"Profiles\".")}});
-  std::filesystem::create_directories(dir / "profiles");
-  for (const props::Group group :
-       {props::Group::translation, props::Group::se2, props::Group::c8}) {
-    props::ProfileOptions options;
-    options.scenes = 8;
-    std::vector<props::Profile> profiles;
-    for (const experiments::Cell* cell : models) {
-      props::Profile p =
-          profile_model((dir / "table1" / cell->model_path()).string(), group, options);
-      p.name = cell->method;
-      profiles.push_back(std::move(p));
-    }
-    if (profiles.empty()) continue;
-    const std::string name = props::to_string(group);
-    experiments::write_profiles_png((dir / "profiles" / (name + ".png")).string(), profiles);
-    out.blocks.push_back(Figure{"profiles/" + name + ".png",
-                                "profiles of Table 1's models under " + name,
-                                {plain("Under " + name + " (" + props::profile_unit(group) +
-                                       "): filled dots the pointwise median, open circles its "
-                                       "maximum, hollow squares the in-distribution median.")},
-                                0});
-  }
-  return out;
-}
-
-int write_report_page(const ReportOptions& options, const PageOptions& page) {
-  const auto start = std::chrono::steady_clock::now();
-  if (page.table2_demos < 1 || page.table2_demos > 1000) {
-    throw InvalidArgument("--table2-demos " + std::to_string(page.table2_demos) +
-                          " is out of range: use 1..1000");
-  }
-  const std::filesystem::path dir = std::filesystem::absolute(page.out);
-  std::filesystem::create_directories(dir);
-  std::vector<experiments::PageFile> files;
-  experiments::Document doc;
-  doc.title = "handcentric report";
-  bool audit_matches = false, verified = false, sim_passes = false;
-  std::vector<Section> witnesses;
-  std::vector<Section> sections = audit_sections(options, files, witnesses, audit_matches);
-  sections.push_back(certificates_section(files, verified));
-  sections.push_back(sim_section(sim_passes));
-  for (Section& s : conventions_page_sections(page)) sections.push_back(std::move(s));
-
-  std::fprintf(stderr, "report: Fig. 3\n");
-  experiments::write_flow_figure_png((dir / "fig3.png").string(),
-                                     experiments::compute_flow_figure());
-  Section fig3 = section("fig3", "Fig. 3: the flow of the first action under a global transform");
-  fig3.blocks.push_back(Figure{
-      "fig3.png",
-      "Fig. 3",
-      {plain("Rows: a demonstrated chunk and the same chunk after a global transform g; columns: "
-             "absolute, relative and hand-centric actions ("),
-       code("handcentric figure flow"), plain(").")},
-      0});
-  sections.push_back(std::move(fig3));
-
-  const std::vector<int> demo_counts = page.full
-                                           ? std::vector<int>(experiments::kPaperDemoCounts.begin(),
-                                                              experiments::kPaperDemoCounts.end())
-                                           : experiments::parse_int_list(page.demos, "--demos");
-  const int trials = page.full ? 100 : page.trials;
-  std::fprintf(stderr, "report: Table 1 (%zu demo counts, %d trials per scene set)\n",
-               demo_counts.size(), trials);
-  std::vector<experiments::Cell> table1_cells;
-  const auto table1 =
-      table_into((dir / "table1").string(), demo_counts, trials,
-                 experiments::parse_methods(page.methods), {"flow"}, page, &table1_cells);
-  Section t1 = section("table1", std::string("Table 1") + (page.full ? "" : " (quick)") +
-                                     ": success on the 2D task against the paper's");
-  t1.blocks.push_back(Paragraph{
-      {plain(page.full
-                 ? "The paper's grid: 5 to 100 demos, 100 rollouts per scene set. "
-                 : "A quick run: demo counts " + page.demos + " only, " + std::to_string(trials) +
-                       " rollouts per scene set (the paper: 5 to 100 demos, 100 trials; "
-                       "--full runs its grid). "),
-       plain("Success rates with their Wilson 95% intervals; OOD (independent) scenes are new "
-             "scenes out of the training distribution, OOD (paired) the in-distribution scenes "
-             "under a global transform. Models and result files: "),
-       plain("table1/", "table1/table1.json"), plain(".")}});
-  t1.blocks.push_back(
-      experiments::table1_table(table1, "table1-rows", "Table 1: ours beside the paper"));
-  t1.blocks.push_back(Figure{"table1/table1.svg",
-                             "Table 1 plotted",
-                             {plain(table1_figure_caption(demo_counts.size())),
-                              plain("PNG", "table1/table1.png"), plain(").")},
-                             0});
-  sections.push_back(std::move(t1));
-  std::fprintf(stderr, "report: the profiles of Table 1's models\n");
-  sections.push_back(profiles_section(dir, table1_cells));
-
-  experiments::Table2Options t2options;
-  t2options.demos = page.table2_demos;
-  t2options.trials = trials;
-  t2options.steps = page.steps > 0 ? page.steps : (page.full ? 0 : kQuickTable2Steps);
-  t2options.jobs = page.jobs;
-  t2options.out = (dir / "table2").string();
-  t2options.quiet = true;
-  t2options.validate();
-  std::fprintf(stderr, "report: Table 2 (%d demos, %d trials per scene set)\n", t2options.demos,
-               trials);
-  const std::vector<experiments::Table2Row> table2 = experiments::run_table2(t2options);
-  Section t2 = section("table2", std::string("Table 2") + (page.full ? "" : " (quick)") +
-                                     ": the 3D blade insertion against the paper's");
-  t2.blocks.push_back(Paragraph{
-      {plain("The analogue of the paper's real-robot Table 2 on the simulated 3D insertion: flow "
-             "policies trained on " +
-             std::to_string(t2options.demos) + " expert demos of train scenes, each evaluated on " +
-             std::to_string(trials) +
-             " closed-loop rollouts per set; ood and random-se3 scene i is a global transform of "
-             "train scene i. The paper's row is a real robot's (not rerunnable here). Files: "),
-       plain("table2/", "table2/table2.json"), plain(".")}});
-  t2.blocks.push_back(experiments::table2_table(table2, "table2-rows"));
-  t2.blocks.push_back(Figure{"table2/table2.svg",
-                             "Table 2 plotted",
-                             {plain("Success per method and scene set, Wilson 95% bars, the "
-                                    "paper's hand-centric numbers as black ticks (SVG; "),
-                              plain("PNG", "table2/table2.png"), plain(").")},
-                             0});
-  sections.push_back(std::move(t2));
-
-  const std::vector<int> ablation_counts =
-      page.full ? std::vector<int>{10, 40, 100}
-                : experiments::parse_int_list(page.ablation_demos, "--ablation-demos");
-  std::fprintf(stderr, "report: Fig. 5 (heads flow, ddpm, cvae)\n");
-  const auto ablation = table_into((dir / "fig5").string(), ablation_counts, trials,
-                                   experiments::parse_methods("hand_centric,absolute"),
-                                   {"flow", "ddpm", "cvae"}, page);
-  Section fig5 =
-      section("fig5", "Fig. 5: the learning algorithm against the representation (App. B)");
-  fig5.blocks.push_back(Paragraph{
-      {plain("Hand-centric and absolute actions, each with a flow, a DDPM and a CVAE head, at demo "
-             "counts " +
-             (page.full ? std::string("10, 40, 100") : page.ablation_demos) + ", " +
-             std::to_string(trials) +
-             " rollouts per scene set. The paper's finding: the representation, not the learning "
-             "algorithm, decides success.")}});
-  fig5.blocks.push_back(experiments::table1_table(ablation, "fig5-rows", "Fig. 5's grid"));
-  fig5.blocks.push_back(Figure{"fig5/table1.svg",
-                               "Fig. 5",
-                               {plain(table1_figure_caption(ablation_counts.size())),
-                                plain("PNG", "fig5/table1.png"), plain(").")},
-                               0});
-  sections.push_back(std::move(fig5));
-  for (Section& s : witnesses) sections.push_back(std::move(s));
-
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const std::string took = "made in " + fixed(seconds, "%.0f") + " s of wall time";
-  doc.intro.push_back(Paragraph{
-      {plain("What this library checks of \"Guaranteed SE(3)-Equivariant Control via "
-             "Hand-Centric Behavior Cloning\", run on this machine (" +
-             took + "). Regenerate with "),
-       code(std::string("handcentric report --out DIR") + (page.full ? " --full" : "")),
-       plain("; the same content as Markdown: "), plain("index.md", "index.md"), plain(".")}});
-  doc.intro.push_back(List{{
-      {bold(audit_matches ? "✓ audit" : "✗ audit"),
-       plain(audit_matches ? ": every cell matches App. A" : ": cells differ from App. A"),
-       plain(" (", ""), plain("grids", "#audit"), plain(")")},
-      {bold(verified ? "✓ certificates" : "✗ certificates"),
-       plain(verified ? ": all verified" : ": some not verified"), plain(" ("),
-       plain("table", "#certificates"), plain(")")},
-      {bold(sim_passes ? "✓ sim" : "✗ sim"),
-       plain(sim_passes ? ": the expert meets its 99% bar" : ": the expert is below its bar"),
-       plain(" ("), plain("numbers", "#sim"), plain(")")},
-  }});
-  doc.sections = std::move(sections);
-  const int status = audit_matches && verified && sim_passes ? 0 : 1;
-
-  // Everything is built and checked before the first file is written.
-  const std::string html = experiments::to_html(doc);
-  const std::string markdown = experiments::to_markdown(doc);
-  for (const experiments::PageFile& file : files) {
-    const std::filesystem::path path = dir / file.path;
-    std::filesystem::create_directories(path.parent_path());
-    write_file_atomically(path.string(), file.bytes);
-  }
-  write_file_atomically((dir / "index.md").string(), markdown);
-  write_file_atomically((dir / "index.html").string(), html);
-  std::cout << "wrote " << (dir / "index.html").string() << " and index.md (" << took << ")"
-            << (status == 0 ? "" : "; a section FAILS its bar") << "\n";
-  return status;
-}
-
-}  // namespace
-
 void add_report_command(CLI::App& app, int& exit_code) {
   auto options = std::make_shared<ReportOptions>();
-  auto page = std::make_shared<PageOptions>();
+  auto page = std::make_shared<experiments::ReportPageOptions>();
+  page->conventions = HANDCENTRIC_CONVENTIONS_DIR;  // the source tree's, not the working folder's
   CLI::App* cmd = app.add_subcommand("report", "the main report (what plain `handcentric` runs)");
   cmd->add_option("--cases", options->cases, "cases per pointwise cell of the audit section")
       ->capture_default_str();
@@ -535,7 +46,9 @@ void add_report_command(CLI::App& app, int& exit_code) {
                   "write the report as a page: DIR/index.html and index.md, with a quick Table 1 "
                   "and Table 2 and Figs. 3 and 5");
   cmd->add_flag("--full", page->full,
-                "with --out: the paper's whole grid (7 demo counts, 100 trials)");
+                "with --out: the paper's whole grid (" +
+                    std::to_string(experiments::kPaperDemoCounts.size()) + " demo counts, " +
+                    std::to_string(experiments::EvalSettings{}.trials) + " trials)");
   cmd->add_option("--demos", page->demos, "with --out: the quick Table 1's demo counts")
       ->capture_default_str();
   cmd->add_option("--trials", page->trials,
@@ -549,7 +62,8 @@ void add_report_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->add_option("--steps", page->steps,
                   "with --out: Adam steps per cell and Table 2 policy (0: the library's budget; "
-                  "the quick Table 2: 15000)")
+                  "the quick Table 2: " +
+                      std::to_string(experiments::kQuickTable2Steps) + ")")
       ->capture_default_str();
   cmd->add_option("--jobs", page->jobs, "with --out: trainings at once (0: one per core)")
       ->capture_default_str();
@@ -560,8 +74,13 @@ void add_report_command(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   cmd->callback([options, page, &exit_code] {
     (void)props::checked_cases(options->cases);  // before any work: one line, exit 1
-    exit_code = page->out.empty() ? run_main_report(std::cout, *options)
-                                  : write_report_page(*options, *page);
+    if (page->out.empty()) {
+      exit_code = run_main_report(std::cout, *options);
+      return;
+    }
+    page->cases = options->cases;
+    page->seed = options->seed;
+    exit_code = experiments::write_report_page(*page);
   });
 }
 

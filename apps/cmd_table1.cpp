@@ -9,6 +9,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "commands.hpp"
 #include "difficulty_options.hpp"
@@ -18,11 +19,24 @@
 namespace handcentric::apps {
 namespace {
 
+// A list as its flag spells it, "5,10,20": the library's defaults (Table1Options), which the
+// flags show and parse back.
+template <class Value, class Text>
+std::string comma_list(const std::vector<Value>& values, Text text) {
+  std::string out;
+  for (const Value& v : values) out += (out.empty() ? "" : ",") + text(v);
+  return out;
+}
+
 struct Table1CommandOptions {
-  std::string demos = "5,10,20,40,60,80,100";
-  std::string methods = "hand_centric,relative,absolute,c8_centre,c8_base,c8_averaged";
-  std::string heads = "flow";
-  std::string train_seeds = "1";
+  std::string demos =
+      comma_list(experiments::Table1Options{}.demo_counts, [](int n) { return std::to_string(n); });
+  std::string methods = comma_list(experiments::Table1Options{}.methods,
+                                   [](const experiments::Method& m) { return m.name; });
+  std::string heads =
+      comma_list(experiments::Table1Options{}.heads, [](const std::string& h) { return h; });
+  std::string train_seeds = comma_list(experiments::Table1Options{}.train_seeds,
+                                       [](std::uint64_t seed) { return std::to_string(seed); });
   std::string protocol = "library";
   bool recipe_flags = false;  ///< --no-mirror or --perturbed-copies given
   experiments::Table1Options table;

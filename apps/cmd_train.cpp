@@ -57,13 +57,6 @@ struct TrainOptions {
   bool quiet = false;
 };
 
-std::string clock_text(double seconds) {
-  const long s = static_cast<long>(seconds + 0.5);
-  char text[32];
-  std::snprintf(text, sizeof text, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
-  return text;
-}
-
 // The number of demos trained on: --max-demos of the `held` in the file, 0 meaning all.
 std::size_t demos_used(const TrainOptions& options, std::size_t held) {
   if (options.max_demos < 0 || options.max_demos > static_cast<int>(held)) {
@@ -146,7 +139,7 @@ int run_train(const TrainOptions& options) {
     last_rate = p.samples_per_second;
     if (options.quiet) return;
     std::fprintf(stderr, "%sstep %d/%d  loss %.5f  %.0f samples/s  ETA %s%s", terminal ? "\r" : "",
-                 p.step, p.steps, p.loss, p.samples_per_second, clock_text(p.eta_seconds).c_str(),
+                 p.step, p.steps, p.loss, p.samples_per_second, format_clock(p.eta_seconds).c_str(),
                  terminal ? "  " : "\n");
     if (terminal && p.step == p.steps) std::fprintf(stderr, "\n");
   };
@@ -171,7 +164,7 @@ int run_train(const TrainOptions& options) {
                       : std::string())
             << "): " << config.steps << " steps, final loss " << last_loss << ", "
             << static_cast<long>(last_rate) << " samples/s ("
-            << policy::to_string(policy::kernel_isa()) << " kernels), " << clock_text(seconds)
+            << policy::to_string(policy::kernel_isa()) << " kernels), " << format_clock(seconds)
             << " -> " << options.out << "\n";
   return 0;
 }

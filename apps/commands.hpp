@@ -11,18 +11,15 @@
 #include <span>
 #include <string_view>
 
-namespace handcentric::apps {
+#include "handcentric/props/audit.hpp"
 
-/// The 2D sim's bar in the report (run_sim_section and the page): the expert's demos on this many
-/// scenes per distribution and its closed-loop rollouts on this many, from this seed.
-inline constexpr int kSimBarScenes = 200;
-inline constexpr int kSimBarRollouts = 50;
-inline constexpr std::uint64_t kSimBarSeed = 1;
+namespace handcentric::apps {
 
 /// What `handcentric report` lets a user set (plain `handcentric` uses the defaults).
 struct ReportOptions {
-  long long cases = 1000;  ///< cases per pointwise cell of the audit section (1 to 10^7)
-  std::uint64_t seed = 1;  ///< seed of the audit section
+  /// cases per pointwise cell of the audit section (1 to props::kMaxCases) and its seed
+  long long cases = props::kDefaultCases;
+  std::uint64_t seed = props::AuditOptions{}.seed;
 };
 
 using AddCommand = void (*)(CLI::App& app, int& exit_code);

@@ -64,7 +64,7 @@ py::object json_loads(const std::string& text) {
 /// What the audited callable was shown besides poses: the report says how its images were made.
 py::dict cameras_dict(const props::CameraRig& rig) {
   py::list views;
-  for (const props::CameraView view : rig.views) views.append(props::to_string(view));
+  for (const props::View view : rig.views) views.append(props::to_string(view));
   py::dict d;
   d["views"] = views;
   d["image_size"] = py::make_tuple(rig.camera.width, rig.camera.height);

@@ -25,15 +25,7 @@ std::vector<std::string> names_of(py::handle value, const std::string& what) {
 }
 
 std::vector<props::Group> groups_of(py::handle value) {
-  std::vector<props::Group> out;
-  for (const std::string& name : names_of(value, "groups")) {
-    if (name == "all") return props::all_groups();
-    out.push_back(props::parse_group(name));  // InvalidArgument naming the valid names
-  }
-  if (out.empty())
-    throw InvalidArgument(
-        "groups is empty; name at least one of translation, rotation, se2, se3, c8");
-  return out;
+  return props::parse_groups(names_of(value, "groups"), "groups", props::kPythonSpelling);
 }
 
 std::vector<props::View> views_of(py::handle value) {

@@ -94,12 +94,9 @@ py::dict equivariance_profile(const Profiled& what, py::object group_object,
   props::ProfileOptions options;
   options.sizes = sizes_of(sizes);
   options.scenes = scenes;
-  options.seed = seed;
-  options.noise_seed = seed;  // the policy's fixed noise and the laws' draws come from the seed too
   options.samples = samples;
-  const props::ClassifierOptions c = classifier_for(o);
-  options.shape = props::with_view(c.check, parsed_view).shape;
-  options.prefetch = o.batch_size.has_value();
+  // The audit's scenes, seed (the policy's fixed noise and the laws' draws too) and prefetch.
+  options = props::with_audit_setup(options, classifier_for(o), parsed_view);
   const py::object map = !what.policy.is_none()           ? what.policy
                          : !what.representation.is_none() ? what.representation
                                                           : what.either;

@@ -1,6 +1,8 @@
 #include "handcentric/core/sampling.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
@@ -24,6 +26,49 @@ Rotation shoemake_rotation(double u1, double u2, double u3) {
   const double t1 = 2.0 * std::numbers::pi * u2, t2 = 2.0 * std::numbers::pi * u3;
   return Rotation::from_quaternion(b * std::cos(t2), a * std::sin(t1), a * std::cos(t1),
                                    b * std::sin(t2));
+}
+
+namespace {
+
+// t - sin t without the cancellation of its two terms at small t: below 1 rad, the Taylor
+// series t^3/3! - t^5/5! + ... (ten terms leave less than 1e-19 of the first).
+double t_minus_sin(double t) {
+  if (t >= 1.0) return t - std::sin(t);
+  const double t2 = t * t;
+  double term = t * t2 / 6.0, sum = 0.0;
+  for (int n = 1; n <= 10; ++n) {
+    sum += term;
+    term *= -t2 / ((2.0 * n + 2.0) * (2.0 * n + 3.0));
+  }
+  return sum;
+}
+
+}  // namespace
+
+double haar_angle(double u) {
+  constexpr double kPi = std::numbers::pi;
+  if (!(u > 0.0)) return 0.0;
+  if (u >= 1.0) return kPi;
+  // Solve F(t) = (t - sin t) / pi = u by Newton's method, kept inside a bracket of the root
+  // (bisection when a step leaves it). t - sin t <= t^3 / 6, so cbrt(6 pi u) starts at or below
+  // the root; F is convex on [0, pi], so after one step the iterates fall monotonically to it.
+  const double target = kPi * u;
+  double low = 0.0, high = kPi;
+  double t = std::min(std::cbrt(6.0 * target), kPi);
+  for (int i = 0; i < 100; ++i) {
+    const double f = t_minus_sin(t) - target;
+    if (f == 0.0) break;
+    (f < 0.0 ? low : high) = t;
+    const double half_sine = std::sin(0.5 * t);
+    const double step = f / (2.0 * half_sine * half_sine);  // pi F'(t) = 1 - cos t
+    if (std::abs(step) <= 4.0 * std::numeric_limits<double>::epsilon() * t) {
+      t -= step;
+      break;
+    }
+    t -= step;
+    if (!(t > low && t < high)) t = 0.5 * (low + high);
+  }
+  return t;
 }
 
 namespace {

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numeric>
 
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/witness_figure.hpp"
 
 namespace handcentric::experiments {
@@ -19,20 +20,13 @@ constexpr Component kComponents[] = {Component::actions, Component::observation,
                                      Component::flow_input, Component::flow_target,
                                      Component::policy};
 
-std::string scientific(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1e", value);
-  return text;
-}
-
-std::string digits(double value, const char* format = "%.6g") {
-  char text[48];
-  std::snprintf(text, sizeof text, format, value);
-  return text;
-}
-
 std::string vector_text(const Eigen::Vector3d& v) {
-  return "(" + digits(v.x()) + ", " + digits(v.y()) + ", " + digits(v.z()) + ")";
+  std::string text = "(";  // appends: GCC 12 warns, falsely, on "(" + std::string&&
+  for (int i = 0; i < 3; ++i) {
+    if (i > 0) text += ", ";
+    text += format_significant(v[i], 6);
+  }
+  return text + ")";
 }
 
 std::string row_label(Component component, Mode mode) {
@@ -73,10 +67,10 @@ Table coordinates_table(const std::string& id, const props::Witness& witness) {
                      std::to_string(n) + " coordinates";
   }
   for (Eigen::Index i : order) {
-    table.rows.push_back({text_cell(std::to_string(i)),
-                          text_cell(digits(witness.before[i], "%.10g")),
-                          text_cell(digits(witness.after[i], "%.10g")),
-                          text_cell(scientific(std::abs(witness.after[i] - witness.before[i])))});
+    table.rows.push_back(
+        {text_cell(std::to_string(i)), text_cell(format_significant(witness.before[i], 10)),
+         text_cell(format_significant(witness.after[i], 10)),
+         text_cell(format_scientific(std::abs(witness.after[i] - witness.before[i]), 1))});
   }
   return table;
 }
@@ -116,10 +110,10 @@ Section witness_section(const std::string& id, const std::string& name, const Ve
        std::to_string(w.scene.history_length()) + ", " + std::to_string(w.scene.chunk_length()));
   fact("scene: world points, hand points", std::to_string(w.scene.world_points.size()) + ", " +
                                                std::to_string(w.scene.hand_points.size()));
-  fact("error", scientific(w.error));
-  fact("tolerance", scientific(w.tolerance));
+  fact("error", format_scientific(w.error, 1));
+  fact("tolerance", format_scientific(w.tolerance, 1));
   if (verdict.method == props::Method::energy_test || verdict.method == props::Method::partly_exact)
-    fact("p-value (3 x the smallest)", digits(w.p_value, "%.3g"));
+    fact("p-value (3 x the smallest)", format_significant(w.p_value, 3));
   if (!w.detail.empty()) fact("detail", w.detail);
   if (w.off_case) fact("moved off the case drawn", "yes: a symmetry breaking, not a bin edge");
   section.blocks.push_back(std::move(facts));
@@ -188,7 +182,7 @@ AuditPart audit_part(const std::vector<props::Classification>& classifications,
               link = "#" + link;
             }
             TableCell cell =
-                verdict_cell(verdict->invariant, scientific(verdict->max_error) + " m/1",
+                verdict_cell(verdict->invariant, format_scientific(verdict->max_error, 1) + " m/1",
                              method_label(*verdict), link);
             cell.tooltip = std::to_string(verdict->cases) + " cases, seed " +
                            std::to_string(verdict->seed) +

@@ -1,9 +1,9 @@
 #include "handcentric/experiments/cell.hpp"
 
 #include <algorithm>
+#include <filesystem>
 
-#include <cstdio>
-
+#include "handcentric/core/format.hpp"
 #include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 #include "handcentric/sim/rollout.hpp"
@@ -20,6 +20,11 @@ std::string to_string(SceneSet set) {
       return "paired";
   }
   return "?";
+}
+
+sim::SceneDistribution scene_distribution(SceneSet set, const sim::Difficulty& difficulty) {
+  return difficulty.apply(set == SceneSet::id ? sim::SceneDistribution::train()
+                                              : sim::SceneDistribution::ood());
 }
 
 std::string Cell::describe() const {
@@ -40,15 +45,21 @@ std::string Cell::audit_path(const EvalSettings& eval) const {
   return "results/" + hash + ".audit-pointwise-n" + std::to_string(eval.audit_cases) + ".json";
 }
 
+bool Cell::done(const EvalSettings& eval, const std::string& dir) const {
+  const std::filesystem::path root = dir;
+  for (const SceneSet set : kSceneSets) {
+    if (!std::filesystem::exists(root / result_path(set, eval))) return false;
+  }
+  return eval.audit_cases == 0 || std::filesystem::exists(root / audit_path(eval));
+}
+
 std::string digest(const std::string& bytes) {
   std::uint64_t h = 1469598103934665603ull;
   for (const unsigned char c : bytes) {
     h ^= c;
     h *= 1099511628211ull;
   }
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
-  return text;
+  return format_hex(h, 16);
 }
 
 std::string cell_hash(const Cell& cell) {

@@ -1,28 +1,28 @@
 #include "handcentric/experiments/chart.hpp"
 
-#include <cairo-svg.h>
 #include <cairo.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstdio>
-#include <cstring>
 #include <functional>
-#include <memory>
 #include <numbers>
 
 #include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
+#include "handcentric/sim/canvas.hpp"
 
 namespace handcentric::experiments {
 namespace {
 
 using Box = ChartLayout::Box;
+using sim::Align;
+using sim::lines_of;
+using sim::set_grey;
+using sim::text;
+using sim::text_width;
+using sim::white_page;
 
-// DejaVu Sans (Debian's fonts-dejavu-core, which fontconfig also falls back to): a real outline
-// font, whose glyphs the SVG surface writes as paths, so the SVG reads the same everywhere.
-constexpr const char* kFont = "DejaVu Sans";
 constexpr double kMarker = 4.5;      // marker half size, px
 constexpr double kCurveShift = 1.5;  // px between curves at one x, so their bars stay apart
 constexpr double kLegendText = 12.0, kNoteText = 11.0;  // px
@@ -30,19 +30,6 @@ constexpr double kLegendText = 12.0, kNoteText = 11.0;  // px
 struct Frame {
   double x0, y0, x1, y1;
 };
-
-// The advance of `s` in the chart's font at `size` px, from a scratch surface.
-double text_width(const std::string& s, double size) {
-  cairo_surface_t* surface = cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1);
-  cairo_t* cr = cairo_create(surface);
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t extents;
-  cairo_text_extents(cr, s.c_str(), &extents);
-  cairo_destroy(cr);
-  cairo_surface_destroy(surface);
-  return extents.x_advance;
-}
 
 // The axes' frame, leaving room on the right for the widest legend line (a 40 px key before a
 // label; notes start at the key).
@@ -229,8 +216,7 @@ ValueLabel value_label(const BarGeometry& g, const BarChart& chart, std::size_t 
     // The label's box spans top - 4 - 9 .. top - 4, the line r +- 1.25.
     if (r > top - 18.0 && r < top + 2.0) top = r - 2.0;
   }
-  char text[16];
-  std::snprintf(text, sizeof text, "%.2f", v.value);
+  const std::string text = format_fixed(v.value, 2);
   const double centre = g.bar_x0(group, series, chart.series.size()) + 0.5 * g.bar_width;
   const double half = 0.5 * text_width(text, kValueText);
   return {text,
@@ -252,39 +238,6 @@ BarGeometry bar_geometry(const BarChart& chart, int width, int height) {
 void set_colour(cairo_t* cr, int index) {
   const auto c = chart_colour(index);
   cairo_set_source_rgb(cr, c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
-}
-
-void set_grey(cairo_t* cr, double level) {
-  cairo_set_source_rgb(cr, level, level, level);
-}
-
-enum class Align { left, centre, right };
-
-// Text with its baseline at y; `size` in px; returns its width.
-double text(cairo_t* cr, const std::string& s, double x, double y, double size,
-            Align align = Align::left, bool bold = false) {
-  cairo_select_font_face(cr, kFont, CAIRO_FONT_SLANT_NORMAL,
-                         bold ? CAIRO_FONT_WEIGHT_BOLD : CAIRO_FONT_WEIGHT_NORMAL);
-  cairo_set_font_size(cr, size);
-  cairo_text_extents_t extents;
-  cairo_text_extents(cr, s.c_str(), &extents);
-  const double dx = align == Align::left     ? 0.0
-                    : align == Align::centre ? -0.5 * extents.x_advance
-                                             : -extents.x_advance;
-  cairo_move_to(cr, x + dx, y);
-  cairo_show_text(cr, s.c_str());
-  return extents.x_advance;
-}
-
-std::vector<std::string> lines_of(const std::string& s) {
-  std::vector<std::string> lines;
-  std::size_t start = 0;
-  for (std::size_t at = s.find('\n'); at != std::string::npos; at = s.find('\n', start)) {
-    lines.push_back(s.substr(start, at - start));
-    start = at + 1;
-  }
-  lines.push_back(s.substr(start));
-  return lines;
 }
 
 void marker(cairo_t* cr, Marker shape, double x, double y, int colour, bool hollow) {
@@ -315,12 +268,6 @@ void marker(cairo_t* cr, Marker shape, double x, double y, int colour, bool holl
   }
 }
 
-void white_page(cairo_t* cr, int width, int height) {
-  cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
-  cairo_rectangle(cr, 0, 0, width, height);
-  cairo_fill(cr);
-}
-
 // The frame, horizontal grid lines and y ticks every 0.2 (of [lo, hi]), the y label and title.
 void axes(cairo_t* cr, const Frame& f, const std::function<double(double)>& py, double lo,
           double hi, const std::string& title, const std::string& y_label) {
@@ -331,9 +278,7 @@ void axes(cairo_t* cr, const Frame& f, const std::function<double(double)>& py, 
     cairo_line_to(cr, f.x1, std::round(py(y)) + 0.5);
     cairo_stroke(cr);
     set_grey(cr, 0.15);
-    char label[16];
-    std::snprintf(label, sizeof label, "%.1f", y);
-    text(cr, label, f.x0 - 8.0, py(y) + 4.0, 11.0, Align::right);
+    text(cr, format_fixed(y, 1), f.x0 - 8.0, py(y) + 4.0, 11.0, Align::right);
   }
   set_grey(cr, 0.15);
   cairo_rectangle(cr, f.x0 + 0.5, f.y0 + 0.5, f.x1 - f.x0 - 1.0, f.y1 - f.y0 - 1.0);
@@ -367,9 +312,7 @@ void notes(cairo_t* cr, const std::vector<std::string>& lines, double x, double 
 }
 
 std::string tick_text(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", x);
-  return text;
+  return format_significant(x, 6);
 }
 
 void draw(cairo_t* cr, const LineChart& chart, int width, int height) {
@@ -505,81 +448,40 @@ void draw(cairo_t* cr, const BarChart& chart, int width, int height) {
 
 // --- Surfaces -------------------------------------------------------------------------------
 
-using Surface = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
-using Context = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
-
-cairo_status_t append(void* closure, const unsigned char* data, unsigned int length) {
-  static_cast<std::string*>(closure)->append(reinterpret_cast<const char*>(data), length);
-  return CAIRO_STATUS_SUCCESS;
-}
-
-void check(cairo_status_t status, const std::string& what) {
-  if (status != CAIRO_STATUS_SUCCESS)
-    throw Error("chart: " + what + " failed in Cairo: " + cairo_status_to_string(status));
-}
-
 template <class Chart>
 sim::Image render(const Chart& chart, int width, int height) {
   check_size(width, height);
   validate(chart);
-  Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height),
-                  &cairo_surface_destroy);
-  check(cairo_surface_status(surface.get()), "an image surface");
-  {
-    Context cr(cairo_create(surface.get()), &cairo_destroy);
-    draw(cr.get(), chart, width, height);
-    check(cairo_status(cr.get()), "drawing");
-  }
-  cairo_surface_flush(surface.get());
-  sim::Image image;
-  image.width = width;
-  image.height = height;
-  image.rgb.resize(static_cast<std::size_t>(width) * height * 3);
-  const unsigned char* data = cairo_image_surface_get_data(surface.get());
-  const int stride = cairo_image_surface_get_stride(surface.get());
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      // RGB24: one native-endian 32-bit word per pixel, 0x00RRGGBB.
-      std::uint32_t word;
-      std::memcpy(&word, data + static_cast<std::ptrdiff_t>(y) * stride + 4 * x, 4);
-      std::uint8_t* out = &image.rgb[(static_cast<std::size_t>(y) * width + x) * 3];
-      out[0] = static_cast<std::uint8_t>(word >> 16);
-      out[1] = static_cast<std::uint8_t>(word >> 8);
-      out[2] = static_cast<std::uint8_t>(word);
-    }
-  }
-  return image;
+  const sim::Canvas canvas(width, height);
+  draw(canvas.cr(), chart, width, height);
+  return canvas.image();
 }
 
 template <class Chart>
 void write(const Chart& chart, const std::string& stem, int width, int height) {
   check_size(width, height);
   validate(chart);
-  std::string png;
-  {
-    Surface surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, 2 * width, 2 * height),
-                    &cairo_surface_destroy);
-    Context cr(cairo_create(surface.get()), &cairo_destroy);
-    cairo_scale(cr.get(), 2.0, 2.0);
-    draw(cr.get(), chart, width, height);
-    check(cairo_status(cr.get()), "drawing " + stem + ".png");
-    check(cairo_surface_write_to_png_stream(surface.get(), append, &png), "PNG encoding");
-  }
-  std::string svg;
-  {
-    Surface surface(cairo_svg_surface_create_for_stream(append, &svg, width, height),
-                    &cairo_surface_destroy);
-    check(cairo_surface_status(surface.get()), "an SVG surface");
-    {
-      Context cr(cairo_create(surface.get()), &cairo_destroy);
-      draw(cr.get(), chart, width, height);
-      check(cairo_status(cr.get()), "drawing " + stem + ".svg");
-    }
-    cairo_surface_finish(surface.get());
-    check(cairo_surface_status(surface.get()), "SVG encoding");
-  }
+  const sim::Canvas canvas(2 * width, 2 * height);  // twice the pixels, for sharp text
+  cairo_scale(canvas.cr(), 2.0, 2.0);
+  draw(canvas.cr(), chart, width, height);
+  const std::string png = canvas.png();
+  const std::string svg =
+      sim::svg_drawing(width, height, [&](cairo_t* cr) { draw(cr, chart, width, height); });
   write_file_atomically(stem + ".png", png);
   write_file_atomically(stem + ".svg", svg);
+}
+
+// "(x0, y0)-(x1, y1)", one decimal.
+std::string box_text(const Box& b) {
+  std::string text = "(";  // appends: GCC 12 warns, falsely, on "(" + std::string&&
+  text += format_fixed(b.x0, 1);
+  text += ", ";
+  text += format_fixed(b.y0, 1);
+  text += ")-(";
+  text += format_fixed(b.x1, 1);
+  text += ", ";
+  text += format_fixed(b.y1, 1);
+  return text + ")";
 }
 
 template <class Geometry>
@@ -652,10 +554,7 @@ std::string label_under_line(const ChartLayout& layout) {
     for (const Box& line : layout.lines) {
       if (label.x1 <= line.x0 || line.x1 <= label.x0 || label.y1 <= line.y0 || line.y1 <= label.y0)
         continue;
-      char text[160];
-      std::snprintf(text, sizeof text, " at (%.1f, %.1f)-(%.1f, %.1f) is crossed by ", label.x0,
-                    label.y0, label.x1, label.y1);
-      return label.what + text + line.what;
+      return label.what + " at " + box_text(label) + " is crossed by " + line.what;
     }
   }
   return "";
@@ -665,11 +564,7 @@ std::string mark_outside_axes(const ChartLayout& layout) {
   const Box& f = layout.frame;
   for (const Box& m : layout.marks) {
     if (m.x0 >= f.x0 && m.x1 <= f.x1 && m.y0 >= f.y0 && m.y1 <= f.y1) continue;
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  " at (%.1f, %.1f)-(%.1f, %.1f) outside the axes (%.1f, %.1f)-(%.1f, %.1f)", m.x0,
-                  m.y0, m.x1, m.y1, f.x0, f.y0, f.x1, f.y1);
-    return m.what + text;
+    return m.what + " at " + box_text(m) + " outside the axes " + box_text(f);
   }
   return "";
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/document_markdown.hpp"
 #include "handcentric/props/audit.hpp"
 #include "handcentric/props/transport/batch.hpp"
@@ -53,9 +54,7 @@ std::string shell_quoted(const std::string& path) {
 std::string rounded(double value) {
   if (!std::isfinite(value)) return value > 0 ? "inf" : (value < 0 ? "-inf" : "nan");
   if (std::abs(value) < 1e-9) value = 0.0;
-  char text[32];
-  std::snprintf(text, sizeof text, "%.3g", value);
-  return text;
+  return format_significant(value, 3);
 }
 
 std::string rounded_vector(const Eigen::Vector3d& v) {

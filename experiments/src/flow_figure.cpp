@@ -2,23 +2,24 @@
 
 #include <algorithm>
 #include <cmath>
-#include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "drawing.hpp"
 #include "handcentric/core/errors.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/core/representations.hpp"
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
 #include "handcentric/sim/expert.hpp"
+#include "handcentric/sim/canvas.hpp"
 #include "handcentric/sim/scenes.hpp"
 
 namespace handcentric::experiments {
 namespace {
 
-using drawing::rgb;
-using drawing::text;
+using sim::Align;
+using sim::set_rgb;
+using sim::text;
 
 constexpr double kPi = 3.14159265358979323846;
 // The policy's own chunk shape (PolicyConfig's defaults): no history, K = 16.
@@ -118,20 +119,34 @@ sim::Image draw_flow_figure(const FlowFigure& figure, int panel_size) {
   const int columns = static_cast<int>(figure.columns.size());
   const int width = kLeft + columns * (panel_size + kGap);
   const int height = kTop + 2 * (panel_size + kCaption) + 40;
-  cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-  const cv::Scalar blue = rgb(86, 140, 210), orange = rgb(230, 120, 0), grey = rgb(150, 150, 150);
-  text(
-      canvas,
-      "Fig. 3: flow of a_1's position towards one chunk's a_1 (orange) and all training a_1 (blue)",
-      cv::Point(kLeft, 28), 0.6);
-  text(canvas,
+  const sim::Canvas canvas(width, height);
+  cairo_t* cr = canvas.cr();
+  const auto blue = [cr] { set_rgb(cr, 86, 140, 210); };
+  const auto orange = [cr] { set_rgb(cr, 230, 120, 0); };
+  const auto grey = [cr] { set_rgb(cr, 150, 150, 150); };
+  const auto ink = [cr] { set_rgb(cr, 20, 20, 20); };
+  const auto dot = [cr](const Eigen::Vector2d& at, double r) {
+    cairo_new_sub_path(cr);
+    cairo_arc(cr, at.x(), at.y(), r, 0.0, 2.0 * kPi);
+    cairo_fill(cr);
+  };
+  const auto segment = [cr](const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+    cairo_move_to(cr, from.x(), from.y());
+    cairo_line_to(cr, to.x(), to.y());
+  };
+  ink();
+  text(cr,
+       "Fig. 3: flow of a_1's position towards one chunk's a_1 (orange) and all training a_1 "
+       "(blue)",
+       kLeft, 28, 15.0, Align::left, true);
+  text(cr,
        "x, y in cm, each column at one scale; + marks the origin of the representation's frame; "
        "grey dots: noise draws",
-       cv::Point(kLeft, 52), 0.45);
+       kLeft, 52, 12.0);
   const char* row_names[2] = {"chunk", "g * chunk"};
   for (int row = 0; row < 2; ++row) {
     const PanelBox box = flow_panel_box(0, row, panel_size);
-    text(canvas, row_names[row], cv::Point(10, box.y + panel_size / 2), 0.55);
+    text(cr, row_names[row], 10, box.y + panel_size / 2, 14.0);
   }
   for (int c = 0; c < columns; ++c) {
     const FlowColumn& column = figure.columns[static_cast<std::size_t>(c)];
@@ -141,35 +156,57 @@ sim::Image draw_flow_figure(const FlowFigure& figure, int panel_size) {
       const int x0 = box.x, y0 = box.y;
       const auto px = [&](const Eigen::Vector2d& p) {
         const Eigen::Vector2d s = (p - window.centre) / (2.0 * window.half_width);
-        return cv::Point(x0 + static_cast<int>(std::lround((0.5 + s.x()) * panel_size)),
-                         y0 + static_cast<int>(std::lround((0.5 - s.y()) * panel_size)));
+        return Eigen::Vector2d(x0 + std::round((0.5 + s.x()) * panel_size),
+                               y0 + std::round((0.5 - s.y()) * panel_size));
       };
-      cv::rectangle(canvas, cv::Point(x0, y0), cv::Point(x0 + panel_size, y0 + panel_size), grey,
-                    1);
+      grey();
+      cairo_set_line_width(cr, 1.0);
+      cairo_rectangle(cr, x0 + 0.5, y0 + 0.5, panel_size, panel_size);
+      cairo_stroke(cr);
       // The origin of the representation's frame (the world's, or the hand's now).
-      const cv::Point origin = px(Eigen::Vector2d::Zero());
-      cv::drawMarker(canvas, origin, grey, cv::MARKER_CROSS, 12, 1);
-      for (const auto& p : column.training_positions)
-        cv::circle(canvas, px(p), 2, blue, cv::FILLED, cv::LINE_AA);
+      const Eigen::Vector2d origin = px(Eigen::Vector2d::Zero());
+      segment(origin - Eigen::Vector2d(6, 0), origin + Eigen::Vector2d(6, 0));
+      segment(origin - Eigen::Vector2d(0, 6), origin + Eigen::Vector2d(0, 6));
+      cairo_stroke(cr);
+      blue();
+      for (const auto& p : column.training_positions) dot(px(p), 2.0);
       const Eigen::Vector2d target = row == 0 ? column.original : column.transformed;
       for (const auto& eps : figure.noise) {
-        cv::circle(canvas, px(eps), 3, grey, cv::FILLED, cv::LINE_AA);
-        cv::arrowedLine(canvas, px(eps), px(eps + 0.92 * (target - eps)), orange, 1, cv::LINE_AA, 0,
-                        0.04);
+        grey();
+        dot(px(eps), 3.0);
+        // An arrow 92% of the way to the target, its head 4% of its length (at least 4 px).
+        const Eigen::Vector2d from = px(eps), to = px(eps + 0.92 * (target - eps));
+        const Eigen::Vector2d back = from - to;
+        orange();
+        segment(from, to);
+        if (back.norm() > 0.0) {
+          const Eigen::Vector2d head = back.normalized() * std::max(4.0, 0.04 * back.norm());
+          const Eigen::Vector2d side(-head.y(), head.x());
+          segment(to, to + head + 0.5 * side);
+          segment(to, to + head - 0.5 * side);
+        }
+        cairo_stroke(cr);
       }
-      cv::circle(canvas, px(target), 6, orange, cv::FILLED, cv::LINE_AA);
-      if (row == 0) text(canvas, column.representation, cv::Point(x0 + 5, y0 - 8), 0.6);
+      orange();
+      dot(px(target), 6.0);
+      ink();
+      if (row == 0) text(cr, column.representation, x0 + 5, y0 - 8, 15.0);
     }
-    char line[128];
     const PanelBox bottom = flow_panel_box(c, 1, panel_size);
     const int y_caption = bottom.y + panel_size + 22;
-    std::snprintf(line, sizeof line, "|a_1(g*chunk) - a_1(chunk)| = %.2g", column.a1_change);
-    text(canvas, line, cv::Point(bottom.x, y_caption), 0.5);
-    text(canvas, column.a1_change < 1e-9 ? "flow unchanged by g" : "flow moved by g",
-         cv::Point(bottom.x, y_caption + 20), 0.5,
-         column.a1_change < 1e-9 ? rgb(40, 150, 60) : rgb(200, 40, 40));
+    ink();
+    std::string change = "|a_1(g*chunk) - a_1(chunk)| = ";  // appends (GCC 12 -Wrestrict)
+    change += format_significant(column.a1_change, 2);
+    text(cr, change, bottom.x, y_caption, 13.0);
+    if (column.a1_change < 1e-9) {
+      set_rgb(cr, 40, 150, 60);
+    } else {
+      set_rgb(cr, 200, 40, 40);
+    }
+    text(cr, column.a1_change < 1e-9 ? "flow unchanged by g" : "flow moved by g", bottom.x,
+         y_caption + 20, 13.0);
   }
-  return drawing::to_image(canvas);
+  return canvas.image();
 }
 
 void write_flow_figure_png(const std::string& path, const FlowFigure& figure) {

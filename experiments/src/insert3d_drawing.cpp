@@ -10,13 +10,13 @@
 #include "drawing.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/experiments/insert3d_image.hpp"
+#include "handcentric/sim/canvas.hpp"
 
 namespace handcentric::experiments {
 namespace {
 
 namespace insert3d = sim::insert3d;
 using drawing::rgb;
-using drawing::text;
 
 constexpr int kViewWidth = 760;
 constexpr int kViewHeight = 640;
@@ -143,8 +143,8 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
           ? rgb(sim::kCollisionRgb[0], sim::kCollisionRgb[1], sim::kCollisionRgb[2])
           : rgb(120, 120, 120);
   draw_box(canvas, view, rollout.world_T_hand.back(), geometry.blade_in_hand(), last_colour, 3);
-  text(canvas, caption, {12, kViewHeight - 16}, 0.5);
-  text(canvas, "fixed view from world (1, -1.5, 1), world z up", {12, 22}, 0.5);
+  std::vector<sim::Label> labels = {{caption, 12, kViewHeight - 16},
+                                    {"fixed view from world (1, -1.5, 1), world z up", 12, 22}};
 
   const int x0 = kViewWidth + 20;
   const auto paste = [&](const RigidTransform& world_T_hand, int y, const std::string& label) {
@@ -153,14 +153,14 @@ sim::Image draw_insert3d_rollout(const insert3d::TaskScene& scene, const insert3
                     camera.max_range, scale);
     panel.copyTo(canvas(cv::Rect(x0, y, panel.cols, panel.rows)));
     cv::rectangle(canvas, cv::Rect(x0, y, panel.cols, panel.rows), rgb(20, 20, 20), 1);
-    text(canvas, label, {x0, y - 8}, 0.5);
+    labels.push_back({label, static_cast<double>(x0), y - 8.0});
   };
   paste(rollout.world_T_hand.front(), 60, "hand camera depth, first pose");
   if (n > 1) {
     paste(rollout.world_T_hand.back(), 60 + camera.height * scale + 60,
           "hand camera depth, last pose");
   }
-  return drawing::to_image(canvas);
+  return sim::labelled(drawing::to_image(canvas), labels);
 }
 
 sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
@@ -168,7 +168,6 @@ sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
                                        const insert3d::BladeSlotGeometry& geometry,
                                        const std::vector<insert3d::DepthCamera>& rig,
                                        bool normals) {
-  using drawing::text;
   if (rollout.world_T_hand.empty())
     throw InvalidArgument("draw_insert3d_camera_frames: the rollout has no pose");
   if (every < 1 || columns < 1) {
@@ -192,6 +191,7 @@ sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
   const int rows = (static_cast<int>(steps.size()) + cols - 1) / cols;
   cv::Mat canvas(rows * (panel_h + kLabel + kGap) + kGap, cols * (panel_w + kGap) + kGap, CV_8UC3,
                  cv::Scalar(255, 255, 255));
+  std::vector<sim::Label> labels;
   for (std::size_t i = 0; i < steps.size(); ++i) {
     const int x = kGap + static_cast<int>(i % static_cast<std::size_t>(cols)) * (panel_w + kGap);
     const int y =
@@ -207,9 +207,10 @@ sim::Image draw_insert3d_camera_frames(const insert3d::TaskScene& scene,
             .copyTo(canvas(cv::Rect(x + image_w + kGap, top, image_w, image_h)));
       }
     }
-    text(canvas, "step " + std::to_string(steps[i]), {x, y + kLabel - 5}, 0.4);
+    labels.push_back({"step " + std::to_string(steps[i]), static_cast<double>(x),
+                      static_cast<double>(y + kLabel - 5), 11.0});
   }
-  return drawing::to_image(canvas);
+  return sim::labelled(drawing::to_image(canvas), labels);
 }
 
 }  // namespace handcentric::experiments

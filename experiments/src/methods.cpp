@@ -12,15 +12,15 @@ constexpr const char* kMethodNames =
     "hand_centric, relative, absolute, c8_centre, c8_base, c8_averaged, c8flow_centre, "
     "c8flow_averaged";
 
-std::vector<std::string> split(const std::string& list) {
+}  // namespace
+
+std::vector<std::string> split_list(const std::string& list) {
   std::vector<std::string> items;
   std::stringstream in(list);
   std::string item;
   while (std::getline(in, item, ',')) items.push_back(item);
   return items;
 }
-
-}  // namespace
 
 const std::vector<Method>& table1_methods() {
   static const std::vector<Method> methods = {
@@ -49,7 +49,7 @@ const std::vector<Method>& table1_methods() {
 
 std::vector<Method> parse_methods(const std::string& list) {
   std::vector<Method> chosen;
-  for (const std::string& name : split(list)) {
+  for (const std::string& name : split_list(list)) {
     const auto& all = table1_methods();
     const auto it =
         std::find_if(all.begin(), all.end(), [&](const Method& m) { return m.name == name; });
@@ -70,7 +70,7 @@ std::vector<Method> parse_methods(const std::string& list) {
 
 std::vector<std::string> parse_heads(const std::string& list) {
   std::vector<std::string> heads;
-  for (const std::string& head : split(list)) {
+  for (const std::string& head : split_list(list)) {
     if (head != "flow" && head != "ddpm" && head != "cvae") {
       throw InvalidArgument("--heads: unknown head '" + head + "': use flow, ddpm, cvae");
     }

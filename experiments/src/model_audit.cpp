@@ -12,17 +12,18 @@
 namespace handcentric::experiments {
 
 std::vector<props::Group> model_groups(const policy::PolicyConfig& config,
-                                       const std::vector<props::Group>& groups,
-                                       const std::string& asked, const std::string& model) {
+                                       const std::vector<props::Group>& groups, bool named,
+                                       const std::string& model) {
   if (config.task != policy::kTaskPeg2d) return groups;
   std::vector<props::Group> kept;
   for (props::Group g : groups) {
     if (g == props::Group::rotation || g == props::Group::se3) {
-      if (asked != "all") {
-        throw InvalidArgument("--group " + asked + ": " + model +
+      if (named) {
+        const std::string name = props::to_string(g);
+        throw InvalidArgument("--group " + name + ": " + model +
                               " is a model of the 2D task (peg2d), whose scenes lie in a plane "
                               "that " +
-                              asked + " tilts; audit it under translation, se2 or c8 (or all)");
+                              name + " tilts; audit it under translation, se2 or c8 (or all)");
       }
       continue;
     }
@@ -78,7 +79,7 @@ std::string table1_model_audit_json(const std::string& dir, const std::string& p
   const std::lock_guard lock(one_at_a_time);
   auto model = load_audited_model(dir + "/" + path);
   props::AuditOptions audit;
-  audit.groups = model_groups(model->config(), props::all_groups(), "all", path);
+  audit.groups = model_groups(model->config(), props::all_groups(), false, path);
   audit.views = {props::View::eye_in_hand};
   audit.cases = cases;
   props::ClassifierOptions classifier =

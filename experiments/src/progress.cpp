@@ -1,3 +1,4 @@
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/progress.hpp"
 
 #include <unistd.h>
@@ -12,14 +13,7 @@ Progress::Progress(int jobs, double total_work, std::FILE* out, bool quiet)
       total_work_(total_work) {}
 
 std::string Progress::clock(double seconds) {
-  const long s = static_cast<long>(seconds + 0.5);
-  char text[32];
-  if (s >= 3600) {
-    std::snprintf(text, sizeof text, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
-  } else {
-    std::snprintf(text, sizeof text, "%ld:%02ld", s / 60, s % 60);
-  }
-  return text;
+  return format_clock(seconds);
 }
 
 void Progress::start(int worker, const std::string& what) {

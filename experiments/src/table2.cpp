@@ -233,15 +233,10 @@ std::string row_label(const Table2Row& row) {
   return row.observation == policy::ObservationKind::image ? row.method + " (image)" : row.method;
 }
 
-std::string percent(double rate) {
-  char text[16];
-  std::snprintf(text, sizeof text, "%.2f", rate);
-  return text;
-}
-
 std::string rate_with_interval(const Insert3dCounts& counts) {
   const Interval ci = wilson_interval(counts.success, counts.trials);
-  return percent(counts.success_rate()) + " [" + percent(ci.lo) + ", " + percent(ci.hi) + "]";
+  return format_fixed(counts.success_rate(), 2) + " [" + format_fixed(ci.lo, 2) + ", " +
+         format_fixed(ci.hi, 2) + "]";
 }
 
 }  // namespace

@@ -1,13 +1,14 @@
 #include "handcentric/experiments/witness_figure.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstdio>
 #include <limits>
-#include <sstream>
+#include <numbers>
 #include <vector>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/sim/canvas.hpp"
 
 namespace handcentric::experiments {
 namespace {
@@ -24,10 +25,41 @@ Drawn positions(const Scene& scene) {
   return out;
 }
 
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.1f", value);
-  return text;
+// Margin for the markers, and room at the top for the legend, in px.
+constexpr double kMargin = 18.0, kLegend = 34.0;
+
+// One scene's marks, drawn in `colour` (0-255 RGB): solid with circles, or dashed with squares.
+void draw_marks(cairo_t* cr, const WitnessMarks& marks, const std::array<int, 3>& colour,
+                bool dashed) {
+  const auto set_colour = [&] { sim::set_rgb(cr, colour[0], colour[1], colour[2]); };
+  set_colour();
+  cairo_set_line_width(cr, 1.5);
+  const double dash[] = {5.0, 3.0};
+  cairo_set_dash(cr, dash, dashed ? 2 : 0, 0.0);
+  cairo_new_path(cr);
+  for (const Eigen::Vector2d& p : marks.path) cairo_line_to(cr, p.x(), p.y());
+  cairo_stroke(cr);
+  cairo_set_dash(cr, dash, 0, 0.0);
+  cairo_set_line_width(cr, 1.0);
+  const auto marker = [&](const Eigen::Vector2d& p, double r, bool filled) {
+    cairo_new_sub_path(cr);
+    if (dashed) {
+      cairo_rectangle(cr, p.x() - r, p.y() - r, 2 * r, 2 * r);
+    } else {
+      cairo_arc(cr, p.x(), p.y(), r, 0.0, 2.0 * std::numbers::pi);
+    }
+    if (filled) {
+      set_colour();
+    } else {
+      cairo_set_source_rgb(cr, 1.0, 1.0, 1.0);
+    }
+    cairo_fill_preserve(cr);
+    set_colour();
+    cairo_stroke(cr);
+  };
+  for (const Eigen::Vector2d& p : marks.chunk) marker(p, 2.0, false);
+  marker(marks.t0, 4.5, true);
+  for (const Eigen::Vector2d& p : marks.points) marker(p, 3.5, true);
 }
 
 }  // namespace
@@ -43,7 +75,7 @@ bool drawable(const Scene& scene) {
   return true;
 }
 
-std::string witness_svg(const Scene& scene, const RigidTransform& g, int width, int height) {
+WitnessPicture witness_picture(const Scene& scene, const RigidTransform& g, int width, int height) {
   if (!drawable(scene)) {
     throw InvalidArgument("witness figure: the scene has no hand pose or a non-finite position");
   }
@@ -61,7 +93,9 @@ std::string witness_svg(const Scene& scene, const RigidTransform& g, int width, 
     }
   }
   const Eigen::Vector3d spread = hi - lo;
-  int a = 0, b = 1;  // x and y unless z spreads more than one of them
+  WitnessPicture picture;
+  int& a = picture.across;
+  int& b = picture.up;  // x and y unless z spreads more than one of them
   if (spread.z() > std::min(spread.x(), spread.y())) {
     if (spread.x() < spread.y())
       a = 2;
@@ -69,57 +103,49 @@ std::string witness_svg(const Scene& scene, const RigidTransform& g, int width, 
       b = 2;
     if (a > b) std::swap(a, b);
   }
-  const char* axis_names[] = {"x", "y", "z"};
-  const double lo_x = lo[a], lo_y = lo[b], hi_x = hi[a], hi_y = hi[b];
-  // One scale for both axes (the picture is not distorted), and a margin for the markers and
-  // the legend.
-  const double margin = 18.0, legend = 34.0;
-  const double span = std::max({hi_x - lo_x, hi_y - lo_y, 1e-9});
-  const double scale = std::min((width - 2 * margin) / span, (height - 2 * margin - legend) / span);
-  const auto sx = [&](const Eigen::Vector3d& p) { return number(margin + (p[a] - lo_x) * scale); };
-  const auto sy = [&](const Eigen::Vector3d& p) {
-    return number(height - margin - (p[b] - lo_y) * scale);
+  // One scale for both axes (the picture is not distorted).
+  const double span = std::max({hi[a] - lo[a], hi[b] - lo[b], 1e-9});
+  const double scale =
+      std::min((width - 2 * kMargin) / span, (height - 2 * kMargin - kLegend) / span);
+  const auto px = [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector2d(kMargin + (p[a] - lo[a]) * scale,
+                           height - kMargin - (p[b] - lo[b]) * scale);
   };
-
-  std::ostringstream svg;
-  svg << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << width << "\" height=\"" << height
-      << "\" viewBox=\"0 0 " << width << " " << height << "\" font-family=\"sans-serif\" "
-      << "font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n";
-  const auto draw = [&](const Drawn& drawn, const char* colour, bool dashed) {
-    std::string path;
-    for (const auto* list : {&drawn.history, &drawn.chunk}) {
-      // The history runs from T_0 backwards; drawn from the oldest pose to the last of the chunk.
-      std::vector<Eigen::Vector3d> ordered = *list;
-      if (list == &drawn.history) std::reverse(ordered.begin(), ordered.end());
-      for (const Eigen::Vector3d& p : ordered)
-        path += (path.empty() ? "M" : " L") + sx(p) + "," + sy(p);
+  const auto marks_of = [&](const Drawn& drawn) {
+    WitnessMarks marks;
+    // The history runs from T_0 backwards; drawn from the oldest pose to the last of the chunk.
+    for (auto it = drawn.history.rbegin(); it != drawn.history.rend(); ++it)
+      marks.path.push_back(px(*it));
+    for (const Eigen::Vector3d& p : drawn.chunk) {
+      marks.path.push_back(px(p));
+      marks.chunk.push_back(px(p));
     }
-    svg << "<path d=\"" << path << "\" fill=\"none\" stroke=\"" << colour
-        << "\" stroke-width=\"1.5\"" << (dashed ? " stroke-dasharray=\"5,3\"" : "") << "/>\n";
-    const auto marker = [&](const Eigen::Vector3d& p, double r, bool filled) {
-      const std::string fill = filled ? colour : "white";
-      if (dashed) {
-        svg << "<rect x=\"" << number(margin + (p[a] - lo_x) * scale - r) << "\" y=\""
-            << number(height - margin - (p[b] - lo_y) * scale - r) << "\" width=\"" << number(2 * r)
-            << "\" height=\"" << number(2 * r) << "\" fill=\"" << fill << "\" stroke=\"" << colour
-            << "\"/>\n";
-      } else {
-        svg << "<circle cx=\"" << sx(p) << "\" cy=\"" << sy(p) << "\" r=\"" << number(r)
-            << "\" fill=\"" << fill << "\" stroke=\"" << colour << "\"/>\n";
-      }
-    };
-    for (const Eigen::Vector3d& p : drawn.chunk) marker(p, 2.0, false);
-    marker(drawn.history.front(), 4.5, true);  // T_0
-    for (const Eigen::Vector3d& p : drawn.points) marker(p, 3.5, true);
+    marks.t0 = px(drawn.history.front());
+    for (const Eigen::Vector3d& p : drawn.points) marks.points.push_back(px(p));
+    return marks;
   };
-  draw(before, "#1f5fa8", false);
-  draw(after, "#c0561b", true);
-  svg << "<text x=\"" << margin << "\" y=\"14\">solid, circles: s; dashed, squares: g&#183;s"
-      << "</text>\n<text x=\"" << margin
-      << "\" y=\"28\">big mark: T_0; path: history, then the chunk; axes (" << axis_names[a] << ", "
-      << axis_names[b] << ")</text>\n"
-      << "</svg>\n";
-  return svg.str();
+  picture.s = marks_of(before);
+  picture.g_s = marks_of(after);
+  return picture;
+}
+
+std::string witness_svg(const Scene& scene, const RigidTransform& g, int width, int height) {
+  const WitnessPicture picture = witness_picture(scene, g, width, height);
+  const char* axis_names[] = {"x", "y", "z"};
+  return sim::svg_drawing(
+      width, height,
+      [&](cairo_t* cr) {
+        sim::white_page(cr, width, height);
+        draw_marks(cr, picture.s, {31, 95, 168}, false);
+        draw_marks(cr, picture.g_s, {192, 86, 27}, true);
+        sim::set_rgb(cr, 20, 20, 20);
+        sim::text(cr, "solid, circles: s; dashed, squares: g\u00b7s", kMargin, 14, 10.0);
+        sim::text(cr,
+                  std::string("big mark: T_0; path: history, then the chunk; axes (") +
+                      axis_names[picture.across] + ", " + axis_names[picture.up] + ")",
+                  kMargin, 28, 10.0);
+      },
+      sim::SvgUnit::px);
 }
 
 }  // namespace handcentric::experiments

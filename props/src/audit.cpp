@@ -35,11 +35,11 @@ std::string view_heading(View view, bool recorded) {
 // difference of the laws' moments, or the energy distance, marked '~' when tests decided all or
 // part of the cell).
 std::string cell_text(const Verdict& verdict) {
-  char text[40];
-  std::snprintf(
-      text, sizeof(text), "%-3s %8.1e%s", verdict.invariant ? "yes" : "NO", verdict.max_error,
-      verdict.method == Method::energy_test || verdict.method == Method::partly_exact ? "~" : "");
-  return text;
+  const std::string error = format_scientific(verdict.max_error, 1);
+  return std::string(verdict.invariant ? "yes " : "NO  ") +
+         std::string(error.size() < 8 ? 8 - error.size() : 0, ' ') + error +
+         (verdict.method == Method::energy_test || verdict.method == Method::partly_exact ? "~"
+                                                                                          : "");
 }
 
 std::string cell_name(const Verdict& verdict) {
@@ -211,7 +211,6 @@ std::vector<Classification> audit_builtins(const std::vector<std::string>& names
                             valid + " (or --exec 'COMMAND' for your own)");
     }
   }
-  for (auto& c : out) { int n = 0; for (auto& v : c.verdicts) n += v.first_failure.has_value(); fprintf(stderr, "DBG props %s %zu verdicts %d engaged sizeof %zu\n", c.name.c_str(), c.verdicts.size(), n, sizeof(Verdict)); }
   return out;
 }
 
@@ -269,9 +268,8 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
       }
     }
     if (tested_yes > 0) {
-      char shift[32], ratio[32];
-      std::snprintf(shift, sizeof(shift), "%.2g", largest_shift);
-      std::snprintf(ratio, sizeof(ratio), "%.3g", largest_ratio);
+      const std::string shift = format_significant(largest_shift, 2);
+      const std::string ratio = format_significant(largest_ratio, 3);
       out << "  note: " << tested_yes
           << " in-distribution 'yes' cell(s) (marked ~) were decided by tests, the output not "
              "being (wholly) affine in the noise: each finds, with 90% power, a mean shift of "
@@ -294,8 +292,7 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
         fewest_cases = verdict.cases;
     }
     if (fewest_cases > 0) {
-      char frequency[32];
-      std::snprintf(frequency, sizeof(frequency), "%.2g", detectable_frequency(fewest_cases));
+      const std::string frequency = format_significant(detectable_frequency(fewest_cases), 2);
       out << "  note: a pointwise 'yes' on " << fewest_cases
           << " far cases finds, with 99% probability, a breaking that occurs in at least "
           << frequency

@@ -34,4 +34,17 @@ Group parse_group(const std::string& name) {
                         "'; choose one of translation, rotation, se2, se3, c8");
 }
 
+std::vector<Group> parse_groups(const std::vector<std::string>& names, const std::string& option,
+                                const Spelling& spelling) {
+  std::vector<Group> out;
+  for (const std::string& name : names) {
+    if (name == "all") return all_groups();
+    out.push_back(parse_group(name));
+  }
+  if (out.empty())
+    throw InvalidArgument(spelling.option(option) +
+                          " is empty; name at least one of translation, rotation, se2, se3, c8");
+  return out;
+}
+
 }  // namespace handcentric::props

@@ -1,5 +1,6 @@
 #include "handcentric/props/verdict.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -10,20 +11,40 @@
 namespace handcentric::props {
 namespace {
 
-// "r = [..], p = [..]" of a pose: the rotation vector and the translation.
+// "r = [..], p = [..]" of a scene's pose: the rotation vector and the translation, readable (6
+// digits, below 1e-9 (1 + the largest) as 0, where the off-case move lies: format_readable);
+// the JSON keeps every bit.
 std::string pose_text(const RigidTransform& T) {
-  return "r = " + format_matrix(T.rotation().log()) + ", p = " + format_matrix(T.translation());
+  return "r = " + format_readable(T.rotation().log()) + ", p = " + format_readable(T.translation());
+}
+
+// g's pose text: g is drawn exactly and never moved off its case, so only what lies below 1e-9
+// of its largest entry is noise (an edge case's 1e-12 rad stays visible).
+std::string g_text(const RigidTransform& g) {
+  const auto readable = [](const Eigen::Vector3d& v) {
+    return format_readable(v, 6, 1e-9 * largest_magnitude(v));
+  };
+  return "r = " + readable(g.rotation().log()) + ", p = " + readable(g.translation());
 }
 
 // A long vector shows its first 12 entries and how many it has.
-std::string vector_text(const Eigen::VectorXd& v) {
-  if (v.size() <= 12) return format_matrix(v);
+std::string vector_text(const Eigen::VectorXd& v, int digits, double noise) {
+  if (v.size() <= 12) return format_readable(v, digits, noise);
   std::string text("(");
   text += std::to_string(v.size());
   text += " numbers) ";
-  text += format_matrix(v.head(12));
+  text += format_readable(v.head(12), digits, noise);
   text += " ...";
   return text;
+}
+
+// The digits at which before and after print apart where they differ most (6 at least): a
+// difference of 1e-9 in entries near 1 shows in the text, not only in the error.
+int before_after_digits(const Eigen::VectorXd& before, const Eigen::VectorXd& after) {
+  if (before.size() != after.size() || before.size() == 0) return 6;
+  Eigen::Index most = 0;
+  (before - after).cwiseAbs().maxCoeff(&most);
+  return digits_to_tell_apart(before(most), after(most));
 }
 
 }  // namespace
@@ -46,10 +67,6 @@ std::string to_string(Component component) {
 
 std::string to_string(Mode mode) {
   return mode == Mode::pointwise ? "pointwise" : "distribution";
-}
-
-std::string to_string(View view) {
-  return view == View::eye_in_hand ? "eye_in_hand" : "third_person";
 }
 
 std::vector<View> parse_views(const std::vector<std::string>& names, const std::string& option,
@@ -87,7 +104,7 @@ std::string to_string(Method method) {
 std::string format_witness(const Witness& witness) {
   std::ostringstream out;
   const Scene& s = witness.scene;
-  out << "g: " << pose_text(witness.g) << "\n"
+  out << "g: " << g_text(witness.g) << "\n"
       << "scene: H = " << s.history_length() << ", K = " << s.chunk_length() << ", "
       << s.hand_points.size() << " eye-in-hand and " << s.world_points.size() << " world points\n";
   for (std::size_t h = 0; h < s.world_T_hand_history.size(); ++h) {
@@ -97,30 +114,40 @@ std::string format_witness(const Witness& witness) {
   for (std::size_t k = 0; k < s.world_T_hand_chunk.size(); ++k) {
     out << "  T_" << k + 1 << ": " << pose_text(s.world_T_hand_chunk[k]) << "\n";
   }
-  for (const auto& x : s.hand_points) out << "  eye-in-hand point: " << format_matrix(x) << "\n";
-  for (const auto& x : s.world_points) out << "  world point: " << format_matrix(x) << "\n";
+  for (const auto& x : s.hand_points) out << "  eye-in-hand point: " << format_readable(x) << "\n";
+  for (const auto& x : s.world_points) out << "  world point: " << format_readable(x) << "\n";
   for (const auto& [name, T] : s.extra_poses)
     out << "  extra pose '" << name << "': " << pose_text(T) << "\n";
   for (const auto& [name, value] : s.scalars)
-    out << "  scalar '" << name << "': " << format_number(value) << "\n";
+    out << "  scalar '" << name << "': " << format_digits(value) << "\n";
   for (const auto& [name, array] : s.held)
     out << "  held array '" << name << "': " << array->describe() << " (unchanged by g)\n";
   const bool law = !witness.detail.empty();
-  out << (law ? "mean before: " : "before: ") << vector_text(witness.before) << "\n"
-      << (law ? "mean after:  " : "after:  ") << vector_text(witness.after) << "\n";
+  const int digits = before_after_digits(witness.before, witness.after);
+  // Noise as in the scene's poses, but never as large as a thousandth of the error: the entry
+  // that differs by the error stays (at least one side of it is error / 2 or more).
+  const double noise = std::min(
+      1e-9 * (1.0 + std::max(largest_magnitude(witness.before), largest_magnitude(witness.after))),
+      1e-3 * witness.error);
+  out << (law ? "mean before: " : "before: ") << vector_text(witness.before, digits, noise) << "\n"
+      << (law ? "mean after:  " : "after:  ") << vector_text(witness.after, digits, noise) << "\n";
+  // The error beside what it is compared with, at the digits that tell the two apart.
+  const int compared = digits_to_tell_apart(witness.error, witness.tolerance);
   if (law) out << witness.detail << "\n";
   if (witness.p_value < 1.0) {
-    out << "energy distance " << format_number(witness.error)
-        << " (unitless statistic), permutation p = " << format_number(witness.p_value)
-        << " < level " << format_number(witness.tolerance);
+    const int p_digits = digits_to_tell_apart(witness.p_value, witness.tolerance);
+    out << "energy distance " << format_digits(witness.error)
+        << " (unitless statistic), permutation p = " << format_digits(witness.p_value, p_digits)
+        << " < level " << format_digits(witness.tolerance, p_digits);
     return out.str();
   }
-  out << "error " << format_number(witness.error) << " (largest difference; m, rad or the "
-      << "component's units) > tolerance " << format_number(witness.tolerance);
+  out << "error " << format_digits(witness.error, compared)
+      << " (largest difference; m, rad or the component's units) > tolerance "
+      << format_digits(witness.tolerance, compared);
   if (witness.length_scale > 0.0)
-    out << " = REL (1 + L) with L = " << format_number(witness.length_scale) << " m";
+    out << " = REL (1 + L) with L = " << format_digits(witness.length_scale) << " m";
   if (witness.rounding_response > 0.0) {
-    out << "\nthe map's own rounding response here: " << format_number(witness.rounding_response)
+    out << "\nthe map's own rounding response here: " << format_digits(witness.rounding_response)
         << " (its outputs' change when the inputs move by a few units of rounding)";
   }
   // Off the case the difference persisted (check.cpp, decide_pointwise); whether that rules out
@@ -146,9 +173,12 @@ double detectable_frequency(int cases) {
 std::string pose_summary(const RigidTransform& T) {
   // 4 significant digits: enough to recognise a scene; the seed replays it exactly.
   const auto short_vector = [](const Eigen::Vector3d& v) {
-    char buffer[96];
-    std::snprintf(buffer, sizeof buffer, "[%.4g, %.4g, %.4g]", v.x(), v.y(), v.z());
-    return std::string(buffer);
+    std::string text = "[";  // appends: GCC 12 warns, falsely, on "[" + std::string&&
+    for (int i = 0; i < 3; ++i) {
+      if (i > 0) text += ", ";
+      text += format_significant(v[i], 4);
+    }
+    return text + "]";
   };
   return "(p = " + short_vector(T.translation()) + " m, r = " + short_vector(T.rotation().log()) +
          ")";

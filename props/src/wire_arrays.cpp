@@ -65,8 +65,8 @@ void append_base64(std::string& out, const unsigned char* bytes, std::size_t n) 
 std::string shown(char c) {
   const auto u = static_cast<unsigned char>(c);
   if (u >= 0x20 && u < 0x7f) return std::string("'") + c + "'";
-  char text[8];
-  std::snprintf(text, sizeof(text), "0x%02x", u);
+  std::string text = "0x";  // appends: GCC 12 warns, falsely, on "0x" + std::string&&
+  text += format_hex(u, 2);
   return text;
 }
 

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "demo_file.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/scenes.hpp"
 
@@ -118,14 +119,11 @@ void TrainingData::validate() const {
 }
 
 std::string TrainingData::to_text() const {
-  char text[256];
-  std::snprintf(
-      text, sizeof text,
-      "mirror=%d\nperturbed_copies=%d\noffset_cm=%.17g\noffset_deg=%.17g\nrecovery_steps=%d\n"
-      "perturbation_seed=%llu\n",
-      mirror ? 1 : 0, perturbed_copies, offset_cm, offset_deg, recovery_steps,
-      static_cast<unsigned long long>(perturbation_seed));
-  return text;
+  return "mirror=" + std::to_string(mirror ? 1 : 0) +
+         "\nperturbed_copies=" + std::to_string(perturbed_copies) +
+         "\noffset_cm=" + format_number(offset_cm) + "\noffset_deg=" + format_number(offset_deg) +
+         "\nrecovery_steps=" + std::to_string(recovery_steps) +
+         "\nperturbation_seed=" + std::to_string(perturbation_seed) + "\n";
 }
 
 namespace {

@@ -1,15 +1,14 @@
-// OpenCV drawings of scenes, demos and rollouts (draw.hpp), written as PNG by png.hpp.
+// OpenCV drawings of scenes, demos and rollouts (draw.hpp), captioned in Cairo text (canvas.hpp).
 #include "handcentric/sim/draw.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "handcentric/core/atomic_file.hpp"
 #include "handcentric/core/errors.hpp"
-#include "png.hpp"
+#include "handcentric/core/format.hpp"
+#include "handcentric/sim/canvas.hpp"
 
 namespace handcentric::sim {
 namespace {
@@ -92,48 +91,27 @@ void draw_hole(cv::Mat& canvas, const View& view, const RigidTransform& world_T_
   }
 }
 
-void caption(cv::Mat& canvas, const std::string& text) {
-  cv::putText(canvas, text, cv::Point(10, 24), cv::FONT_HERSHEY_SIMPLEX, 0.6, rgb(20, 20, 20), 1,
-              cv::LINE_AA);
-}
-
 void check_size(int size) {
   if (size < 64 || size > 4096)
     throw InvalidArgument("image size must be in [64, 4096] pixels, got " + std::to_string(size));
 }
 
-Image to_image(const cv::Mat& bgr) {
+// The drawing with its caption at the top left (Cairo text).
+Image captioned(const cv::Mat& bgr, const std::string& caption) {
   cv::Mat rgb_mat;
   cv::cvtColor(bgr, rgb_mat, cv::COLOR_BGR2RGB);
   Image image;
   image.width = rgb_mat.cols;
   image.height = rgb_mat.rows;
   image.rgb.assign(rgb_mat.data, rgb_mat.data + rgb_mat.total() * 3);
-  return image;
+  return labelled(image, {{caption, 10.0, 24.0, 15.0}});
 }
 
 cv::Mat blank(int size) {
   return cv::Mat(size, size, CV_8UC3, cv::Scalar(255, 255, 255));
 }
 
-std::string fmt(const char* format, double a) {
-  char buffer[64];
-  std::snprintf(buffer, sizeof(buffer), format, a);
-  return buffer;
-}
-
 }  // namespace
-
-int Image::count_pixels(std::uint8_t r, std::uint8_t g, std::uint8_t b, int tolerance) const {
-  int count = 0;
-  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) {
-    if (std::abs(rgb[i] - r) <= tolerance && std::abs(rgb[i + 1] - g) <= tolerance &&
-        std::abs(rgb[i + 2] - b) <= tolerance) {
-      ++count;
-    }
-  }
-  return count;
-}
 
 Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry, int size) {
   check_size(size);
@@ -145,10 +123,10 @@ Image draw_scene(const TaskScene& scene, const PegHoleGeometry& geometry, int si
   cv::circle(canvas, view.px(scene.world_T_hand_start * Eigen::Vector3d::Zero()), 3,
              rgb(30, 90, 220), cv::FILLED);
   const Eigen::Vector3d q = planar_coordinates(scene.world_T_hole);
-  caption(canvas, "scene: hole at (" + fmt("%.1f", q(1)) + ", " + fmt("%.1f", q(2)) +
-                      ") cm, angle " + fmt("%.1f", q(0) * 180.0 / 3.14159265358979) +
-                      " deg; peg start in blue");
-  return to_image(canvas);
+  return captioned(canvas, "scene: hole at (" + format_fixed(q(1), 1) + ", " +
+                               format_fixed(q(2), 1) + ") cm, angle " +
+                               format_fixed(q(0) * 180.0 / 3.14159265358979, 1) +
+                               " deg; peg start in blue");
 }
 
 Image draw_demos(const std::vector<Demo>& demos, const PegHoleGeometry& geometry, int size) {
@@ -180,9 +158,8 @@ Image draw_demos(const std::vector<Demo>& demos, const PegHoleGeometry& geometry
     cv::polylines(canvas, line, false, colour, 2, cv::LINE_AA);
   }
   draw_hole(canvas, view, RigidTransform(), geometry);
-  caption(canvas,
-          std::to_string(demos.size()) + " demos in the hole frame: hand paths, peg every 6 steps");
-  return to_image(canvas);
+  return captioned(canvas, std::to_string(demos.size()) +
+                               " demos in the hole frame: hand paths, peg every 6 steps");
 }
 
 Image draw_rollout(const TaskScene& scene, const Rollout& rollout, const PegHoleGeometry& geometry,
@@ -209,19 +186,10 @@ Image draw_rollout(const TaskScene& scene, const Rollout& rollout, const PegHole
                                                                           : rgb(110, 110, 110);
   const auto last = outline(view, rollout.world_T_hand.back(), geometry.peg_in_hand());
   cv::fillConvexPoly(canvas, last, final_colour);  // no anti-aliasing: tests count these pixels
-  caption(canvas, outcome_name(rollout.outcome) + " after " + std::to_string(rollout.steps) +
-                      " steps, " + std::to_string(rollout.replans) + " replans, " +
-                      std::to_string(rollout.clipped) + " clipped");
-  return to_image(canvas);
-}
-
-void write_png(const std::string& path, const Image& image) {
-  if (image.width <= 0 || image.height <= 0 ||
-      image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3) {
-    throw InvalidArgument("write_png: the image is empty or its pixel buffer has the wrong size");
-  }
-  write_file_atomically(path,
-                        encode_png(image.rgb.data(), image.rgb.size(), image.width, image.height));
+  return captioned(canvas, outcome_name(rollout.outcome) + " after " +
+                               std::to_string(rollout.steps) + " steps, " +
+                               std::to_string(rollout.replans) + " replans, " +
+                               std::to_string(rollout.clipped) + " clipped");
 }
 
 }  // namespace handcentric::sim

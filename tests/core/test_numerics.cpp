@@ -555,3 +555,30 @@ TEST_CASE("mutant_std_max_passes_the_tolerance_check_on_a_nan_among_finite_error
     CHECK(worst <= 1e-9);
   }
 }
+
+TEST_CASE("format_readable_prints_rounding_noise_as_0_and_keeps_the_rest", "[unit]") {
+  // A half turn about y, with what rounding leaves of the other two components.
+  const Eigen::Vector3d half_turn(-2.3e-10, -std::numbers::pi, 9.7e-10);
+  CHECK(format_readable(half_turn) == "[0, -3.14159, 0]");
+  // The noise is 1e-9 (1 + the largest): a pose 1 cm out moved off by 1e-9 m reads as 1 cm out.
+  CHECK(format_readable(Eigen::Vector3d(-7.6e-10, 5.6e-11, -0.01)) == "[0, 0, -0.01]");
+  CHECK(format_readable(Eigen::Vector3d(1.0, 2.1e-9, -0.0)) == "[1, 2.1e-09, 0]");
+  // Below a noise of 0, or of 1e-9 of the largest (as g prints), 1e-12 rad is a value.
+  CHECK(format_readable(Eigen::Vector3d(0.0, 0.0, 1e-12), 6, 0.0) == "[0, 0, 1e-12]");
+  CHECK(format_readable(Eigen::Vector3d(0.0, 0.0, 1e-12), 6, 1e-21) == "[0, 0, 1e-12]");
+  CHECK(format_readable(Eigen::Vector3d(0.1 + 0.2, 1.0 / 3.0, kNan), 3, 1.0) == "[0, 0, nan]");
+  CHECK(format_readable(Eigen::Vector3d(0.1 + 0.2, 1.0 / 3.0, 2.0), 3, 0.0) == "[0.3, 0.333, 2]");
+  CHECK(std::isnan(largest_magnitude(Eigen::Vector3d(1.0, kNan, 0.0))));
+  CHECK(format_digits(-0.0) == "0");
+  CHECK(format_digits(INFINITY) == "inf");
+  // The planted fault, the same digits with no noise, reads the rounding as values.
+  CHECK(format_readable(half_turn, 6, 0.0) == "[-2.3e-10, -3.14159, 9.7e-10]");
+}
+
+TEST_CASE("digits_to_tell_apart_shows_the_difference_an_error_names", "[unit]") {
+  CHECK(digits_to_tell_apart(1.0, 2.0) == 6);
+  CHECK(digits_to_tell_apart(1.0, 1.0 + 1e-9) == 10);
+  CHECK(format_digits(1.0, 10) != format_digits(1.0 + 1e-9, 10));
+  CHECK(digits_to_tell_apart(0.5, 0.5) == 6);
+  CHECK(digits_to_tell_apart(1.0, std::nextafter(1.0, 2.0)) == 17);
+}

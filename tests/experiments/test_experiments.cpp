@@ -289,27 +289,40 @@ TEST_CASE("the_markdown_puts_each_row_beside_the_papers", "[unit]") {
                                  row("hand_centric", 100, 0.97, 0.95),
                                  row("absolute", 10, 0.0, 0.0), row("absolute", 100, 0.12, 0.01)};
   const std::string md = table1_markdown(rows, EvalSettings(), 1);
-  CHECK_THAT(md, Contains("| policy | scenes | 10 | 100 |"));
-  CHECK_THAT(md, Contains("| hand_centric/flow | id | 0.50 | 0.97 |"));
-  CHECK_THAT(md, Contains("| hand_centric/flow | ood | 0.48 | 0.95 |"));
-  CHECK_THAT(md, Contains("| Hand-Centric-Flow (paper) | id | 0.25 | 0.98 |"));
-  CHECK_THAT(md, Contains("| Hand-Centric-Flow (paper) | ood | - | 0.96 |"));
-  CHECK_THAT(md, Contains("| Absolute-Action-Flow (paper) | id | 0.00 | 0.14 |"));
+  // table1_table's columns, through the page's Markdown renderer ('_' escaped).
+  CHECK_THAT(md,
+             Contains("| method / head | demos | trials | in distribution | paper (Table 1) "
+                      "| OOD (independent) | paper (Table 1, OOD at 100 demos) | OOD (paired) |"));
+  CHECK_THAT(md, Contains("| hand\\_centric / flow | 10 | 100 | 0.50 \\["));
+  CHECK_THAT(md, Contains("| 0.25 (Hand-Centric-Flow) | 0.48 \\["));
+  CHECK_THAT(md, Contains("| hand\\_centric / flow | 100 | 100 | 0.97 \\["));
+  CHECK_THAT(md, Contains("| 0.98 (Hand-Centric-Flow) | 0.95 \\["));
+  CHECK_THAT(md, Contains("| 0.96 | 0.97 |"));  // the paper's OOD at 100 demos, then paired
+  CHECK_THAT(md, Contains("| 0.14 (Absolute-Action-Flow) | 0.01 \\["));
   // A missing result is a dash, not a zero.
   Row partial = row("relative", 10, 0.1, 0.0);
   partial.ood_success.reset();
   CHECK_THAT(table1_markdown({partial}, EvalSettings(), 1),
-             Contains("| relative/flow | ood | - |"));
-  // The two C8 rows stand in for one paper row: its lines once, after both.
+             Contains("| 0.00 (Relative-Action-Flow) | - | - | 0.10 |"));
+  // The two C8 rows stand in for one paper row: each carries its number.
   const std::string c8 = table1_markdown(
       {row("c8_centre", 100, 0.0, 0.0), row("c8_base", 100, 0.0, 0.0)}, EvalSettings(), 1);
-  const auto paper_line = c8.find("| Equivariant-DiffPo [7] (paper) | id | 0.27 |");
-  REQUIRE(paper_line != std::string::npos);
-  // The next mention is the paper's OOD line ("| " before the label), and there is no other.
-  const auto ood_line = c8.find("| Equivariant-DiffPo [7] (paper) | ood |");
-  CHECK(c8.find("Equivariant-DiffPo", c8.find('\n', paper_line)) == ood_line + 2);
-  CHECK(c8.find("Equivariant-DiffPo", ood_line + 3) == std::string::npos);
-  CHECK(c8.find("c8_base/c8ddpm | id") < paper_line);
+  CHECK_THAT(c8, Contains("| c8\\_centre / c8ddpm | 100 |"));
+  CHECK_THAT(c8, Contains("| c8\\_base / c8ddpm | 100 |"));
+  std::size_t papers = 0;
+  for (std::size_t at = c8.find("0.27 (Equivariant-DiffPo \\[7\\])"); at != std::string::npos;
+       at = c8.find("0.27 (Equivariant-DiffPo \\[7\\])", at + 1))
+    ++papers;
+  CHECK(papers == 2);
+  // Several training seeds get a column; an audited row its symmetry.
+  Row second = rows[0];
+  second.train_seed = 2;
+  second.symmetry = {{"se2", true, 3e-16}, {"c8", false, 0.5}};
+  const std::string seeds = table1_markdown({rows[0], second}, EvalSettings(), 1);
+  CHECK_THAT(seeds, Contains("| demos | training seed | trials |"));
+  CHECK_THAT(seeds, Contains("| 10 | 2 | 100 |"));
+  CHECK_THAT(seeds, Contains("se2 yes (3.0e-16), c8 no (5.0e-01) |"));
+  CHECK_THAT(seeds, Contains("`audited symmetry`"));
 }
 
 TEST_CASE("the_figure_draws_curves_for_several_demo_counts_with_every_mark_inside", "[unit]") {
@@ -451,8 +464,8 @@ TEST_CASE("collect_builds_the_table_from_whatever_results_exist", "[unit]") {
   std::ofstream(dir / cell.result_path(SceneSet::id, eval))
       << eval_json(summary, "flow/hand_centric", "train", 100);
   const std::string md = collect_table1(dir.string());
-  CHECK_THAT(md, Contains("| hand_centric/flow | id | 0.40 |"));
-  CHECK_THAT(md, Contains("| hand_centric/flow | ood | - |"));
+  // id 0.40 with its interval, then the paper's number, and no OOD result yet.
+  CHECK_THAT(md, Contains("| 0.40 \\[") && Contains("(Hand-Centric-Flow) | - |"));
   std::ifstream json(dir / "table1.json");
   const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
   CHECK_THAT(text, Contains("\"id_success\": 0.4"));
@@ -495,7 +508,7 @@ TEST_CASE("table1_audits_every_model_and_shows_its_symmetry_beside_its_success",
   CHECK_FALSE(verdict("c8_averaged", "translation"));
   CHECK_FALSE(rows[0].at("symmetry").contains("se3"));
   CHECK_THAT(md, Contains("| audited symmetry |"));
-  CHECK_THAT(md, Contains("| c8_averaged/c8ddpm_avg | id | ") && Contains(", c8 yes ("));
+  CHECK_THAT(md, Contains("| c8\\_averaged / c8ddpm\\_avg |") && Contains(", c8 yes ("));
   // A damaged audit file is named, not read as a verdict.
   HC_CHECK_THROWS(parse_audit_json("{\"policies\": []}", "a.json"), InvalidArgument,
                   Contains("'a.json'"));

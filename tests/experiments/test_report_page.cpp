@@ -200,14 +200,22 @@ TEST_CASE("witness_figure_draws_both_scenes_and_refuses_an_empty_one", "[unit]")
   scene.world_T_hand_history = {RigidTransform::planar(0.0, 0.0, 0.0)};
   scene.world_T_hand_chunk = {RigidTransform::planar(0.0, 1.0, 0.0)};
   scene.world_points = {Eigen::Vector3d(0.5, 0.5, 0.0)};
-  const std::string svg = witness_svg(scene, RigidTransform::planar(0.0, 3.0, 0.0));
-  CHECK(count(svg, "<circle") == 3);   // s: the chunk's pose, T_0, the world point
-  CHECK(count(svg, "<rect x=") == 3);  // g s: chunk, T_0, point
-  CHECK_THAT(svg, Contains("axes (x, y)"));
+  const RigidTransform g = RigidTransform::planar(0.0, 3.0, 0.0);
+  const WitnessPicture picture = witness_picture(scene, g);
+  for (const WitnessMarks* marks : {&picture.s, &picture.g_s}) {
+    CHECK(marks->chunk.size() == 1);  // the chunk's pose; T_0 and the world point beside it
+    CHECK(marks->points.size() == 1);
+    CHECK(marks->path.size() == 2);  // T_0, then the chunk
+  }
+  CHECK(picture.g_s.t0.x() > picture.s.t0.x());  // g moves the hand along +x
+  CHECK(picture.across == 0);
+  CHECK(picture.up == 1);
+  CHECK_THAT(witness_svg(scene, g), Contains("<svg"));
   // A g along z would draw s and g s on top of each other from above: the side view shows it.
-  const std::string side =
-      witness_svg(scene, RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, 5.0)));
-  CHECK_THAT(side, Contains("axes (x, z)"));
+  const WitnessPicture side =
+      witness_picture(scene, RigidTransform::from_translation(Eigen::Vector3d(0.0, 0.0, 5.0)));
+  CHECK(side.across == 0);
+  CHECK(side.up == 2);
 }
 
 TEST_CASE("claims_part_links_each_claim_to_its_line_of_the_claims_file", "[unit]") {

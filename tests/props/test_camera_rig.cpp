@@ -17,14 +17,14 @@
 
 using namespace handcentric;
 using props::CameraRig;
-using props::CameraView;
 using props::Group;
+using props::View;
 
 namespace {
 
 constexpr int kImageChunk = 2;
 
-CameraRig small_rig(CameraView view, bool floor = false) {
+CameraRig small_rig(View view, bool floor = false) {
   CameraRig rig;
   rig.views = {view};
   rig.camera = PinholeCamera{16, 12, 90.0, 20.0};
@@ -87,7 +87,7 @@ class RandomImagePolicy final : public props::ImagePolicy {
   HandCentricRepresentation hand_centric_;
 };
 
-props::Verdict audit_image_policy(CameraView view) {
+props::Verdict audit_image_policy(View view) {
   const CameraRig rig = small_rig(view);
   const props::CameraPolicy policy(std::make_shared<RandomImagePolicy>(rig), rig);
   props::CheckOptions options;
@@ -100,19 +100,19 @@ props::Verdict audit_image_policy(CameraView view) {
 
 TEST_CASE("the_eye_in_hand_image_is_se3_invariant", "[property]") {
   props::require_property("eye-in-hand image under se3",
-                          image_is_invariant(small_rig(CameraView::eye_in_hand), Group::se3));
+                          image_is_invariant(small_rig(View::eye_in_hand), Group::se3));
 }
 
 TEST_CASE("mutant_the_third_person_image_is_not_invariant", "[property]") {
   for (const Group group : {Group::translation, Group::rotation, Group::se2, Group::c8}) {
     INFO(props::to_string(group));
     props::require_falsified("third-person image",
-                             image_is_invariant(small_rig(CameraView::third_person), group));
+                             image_is_invariant(small_rig(View::third_person), group));
   }
 }
 
 TEST_CASE("with_the_floor_the_eye_in_hand_image_is_invariant_under_se2_and_c8_only", "[property]") {
-  const CameraRig rig = small_rig(CameraView::eye_in_hand, true);
+  const CameraRig rig = small_rig(View::eye_in_hand, true);
   for (const Group group : {Group::se2, Group::c8}) {
     INFO(props::to_string(group));
     props::require_property("eye-in-hand image with floor and lamp",
@@ -128,7 +128,7 @@ TEST_CASE("with_the_floor_the_eye_in_hand_image_is_invariant_under_se2_and_c8_on
 TEST_CASE("the_eye_in_hand_image_shows_the_points_where_the_hand_sees_them", "[unit]") {
   // One eye-in-hand point 1 m straight ahead of the camera (the hand's +z), drawn with radius
   // 0.2: the centre pixels read its near surface, just beyond 1 - r, the corners see nothing.
-  CameraRig rig = small_rig(CameraView::eye_in_hand);
+  CameraRig rig = small_rig(View::eye_in_hand);
   rig.point_radius = 0.2;
   Scene scene;
   scene.world_T_hand_history = {RigidTransform::planar(0.7, 3.0, -2.0)};
@@ -149,11 +149,11 @@ TEST_CASE("the_eye_in_hand_image_shows_the_points_where_the_hand_sees_them", "[u
 
 TEST_CASE("a_network_on_the_eye_in_hand_image_is_equivariant_on_the_third_person_image_not",
           "[property]") {
-  const props::Verdict eye = audit_image_policy(CameraView::eye_in_hand);
+  const props::Verdict eye = audit_image_policy(View::eye_in_hand);
   INFO((eye.witness ? props::format_witness(*eye.witness) : std::string("no witness")));
   CHECK(eye.invariant);
   CHECK(eye.cases > 30);  // a verdict with cases behind it
-  const props::Verdict fixed = audit_image_policy(CameraView::third_person);
+  const props::Verdict fixed = audit_image_policy(View::third_person);
   CHECK_FALSE(fixed.invariant);
   REQUIRE(fixed.witness);
 }
@@ -162,7 +162,7 @@ TEST_CASE("bad_camera_rigs_are_refused_with_the_value_and_the_fix", "[unit]") {
   CameraRig rig;
   rig.views = {};
   CHECK_THROWS_WITH(rig.validate(), Catch::Matchers::Contains("at least one camera"));
-  rig.views = {CameraView::eye_in_hand, CameraView::eye_in_hand};
+  rig.views = {View::eye_in_hand, View::eye_in_hand};
   CHECK_THROWS_WITH(rig.validate(), Catch::Matchers::Contains("named twice"));
   rig = CameraRig();
   rig.point_radius = 0.0;

@@ -46,8 +46,7 @@ double upper_fraction(const std::function<rc::Gen<int>()>& integers) {
 
 }  // namespace
 
-TEST_CASE("an_integer_is_uniform_in_every_case_and_the_sized_inRange_is_caught",
-          "[props][generators]") {
+TEST_CASE("an_integer_is_uniform_in_every_case_and_the_sized_inRange_is_caught", "[property]") {
   const double uniform = upper_fraction([] { return uniform_integer(0, 1 << 20); });
   CHECK(uniform == Approx(2.0 / 3.0).epsilon(0.05));
   // The planted fault: RapidCheck's inRange, whose range grows with the case number.
@@ -56,8 +55,7 @@ TEST_CASE("an_integer_is_uniform_in_every_case_and_the_sized_inRange_is_caught",
   CHECK(sized < 0.4);
 }
 
-TEST_CASE("scene_scales_are_log_uniform_from_1_cm_to_10_m_in_the_first_cases_too",
-          "[props][generators]") {
+TEST_CASE("scene_scales_are_log_uniform_from_1_cm_to_10_m_in_the_first_cases_too", "[property]") {
   // P(L > 0.1 m) = log(100) / log(1000) = 2/3 for L log-uniform in [0.01, 10] m, in a check of
   // 10 cases (an in-distribution check's) as in one of 2000.
   const SceneShape shape = eye_in_hand_shape();
@@ -76,7 +74,7 @@ TEST_CASE("scene_scales_are_log_uniform_from_1_cm_to_10_m_in_the_first_cases_too
   CHECK(far_in_small_checks / 200.0 == Approx(2.0 / 3.0).epsilon(0.12));
 }
 
-TEST_CASE("c8_draws_each_of_its_eight_elements_equally_often", "[props][generators]") {
+TEST_CASE("c8_draws_each_of_its_eight_elements_equally_often", "[property]") {
   auto angle = [] {
     return std::abs(detail::draw_case(eye_in_hand_shape(), Group::c8).second.rotation().log().z());
   };
@@ -86,7 +84,7 @@ TEST_CASE("c8_draws_each_of_its_eight_elements_equally_often", "[props][generato
   CHECK(fraction_above(angles, 3.0) == Approx(1.0 / 8.0).epsilon(0.25));
 }
 
-TEST_CASE("recorded_observations_are_drawn_uniformly_from_the_whole_file", "[props][generators]") {
+TEST_CASE("recorded_observations_are_drawn_uniformly_from_the_whole_file", "[property]") {
   auto recorded = std::make_shared<RecordedObservations>();
   recorded->source = "a file of 100 observations";
   for (int i = 0; i < 100; ++i) {

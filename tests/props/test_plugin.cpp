@@ -131,8 +131,7 @@ TEST_CASE("a_hellos_cameras_are_read_and_each_bad_field_named", "[unit]") {
       R"( "floor": true})");
   REQUIRE(good.hello->cameras);
   CHECK(good.hello->cameras->views ==
-        std::vector<props::CameraView>{props::CameraView::third_person,
-                                       props::CameraView::eye_in_hand});
+        std::vector<props::View>{props::View::third_person, props::View::eye_in_hand});
   CHECK(good.hello->cameras->camera.width == 32);
   CHECK(good.hello->cameras->channels == props::ImageChannels::depth);
   CHECK(good.hello->cameras->floor);

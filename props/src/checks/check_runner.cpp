@@ -210,13 +210,17 @@ CaseOutcome decided_off_the_case(const CaseFunction& decide_case, const Scene& s
 
 Verdict run_check(const CaseFunction& decide_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget,
-                  LawStatistics* statistics) {
-  const CaseFunction run_case =
-      mode != Mode::distribution
-          ? decide_case
-          : CaseFunction([&decide_case, &options](const Scene& scene, const RigidTransform& g) {
-              return decided_off_the_case(decide_case, scene, g, options);
-            });
+                  LawStatistics* statistics, const CaseFunction& decide_extra_case) {
+  // In distribution, a case is decided off the case too (decided_off_the_case, above).
+  auto with_rules = [mode, &options](const CaseFunction& decide) {
+    if (mode != Mode::distribution) return decide;
+    return CaseFunction([decide, &options](const Scene& scene, const RigidTransform& g) {
+      return decided_off_the_case(decide, scene, g, options);
+    });
+  };
+  const CaseFunction run_case = with_rules(decide_case);
+  const CaseFunction run_extra_case =
+      with_rules(decide_extra_case ? decide_extra_case : decide_case);
   if (cases < 1)
     throw InvalidArgument("a check needs at least 1 case, got " + std::to_string(cases));
   if (!(options.relative_tolerance > 0.0) || !std::isfinite(options.relative_tolerance)) {
@@ -237,8 +241,9 @@ Verdict run_check(const CaseFunction& decide_case, Component component, Group gr
     // The extra cases run after the search: their inputs are asked for in passes of their own,
     // so that a batched map answers them in a few calls, not one per input.
     const auto& extra = options.extra_cases;
-    answer_units_ahead(true, extra.size(),
-                       [&](std::size_t k) { (void)run_case(extra[k].first, extra[k].second); });
+    answer_units_ahead(true, extra.size(), [&](std::size_t k) {
+      (void)run_extra_case(extra[k].first, extra[k].second);
+    });
   }
   Verdict verdict;
   verdict.component = component;
@@ -259,9 +264,9 @@ Verdict run_check(const CaseFunction& decide_case, Component component, Group gr
   // One case of the search: false when it failed (or raised: `error`).
   std::string case_label;  // set before each search_case: "case 12", "the extra case 1"
   auto search_case = [&](const Scene& scene, const RigidTransform& g, CaseOutcome& outcome,
-                         bool decided = false) {
+                         bool decided = false, const CaseFunction* decide = nullptr) {
     try {
-      if (!decided) outcome = run_case(scene, g);
+      if (!decided) outcome = (decide ? *decide : run_case)(scene, g);
     } catch (Error& e) {
       // The function under test could not answer here: say where, so that it can be replayed.
       e.add_context("raised in " + case_label + " of the " + to_string(component) + " (" +
@@ -334,7 +339,7 @@ Verdict run_check(const CaseFunction& decide_case, Component component, Group gr
     // candidate pass, above), so a callable that raises costs one call whatever `cases` is.
     if (error) RC_FAIL("the function under test could not answer");
     if (!holds) {
-      // XX if (searching) verdict.first_failure = {outcome.witness.scene, outcome.witness.g};
+      if (searching) verdict.first_failure = {outcome.witness.scene, outcome.witness.g};
       searching = false;
       verdict.witness = std::move(outcome.witness);  // the last failure is the shrunk one
       RC_FAIL("not invariant");
@@ -346,8 +351,8 @@ Verdict run_check(const CaseFunction& decide_case, Component component, Group gr
   for (std::size_t k = 0; k < options.extra_cases.size() && !verdict.witness; ++k) {
     CaseOutcome outcome;
     case_label = "the extra case " + std::to_string(k + 1);
-    const bool holds =
-        search_case(options.extra_cases[k].first, options.extra_cases[k].second, outcome);
+    const bool holds = search_case(options.extra_cases[k].first, options.extra_cases[k].second,
+                                   outcome, false, &run_extra_case);
     if (error) std::rethrow_exception(error);
     if (!holds) {
       verdict.witness = std::move(outcome.witness);

@@ -381,7 +381,11 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
       std::to_string(scan_pairs) + " resolution pairs" +
       (result.resolution ? " at changes of " + format_number(kSmallestLoss) + " or more" : "");
 
-  if (result.collision) {
+  // A pair apart by no more than the resolution is one of the scan's collisions, found first:
+  // the loss is then named by the resolution, with the scan's pair at it as the witness.
+  const bool below_resolution = result.collision && loses(result.resolution) &&
+                                result.collision->chunk_distance <= *result.resolution;
+  if (result.collision && !below_resolution) {
     result.injective = false;
     result.how = "two different chunks (apart by " +
                  format_number(result.collision->chunk_distance) +
@@ -412,9 +416,8 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
 }
 
 std::string format_resolution(double value, const std::string& unit) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%.1e", value);
-  std::string text = buffer;  // e.g. 7.8e-03: drop the exponent's leading zeros
+  std::string text =
+      format_scientific(value, 1);  // e.g. 7.8e-03: drop the exponent's leading zeros
   const std::size_t e = text.find('e');
   if (e != std::string::npos && e + 2 < text.size()) {
     std::size_t digits = e + 2;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <numeric>
 
+#include "handcentric/core/format.hpp"
 #include "handcentric/props/prefetch.hpp"
 #include "handcentric/props/scene_key.hpp"
 #include "handcentric/props/checks/policy_audit.hpp"
@@ -41,9 +42,7 @@ std::vector<Scene> preflight_scenes(const CheckOptions& check, int wanted) {
 }
 
 std::string metres(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof buffer, "%.2g m", x);
-  return buffer;
+  return format_significant(x, 2) + " m";
 }
 
 std::string joined(const std::vector<std::string>& names) {

@@ -269,6 +269,16 @@ ProfiledMap function_map(const SceneFunction& f) {
 
 }  // namespace
 
+ProfileOptions with_audit_setup(ProfileOptions options, const ClassifierOptions& classifier,
+                                View view) {
+  const CheckOptions check = with_view(classifier.check, view);
+  options.shape = check.shape;
+  options.prefetch = check.prefetch;
+  options.seed = check.seed;
+  options.noise_seed = check.noise_seed;
+  return options;
+}
+
 std::vector<ProfileCase> profile_cases(const ProfileOptions& options) {
   require_options(options, Group::se3);
   std::vector<Scene> scenes;

@@ -45,13 +45,9 @@ Light rig_light(const CameraRig& rig, const RigidTransform& frame_T_world) {
 
 }  // namespace
 
-std::string to_string(CameraView view) {
-  return view == CameraView::eye_in_hand ? "eye_in_hand" : "third_person";
-}
-
-CameraView parse_camera_view(const std::string& name) {
-  if (name == "eye_in_hand") return CameraView::eye_in_hand;
-  if (name == "third_person") return CameraView::third_person;
+View parse_camera_view(const std::string& name) {
+  if (name == "eye_in_hand") return View::eye_in_hand;
+  if (name == "third_person") return View::third_person;
   throw InvalidArgument("unknown camera '" + name +
                         "': the cameras are eye_in_hand (on the hand) and third_person (fixed "
                         "in the world)");
@@ -133,8 +129,8 @@ std::vector<CameraImage> render_views(const Scene& observation, const CameraRig&
   const RigidTransform& world_T_hand = observation.world_T_hand0();
   std::vector<CameraImage> images;
   images.reserve(rig.views.size());
-  for (const CameraView view : rig.views) {
-    if (view == CameraView::eye_in_hand) {
+  for (const View view : rig.views) {
+    if (view == View::eye_in_hand) {
       // Rendered in the hand frame: only world-frame things pass through T_0^-1.
       const RigidTransform hand_T_world = world_T_hand.inverse();
       images.push_back(

@@ -1,6 +1,7 @@
 #include "handcentric/props/observation/generators.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <type_traits>
@@ -21,10 +22,16 @@ rc::Gen<double> unit_interval() {
                       [](int k) { return static_cast<double>(k) / kResolution; });
 }
 
-// A uniform number in [-max_abs, max_abs].
+// A uniform number in [-max_abs, max_abs] that shrinks toward 0 (RapidCheck shrinks an integer
+// toward the low end of its range, which would be -max_abs: a half turn for an angle). The
+// integer k in [0, 2^31] is taken to 0, 1, -1, 2, -2, ..., 2^30, -2^30, one value each, so the
+// law is the uniform one on the grid and a smaller k is a smaller |value|.
 rc::Gen<double> symmetric(double max_abs) {
-  return rc::gen::map(uniform_integer(-kResolution, kResolution + 1),
-                      [max_abs](int k) { return max_abs * static_cast<double>(k) / kResolution; });
+  return rc::gen::map(uniform_integer<std::int64_t>(0, 2 * std::int64_t{kResolution} + 1),
+                      [max_abs](std::int64_t k) {
+                        const std::int64_t signed_k = k % 2 == 1 ? (k + 1) / 2 : -(k / 2);
+                        return max_abs * static_cast<double>(signed_k) / kResolution;
+                      });
 }
 
 // A Haar-uniform unit axis (the axis of a Haar rotation is uniform on the sphere).
@@ -143,10 +150,11 @@ rc::Gen<Eigen::Vector3d> planar_axis() {
 }  // namespace
 
 rc::Gen<Rotation> haar_rotation() {
-  return rc::gen::map(rc::gen::tuple(unit_interval(), unit_interval(), unit_interval()),
-                      [](const auto& u) {
-                        return shoemake_rotation(std::get<0>(u), std::get<1>(u), std::get<2>(u));
-                      });
+  // A uniform axis and an angle by the inverse CDF of Haar's angle law (haar_angle): exactly
+  // Haar, and the number behind the angle shrinks to 0, the identity, so that a failure shrinks
+  // to the smallest turn that still fails. (Shoemake's map of three uniform numbers is Haar
+  // too, but maps their zeros to a half turn, where rotation vectors jump.)
+  return axis_angle(rc::gen::map(unit_interval(), [](double u) { return haar_angle(u); }));
 }
 
 rc::Gen<Rotation> rotation_near_pi() {
@@ -219,12 +227,14 @@ rc::Gen<Scene> scene(SceneShape shape) {
   // One length scale per scene, log-uniform in [1 cm, 10 m]: the start pose is that far out, and
   // steps and points are drawn in proportion (at 10 m: steps up to 0.1 m, hand points within
   // 1 m, world points within 10 m). Extra poses stay anywhere within 10 m.
+  // The counts come first: RapidCheck shrinks a tuple's elements in order, and a witness reads
+  // best with its chunk and history shortest, whatever the numbers shrink to after them.
   auto geometry = rc::gen::mapcat(log_uniform_length(), [shape](double scale) {
     return rc::gen::apply(
-        [](const Rotation& world_R_hand0, const Eigen::Vector3d& direction, double scale,
-           const Twist& forward, const Twist& backward, int history, int chunk,
-           const std::vector<Eigen::Vector3d>& hand_points,
-           const std::vector<Eigen::Vector3d>& world_points) {
+        [](int history, int chunk, const std::vector<Eigen::Vector3d>& hand_points,
+           const std::vector<Eigen::Vector3d>& world_points, const Rotation& world_R_hand0,
+           const Eigen::Vector3d& direction, double scale, const Twist& forward,
+           const Twist& backward) {
           Scene s;
           const RigidTransform world_T_hand0(world_R_hand0, scale * direction);
           // Smooth, rotating motion: a constant body twist per control step, each way from T_0.
@@ -243,13 +253,13 @@ rc::Gen<Scene> scene(SceneShape shape) {
           s.world_points = world_points;
           return s;
         },
-        shape.planar ? planar_rotation() : rotation(), shape.planar ? planar_axis() : unit_axis(),
-        rc::gen::just(scale), step_or_rest(0.01 * scale, 0.3, shape.planar),
-        step_or_rest(0.01 * scale, 0.3, shape.planar),
         uniform_integer(shape.min_history, shape.max_history + 1),
         uniform_integer(shape.min_chunk, shape.max_chunk + 1),
         points(shape.min_hand_points, shape.max_hand_points, 0.1 * scale, shape.planar),
-        points(shape.min_world_points, shape.max_world_points, scale, shape.planar));
+        points(shape.min_world_points, shape.max_world_points, scale, shape.planar),
+        shape.planar ? planar_rotation() : rotation(), shape.planar ? planar_axis() : unit_axis(),
+        rc::gen::just(scale), step_or_rest(0.01 * scale, 0.3, shape.planar),
+        step_or_rest(0.01 * scale, 0.3, shape.planar));
   });
   if (shape.extra_pose_names.empty() && shape.scalar_names.empty()) return geometry;
   // Named extras: one random pose per name (anywhere within 10 m, any orientation; in the plane

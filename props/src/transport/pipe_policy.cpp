@@ -190,4 +190,10 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_fresh(
   }
 }
 
+std::shared_ptr<const NoisyPolicy> as_checked(std::shared_ptr<const PipePolicy> plugin) {
+  const int batch = plugin->capabilities().batch;
+  if (batch > 0) return std::make_shared<BatchedPolicy>(plugin, batch);
+  return plugin;
+}
+
 }  // namespace handcentric::props

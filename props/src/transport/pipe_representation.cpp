@@ -284,4 +284,10 @@ FlowSample PipeFlowTarget::operator()(const Scene& scene, const Eigen::VectorXd&
   return plugin_->flow(scene, eps, t);
 }
 
+std::shared_ptr<const Representation> as_checked(std::shared_ptr<const PipeRepresentation> plugin) {
+  const int batch = plugin->capabilities().batch;
+  if (batch > 0) return std::make_shared<BatchedRepresentation>(plugin, batch);
+  return plugin;
+}
+
 }  // namespace handcentric::props

@@ -11,13 +11,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A duration as the user typed it: 0.3, not 0.29999999999999999.
-std::string seconds_text(double seconds) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%g", seconds);
-  return text;
-}
-
 const std::string& checked(const std::string& command, double timeout_seconds) {
   if (command.find_first_not_of(" \t") == std::string::npos) {
     throw InvalidArgument(
@@ -62,10 +55,10 @@ std::string PluginConnection::round_trip(const std::string& body, int scenes) {
   // --timeout is per answer: a batch of n scenes has n times as long (to be read and answered).
   const double timeout = timeout_seconds_ * scenes;
   const std::string allowed =
-      seconds_text(timeout) + (scenes > 1
-                                   ? " s (--timeout " + seconds_text(timeout_seconds_) +
-                                         " s per scene, " + std::to_string(scenes) + " scenes)"
-                                   : " s");
+      format_shortest(timeout) + (scenes > 1
+                                      ? " s (--timeout " + format_shortest(timeout_seconds_) +
+                                            " s per scene, " + std::to_string(scenes) + " scenes)"
+                                      : " s");
   const auto started = Clock::now();
   switch (process_.write_all(request_line(id, body), timeout)) {
     case Subprocess::Outcome::done:

@@ -18,8 +18,14 @@ double uniform01(std::mt19937_64& rng);
 double standard_normal(std::mt19937_64& rng);
 
 /// Shoemake's map from three uniforms in [0, 1) to a unit quaternion: Haar-uniform rotations
-/// when the inputs are uniform. Deterministic; shared with the RapidCheck generators.
+/// when the inputs are uniform. Deterministic.
 Rotation shoemake_rotation(double u1, double u2, double u3);
+
+/// The inverse of the CDF F(t) = (t - sin t) / pi of a Haar rotation's angle (density
+/// (1 - cos t) / pi on [0, pi]), to double precision: a uniform u in [0, 1) gives a Haar angle;
+/// haar_angle(0) = 0 and the angle grows with u (so a rotation drawn as a uniform axis and this
+/// angle shrinks toward the identity as u does). Deterministic; u outside (0, 1) clamps.
+double haar_angle(double u);
 
 /// The map from two uniforms in [0, 1) to a uniformly distributed unit vector.
 Eigen::Vector3d sphere_point(double u1, double u2);

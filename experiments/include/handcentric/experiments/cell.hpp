@@ -10,6 +10,8 @@
 
 #include "handcentric/policy/config.hpp"
 #include "handcentric/sim/demos.hpp"
+#include "handcentric/sim/difficulty.hpp"
+#include "handcentric/sim/scenes.hpp"
 
 namespace handcentric::experiments {
 
@@ -22,6 +24,9 @@ namespace handcentric::experiments {
 enum class SceneSet { id, ood, paired };
 inline constexpr SceneSet kSceneSets[] = {SceneSet::id, SceneSet::ood, SceneSet::paired};
 std::string to_string(SceneSet set);
+/// The scenes of `set` for the task's `difficulty`: the train distribution for id, the OOD one
+/// for ood and paired (their seeds tell them apart, EvalSettings::seed).
+sim::SceneDistribution scene_distribution(SceneSet set, const sim::Difficulty& difficulty);
 
 struct EvalSettings {
   int trials = 100;
@@ -52,6 +57,8 @@ struct Cell {
   /// "results/<hash>.audit-pointwise-n<eval.audit_cases>.json": `handcentric audit --model
   /// --view eye_in_hand --pointwise --json` of the model.
   std::string audit_path(const EvalSettings& eval) const;
+  /// True when every result file of the cell (and its audit, when eval has one) is under `dir`.
+  bool done(const EvalSettings& eval, const std::string& dir) const;
 };
 
 /// FNV-1a 64 of `bytes`, as 16 hex digits.

@@ -1,6 +1,7 @@
 #pragma once
-// A drawing of the 3D blade insertion (OpenCV imgproc): the scene and a rollout seen by a
-// pinhole camera from a fixed world direction, and beside it the hand camera's depth images
+// A drawing of the 3D blade insertion (OpenCV imgproc; captions in Cairo text, sim/canvas.hpp):
+// the scene and a rollout seen by a pinhole camera from a fixed world direction, and beside it
+// the hand camera's depth images
 // (sim/insert3d/camera.hpp) at the rollout's first and last pose (the first only for a scene).
 //
 //   left  : the block's five boxes (grey wireframe, the opening's corners orange), the blade's

@@ -34,6 +34,10 @@ inline constexpr std::array<double, 2> kRobotBase = {0.0, -60.0};
 /// The methods of Table 1, in the paper's row order (the C8 rows last).
 const std::vector<Method>& table1_methods();
 
+/// `list` split at commas, empty items kept: the lists of --methods, --heads, --demos and
+/// --train-seeds.
+std::vector<std::string> split_list(const std::string& list);
+
 /// A comma-separated list of method names, e.g. "hand_centric,absolute". Throws InvalidArgument
 /// naming the unknown or repeated name and the valid names.
 std::vector<Method> parse_methods(const std::string& list);

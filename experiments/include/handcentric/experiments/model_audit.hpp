@@ -16,13 +16,13 @@
 
 namespace handcentric::experiments {
 
-/// The groups of `groups` a model of `config`'s task is audited under. `asked` is --group as
-/// given ("all" or one group's name), `model` names the file in errors: a peg2d model leaves
-/// rotation and se3 out of "all", and asked for one of them by name it is an InvalidArgument
-/// naming the groups that apply.
+/// The groups of `groups` a model of `config`'s task is audited under. `named`: --group named
+/// them one by one (not "all"); `model` names the file in errors. A peg2d model leaves rotation
+/// and se3 out of "all", and asked for one of them by name it is an InvalidArgument naming the
+/// groups that apply.
 std::vector<props::Group> model_groups(const policy::PolicyConfig& config,
-                                       const std::vector<props::Group>& groups,
-                                       const std::string& asked, const std::string& model);
+                                       const std::vector<props::Group>& groups, bool named,
+                                       const std::string& model);
 
 /// `classifier` narrowed to a model of `config`: its H and point counts, planar scenes for a
 /// peg2d model, and of classifier.views the one it can see (eye-in-hand without world points).

@@ -19,9 +19,12 @@ inline constexpr int kPaperTable2OutOfDistribution[2] = {5, 5};
 /// "0.93 [0.79, 0.98]" for a rate and its interval; "-" when there is no rate.
 std::string rate_text(const std::optional<double>& rate, const std::optional<Interval>& interval);
 
-/// One row per (method, head, demo count) of `rows`, in their order: in distribution, OOD
-/// (independent) and OOD (paired) with Wilson intervals, the paper's numbers beside them (its
-/// in-distribution rate at the paper's demo counts, its OOD rate at 100 demos).
+/// Table 1's one rendering (the report page, and table1.md through table1_markdown): one row per
+/// row of `rows` (a method, head, demo count and training seed), in their order: in
+/// distribution, OOD (independent) and OOD (paired) with Wilson intervals, the paper's numbers
+/// beside them (its in-distribution rate at the paper's demo counts, its OOD rate at 100 demos);
+/// a training seed column when the rows have several, and an audited symmetry column (per
+/// group: yes or no, and the model's largest error) when a row was audited.
 Table table1_table(const std::vector<Row>& rows, const std::string& id, const std::string& caption);
 
 /// One row per method: train, ood and random-se3 success with counts and Wilson intervals, and

@@ -101,12 +101,10 @@ int write_plan(const Table1Grid& grid, const EvalSettings& eval, const std::stri
 /// Throws InvalidArgument when DIR has no cells.json.
 std::string collect_table1(const std::string& dir);
 
-/// The markdown of `rows`: per method and head, the id success (mean over training seeds) at
-/// each demo count and the OOD success (independent, and paired) at each count, with the
-/// paper's row beside it.
-/// `training`, when not empty, is said under the title (collect_table1 passes
-/// describe_training_data of the cells' recipe when they share one).
-/// A non-default `difficulty` is said under the title too.
+/// table1.md: the run's settings under the title (`training`, when not empty, says what every
+/// cell trained on: collect_table1 passes describe_training_data of the cells' recipe when they
+/// share one; a non-default `difficulty` is said too), then table1_table (results_page.hpp) of
+/// `rows`, rendered by the report page's Markdown renderer.
 std::string table1_markdown(const std::vector<Row>& rows, const EvalSettings& eval,
                             std::uint64_t demo_seed, const std::string& training = "",
                             const sim::Difficulty& difficulty = {});

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "handcentric/props/spelling.hpp"
+
 namespace handcentric::props {
 
 enum class Group { translation, rotation, se2, se3, c8 };
@@ -22,5 +24,12 @@ std::string to_string(Group group);
 
 /// Parses a group name; throws handcentric::InvalidArgument naming the value and the valid names.
 Group parse_group(const std::string& name);
+
+/// The groups `names` name, in their order, or all_groups() when one of them is "all" (as the
+/// command line's `--group rotation se3` and Python's groups=("rotation", "se3") take them).
+/// Throws InvalidArgument for an unknown name (parse_group's message) or none, naming the option
+/// `option` ("group" on the command line, "groups" in Python) in the caller's spelling.
+std::vector<Group> parse_groups(const std::vector<std::string>& names, const std::string& option,
+                                const Spelling& spelling = kCommandLineSpelling);
 
 }  // namespace handcentric::props

@@ -17,6 +17,7 @@
 #include "handcentric/core/scene.hpp"
 #include "handcentric/props/group.hpp"
 #include "handcentric/props/spelling.hpp"
+#include "handcentric/props/view.hpp"
 
 namespace handcentric::props {
 
@@ -28,10 +29,6 @@ enum class Component { actions, observation, flow_input, flow_target, policy };
 /// distribution: the law of f(s, eps), eps ~ N(0, I), equals the law of f(g * s, eps)
 /// (distribution.hpp says how that is decided).
 enum class Mode { pointwise, distribution };
-
-/// Which scenes a check ran on. eye_in_hand: no world points (Theorem 1's assumption);
-/// third_person: one to eight world-frame points that move with g, beside eye-in-hand points.
-enum class View { eye_in_hand, third_person };
 
 /// How an in-distribution verdict was decided (pointwise checks compare values: `compared`).
 ///   exact_gaussian: the component is affine in eps on every case (checked), so its law is the
@@ -48,8 +45,6 @@ enum class Method { compared, exact_gaussian, energy_test, partly_exact };
 std::string to_string(Component component);
 /// "pointwise", "distribution".
 std::string to_string(Mode mode);
-/// "eye_in_hand", "third_person".
-std::string to_string(View view);
 /// The views `names` name, each "eye_in_hand" or "third_person", or "all" for both; InvalidArgument
 /// naming the option `option` ("views", "view") in the caller's spelling for an unknown name or
 /// none.

@@ -12,6 +12,12 @@ namespace handcentric::sim {
 /// succeed, on each distribution (docs/SIM.md, "The expert").
 constexpr double kExpertBar = 0.99;
 
+/// The main report's check of the bar (its terminal section and its page): the expert's demos on
+/// this many scenes per distribution and its closed-loop rollouts on this many, from this seed.
+constexpr int kExpertBarScenes = 200;
+constexpr int kExpertBarRollouts = 50;
+constexpr std::uint64_t kExpertBarSeed = 1;
+
 struct ExpertCheck {
   double solved_rate = 0.0;   ///< scenes with a valid demo (ExpertRun::solved_rate)
   double discard_rate = 0.0;  ///< invalid solutions among the optimizations run

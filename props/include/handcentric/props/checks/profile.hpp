@@ -95,6 +95,13 @@ struct ProfileOptions {
   bool prefetch = false;
 };
 
+/// `options` on the scenes the audit's checks of `view` draw (with_view(classifier.check, view),
+/// classifier.hpp): their shape (a plug-in's extra poses and scalars, fixed sizes), prefetch,
+/// seed and noise seed; sizes, scene count and the rest kept. The command line and Python set a
+/// profile up through the audit's options so that both draw the scenes an audit would.
+ProfileOptions with_audit_setup(ProfileOptions options, const ClassifierOptions& classifier,
+                                View view);
+
 /// A profile's scene i with its unit rotation axis and unit translation direction (z and a
 /// direction in the plane for planar shapes), as profile_transform takes them.
 struct ProfileCase {

@@ -22,15 +22,13 @@
 
 #include "handcentric/core/camera.hpp"
 #include "handcentric/core/scene.hpp"
+#include "handcentric/props/view.hpp"
 
 namespace handcentric::props {
 
-enum class CameraView { eye_in_hand, third_person };
-
-/// "eye_in_hand", "third_person".
-std::string to_string(CameraView view);
-/// Throws InvalidArgument naming the value and the valid names.
-CameraView parse_camera_view(const std::string& name);
+/// The camera named "eye_in_hand" or "third_person" (View, view.hpp). Throws InvalidArgument
+/// naming the value and the valid names.
+View parse_camera_view(const std::string& name);
 
 /// What each pixel carries for a network: depth; red, green, blue; or red, green, blue, depth.
 enum class ImageChannels { depth, rgb, rgbd };
@@ -44,7 +42,7 @@ int channel_count(ImageChannels channels);
 
 struct CameraRig {
   /// The cameras rendered, in this order (a name at most once).
-  std::vector<CameraView> views = {CameraView::eye_in_hand};
+  std::vector<View> views = {View::eye_in_hand};
   /// Both cameras' intrinsics; lengths in the scene's unit (metres for the audit's scenes).
   PinholeCamera camera{64, 48, 90.0, 20.0};
   ImageChannels channels = ImageChannels::rgbd;

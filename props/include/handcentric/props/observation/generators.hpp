@@ -1,9 +1,10 @@
 #pragma once
 // RapidCheck generators for rotations, rigid transforms and scenes.
 //
-// Rotations are Haar-uniform (Shoemake's method from three uniform numbers), mixed with the
-// edge cases where SO(3) code breaks: the identity, angles of 1e-12, angles within 1e-9 of pi
-// and exactly pi. Every generator shrinks toward simpler values (smaller numbers, fewer poses).
+// Rotations are Haar-uniform (a uniform axis and an angle by the inverse CDF of Haar's angle
+// law), mixed with the edge cases where SO(3) code breaks: the identity, angles of 1e-12, angles
+// within 1e-9 of pi and exactly pi. Every generator shrinks toward simpler values (smaller
+// numbers, fewer poses); rotations toward the identity, the smallest angle that still fails.
 #include <rapidcheck.h>
 
 #include <memory>
@@ -25,15 +26,15 @@ struct RecordedObservations;  // observation/recorded.hpp
 /// An integer uniform in [low, high) in every case of a check, shrinking toward low. Every draw
 /// of the audit goes through it, not through rc::gen::inRange: RapidCheck scales inRange's range
 /// with the case's size, which grows from 0 with the case number, so a check's first cases
-/// would draw only near `low` (lengths near 1 cm, Shoemake's half turn, a recorded file's first
-/// scenes, the identity of C8), and the cases would not be draws of one law, which every
+/// would draw only near `low` (lengths near 1 cm, rotations near the identity, a recorded file's
+/// first scenes, the identity of C8), and the cases would not be draws of one law, which every
 /// verdict's arithmetic (detectable_frequency, the tests' levels) assumes.
 template <class T>
 rc::Gen<T> uniform_integer(T low, T high) {
   return rc::gen::resize(rc::kNominalSize, rc::gen::inRange<T>(low, high));
 }
 
-/// A Haar-uniform rotation (no edge cases).
+/// A Haar-uniform rotation (no edge cases); shrinks toward the identity.
 rc::Gen<Rotation> haar_rotation();
 
 /// Haar-uniform rotations mixed with edge cases (identity, 1e-12, pi - 1e-9, pi): 1 in 5 is an edge

@@ -86,4 +86,8 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   mutable std::size_t chunk_length_ = 0;
 };
 
+/// `plugin` as the checks ask it: in batched requests of its hello's size (BatchedPolicy) when it
+/// answers batches, else one observation per request. Runs the handshake if it has not run.
+std::shared_ptr<const NoisyPolicy> as_checked(std::shared_ptr<const PipePolicy> plugin);
+
 }  // namespace handcentric::props

@@ -145,4 +145,8 @@ class PipeFlowTarget final : public FlowTarget {
   std::shared_ptr<const PipeRepresentation> plugin_;
 };
 
+/// `plugin` as the checks ask it: in batched requests of its hello's size (BatchedRepresentation)
+/// when it answers batches, else one scene per request. Runs the handshake if it has not run.
+std::shared_ptr<const Representation> as_checked(std::shared_ptr<const PipeRepresentation> plugin);
+
 }  // namespace handcentric::props

@@ -13,6 +13,11 @@
 
 namespace handcentric::props {
 
+/// Seconds a plug-in has for each answer unless its caller says otherwise (`handcentric audit
+/// --timeout`): long enough for a network's first call, short enough that a hung plug-in is
+/// named within a CI step.
+inline constexpr double kDefaultPluginTimeout = 10.0;
+
 class PluginConnection {
  public:
   /// Starts `command`. Throws InvalidArgument for an empty command or a timeout <= 0,
