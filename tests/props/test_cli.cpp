@@ -453,6 +453,32 @@ TEST_CASE("policy_exec_hands_a_plugin_the_images_of_its_hellos_cameras", "[unit]
   std::filesystem::remove_all(dir);
 }
 
+// A policy that clips its positions to a box in world axes (world_clip) breaks every group, but
+// only on scenes that reach past the box: each pointwise NO must come with an in-distribution
+// NO. The law's check runs the pointwise witness and the failing case as first drawn as extra
+// cases, with 1024 shared draws for the paired mean test; with 32, seed 5 was "yes" under c8
+// in distribution (with 256 draws for every test, NO at p = 1.2e-4 against a level of 3.3e-4).
+TEST_CASE("a_policy_clipping_world_positions_is_no_in_distribution_wherever_it_is_no_pointwise",
+          "[unit]") {
+  const std::string audit = test::cli() + " audit --policy-exec '" +
+                            test::test_plugin("policy_hand_centric.py", "world_clip") +
+                            "' --group rotation c8 --view eye_in_hand --json ";
+  for (const std::string run :
+       {"--cases 40 --seed 1", "--cases 40 --seed 2", "--cases 40 --seed 3", "--cases 40 --seed 5",
+        "--cases 200 --seed 5", "--cases 200 --seed 12"}) {
+    const auto result = test::run_command(audit + run);
+    INFO(run << "\n" << result.err);
+    REQUIRE(result.exit_code == 0);
+    const auto summary =
+        nlohmann::json::parse(result.out).at("policies").at(0).at("summary").at("eye_in_hand");
+    for (const char* group : {"rotation", "c8"}) {
+      INFO(group);
+      CHECK(summary.at("pointwise").at(group) == false);
+      CHECK(summary.at("distribution").at(group) == false);
+    }
+  }
+}
+
 TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[unit]") {
   const auto pass = test::run_command(
       test::cli() + " audit --repr hand_centric --cases 30 --expect se3,actions:c8");

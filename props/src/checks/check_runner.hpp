@@ -63,10 +63,13 @@ using CaseFunction = std::function<CaseOutcome(const Scene& scene, const RigidTr
 /// With options.prefetch, the prefetch passes of prefetch.hpp run first and keep the outcome of
 /// each case they decide, so a case is decided once whether batched or not. `statistics`, when
 /// given, receives the merged statistics of every case the verdict rests on (the search, the
-/// shrinking, the extra cases), in the order an unbatched check decides them.
+/// shrinking, the extra cases), in the order an unbatched check decides them. `decide_extra_case`,
+/// when given, decides options.extra_cases instead of `run_case` (an in-distribution check draws
+/// more noise there).
 Verdict run_check(const CaseFunction& run_case, Component component, Group group, Mode mode,
                   const CheckOptions& options, int cases, int shrink_budget,
-                  LawStatistics* statistics = nullptr);
+                  LawStatistics* statistics = nullptr,
+                  const CaseFunction& decide_extra_case = CaseFunction());
 
 /// Two functions of the noise whose laws (eps ~ N(0, I)) a distribution check compares:
 /// f(s, .) and f(g s, .) for a flow; g * a(o, .) and a(g o, .) for a policy.
@@ -78,9 +81,20 @@ struct NoisePair {
 
 /// One in-distribution case: exact Gaussian laws for the coordinates affine in eps on both
 /// sides, the tests for the others (distribution.hpp). The witness's scene and g are left for the
-/// caller; the outcome carries the case's statistics.
+/// caller; the outcome carries the case's statistics. `paired_draws`: the paired mean test's
+/// shared draws when more than the other tests' (an extra case's).
 CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOptions& options,
-                         const DistributionOptions& distribution);
+                         const DistributionOptions& distribution, int paired_draws = 0);
+
+/// The two functions of the noise to compare at a case: (scene, g scene, g) -> the pair.
+using PairOfCase =
+    std::function<NoisePair(const Scene& scene, const Scene& moved, const RigidTransform& g)>;
+
+/// An in-distribution check: run_check over compare_laws of each case's pair, the extra cases
+/// with extra_case_paired_draws, then finish_distribution_verdict.
+Verdict run_distribution_check(const PairOfCase& pair_of, Component component, Group group,
+                               const CheckOptions& options,
+                               const DistributionOptions& distribution);
 
 /// Sets the verdict's method and, for a "yes" by tests, its detectable shift and scale ratio.
 void finish_distribution_verdict(Verdict& verdict, const LawStatistics& statistics,
@@ -113,6 +127,10 @@ Eigen::VectorXd flatten_affine(const std::vector<RigidTransform>& chunk);
 std::vector<RigidTransform> checked_act(const NoisyPolicy& policy, const Scene& observation,
                                         const Eigen::VectorXd& noise,
                                         double pose_tolerance = kOutputPoseTolerance);
+
+/// One case as every check draws it, inside a RapidCheck property: (scene, g) from the recorded
+/// observations, else inside the workspace, else from the generators (scene first, then g).
+std::pair<Scene, RigidTransform> draw_case(const SceneShape& shape, Group group);
 
 /// Runs a RapidCheck property (it calls RC_FAIL to fail) for `cases` cases from `seed`, printing
 /// nothing: the caller records what it needs from inside the property.

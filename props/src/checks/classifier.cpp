@@ -6,13 +6,22 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
 #include "handcentric/props/observation/recorded.hpp"
+#include "handcentric/props/scene_key.hpp"
 #include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
 
 std::vector<std::pair<Scene, RigidTransform>> witness_cases(const Verdict& verdict) {
   if (!verdict.witness) return {};
-  return {{verdict.witness->scene, verdict.witness->g}};
+  std::vector<std::pair<Scene, RigidTransform>> cases = {
+      {verdict.witness->scene, verdict.witness->g}};
+  const auto& first = verdict.first_failure;
+  const bool same =
+      first &&
+      detail::scene_key(first->first, true) == detail::scene_key(cases.front().first, true) &&
+      first->second.matrix() == cases.front().second.matrix();
+  if (first && !same) cases.push_back(*first);
+  return cases;
 }
 
 Verdict with_precision_note(Verdict verdict, const ClassifierOptions& options,

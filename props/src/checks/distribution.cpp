@@ -282,11 +282,14 @@ void run_tests(const NoisePair& pair, const SharedDraws& shared,
   ask_ahead([&] { return fresh_draws; }, pair.after);
   for (int i = 0; i < plan.draws; ++i)
     y.row(i) = pair.after(fresh_draws[static_cast<std::size_t>(i)]).transpose();
-  const Eigen::MatrixXd before = columns_of(shared.x, tested), after = columns_of(y, tested);
+  // The shared draws: plan.draws, or more at an extra case (for the paired test alone).
+  const Eigen::MatrixXd shared_before = columns_of(shared.x, tested);
+  const Eigen::MatrixXd before = shared_before.topRows(plan.draws), after = columns_of(y, tested);
   const TwoSampleResult test =
       energy_test(before.topRows(plan.samples), after.topRows(plan.samples),
                   permutations_for(plan.level), options.seed, plan.level);
-  const double paired = paired_mean_test(before - columns_of(shared.same_eps, tested), tolerance);
+  const double paired =
+      paired_mean_test(shared_before - columns_of(shared.same_eps, tested), tolerance);
   ScaleTestResult scale;
   if (distribution.scale_test) {
     scale = scale_test(before, after, plan.scale_permutations, options.seed ^ 0x5ca1e5ca1e5ca1e5ULL,
@@ -297,7 +300,11 @@ void run_tests(const NoisePair& pair, const SharedDraws& shared,
   outcome.witness.p_value = std::min(1.0, 3.0 * std::min({test.p_value, paired, scale.p_value}));
   outcome.witness.detail =
       "energy test p = " + format_number(test.p_value) + " (" + std::to_string(plan.samples) +
-      " draws), paired mean test p = " + format_number(paired) + ", " +
+      " draws), paired mean test p = " + format_number(paired) +
+      (shared_before.rows() > plan.draws
+           ? " (" + std::to_string(shared_before.rows()) + " shared draws)"
+           : std::string()) +
+      ", " +
       (distribution.scale_test
            ? "scale test p = " + format_number(scale.p_value) +
                  (scale.coordinate >= 0
@@ -324,7 +331,7 @@ void merge(LawStatistics& into, const LawStatistics& one) {
 }
 
 CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOptions& options,
-                         const DistributionOptions& distribution) {
+                         const DistributionOptions& distribution, int paired_draws) {
   const double alpha = distribution.family_alpha / distribution.cases;  // Bonferroni
   const double level = alpha / 3.0;                                     // each of the three tests
   CaseOutcome outcome;
@@ -364,6 +371,8 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   // Not pointwise: more shared draws if the scale test needs them, as many independent ones, and
   // the three tests.
   if (plan.draws > plan.samples) shared.draw(plan.samples, plan.draws);
+  // An extra case: more shared draws, for the paired mean test only.
+  if (paired_draws > plan.draws) shared.draw(plan.draws, paired_draws);
   run_tests(pair, shared, tested, plan, tolerance, options, distribution, part.exact_text, outcome);
   return outcome;
 }
@@ -392,18 +401,43 @@ void finish_distribution_verdict(Verdict& verdict, const LawStatistics& statisti
 
 void require_distribution_options(const DistributionOptions& distribution) {
   if (distribution.cases < 1 || distribution.samples < 2 ||
+      distribution.extra_case_paired_draws < 0 ||
       !(distribution.family_alpha > 0.0 && distribution.family_alpha < 1.0) ||
       distribution.affinity_checks < 1 ||
       (distribution.scale_test &&
        !(distribution.scale_ratio > 1.0 && std::isfinite(distribution.scale_ratio)))) {
     throw InvalidArgument(
-        "distribution options need cases >= 1, samples >= 2, 0 < alpha < 1, affinity_checks >= "
-        "1 and a scale ratio > 1, got cases " +
+        "distribution options need cases >= 1, samples >= 2, extra_case_paired_draws >= 0, 0 < "
+        "alpha < 1, affinity_checks >= 1 and a scale ratio > 1, got cases " +
         std::to_string(distribution.cases) + ", samples " + std::to_string(distribution.samples) +
+        ", extra_case_paired_draws " + std::to_string(distribution.extra_case_paired_draws) +
         ", alpha " + format_number(distribution.family_alpha) + ", affinity_checks " +
         std::to_string(distribution.affinity_checks) + ", scale ratio " +
         format_number(distribution.scale_ratio));
   }
+}
+
+Verdict run_distribution_check(const PairOfCase& pair_of, Component component, Group group,
+                               const CheckOptions& options,
+                               const DistributionOptions& distribution) {
+  // A drawn case, or (paired_draws = extra_case_paired_draws) an extra one.
+  auto case_with = [&](int paired_draws) {
+    return [&, paired_draws](const Scene& scene, const RigidTransform& g) {
+      const Scene moved = g * scene;
+      CaseOutcome outcome = compare_laws(
+          pair_of(scene, moved, g), pointwise_tolerance(scene, moved, options.relative_tolerance),
+          options, distribution, paired_draws);
+      outcome.witness.scene = scene;
+      outcome.witness.g = g;
+      return outcome;
+    };
+  };
+  LawStatistics statistics;
+  Verdict verdict = run_check(case_with(0), component, group, Mode::distribution, options,
+                              distribution.cases, distribution.shrink_budget, &statistics,
+                              case_with(distribution.extra_case_paired_draws));
+  finish_distribution_verdict(verdict, statistics, distribution);
+  return verdict;
 }
 
 }  // namespace detail
@@ -417,27 +451,17 @@ Verdict check_distribution_invariance(std::shared_ptr<const FlowTarget> target, 
                           to_string(component));
   }
   detail::require_distribution_options(distribution);
-  auto run_case = [&](const Scene& scene, const RigidTransform& g) {
-    const Scene moved = g * scene;
+  auto pair_of = [&](const Scene& scene, const Scene& moved, const RigidTransform&) {
     auto part_of = [&](const Scene& s) {
       return [&target, &options, component, s](const Eigen::VectorXd& eps) -> Eigen::VectorXd {
         const FlowSample sample = (*target)(s, eps, options.flow_time);
         return component == Component::flow_input ? sample.input : sample.target;
       };
     };
-    const detail::NoisePair pair{part_of(scene), part_of(moved), target->noise_dimension(scene),
-                                 target->name() + ": the " + to_string(component)};
-    detail::CaseOutcome outcome = detail::compare_laws(
-        pair, pointwise_tolerance(scene, moved, options.relative_tolerance), options, distribution);
-    outcome.witness.scene = scene;
-    outcome.witness.g = g;
-    return outcome;
+    return detail::NoisePair{part_of(scene), part_of(moved), target->noise_dimension(scene),
+                             target->name() + ": the " + to_string(component)};
   };
-  detail::LawStatistics statistics;
-  Verdict verdict = detail::run_check(run_case, component, group, Mode::distribution, options,
-                                      distribution.cases, distribution.shrink_budget, &statistics);
-  detail::finish_distribution_verdict(verdict, statistics, distribution);
-  return verdict;
+  return detail::run_distribution_check(pair_of, component, group, options, distribution);
 }
 
 }  // namespace handcentric::props

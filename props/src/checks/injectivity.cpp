@@ -144,7 +144,7 @@ using detail::inf_distance;
 // A uniform number in [0, 1) in steps of 2^-30, as the scene generators draw.
 double unit_fraction() {
   constexpr int kSteps = 1 << 30;
-  return static_cast<double>(*rc::gen::inRange(0, kSteps)) / kSteps;
+  return static_cast<double>(*uniform_integer(0, kSteps)) / kSteps;
 }
 
 // What the resolution scan found, per unit (0: m, 1: rad): the largest colliding size and its
@@ -205,7 +205,7 @@ Scan scan_resolution(const Representation& representation, const CheckOptions& o
         const auto change = static_cast<ScanChange>(c);
         const std::size_t unit = in_metres(change) ? 0 : 1;
         const double size = decades[i] * std::pow(10.0, unit_fraction());
-        const auto k = static_cast<std::size_t>(*rc::gen::inRange(0, first.chunk_length()));
+        const auto k = static_cast<std::size_t>(*uniform_integer(0, first.chunk_length()));
         const Eigen::Vector3d u = *haar_rotation() * Eigen::Vector3d::UnitX();
         pairs.push_back({change, unit, size, k, u});
       }
@@ -292,8 +292,8 @@ Injectivity check_injectivity(std::shared_ptr<const Representation> representati
     if (error) return;
     if (!searching && ++shrink_evaluations > (options.shrink ? 1000 : 0)) return;
     const Scene first = *shaped_scene(shape);
-    const auto change = static_cast<Change>(*rc::gen::inRange(0, 4));
-    const int index = *rc::gen::inRange(0, 64);
+    const auto change = static_cast<Change>(*uniform_integer(0, 4));
+    const int index = *uniform_integer(0, 64);
     const Eigen::Vector3d v = *translation(1.0), w = *translation(1.0);
     const Rotation R = *rotation();
     Scene second = first;

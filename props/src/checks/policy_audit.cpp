@@ -120,30 +120,20 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
   detail::require_distribution_options(distribution);
   const double poses = output_pose_tolerance(
       options.output_unit_roundoff > 0.0 ? options.output_unit_roundoff : options.unit_roundoff);
-  auto run_case = [&](const Scene& scene, const RigidTransform& g) {
-    const Scene moved = g * scene;
+  auto pair_of = [&](const Scene& scene, const Scene& moved, const RigidTransform& g) {
     detail::NoisePair pair;
-    pair.before = [&policy, &scene, g, poses](const Eigen::VectorXd& noise) {
+    pair.before = [&policy, scene, g, poses](const Eigen::VectorXd& noise) {
       return detail::flatten_affine(
           detail::moved_by(g, detail::checked_act(policy, scene, noise, poses)));
     };
-    pair.after = [&policy, &moved, poses](const Eigen::VectorXd& noise) {
+    pair.after = [&policy, moved, poses](const Eigen::VectorXd& noise) {
       return detail::flatten_affine(detail::checked_act(policy, moved, noise, poses));
     };
     pair.noise_dimension = policy.noise_dimension();
     pair.name = policy.name() + ": the chunk";
-    detail::CaseOutcome outcome = detail::compare_laws(
-        pair, pointwise_tolerance(scene, moved, options.relative_tolerance), options, distribution);
-    outcome.witness.scene = scene;
-    outcome.witness.g = g;
-    return outcome;
+    return pair;
   };
-  detail::LawStatistics statistics;
-  Verdict verdict =
-      detail::run_check(run_case, Component::policy, group, Mode::distribution, options,
-                        distribution.cases, distribution.shrink_budget, &statistics);
-  detail::finish_distribution_verdict(verdict, statistics, distribution);
-  return verdict;
+  return detail::run_distribution_check(pair_of, Component::policy, group, options, distribution);
 }
 
 Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,

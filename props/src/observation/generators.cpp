@@ -18,7 +18,7 @@ constexpr int kResolution = 1 << 30;  // uniform numbers are k / 2^30, k an inte
 
 // A uniform number in [0, 1).
 rc::Gen<double> unit_interval() {
-  return rc::gen::map(rc::gen::inRange(0, kResolution),
+  return rc::gen::map(uniform_integer(0, kResolution),
                       [](int k) { return static_cast<double>(k) / kResolution; });
 }
 
@@ -27,7 +27,7 @@ rc::Gen<double> unit_interval() {
 // integer k in [0, 2^31] is taken to 0, 1, -1, 2, -2, ..., 2^30, -2^30, one value each, so the
 // law is the uniform one on the grid and a smaller k is a smaller |value|.
 rc::Gen<double> symmetric(double max_abs) {
-  return rc::gen::map(rc::gen::inRange<std::int64_t>(0, 2 * std::int64_t{kResolution} + 1),
+  return rc::gen::map(uniform_integer<std::int64_t>(0, 2 * std::int64_t{kResolution} + 1),
                       [max_abs](std::int64_t k) {
                         const std::int64_t signed_k = k % 2 == 1 ? (k + 1) / 2 : -(k / 2);
                         return max_abs * static_cast<double>(signed_k) / kResolution;
@@ -58,7 +58,7 @@ rc::Gen<Rotation> z_rotation_edge_cases() {
 }
 
 rc::Gen<Rotation> c8_rotation() {
-  return rc::gen::map(rc::gen::inRange(0, 8),
+  return rc::gen::map(uniform_integer(0, 8),
                       [](int i) { return Rotation::about_z(i * kPi / 4.0); });
 }
 
@@ -210,18 +210,15 @@ rc::Gen<Eigen::Vector3d> point(double max_abs, bool planar) {
   });
 }
 
-// Between min_count and max_count points; with min_count = 0, RapidCheck's sized container.
+// Between min_count and max_count points, the count uniform.
 rc::Gen<std::vector<Eigen::Vector3d>> points(int min_count, int max_count, double max_abs,
                                              bool planar) {
-  if (min_count <= 0) {
-    return rc::gen::resize(
-        max_count, rc::gen::container<std::vector<Eigen::Vector3d>>(point(max_abs, planar)));
-  }
-  return rc::gen::mapcat(rc::gen::inRange(min_count, std::max(min_count, max_count) + 1),
-                         [max_abs, planar](int count) {
-                           return rc::gen::container<std::vector<Eigen::Vector3d>>(
-                               static_cast<std::size_t>(count), point(max_abs, planar));
-                         });
+  return rc::gen::mapcat(
+      uniform_integer(std::max(min_count, 0), std::max(min_count, max_count) + 1),
+      [max_abs, planar](int count) {
+        return rc::gen::container<std::vector<Eigen::Vector3d>>(static_cast<std::size_t>(count),
+                                                                point(max_abs, planar));
+      });
 }
 
 }  // namespace
@@ -230,12 +227,14 @@ rc::Gen<Scene> scene(SceneShape shape) {
   // One length scale per scene, log-uniform in [1 cm, 10 m]: the start pose is that far out, and
   // steps and points are drawn in proportion (at 10 m: steps up to 0.1 m, hand points within
   // 1 m, world points within 10 m). Extra poses stay anywhere within 10 m.
+  // The counts come first: RapidCheck shrinks a tuple's elements in order, and a witness reads
+  // best with its chunk and history shortest, whatever the numbers shrink to after them.
   auto geometry = rc::gen::mapcat(log_uniform_length(), [shape](double scale) {
     return rc::gen::apply(
-        [](const Rotation& world_R_hand0, const Eigen::Vector3d& direction, double scale,
-           const Twist& forward, const Twist& backward, int history, int chunk,
-           const std::vector<Eigen::Vector3d>& hand_points,
-           const std::vector<Eigen::Vector3d>& world_points) {
+        [](int history, int chunk, const std::vector<Eigen::Vector3d>& hand_points,
+           const std::vector<Eigen::Vector3d>& world_points, const Rotation& world_R_hand0,
+           const Eigen::Vector3d& direction, double scale, const Twist& forward,
+           const Twist& backward) {
           Scene s;
           const RigidTransform world_T_hand0(world_R_hand0, scale * direction);
           // Smooth, rotating motion: a constant body twist per control step, each way from T_0.
@@ -254,13 +253,13 @@ rc::Gen<Scene> scene(SceneShape shape) {
           s.world_points = world_points;
           return s;
         },
+        uniform_integer(shape.min_history, shape.max_history + 1),
+        uniform_integer(shape.min_chunk, shape.max_chunk + 1),
+        points(shape.min_hand_points, shape.max_hand_points, 0.1 * scale, shape.planar),
+        points(shape.min_world_points, shape.max_world_points, scale, shape.planar),
         shape.planar ? planar_rotation() : rotation(), shape.planar ? planar_axis() : unit_axis(),
         rc::gen::just(scale), step_or_rest(0.01 * scale, 0.3, shape.planar),
-        step_or_rest(0.01 * scale, 0.3, shape.planar),
-        rc::gen::inRange(shape.min_history, shape.max_history + 1),
-        rc::gen::inRange(shape.min_chunk, shape.max_chunk + 1),
-        points(shape.min_hand_points, shape.max_hand_points, 0.1 * scale, shape.planar),
-        points(shape.min_world_points, shape.max_world_points, scale, shape.planar));
+        step_or_rest(0.01 * scale, 0.3, shape.planar));
   });
   if (shape.extra_pose_names.empty() && shape.scalar_names.empty()) return geometry;
   // Named extras: one random pose per name (anywhere within 10 m, any orientation; in the plane
@@ -442,7 +441,7 @@ rc::Gen<std::pair<Scene, RigidTransform>> recorded_case(const SceneShape& shape,
   if (!shape.recorded) throw InvalidArgument("recorded_case needs recorded observations");
   std::shared_ptr<const RecordedObservations> data = shape.recorded;
   const bool eye_in_hand = shape.max_world_points == 0;
-  const auto index = rc::gen::inRange<std::size_t>(0, data->scenes.size());
+  const auto index = uniform_integer<std::size_t>(0, data->scenes.size());
   const auto observation = rc::gen::map(index, [data, eye_in_hand](std::size_t i) {
     Scene s = data->scenes[i];
     if (eye_in_hand) s.world_points.clear();

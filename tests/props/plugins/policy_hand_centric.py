@@ -21,6 +21,10 @@ argv[1] picks a planted fault (the audit must find each):
                 with rng="numpy") it is equivariant
   own_noise_world  the same noise added in the world frame: with --rng, not equivariant under
                 rotations
+  world_clip    clips each position to [-0.5, 0.5] m per WORLD axis, as a policy clipping its
+                output to a workspace box does: equivariant only while the hand stays inside
+                the box, so under no group, pointwise or in distribution; seen only on cases
+                whose scenes reach past 0.5 m (a check that drew small scenes called it "yes")
 --batched (after the fault, if any): the same policy served batched, row by row (each row as
 the unbatched call computes it, so the audit's JSON must not change); --batched row_bias adds
 1e-7 times the row's index in its batch to every translation (an answer that depends on its
@@ -64,6 +68,8 @@ def policy(history, hand_points, world_points, noise):
     chunk = T0 @ hand0_T_handk
     if FAULT == "world_noise":
         chunk[:, :3, 3] += 0.05 * noise[8:8 + 3 * K].reshape(K, 3)
+    if FAULT == "world_clip":
+        chunk[:, :3, 3] = np.clip(chunk[:, :3, 3], -0.5, 0.5)
     if FAULT.startswith("own_noise"):
         step = 0.01 * np.random.normal(size=(K, 3))
         chunk[:, :3, 3] += step if FAULT == "own_noise_world" else step @ T0[:3, :3].T

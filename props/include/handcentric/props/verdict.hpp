@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "handcentric/core/rigid_transform.hpp"
@@ -100,6 +101,11 @@ struct Verdict {
   /// A remark the reader needs, e.g. that a failure would pass at float32 rounding.
   std::string note;
   std::optional<Witness> witness;  ///< present when !invariant
+  /// The failing case as the search drew it, before shrinking (present when !invariant, unless
+  /// the witness came from an extra case): a typical failure, where the witness is the smallest
+  /// one, so the stronger evidence when another check runs it again (classifier.hpp,
+  /// witness_cases).
+  std::optional<std::pair<Scene, RigidTransform>> first_failure;
 };
 
 /// What a pointwise "yes" on `cases` far cases could have missed: the smallest frequency f of

@@ -77,8 +77,10 @@ Classification classify_flow_target(std::shared_ptr<const FlowTarget> target,
 Verdict with_precision_note(Verdict verdict, const ClassifierOptions& options,
                             const std::function<Verdict(const CheckOptions&)>& recheck);
 
-/// The witness of a failed verdict as one (scene, g) case for another check
-/// (CheckOptions::extra_cases), or none when it held.
+/// The cases of a failed verdict for another check (CheckOptions::extra_cases): its witness, then
+/// the failing case as first drawn when that is another one (the witness is shrunk to barely
+/// fail, where a law's difference can hide in its spread; the case drawn is a typical failure).
+/// None when it held.
 std::vector<std::pair<Scene, RigidTransform>> witness_cases(const Verdict& verdict);
 
 /// `check` with the scenes of `view` (its world-point counts), everything else kept; a fixed

@@ -47,8 +47,13 @@ struct DistributionOptions {
   /// scale tests draw more when scale_ratio asks for it)
   int samples = 32;
   double family_alpha = 0.01;  ///< tests: per check, split evenly over the cases (Bonferroni)
-  int shrink_budget = 20;      ///< evaluations spent shrinking a witness
-  int affinity_checks = 2;     ///< random eps at which an affine law is verified, per scene
+  /// Shared eps draws of the paired mean test at an extra case (another check's witness,
+  /// CheckOptions::extra_cases), where a failure was already seen: a mean difference too small
+  /// for the drawn cases' draws is still found there, at a drawn case's level. (The energy and
+  /// scale tests keep their draws: they cost n^2 and n per permutation.)
+  int extra_case_paired_draws = 1024;
+  int shrink_budget = 20;   ///< evaluations spent shrinking a witness
+  int affinity_checks = 2;  ///< random eps at which an affine law is verified, per scene
   /// The paired mean and scale tests draw max(samples, samples_for_scale_ratio(coordinates
   /// tested, level of the scale test, scale_ratio)) so that the scale test finds a standard
   /// deviation changed by this factor in one coordinate with 90% power.

@@ -23,6 +23,17 @@ namespace handcentric::props {
 
 struct RecordedObservations;  // observation/recorded.hpp
 
+/// An integer uniform in [low, high) in every case of a check, shrinking toward low. Every draw
+/// of the audit goes through it, not through rc::gen::inRange: RapidCheck scales inRange's range
+/// with the case's size, which grows from 0 with the case number, so a check's first cases
+/// would draw only near `low` (lengths near 1 cm, rotations near the identity, a recorded file's
+/// first scenes, the identity of C8), and the cases would not be draws of one law, which every
+/// verdict's arithmetic (detectable_frequency, the tests' levels) assumes.
+template <class T>
+rc::Gen<T> uniform_integer(T low, T high) {
+  return rc::gen::resize(rc::kNominalSize, rc::gen::inRange<T>(low, high));
+}
+
 /// A Haar-uniform rotation (no edge cases); shrinks toward the identity.
 rc::Gen<Rotation> haar_rotation();
 
