@@ -69,7 +69,9 @@ built=$(date +%s)
 #    in view (sim_cli_audit_with_the_table_...), and the world-delta map in law on 50 seeds x 4
 #    groups (the_world_delta_mode_is_never_called_...): 44 s under ASan; the flag parsing runs
 #    here in the command's refusals, the image audit in the other sim_cli_audit tests, the exact
-#    Gaussian test in the world-delta map's translation test;
+#    Gaussian test in the world-delta map's translation test; and six audits of a Python plug-in
+#    that clips its positions (a_policy_clipping_world_positions_...: Python runs unsanitized;
+#    the extra cases' paired draws run here in the in-distribution tests of test_policy_audit);
 #  - the 300 mutated .npz files: their bound on the peak memory reads the RSS, which ASan's shadow
 #    and quarantine inflate; the readers run here under the fuzz target fuzz_observations and in
 #    the other .npz tests;
@@ -97,7 +99,7 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^policy_exec_hands_a_plugin_the_images|^300_mutated_npz_files|'\
 '^builtin_representations_are_classified_as_the_paper|^every_builtin_cell_matches_its_exp|'\
 '^audit_takes_several_groups_and_views|^sim_cli_audit_with_the_table_in_view_loses_se3|'\
-'^the_world_delta_mode_is_never_called_invariant'
+'^the_world_delta_mode_is_never_called_invariant|^a_policy_clipping_world_positions'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 
