@@ -168,7 +168,7 @@ TEST_CASE("a_chunk_pose_whose_rotation_block_is_not_a_rotation_stops_the_audit",
   for (Group group : {Group::translation, Group::se3}) {
     CHECK_THROWS_WITH(props::check_policy_equivariance(ScaledRotation(), group, options),
                       Catch::Contains("chunk pose 1 (T_2)") && Catch::Contains("not a rotation") &&
-                          Catch::Contains("det R = 8"));
+                          (Catch::Contains("det R = 8") || Catch::Contains("det R = 7.99999999")));
     CHECK_THROWS_AS(props::check_policy_distribution(ScaledRotation(), group, options),
                     InvalidArgument);
   }
