@@ -168,11 +168,17 @@ Eigen::VectorXd draw_noise(Eigen::Index noise, std::mt19937_64& rng) {
 }
 
 // The draws with the same eps on both sides: x = before(eps_i), same_eps = after(eps_i), eps_i
-// from mt19937_64(noise_seed), drawn in stretches (the first `samples`, then the scale test's).
+// from mt19937_64(noise_seed), drawn in stretches (the first `samples`, or an extra case's
+// paired draws, then the scale test's).
 struct SharedDraws {
   const NoisePair& pair;
   std::mt19937_64 rng;
   Eigen::MatrixXd x, same_eps;
+
+  // Rows [x.rows(), to) drawn, in the order of one generator whatever the steps.
+  void draw_up_to(int to) {
+    if (to > x.rows()) draw(static_cast<int>(x.rows()), to);
+  }
 
   void draw(int from, int to) {
     std::vector<Eigen::VectorXd> drawn;
@@ -274,6 +280,34 @@ void run_tests(const NoisePair& pair, const SharedDraws& shared,
                const std::vector<Eigen::Index>& tested, const TestPlan& plan, double tolerance,
                const CheckOptions& options, const DistributionOptions& distribution,
                const std::string& exact_text, CaseOutcome& outcome) {
+  // The shared draws: plan.draws, or more at an extra case (for the paired test alone).
+  const Eigen::MatrixXd shared_before = columns_of(shared.x, tested);
+  const Eigen::MatrixXd shared_after = columns_of(shared.same_eps, tested);
+  const std::string shared_text =
+      shared_before.rows() > plan.draws
+          ? " (" + std::to_string(shared_before.rows()) + " shared draws)"
+          : std::string();
+  const std::string levels_text = " (" + std::to_string(plan.draws) + " draws; each at level " +
+                                  format_number(plan.level) + ")" + exact_text;
+  // A case holds when all three tests do, so the first failing one decides it: the cheap paired
+  // test first (no permutations, no fresh draws), then the energy test, then the scale test.
+  // The verdict, the shrunk witness and the policy's answers up to that test are the ones all
+  // three would give; a failing case only skips the permutations (most of the cost of a failing
+  // check, whose shrinking decides some twenty failing cases) and the fresh draws it no longer
+  // needs.
+  const double paired = paired_mean_test(shared_before - shared_after, tolerance);
+  if (paired < plan.level) {
+    // Both samples of the witness come from the shared draws (each row a draw of its own law).
+    outcome.witness.after = shared.same_eps.row(0).transpose();
+    outcome.witness.error =
+        energy_distance(shared_before.topRows(plan.samples), shared_after.topRows(plan.samples));
+    outcome.witness.p_value = std::min(1.0, 3.0 * paired);
+    outcome.witness.detail = "paired mean test p = " + format_number(paired) + shared_text +
+                             ", below its level: the energy and scale tests were not run" +
+                             levels_text;
+    outcome.holds = false;
+    return;
+  }
   std::mt19937_64 fresh(options.noise_seed ^ 0x9e3779b97f4a7c15ULL);
   Eigen::MatrixXd y(plan.draws, shared.same_eps.cols());
   std::vector<Eigen::VectorXd> fresh_draws;
@@ -282,39 +316,32 @@ void run_tests(const NoisePair& pair, const SharedDraws& shared,
   ask_ahead([&] { return fresh_draws; }, pair.after);
   for (int i = 0; i < plan.draws; ++i)
     y.row(i) = pair.after(fresh_draws[static_cast<std::size_t>(i)]).transpose();
-  // The shared draws: plan.draws, or more at an extra case (for the paired test alone).
-  const Eigen::MatrixXd shared_before = columns_of(shared.x, tested);
   const Eigen::MatrixXd before = shared_before.topRows(plan.draws), after = columns_of(y, tested);
   const TwoSampleResult test =
       energy_test(before.topRows(plan.samples), after.topRows(plan.samples),
                   permutations_for(plan.level), options.seed, plan.level);
-  const double paired =
-      paired_mean_test(shared_before - columns_of(shared.same_eps, tested), tolerance);
-  ScaleTestResult scale;
-  if (distribution.scale_test) {
-    scale = scale_test(before, after, plan.scale_permutations, options.seed ^ 0x5ca1e5ca1e5ca1e5ULL,
-                       plan.level, tolerance);
-  }
   outcome.witness.after = y.row(0).transpose();
   outcome.witness.error = test.energy_distance;
-  outcome.witness.p_value = std::min(1.0, 3.0 * std::min({test.p_value, paired, scale.p_value}));
-  outcome.witness.detail =
+  std::string detail =
       "energy test p = " + format_number(test.p_value) + " (" + std::to_string(plan.samples) +
-      " draws), paired mean test p = " + format_number(paired) +
-      (shared_before.rows() > plan.draws
-           ? " (" + std::to_string(shared_before.rows()) + " shared draws)"
-           : std::string()) +
-      ", " +
-      (distribution.scale_test
-           ? "scale test p = " + format_number(scale.p_value) +
-                 (scale.coordinate >= 0
-                      ? " (coordinate " +
-                            std::to_string(tested[static_cast<std::size_t>(scale.coordinate)]) +
-                            ", sd ratio " + format_number(scale.sd_ratio) + ")"
-                      : "")
-           : std::string("no scale test")) +
-      " (" + std::to_string(plan.draws) + " draws; each at level " + format_number(plan.level) +
-      ")" + exact_text;
+      " draws), paired mean test p = " + format_number(paired) + shared_text + ", ";
+  ScaleTestResult scale;
+  if (test.p_value < plan.level) {
+    detail += "below its level: the scale test was not run";
+  } else if (distribution.scale_test) {
+    scale = scale_test(before, after, plan.scale_permutations, options.seed ^ 0x5ca1e5ca1e5ca1e5ULL,
+                       plan.level, tolerance);
+    detail += "scale test p = " + format_number(scale.p_value) +
+              (scale.coordinate >= 0
+                   ? " (coordinate " +
+                         std::to_string(tested[static_cast<std::size_t>(scale.coordinate)]) +
+                         ", sd ratio " + format_number(scale.sd_ratio) + ")"
+                   : "");
+  } else {
+    detail += "no scale test";
+  }
+  outcome.witness.p_value = std::min(1.0, 3.0 * std::min({test.p_value, paired, scale.p_value}));
+  outcome.witness.detail = detail + levels_text;
   outcome.holds = test.p_value >= plan.level && paired >= plan.level && scale.p_value >= plan.level;
 }
 
@@ -339,7 +366,9 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   if (part.decided) return outcome;
   SharedDraws shared{pair, std::mt19937_64(options.noise_seed), {}, {}};
   const Eigen::MatrixXd &x = shared.x, &same_eps = shared.same_eps;
-  shared.draw(0, distribution.samples);
+  // An extra case takes all its shared draws first: the two laws may agree on the first
+  // `samples` draws and differ on rarer ones, which are what the extra draws are for.
+  shared.draw_up_to(std::max(distribution.samples, paired_draws));
   if (!part.split) {
     part.tested.resize(static_cast<std::size_t>(x.cols()));
     std::iota(part.tested.begin(), part.tested.end(), Eigen::Index{0});
@@ -357,22 +386,22 @@ CaseOutcome compare_laws(const NoisePair& pair, double tolerance, const CheckOpt
   const auto dimension = static_cast<Eigen::Index>(tested.size());
   const TestPlan plan = plan_tests(dimension, level, distribution);
   const Eigen::MatrixXd x_tested = columns_of(x, tested);
-  record_spread(outcome.statistics, x_tested, plan, distribution);
+  record_spread(outcome.statistics, x_tested.topRows(plan.samples), plan, distribution);
   const double pointwise =
       dimension > 0 ? (x_tested - columns_of(same_eps, tested)).lpNorm<Eigen::Infinity>() : 0.0;
   if (pointwise <= tolerance) {
     // The same value on every shared draw: the two distributions are the same one, no test needed.
     outcome.witness.after = same_eps.row(0).transpose();
     outcome.witness.error =
-        dimension > 0 ? energy_distance(x_tested, columns_of(same_eps, tested)) : 0.0;
+        dimension > 0 ? energy_distance(x_tested.topRows(plan.samples),
+                                        columns_of(same_eps, tested).topRows(plan.samples))
+                      : 0.0;
     outcome.witness.p_value = 1.0;
     return outcome;
   }
   // Not pointwise: more shared draws if the scale test needs them, as many independent ones, and
   // the three tests.
-  if (plan.draws > plan.samples) shared.draw(plan.samples, plan.draws);
-  // An extra case: more shared draws, for the paired mean test only.
-  if (paired_draws > plan.draws) shared.draw(plan.draws, paired_draws);
+  shared.draw_up_to(plan.draws);
   run_tests(pair, shared, tested, plan, tolerance, options, distribution, part.exact_text, outcome);
   return outcome;
 }
