@@ -9,8 +9,6 @@
 #include <string_view>
 #include <vector>
 
-#include "handcentric/props/observation/recorded.hpp"
-
 namespace handcentric::props::npz {
 
 struct Array {
@@ -34,6 +32,10 @@ std::map<std::string, Array> read_bytes(std::string_view bytes, const std::strin
 }  // namespace handcentric::props::npz
 
 namespace handcentric::props {
+
+// Declared, not included: recorded.cpp reads .npz files through this header, so this header
+// reaching back up to recorded.hpp would be an include running back up; callers include both.
+struct RecordedObservations;
 
 /// read_observations of an .npz file's bytes (the fuzz target's and the mutation test's entry,
 /// recorded.cpp); `source` names them in messages as a path would.
