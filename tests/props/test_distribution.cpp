@@ -3,10 +3,12 @@
 // that is invariant outright or not at all.
 #include <catch2/catch.hpp>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <memory>
 #include <random>
+#include <vector>
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/representations.hpp"
@@ -398,4 +400,35 @@ TEST_CASE("the_tabulated_detectable_shift_is_the_simulated_one", "[unit]") {
         props::simulated_energy_test_detectable_shift(1, 32, props::kDefaultTestLevel));
   CHECK(props::energy_test_detectable_shift(36, 32, props::kDefaultTestLevel) ==
         props::energy_test_detectable_shift(64, 32, props::kDefaultTestLevel));
+}
+
+TEST_CASE("distribution_options_out_of_range_are_refused_naming_the_value", "[unit]") {
+  // Each bad field alone: the check refuses before any case, and the message names the value.
+  const auto actionflow = std::make_shared<ActionFlowTarget>();
+  struct Bad {
+    std::function<void(props::DistributionOptions&)> set;
+    const char* named;
+  };
+  const std::vector<Bad> bad = {
+      {[](auto& d) { d.cases = 0; }, "cases 0"},
+      {[](auto& d) { d.samples = 1; }, "samples 1"},
+      {[](auto& d) { d.extra_case_paired_draws = -1; }, "extra_case_paired_draws -1"},
+      {[](auto& d) { d.family_alpha = 1.0; }, "alpha 1"},
+      {[](auto& d) { d.family_alpha = std::nan(""); }, "alpha nan"},
+      {[](auto& d) { d.affinity_checks = 0; }, "affinity_checks 0"},
+      {[](auto& d) { d.scale_ratio = 1.0; }, "scale ratio 1"},
+  };
+  for (const Bad& b : bad) {
+    props::DistributionOptions distribution;
+    b.set(distribution);
+    INFO(b.named);
+    CHECK_THROWS_WITH(props::check_distribution_invariance(actionflow, Component::flow_target,
+                                                           Group::rotation, fast_check(),
+                                                           distribution),
+                      Catch::Matchers::Contains(b.named));
+  }
+  props::DistributionOptions none;
+  none.extra_case_paired_draws = 0;  // no extra draws: allowed
+  CHECK_NOTHROW(props::check_distribution_invariance(actionflow, Component::flow_target,
+                                                     Group::rotation, fast_check(), none));
 }

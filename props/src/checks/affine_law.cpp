@@ -113,17 +113,23 @@ LawDifference law_difference(const GaussianLaw& a, const GaussianLaw& b) {
   }
   if (a.mean.size() == 0) return difference;
   difference.mean = (a.mean - b.mean).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
+  // The largest |entry| of a covariance J J^T is on its diagonal (|C_ij| <= sqrt(C_ii C_jj) for a
+  // positive semi-definite C): the largest squared row norm of J, without the product.
+  auto largest_variance = [](const Eigen::MatrixXd& J) {
+    return J.cols() == 0 ? 0.0 : J.rowwise().squaredNorm().maxCoeff<Eigen::PropagateNaN>();
+  };
+  difference.covariance_scale = std::max(1.0, largest_variance(a.noise_map));
   // Equal noise maps give equal covariances, the common case (a rectified flow's J is the same
-  // for every scene): skip the two products then.
-  const bool same_map = a.noise_map.cols() == b.noise_map.cols() && a.noise_map == b.noise_map;
-  const Eigen::MatrixXd covariance_a = a.noise_map * a.noise_map.transpose();
-  difference.covariance_scale =
-      std::max(1.0, covariance_a.cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
-  if (same_map) return difference;
-  const Eigen::MatrixXd covariance_b = b.noise_map * b.noise_map.transpose();
-  difference.covariance_scale = std::max(difference.covariance_scale,
-                                         covariance_b.cwiseAbs().maxCoeff<Eigen::PropagateNaN>());
-  difference.covariance = (covariance_a - covariance_b).cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
+  // for every scene): no product then.
+  if (a.noise_map.cols() == b.noise_map.cols() && a.noise_map == b.noise_map) return difference;
+  difference.covariance_scale = std::max(difference.covariance_scale, largest_variance(b.noise_map));
+  // J_a J_a^T - J_b J_b^T is symmetric: its lower triangle alone (the upper stays 0), by two rank
+  // updates, half the work of the two products (maps that differ in rounding come here too).
+  const Eigen::Index rows = a.noise_map.rows();
+  Eigen::MatrixXd lower = Eigen::MatrixXd::Zero(rows, rows);
+  lower.selfadjointView<Eigen::Lower>().rankUpdate(a.noise_map, 1.0);
+  lower.selfadjointView<Eigen::Lower>().rankUpdate(b.noise_map, -1.0);
+  difference.covariance = lower.cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
   return difference;
 }
 
