@@ -122,7 +122,8 @@ LawDifference law_difference(const GaussianLaw& a, const GaussianLaw& b) {
   // Equal noise maps give equal covariances, the common case (a rectified flow's J is the same
   // for every scene): no product then.
   if (a.noise_map.cols() == b.noise_map.cols() && a.noise_map == b.noise_map) return difference;
-  difference.covariance_scale = std::max(difference.covariance_scale, largest_variance(b.noise_map));
+  difference.covariance_scale =
+      std::max(difference.covariance_scale, largest_variance(b.noise_map));
   // J_a J_a^T - J_b J_b^T is symmetric: its lower triangle alone (the upper stays 0), by two rank
   // updates, half the work of the two products (maps that differ in rounding come here too).
   const Eigen::Index rows = a.noise_map.rows();
