@@ -43,12 +43,6 @@ function(handcentric_test name)
   # Catch2's single header and RapidCheck's are most of each test file's compile time: parse
   # them once per executable.
   target_precompile_headers(${name} PRIVATE <catch2/catch.hpp> <rapidcheck.h> <Eigen/Core>)
-  # Under the sanitizers (scripts/sanitize.sh) a test program's own code compiles at -O0: its
-  # time is in the libraries it tests, which keep the tree's -O1, and its unity files compile in
-  # about 0.57 of the time (test_props's largest: 22 s against 39 s, clang 14 with ASan + UBSan).
-  if(HANDCENTRIC_SANITIZE)
-    target_compile_options(${name} PRIVATE -O0)
-  endif()
   # With CMAKE_UNITY_BUILD (scripts/build.sh) the test files of one program compile together,
   # so their file-local helpers need distinct names.
   handcentric_warnings(${name})
