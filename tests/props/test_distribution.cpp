@@ -422,10 +422,10 @@ TEST_CASE("distribution_options_out_of_range_are_refused_naming_the_value", "[un
     props::DistributionOptions distribution;
     b.set(distribution);
     INFO(b.named);
-    CHECK_THROWS_WITH(props::check_distribution_invariance(actionflow, Component::flow_target,
-                                                           Group::rotation, fast_check(),
-                                                           distribution),
-                      Catch::Matchers::Contains(b.named));
+    CHECK_THROWS_WITH(
+        props::check_distribution_invariance(actionflow, Component::flow_target, Group::rotation,
+                                             fast_check(), distribution),
+        Catch::Matchers::Contains(b.named));
   }
   props::DistributionOptions none;
   none.extra_case_paired_draws = 0;  // no extra draws: allowed
