@@ -52,7 +52,7 @@
 #include "assertions.hpp"
 #include "callables.hpp"
 #include "options.hpp"
-#include "profile.hpp"
+#include "equivariance_profile.hpp"
 
 namespace handcentric::python {
 namespace {

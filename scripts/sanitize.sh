@@ -89,10 +89,13 @@ fi
 #    Gaussian test in the world-delta map's translation test; and six audits of a Python plug-in
 #    that clips its positions (a_policy_clipping_world_positions_...: Python runs unsanitized;
 #    the extra cases' paired draws run here in the in-distribution tests of test_policy_audit);
-#  - two more whole audits, 33 s under ASan: a planted-fault encoder's whole classification
+#  - five more whole audits, 52 s under ASan: a planted-fault encoder's whole classification
 #    (mutant_encoder_is_classified_...; the classifier and its report run here in the other
-#    planted-fault audits) and a float32 policy's audits on several seeds
-#    (a_float32_policy_leaking_...; the float32 path runs here in float32_rounding_gets_a_note_...);
+#    planted-fault audits), a float32 policy's audits on several seeds
+#    (a_float32_policy_leaking_...; the float32 path runs here in float32_rounding_gets_a_note_...)
+#    and three audits of saved models through the command (table2_cli_saved_absolute_image_...,
+#    policy_cli_audit_finds_the_c8_...: a saved model's audit runs here in
+#    table2_cli_saves_each_rows_model and the sim_cli_audit tests);
 #  - the 300 mutated .npz files: their bound on the peak memory reads the RSS, which ASan's shadow
 #    and quarantine inflate; the readers run here under the fuzz target fuzz_observations and in
 #    the other .npz tests;
@@ -121,7 +124,8 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^builtin_representations_are_classified_as_the_paper|^every_builtin_cell_matches_its_exp|'\
 '^audit_takes_several_groups_and_views|^sim_cli_audit_with_the_table_in_view_loses_se3|'\
 '^the_world_delta_mode_is_never_called_invariant|^a_policy_clipping_world_positions|'\
-'^mutant_encoder_is_classified_translation_only|^a_float32_policy_leaking_0.6_mm_fails_on_every'
+'^mutant_encoder_is_classified_translation_only|^a_float32_policy_leaking_0.6_mm_fails_on_every|'\
+'^table2_cli_saved_absolute_image_model_is_not|^policy_cli_audit_finds_the_c8_'
 (cd "$build_dir" && ctest --output-on-failure -j "$jobs" -L 'unit|property|proofs' -E "$end_to_end")
 tested=$(date +%s)
 

@@ -1,7 +1,8 @@
 #pragma once
-// handcentric.equivariance_profile: how far from equivariant (props/profile.hpp) a Python
-// callable (a policy, or a representation's actions / observation function) or a built-in
-// representation is, as a function of the transform's size.
+// handcentric.equivariance_profile: how far from equivariant
+// (handcentric/props/checks/profile.hpp) a Python callable (a policy, or a representation's
+// actions / observation function) or a built-in representation is, as a function of the
+// transform's size.
 #include <pybind11/pybind11.h>
 
 #include <string>

@@ -1,4 +1,4 @@
-#include "profile.hpp"
+#include "equivariance_profile.hpp"
 
 #include <pybind11/stl.h>
 
