@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "difficulty_options.hpp"
 #include "insert3d_options.hpp"
+#include "handcentric/experiments/methods.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/sim/collision.hpp"
 #include "handcentric/sim/demos.hpp"
@@ -22,7 +23,7 @@ namespace {
 
 struct DemosOptions {
   std::string task = "peg2d";
-  int n = 100;
+  int n = experiments::kPaperDemoCounts.back();  ///< the paper's largest demo count
   std::string dist;
   std::string hole_angle_deg;
   std::uint64_t seed = 1;

@@ -23,6 +23,7 @@
 #include "policy_source.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
+#include "handcentric/experiments/cell.hpp"
 #include "handcentric/experiments/results.hpp"
 #include "handcentric/experiments/table2.hpp"
 #include "handcentric/sim/collision.hpp"
@@ -42,7 +43,7 @@ struct EvalOptions {
   std::string policy;
   std::string dist;
   std::string hole_angle_deg;
-  int trials = 100;
+  int trials = experiments::EvalSettings{}.trials;
   std::uint64_t seed = 1;
   std::string transform;
   bool json = false;

@@ -1,12 +1,13 @@
 // `handcentric figure`: the paper's illustrative figures as PNGs. `figure flow` is Fig. 3
 // (experiments/flow_figure.hpp): the rectified-flow problem of the first action under a global
 // transform, for absolute, relative and hand-centric actions.
-#include <cstdio>
+#include <iomanip>
 #include <iostream>
 #include <memory>
 #include <string>
 
 #include "commands.hpp"
+#include "handcentric/core/format.hpp"
 #include "handcentric/experiments/flow_figure.hpp"
 
 namespace handcentric::apps {
@@ -23,9 +24,11 @@ int run_flow_figure(const FigureOptions& options) {
   std::cout << "wrote Fig. 3 to " << options.out
             << ": how far a global transform g moves a_1 (all six numbers)\n";
   for (const auto& column : figure.columns) {
-    std::printf("  %-13s %-9.3g %s\n", column.representation.c_str(), column.a1_change,
-                column.invariant() ? "(invariant: the flow problem is the same)"
-                                   : "(the flow problem moved)");
+    std::cout << "  " << std::left << std::setw(13) << column.representation << ' ' << std::setw(9)
+              << format_significant(column.a1_change, 3) << ' '
+              << (column.invariant() ? "(invariant: the flow problem is the same)"
+                                     : "(the flow problem moved)")
+              << "\n";
   }
   return 0;
 }

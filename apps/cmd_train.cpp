@@ -14,7 +14,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -138,10 +137,11 @@ int run_train(const TrainOptions& options) {
     last_loss = p.loss;
     last_rate = p.samples_per_second;
     if (options.quiet) return;
-    std::fprintf(stderr, "%sstep %d/%d  loss %.5f  %.0f samples/s  ETA %s%s", terminal ? "\r" : "",
-                 p.step, p.steps, p.loss, p.samples_per_second, format_clock(p.eta_seconds).c_str(),
-                 terminal ? "  " : "\n");
-    if (terminal && p.step == p.steps) std::fprintf(stderr, "\n");
+    std::cerr << (terminal ? "\r" : "") << "step " << p.step << '/' << p.steps << "  loss "
+              << format_fixed(p.loss, 5) << "  " << format_fixed(p.samples_per_second, 0)
+              << " samples/s  ETA " << format_clock(p.eta_seconds) << (terminal ? "  " : "\n");
+    if (terminal && p.step == p.steps) std::cerr << "\n";
+    std::cerr.flush();
   };
   const auto start = std::chrono::steady_clock::now();
   const policy::LearnedPolicy trained = policy::train_policy(config, scenes, options.seed, progress,

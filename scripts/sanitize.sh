@@ -90,13 +90,13 @@ fi
 #    Gaussian test in the world-delta map's translation test; and six audits of a Python plug-in
 #    that clips its positions (a_policy_clipping_world_positions_...: Python runs unsanitized;
 #    the extra cases' paired draws run here in the in-distribution tests of test_policy_audit);
-#  - five more whole audits, 52 s under ASan: a planted-fault encoder's whole classification
+#  - seven more whole audits: a planted-fault encoder's whole classification
 #    (mutant_encoder_is_classified_...; the classifier and its report run here in the other
 #    planted-fault audits), a float32 policy's audits on several seeds
 #    (a_float32_policy_leaking_...; the float32 path runs here in float32_rounding_gets_a_note_...)
-#    and three audits of saved models through the command (table2_cli_saved_absolute_image_...,
-#    policy_cli_audit_finds_the_c8_...: a saved model's audit runs here in
-#    table2_cli_saves_each_rows_model and the sim_cli_audit tests);
+#    and five audits of saved models through the command (table2_cli_saved_absolute_image_...,
+#    the four policy_cli_audit_finds_the_c8_...): a saved model's audit runs here in
+#    table2_cli_saved_hand_centric_image_model_is_se3_equivariant and the sim_cli_audit tests;
 #  - the 300 mutated .npz files: their bound on the peak memory reads the RSS, which ASan's shadow
 #    and quarantine inflate; the readers run here under the fuzz target fuzz_observations and in
 #    the other .npz tests;

@@ -2,13 +2,13 @@
 # Quick start, command 2: installs what is missing, builds (Release, every core), runs every
 # ctest suite, then installs the package into a staging prefix and builds and tests
 # examples/downstream against it with find_package(handcentric); last, the sanitizer run
-# (scripts/sanitize.sh: a second tree built by clang with ASan + UBSan, labels unit, property,
-# proofs, then each libFuzzer target for 10 s). SANITIZE=0 leaves the sanitizer run out (a quick
-# local check); CI runs it. The sanitizer tree builds at nice 19 from the start, beside the
-# Release build, tests and downstream projects: they leave part of the two cores idle (serial
-# links, waits on Chromium, Python and subprocesses: ~13% of the tests' time), which the
-# build takes; its output is printed once it is done. Each phase prints its start time;
-# docs/BENCHMARKS.md ("CI") has the measured phases.
+# (scripts/sanitize.sh: a second tree built by clang with ASan + UBSan, labels unit and proofs
+# and the numerics properties, then each libFuzzer target for 10 s). SANITIZE=0 leaves the
+# sanitizer run out (a quick local check); CI runs it. The sanitizer tree builds at nice 19
+# from the start, beside the Release build, tests and downstream projects: they leave part of
+# the two cores idle (serial links, waits on Chromium, Python and subprocesses: ~12% of the
+# tests' time), which the build takes; its output is printed once it is done. Each phase
+# prints its start time; docs/BENCHMARKS.md ("CI") has the measured phases.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build_dir="${BUILD_DIR:-$root/build}"
