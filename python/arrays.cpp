@@ -249,16 +249,6 @@ py::array_t<double> stacked_vectors(const std::vector<const Eigen::VectorXd*>& v
   return a;
 }
 
-py::array_t<double> stacked_extra_pose(const std::vector<const Scene*>& scenes, std::size_t index) {
-  py::array_t<double> a({static_cast<py::ssize_t>(scenes.size()), py::ssize_t{4}, py::ssize_t{4}});
-  double* out = a.mutable_data();
-  for (const Scene* s : scenes) {
-    write_pose(s->extra_poses.at(index).second, out);
-    out += 16;
-  }
-  return a;
-}
-
 py::array_t<double> stacked_scalar(const std::vector<const Scene*>& scenes, std::size_t index) {
   py::array_t<double> a(static_cast<py::ssize_t>(scenes.size()));
   double* out = a.mutable_data();

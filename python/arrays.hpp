@@ -95,13 +95,12 @@ py::object for_callable(py::array_t<double> a, const ArrayKind& kind);
 py::object for_callable(py::array_t<float> a, const ArrayKind& kind);
 
 /// Stacked arguments of scenes of one shape: (B, H+1, 4, 4), (B, K, 4, 4), (B, n, 3), (B, m, 3),
-/// (B, d), a pose per scene (B, 4, 4), a number per scene (B,).
+/// (B, d), a number per scene (B,) (a policy's history and extra poses: pose_layouts.hpp).
 py::array_t<double> stacked_history(const std::vector<const Scene*>& scenes);
 py::array_t<double> stacked_chunk(const std::vector<const Scene*>& scenes);
 py::array_t<double> stacked_hand_points(const std::vector<const Scene*>& scenes);
 py::array_t<double> stacked_world_points(const std::vector<const Scene*>& scenes);
 py::array_t<double> stacked_vectors(const std::vector<const Eigen::VectorXd*>& vectors);
-py::array_t<double> stacked_extra_pose(const std::vector<const Scene*>& scenes, std::size_t index);
 py::array_t<double> stacked_scalar(const std::vector<const Scene*>& scenes, std::size_t index);
 
 }  // namespace handcentric::python

@@ -104,7 +104,8 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                         py::handle views, py::handle cases, std::uint64_t seed,
                         std::optional<double> tolerance, const std::string& precision,
                         py::handle noise_length, py::handle extra_poses, py::handle scalars,
-                        py::handle rng, py::handle reset, const Setup& setup) {
+                        py::handle rng, py::handle reset, py::handle action_format,
+                        py::handle state_format, const Setup& setup) {
   require_numpy("assert_equivariant");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -118,7 +119,7 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                                    extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
   c.in_distribution = mode != "pointwise";
-  set_policy_call(o, c, rng, reset, "assert_equivariant");
+  set_policy_call(o, c, rng, reset, action_format, state_format, "assert_equivariant");
   ProgressLine progress("assert_equivariant", o.quiet);
   c.progress = std::ref(progress);
   const auto python_policy = batched_policy(policy, noise, o);

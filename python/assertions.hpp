@@ -21,6 +21,7 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                         py::handle views, py::handle cases, std::uint64_t seed,
                         std::optional<double> tolerance, const std::string& precision,
                         py::handle noise_length, py::handle extra_poses, py::handle scalars,
-                        py::handle rng, py::handle reset, const Setup& setup);
+                        py::handle rng, py::handle reset, py::handle action_format,
+                        py::handle state_format, const Setup& setup);
 
 }  // namespace handcentric::python

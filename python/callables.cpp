@@ -1,5 +1,7 @@
 #include "callables.hpp"
 
+#include "pose_layouts.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <pybind11/stl.h>
@@ -31,10 +33,8 @@ py::kwargs extras_kwargs(const std::vector<const Scene*>& scenes, const CallOpti
   py::dict poses, scalars;
   const Scene& first = *scenes.front();
   for (std::size_t i = 0; i < first.extra_poses.size(); ++i) {
-    poses[py::str(first.extra_poses[i].first)] =
-        options.stacked
-            ? for_callable(stacked_extra_pose(scenes, i), options.arrays)
-            : for_callable(array_of(first.extra_poses[i].second.matrix()), options.arrays);
+    poses[py::str(first.extra_poses[i].first)] = for_callable(
+        extra_pose_in(scenes, i, options.stacked, options.state_format), options.arrays);
   }
   for (std::size_t i = 0; i < first.scalars.size(); ++i) {
     scalars[py::str(first.scalars[i].first)] =
@@ -274,7 +274,6 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
     return kw;
   };
   const std::string what = "the chunk returned by policy " + name_;
-  std::vector<std::vector<RigidTransform>> out;
   // A (chunk, gripper) tuple or a dict of outputs, named as what it is, not as an array NumPy
   // cannot read.
   const auto chunk_only = [&](py::object result) {
@@ -286,43 +285,30 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
                 : " of " + std::to_string(py::len(result)) + " items") +
           "; a policy returns its world-frame chunk alone, " +
           (options_.stacked ? "(B, K, 4, 4)" : "(K, 4, 4)") +
-          " poses world_T_hand. Grippers, flags and pose vectors (position + quaternion or 6D) "
-          "are not read yet: return the 4x4 poses only");
+          " poses world_T_hand, or pose vectors with action_format= (e.g. \"pos_quat_xyzw\"). "
+          "Grippers and flags beside the poses are not read yet: return the poses only");
     }
     return result;
   };
   if (!options_.stacked) {
+    std::vector<std::vector<RigidTransform>> out;
     for (std::size_t i = 0; i < observations.size(); ++i) {
       const Scene& o = *observations[i];
+      const std::vector<const Scene*> one = {&o};
       py::object result = chunk_only(watched(call(
-          policy_, for_callable(array_of(o.world_T_hand_history), kind),
+          policy_, for_callable(history_in(one, false, options_.state_format), kind),
           for_callable(array_of(o.hand_points), kind), for_callable(array_of(o.world_points), kind),
-          for_callable(array_of(*noises[i]), kind), **kwargs({&o}))));
-      out.push_back(poses_from(result, what, true, "(K, 4, 4)"));
+          for_callable(array_of(*noises[i]), kind), **kwargs(one))));
+      out.push_back(chunks_from(result, 1, false, options_.action_format, what).front());
     }
     return out;
   }
-  py::object result = chunk_only(
-      watched(call(policy_, for_callable(stacked_history(observations), kind),
-                   for_callable(stacked_hand_points(observations), kind),
-                   for_callable(stacked_world_points(observations), kind),
-                   for_callable(stacked_vectors(noises), kind), **kwargs(observations))));
-  const auto a = real_array(result, what);
-  const auto B = static_cast<py::ssize_t>(observations.size());
-  if (a.ndim() != 4 || a.shape(0) != B || a.shape(1) < 1 || a.shape(2) != 4 || a.shape(3) != 4) {
-    throw ShapeError(what + " has shape " + shape_of(a) + " for a batch of " + std::to_string(B) +
-                     " observations; expected (" + std::to_string(B) +
-                     ", K, 4, 4), one chunk per observation");
-  }
-  for (py::ssize_t i = 0; i < B; ++i) {
-    // Per row, so that a NaN names its row (the batch is then asked row by row, batch.cpp, and
-    // the audit names the case and the observation).
-    require_finite(a.data() + i * a.shape(1) * 16, a.shape(1) * 16,
-                   what + "[" + std::to_string(i) + "]");
-    out.push_back(loose_poses(a.data() + i * a.shape(1) * 16, a.shape(1),
-                              what + "[" + std::to_string(i) + "]"));
-  }
-  return out;
+  py::object result = chunk_only(watched(
+      call(policy_, for_callable(history_in(observations, true, options_.state_format), kind),
+           for_callable(stacked_hand_points(observations), kind),
+           for_callable(stacked_world_points(observations), kind),
+           for_callable(stacked_vectors(noises), kind), **kwargs(observations))));
+  return chunks_from(result, observations.size(), true, options_.action_format, what);
 }
 
 }  // namespace handcentric::python

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "arrays.hpp"
+#include "handcentric/core/pose_format.hpp"
 #include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/observation/camera_rig.hpp"
 
@@ -34,6 +35,9 @@ struct CallOptions {
   std::uint64_t rng_seed = 0;
   /// Called with no arguments before every call of a policy (e.g. LeRobot's policy.reset), or None.
   py::object reset = py::none();
+  /// A policy's layout of the poses it returns (action_format=) and of those it is given, the
+  /// history and the extra poses (state_format=): core/pose_format.hpp.
+  PoseFormat action_format, state_format;
 };
 
 /// images={view: array} as a callable receives them for `scenes` (one: (C, h, w); stacked:

@@ -52,6 +52,7 @@
 #include "assertions.hpp"
 #include "callables.hpp"
 #include "options.hpp"
+#include "pose_layouts.hpp"
 #include "equivariance_profile.hpp"
 
 namespace handcentric::python {
@@ -114,7 +115,8 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
 py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py::handle cases,
                       std::uint64_t seed, std::optional<double> tolerance,
                       const std::string& precision, py::handle noise_length, py::handle extra_poses,
-                      py::handle scalars, py::handle rng, py::handle reset, const Setup& setup) {
+                      py::handle scalars, py::handle rng, py::handle reset,
+                      py::handle action_format, py::handle state_format, const Setup& setup) {
   require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -122,7 +124,7 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   CommonOptions o =
       common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
-  set_policy_call(o, c, rng, reset, "audit_policy");
+  set_policy_call(o, c, rng, reset, action_format, state_format, "audit_policy");
   ProgressLine progress("audit_policy", o.quiet);
   c.progress = std::ref(progress);
   const props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
@@ -270,15 +272,18 @@ rectified flow's (eq. 5).
       [](py::object policy, py::handle groups, py::handle views, py::handle cases,
          std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
          py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
-         py::handle reset, HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle reset, py::handle action_format, py::handle state_format,
+         HANDCENTRIC_SETUP_PARAMETERS) {
         return audit_policy(std::move(policy), groups, views, cases, seed, tolerance, precision,
-                            noise, extra_poses, scalars, rng, reset, HANDCENTRIC_SETUP_VALUE);
+                            noise, extra_poses, scalars, rng, reset, action_format, state_format,
+                            HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
       py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
       py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
       py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
       HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
@@ -290,6 +295,11 @@ policy whose answer depends on earlier calls raises StatefulPolicyError (reset=p
 called before every call, starts each afresh), one whose rows depend on their batch
 BatchCouplingError; one that draws its own random numbers gets no pointwise verdicts unless
 rng="torch" / "numpy" / "generator" seeds its draws alike for o and g o (one row per call).
+action_format= names the layout of the poses the policy returns, state_format= that of the
+poses it is given (history, extra_poses): "matrix" (default, (..., 4, 4)), "pos_quat_xyzw",
+"pos_quat_wxyz", "pos_axis_angle", "pos_rot6d_rows", "pos_rot6d_cols", "pos_euler_<axes>"
+(SciPy's spelling: lowercase extrinsic, uppercase intrinsic); then the chunk is (K, w) and the
+history (H+1, w).
 )doc") +
        kSetupDoc)
           .c_str());
@@ -325,22 +335,26 @@ Every view in `views` must hold.
       [](py::object policy, const std::string& group, const std::string& mode, py::handle views,
          py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
          const std::string& precision, py::handle noise, py::handle extra_poses, py::handle scalars,
-         py::handle rng, py::handle reset, HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle rng, py::handle reset, py::handle action_format, py::handle state_format,
+         HANDCENTRIC_SETUP_PARAMETERS) {
         assert_equivariant(std::move(policy), group, mode, views, cases, seed, tolerance, precision,
-                           noise, extra_poses, scalars, rng, reset, HANDCENTRIC_SETUP_VALUE);
+                           noise, extra_poses, scalars, rng, reset, action_format, state_format,
+                           HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("group"), py::kw_only(), py::arg("mode") = "pointwise",
       py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
       py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
       py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
       HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Raise AssertionError unless policy(g o, n) = g policy(o, n) under `group`.
 
 The error carries the shrunk witness.
 mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which
 implies the law's), "distribution" (independent noise: the laws compared) or "both".
-Every view in `views` must hold. rng= and reset= as in audit_policy; a policy that draws its
+Every view in `views` must hold. rng=, reset=, action_format= and state_format= as in
+audit_policy; a policy that draws its
 own random numbers without rng= raises OwnRandomnessError for "pointwise" and "both".
 )doc") +
        kSetupDoc)
@@ -440,6 +454,12 @@ policy saw, e.g. for a witness's scene and g * scene.)doc");
       py::arg("representation"), py::arg("actions"), py::arg("world_T_hand0"),
       "The world-frame chunk (K, 4, 4) a built-in's action vector encodes, given the hand now.");
 
+  m.def("encode_pose", &encode_pose_array, py::arg("poses"), py::arg("format"),
+        "Poses (..., 4, 4) as vectors (..., w) in a pose format (action_format=): "
+        "\"pos_quat_xyzw\", \"pos_euler_xyz\", ...");
+  m.def("decode_pose", &decode_pose_array, py::arg("vectors"), py::arg("format"),
+        "Vectors (..., w) in a pose format as poses (..., 4, 4); ValueError when the numbers "
+        "contradict the layout (a quaternion off unit norm, 6D vectors not orthonormal).");
   m.def(
       "so3_exp",
       [](py::handle r) {

@@ -248,7 +248,17 @@ props::ClassifierOptions classifier_for(const CommonOptions& o) {
 }
 
 void set_policy_call(CommonOptions& o, props::ClassifierOptions& c, py::handle rng,
-                     py::handle reset, const std::string& caller) {
+                     py::handle reset, py::handle action_format, py::handle state_format,
+                     const std::string& caller) {
+  const auto layout = [](py::handle value, const char* keyword) {
+    if (!py::isinstance<py::str>(value)) {
+      throw DtypeError(std::string(keyword) + " must be a pose format name such as \"matrix\" or " +
+                       "\"pos_quat_xyzw\", got a " + type_name(value));
+    }
+    return parse_pose_format(py::str(value), keyword);
+  };
+  o.call.action_format = layout(action_format, "action_format");
+  o.call.state_format = layout(state_format, "state_format");
   if (!rng.is_none() && !py::isinstance<py::str>(rng))
     throw DtypeError("rng must be None or a mode name, got a " + type_name(rng));
   o.call.rng = py::str(py::module_::import("handcentric._rng").attr("check_mode")(rng));

@@ -99,11 +99,13 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
 
 props::ClassifierOptions classifier_for(const CommonOptions& o);
 
-/// A whole policy's rng= (None, "torch", "numpy", "generator") and reset= (None or a callable)
-/// checked and set on o.call (ValueError / TypeError naming the value), and the preflight's
-/// fixes in Python's words on c (`caller` is the function, for mode= advice).
+/// A whole policy's rng= (None, "torch", "numpy", "generator"), reset= (None or a callable),
+/// action_format= and state_format= (pose format names, core/pose_format.hpp) checked and set on
+/// o.call (ValueError / TypeError naming the value), and the preflight's fixes in Python's words
+/// on c (`caller` is the function, for mode= advice).
 void set_policy_call(CommonOptions& o, props::ClassifierOptions& c, py::handle rng,
-                     py::handle reset, const std::string& caller);
+                     py::handle reset, py::handle action_format, py::handle state_format,
+                     const std::string& caller);
 
 /// Prints "handcentric.audit_policy: 12 of 20 checks, 6.1 s, about 4 s left" on stderr (the
 /// same line again on a terminal, a new line at most every 5 s otherwise) once an audit has run

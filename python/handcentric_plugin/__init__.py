@@ -88,9 +88,12 @@ The package, one job a module (standard library only; NumPy where said):
   policy    serve_policy(): a whole policy, its cameras, rng= and reset=
   seeding   a policy's own generator seeded before a call (shared with handcentric's _rng)
   geometry  the SE(3) helpers above
+  formats   pose layouts: 4x4 poses as the vectors shipped policies speak (quaternions, 6D,
+            Euler angles, ...), both ways; the audit's action_format= and state_format=
 Names with a leading underscore are the package's own, shared between its modules; the public
 names are those imported here.
 """
+from . import formats
 from .codec import ENCODINGS
 from .geometry import (batch_relative_points, batch_relative_pose, inverse, pose_matrix,
                        pose_vector, relative_points, relative_pose, rotation_matrix,
@@ -100,5 +103,5 @@ from .policy import serve_policy
 from .protocol import MAX_BATCH, PROTOCOL
 
 __all__ = ["ENCODINGS", "MAX_BATCH", "PROTOCOL", "batch_relative_points", "batch_relative_pose",
-           "inverse", "pose_matrix", "pose_vector", "relative_points", "relative_pose",
-           "rotation_matrix", "rotation_vector", "serve", "serve_policy"]
+           "formats", "inverse", "pose_matrix", "pose_vector", "relative_points",
+           "relative_pose", "rotation_matrix", "rotation_vector", "serve", "serve_policy"]
