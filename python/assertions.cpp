@@ -100,28 +100,13 @@ void assert_invariant(py::object fn, const std::string& group, const std::string
       "replay: the same call with seed=" + std::to_string(seed) + " finds the same witness");
 }
 
-void assert_equivariant(py::object policy, const std::string& group, const std::string& mode,
-                        py::handle views, py::handle cases, std::uint64_t seed,
-                        std::optional<double> tolerance, const std::string& precision,
-                        py::handle noise_length, py::handle extra_poses, py::handle scalars,
-                        py::handle rng, py::handle reset, py::handle action_format,
-                        py::handle state_format, const Setup& setup) {
-  require_numpy("assert_equivariant");
-  if (!PyCallable_Check(policy.ptr()))
-    throw DtypeError("policy must be callable, got a " + type_name(policy));
-  const int noise = noise_of(noise_length);
-  if (mode != "pointwise" && mode != "distribution" && mode != "both") {
-    throw InvalidArgument("unknown mode '" + mode +
-                          "'; use pointwise (the same noise for o and g o), "
-                          "distribution (independent noise) or both");
-  }
-  CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
-                                   extra_poses, scalars, setup);
-  props::ClassifierOptions c = classifier_for(o);
-  c.in_distribution = mode != "pointwise";
-  set_policy_call(o, c, rng, reset, action_format, state_format, "assert_equivariant");
-  ProgressLine progress("assert_equivariant", o.quiet);
-  c.progress = std::ref(progress);
+namespace {
+
+// assert_equivariant on the policy as o.call hands it to the checks (one output of several, or
+// the chunk alone).
+void assert_policy_holds(const py::object& policy, int noise, const CommonOptions& o,
+                         const props::ClassifierOptions& c, const std::string& mode,
+                         std::uint64_t seed) {
   const auto python_policy = batched_policy(policy, noise, o);
   props::Classification result = props::classify_policy(python_policy, c);
   // mode "both" asked for pointwise verdicts too: without the same draws on both sides there are
@@ -161,6 +146,44 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
             "mode='distribution' asserts the law only.";
   }
   assert_all_hold(result, true, hint);
+}
+
+}  // namespace
+
+void assert_equivariant(py::object policy, const std::string& group, const std::string& mode,
+                        py::handle views, py::handle cases, std::uint64_t seed,
+                        std::optional<double> tolerance, const std::string& precision,
+                        py::handle noise_length, py::handle extra_poses, py::handle scalars,
+                        py::handle rng, py::handle reset, py::handle action_format,
+                        py::handle state_format, py::handle outputs, const Setup& setup) {
+  require_numpy("assert_equivariant");
+  if (!PyCallable_Check(policy.ptr()))
+    throw DtypeError("policy must be callable, got a " + type_name(policy));
+  const int noise = noise_of(noise_length);
+  if (mode != "pointwise" && mode != "distribution" && mode != "both") {
+    throw InvalidArgument("unknown mode '" + mode +
+                          "'; use pointwise (the same noise for o and g o), "
+                          "distribution (independent noise) or both");
+  }
+  CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
+                                   extra_poses, scalars, setup);
+  props::ClassifierOptions c = classifier_for(o);
+  c.in_distribution = mode != "pointwise";
+  set_policy_call(o, c, rng, reset, action_format, state_format, "assert_equivariant");
+  ProgressLine progress("assert_equivariant", o.quiet);
+  c.progress = std::ref(progress);
+  o.call.outputs = outputs_from(outputs);
+  if (o.call.outputs.empty()) {
+    assert_policy_holds(policy, noise, o, c, mode, seed);
+    return;
+  }
+  // Named outputs: each must hold (named_outputs.hpp); the first that does not is reported, its
+  // name in every failing check's line.
+  for (const NamedOutput& output : o.call.outputs) {
+    CommonOptions one = o;
+    one.call.output = output.name;
+    assert_policy_holds(policy, noise, one, c, mode, seed);
+  }
 }
 
 }  // namespace handcentric::python

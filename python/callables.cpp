@@ -196,7 +196,8 @@ PythonPolicy::PythonPolicy(py::object policy, Eigen::Index noise, CallOptions op
     : policy_(std::move(policy)),
       noise_(noise),
       options_(std::move(options)),
-      name_("python: " + callable_name(policy_)) {
+      name_("python: " + callable_name(policy_) +
+            (options_.output.empty() ? "" : " output '" + options_.output + "'")) {
   // The preflight watches the global generators of every policy; rng= seeds them per call.
   rng_module_ = py::module_::import("handcentric._rng");
 }
@@ -274,41 +275,56 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
     return kw;
   };
   const std::string what = "the chunk returned by policy " + name_;
-  // A (chunk, gripper) tuple or a dict of outputs, named as what it is, not as an array NumPy
-  // cannot read.
+  // A (chunk, gripper) tuple or a dict of outputs without outputs=, named as what it is, not as
+  // an array NumPy cannot read.
   const auto chunk_only = [&](py::object result) {
     if (py::isinstance<py::tuple>(result) || py::isinstance<py::dict>(result)) {
       const bool dict = py::isinstance<py::dict>(result);
       throw DtypeError(
           what + " is a " + type_name(result) +
-          (dict ? " with keys " + std::string(py::str(py::list(result)))
-                : " of " + std::to_string(py::len(result)) + " items") +
-          "; a policy returns its world-frame chunk alone, " +
-          (options_.stacked ? "(B, K, 4, 4)" : "(K, 4, 4)") +
-          " poses world_T_hand, or pose vectors with action_format= (e.g. \"pos_quat_xyzw\"). "
-          "Grippers and flags beside the poses are not read yet: return the poses only");
+          (dict ? " with keys " + std::string(py::str(py::list(result))) +
+                      "; say what each entry is: outputs={name: \"pose\" or \"invariant\"}"
+                : " of " + std::to_string(py::len(result)) +
+                      " items; a policy returns its world-frame chunk alone, " +
+                      (options_.stacked ? "(B, K, 4, 4)" : "(K, 4, 4)") +
+                      " poses world_T_hand (or pose vectors with action_format=), or a dict of "
+                      "named outputs with outputs={name: \"pose\" or \"invariant\"}"));
     }
     return result;
+  };
+  // The chunks this callable hands the checks, from the policy's result for `rows`.
+  const auto chunks = [&](py::object result, const std::vector<const Scene*>& rows) {
+    if (options_.outputs.empty()) {
+      return chunks_from(chunk_only(std::move(result)), rows.size(), options_.stacked,
+                         options_.action_format, what);
+    }
+    const std::string entry_what = what + "['" + options_.output + "']";
+    const py::object entry = output_entry(result, options_.outputs, options_.output, what);
+    for (const NamedOutput& o : options_.outputs) {
+      if (o.name == options_.output && o.kind == OutputKind::invariant)
+        return invariant_as_poses(entry, rows, options_.stacked, entry_what);
+    }
+    return chunks_from(entry, rows.size(), options_.stacked, options_.action_format, entry_what);
   };
   if (!options_.stacked) {
     std::vector<std::vector<RigidTransform>> out;
     for (std::size_t i = 0; i < observations.size(); ++i) {
       const Scene& o = *observations[i];
       const std::vector<const Scene*> one = {&o};
-      py::object result = chunk_only(watched(call(
+      py::object result = watched(call(
           policy_, for_callable(history_in(one, false, options_.state_format), kind),
           for_callable(array_of(o.hand_points), kind), for_callable(array_of(o.world_points), kind),
-          for_callable(array_of(*noises[i]), kind), **kwargs(one))));
-      out.push_back(chunks_from(result, 1, false, options_.action_format, what).front());
+          for_callable(array_of(*noises[i]), kind), **kwargs(one)));
+      out.push_back(chunks(std::move(result), one).front());
     }
     return out;
   }
-  py::object result = chunk_only(watched(
+  py::object result = watched(
       call(policy_, for_callable(history_in(observations, true, options_.state_format), kind),
            for_callable(stacked_hand_points(observations), kind),
            for_callable(stacked_world_points(observations), kind),
-           for_callable(stacked_vectors(noises), kind), **kwargs(observations))));
-  return chunks_from(result, observations.size(), true, options_.action_format, what);
+           for_callable(stacked_vectors(noises), kind), **kwargs(observations)));
+  return chunks(std::move(result), observations);
 }
 
 }  // namespace handcentric::python

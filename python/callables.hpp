@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "arrays.hpp"
+#include "named_outputs.hpp"
 #include "handcentric/core/pose_format.hpp"
 #include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/observation/camera_rig.hpp"
@@ -38,6 +39,10 @@ struct CallOptions {
   /// A policy's layout of the poses it returns (action_format=) and of those it is given, the
   /// history and the extra poses (state_format=): core/pose_format.hpp.
   PoseFormat action_format, state_format;
+  /// outputs=: the entries of a policy's dict result (named_outputs.hpp), and the one this
+  /// callable hands the checks ("" when the policy returns its chunk alone).
+  std::vector<NamedOutput> outputs;
+  std::string output;
 };
 
 /// images={view: array} as a callable receives them for `scenes` (one: (C, h, w); stacked:

@@ -116,7 +116,8 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
                       std::uint64_t seed, std::optional<double> tolerance,
                       const std::string& precision, py::handle noise_length, py::handle extra_poses,
                       py::handle scalars, py::handle rng, py::handle reset,
-                      py::handle action_format, py::handle state_format, const Setup& setup) {
+                      py::handle action_format, py::handle state_format, py::handle outputs,
+                      const Setup& setup) {
   require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -127,8 +128,49 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   set_policy_call(o, c, rng, reset, action_format, state_format, "audit_policy");
   ProgressLine progress("audit_policy", o.quiet);
   c.progress = std::ref(progress);
-  const props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
-  py::dict report = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
+  o.call.outputs = outputs_from(outputs);
+  if (o.call.outputs.empty()) {
+    const props::Classification result =
+        props::classify_policy(batched_policy(policy, noise, o), c);
+    py::dict report = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
+    add_inputs(report, o);
+    return report;
+  }
+  // Named outputs: each audited as a map of its own (named_outputs.hpp); one report whose checks
+  // each carry their `output`, whose summary holds where every output holds, and `outputs`,
+  // each output's kind and summary.
+  py::dict report, per_output;
+  py::list checks;
+  for (const NamedOutput& output : o.call.outputs) {
+    CommonOptions one = o;
+    one.call.output = output.name;
+    const props::Classification result =
+        props::classify_policy(batched_policy(policy, noise, one), c);
+    py::dict part = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
+    for (auto check : part["checks"]) {
+      check["output"] = output.name;
+      check["kind"] = to_string(output.kind);
+      checks.append(check);
+    }
+    per_output[py::str(output.name)] =
+        py::dict(py::arg("kind") = to_string(output.kind), py::arg("summary") = part["summary"]);
+    if (report.empty()) {
+      report = part;
+      report["name"] = "python: " + callable_name(policy);
+      // A copy: the merged summary below must leave this output's own summary as it is.
+      report["summary"] = py::module_::import("copy").attr("deepcopy")(part["summary"]);
+      continue;
+    }
+    // summary[view][mode][group]: every output's verdict there.
+    for (auto view : part["summary"].cast<py::dict>())
+      for (auto mode : view.second.cast<py::dict>())
+        for (auto group : mode.second.cast<py::dict>()) {
+          py::dict merged = report["summary"][view.first][mode.first];
+          merged[group.first] = merged[group.first].cast<bool>() && group.second.cast<bool>();
+        }
+  }
+  report["checks"] = checks;
+  report["outputs"] = per_output;
   add_inputs(report, o);
   return report;
 }
@@ -272,11 +314,11 @@ rectified flow's (eq. 5).
       [](py::object policy, py::handle groups, py::handle views, py::handle cases,
          std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
          py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
-         py::handle reset, py::handle action_format, py::handle state_format,
+         py::handle reset, py::handle action_format, py::handle state_format, py::handle outputs,
          HANDCENTRIC_SETUP_PARAMETERS) {
         return audit_policy(std::move(policy), groups, views, cases, seed, tolerance, precision,
                             noise, extra_poses, scalars, rng, reset, action_format, state_format,
-                            HANDCENTRIC_SETUP_VALUE);
+                            outputs, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
       py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
@@ -284,7 +326,7 @@ rectified flow's (eq. 5).
       py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
       py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
-      HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("outputs") = py::none(), HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
 Returns one policy of `audit --json`.
@@ -299,7 +341,9 @@ action_format= names the layout of the poses the policy returns, state_format= t
 poses it is given (history, extra_poses): "matrix" (default, (..., 4, 4)), "pos_quat_xyzw",
 "pos_quat_wxyz", "pos_axis_angle", "pos_rot6d_rows", "pos_rot6d_cols", "pos_euler_<axes>"
 (SciPy's spelling: lowercase extrinsic, uppercase intrinsic); then the chunk is (K, w) and the
-history (H+1, w).
+history (H+1, w). outputs={"hand": "pose", "gripper": "invariant"}: the policy returns a dict;
+each pose entry must move with g, each invariant entry (numbers of any shape) must not change;
+each check of the result carries its "output", and "outputs" gives each one's summary.
 )doc") +
        kSetupDoc)
           .c_str());
@@ -336,10 +380,10 @@ Every view in `views` must hold.
          py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
          const std::string& precision, py::handle noise, py::handle extra_poses, py::handle scalars,
          py::handle rng, py::handle reset, py::handle action_format, py::handle state_format,
-         HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle outputs, HANDCENTRIC_SETUP_PARAMETERS) {
         assert_equivariant(std::move(policy), group, mode, views, cases, seed, tolerance, precision,
                            noise, extra_poses, scalars, rng, reset, action_format, state_format,
-                           HANDCENTRIC_SETUP_VALUE);
+                           outputs, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("group"), py::kw_only(), py::arg("mode") = "pointwise",
       py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
@@ -347,14 +391,14 @@ Every view in `views` must hold.
       py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
       py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
-      HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("outputs") = py::none(), HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Raise AssertionError unless policy(g o, n) = g policy(o, n) under `group`.
 
 The error carries the shrunk witness.
 mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which
 implies the law's), "distribution" (independent noise: the laws compared) or "both".
-Every view in `views` must hold. rng=, reset=, action_format= and state_format= as in
-audit_policy; a policy that draws its
+Every view in `views` must hold, and with outputs= every output. rng=, reset=, action_format=,
+state_format= and outputs= as in audit_policy; a policy that draws its
 own random numbers without rng= raises OwnRandomnessError for "pointwise" and "both".
 )doc") +
        kSetupDoc)

@@ -8,12 +8,12 @@ the vectors its code expects, or back:
     formats.encode(T, "pos_quat_xyzw")     # (..., 4, 4) -> (..., 7)
     formats.decode(v, "pos_euler_xyz")     # (..., 6) -> (..., 4, 4)
 
-Layouts: "matrix" (the (..., 4, 4) poses themselves), "pos_quat_xyzw", "pos_quat_wxyz" (7), "pos_axis_angle" (6),
-"pos_rot6d_rows", "pos_rot6d_cols" (9), "pos_euler_<axes>" (6; SciPy's spelling: lowercase
-about the fixed axes, uppercase about the moving ones). Encoding picks the quaternion with
-w >= 0 and SciPy's Euler ranges (the third angle 0 at gimbal lock); decoding normalizes a
-quaternion and orthonormalizes 6D vectors (Gram-Schmidt), after refusing numbers more than
-LAYOUT_TOLERANCE from what the layout says.
+Layouts: "matrix" (the (..., 4, 4) poses themselves), "pos_quat_xyzw", "pos_quat_wxyz" (7),
+"pos_axis_angle" (6), "pos_rot6d_rows", "pos_rot6d_cols" (9), "pos_euler_<axes>" (6; SciPy's
+spelling: lowercase about the fixed axes, uppercase about the moving ones). Encoding picks the
+quaternion with w >= 0 and SciPy's Euler ranges (the third angle 0 at gimbal lock); decoding
+normalizes a quaternion and orthonormalizes 6D vectors (Gram-Schmidt), after refusing numbers
+more than LAYOUT_TOLERANCE from what the layout says.
 """
 from ._numpy import np
 from .geometry import rotation_matrix, rotation_vector
@@ -93,9 +93,12 @@ def _quaternion_wxyz(R):
     big = 0.5 * np.sqrt(np.take_along_axis(candidates, pick[..., None], -1)[..., 0])
     quarter = 0.25 / big
     d = {  # each quaternion component from the picked one
-        "wx": (R[..., 2, 1] - R[..., 1, 2]) * quarter, "wy": (R[..., 0, 2] - R[..., 2, 0]) * quarter,
-        "wz": (R[..., 1, 0] - R[..., 0, 1]) * quarter, "xy": (R[..., 0, 1] + R[..., 1, 0]) * quarter,
-        "xz": (R[..., 0, 2] + R[..., 2, 0]) * quarter, "yz": (R[..., 1, 2] + R[..., 2, 1]) * quarter}
+        "wx": (R[..., 2, 1] - R[..., 1, 2]) * quarter,
+        "wy": (R[..., 0, 2] - R[..., 2, 0]) * quarter,
+        "wz": (R[..., 1, 0] - R[..., 0, 1]) * quarter,
+        "xy": (R[..., 0, 1] + R[..., 1, 0]) * quarter,
+        "xz": (R[..., 0, 2] + R[..., 2, 0]) * quarter,
+        "yz": (R[..., 1, 2] + R[..., 2, 1]) * quarter}
     rows = [np.stack([big, d["wx"], d["wy"], d["wz"]], -1),
             np.stack([d["wx"], big, d["xy"], d["xz"]], -1),
             np.stack([d["wy"], d["xy"], big, d["yz"]], -1),

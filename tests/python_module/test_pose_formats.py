@@ -137,7 +137,7 @@ def test_a_quaternion_off_unit_norm_is_refused_naming_the_pose_and_its_norm():
 
 
 def test_unknown_pose_formats_are_refused_naming_the_keyword_and_value():
-    with pytest.raises(ValueError, match=r"action_format='quat' is not a pose format.*pos_quat_wxyz"):
+    with pytest.raises(ValueError, match=r"action_format='quat' is not a pose format.*quat_wxyz"):
         handcentric.audit_policy(make_policy(), action_format="quat", quiet=True)
     with pytest.raises(ValueError, match=r"state_format='pos_euler_xxz'.*twice in a row"):
         handcentric.assert_equivariant(make_policy(), "se3", state_format="pos_euler_xxz")
