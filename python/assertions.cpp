@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "arrays.hpp"
+#include "hands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/props/checks/check.hpp"
 #include "handcentric/props/checks/policy_audit.hpp"
@@ -155,7 +156,8 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                         std::optional<double> tolerance, const std::string& precision,
                         py::handle noise_length, py::handle extra_poses, py::handle scalars,
                         py::handle rng, py::handle reset, py::handle action_format,
-                        py::handle state_format, py::handle outputs, const Setup& setup) {
+                        py::handle state_format, py::handle outputs, py::handle hands,
+                        const Setup& setup) {
   require_numpy("assert_equivariant");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -172,7 +174,8 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
   set_policy_call(o, c, rng, reset, action_format, state_format, "assert_equivariant");
   ProgressLine progress("assert_equivariant", o.quiet);
   c.progress = std::ref(progress);
-  o.call.outputs = outputs_from(outputs);
+  o.call.outputs = outputs_from(outputs, hands.is_none());
+  set_hands(o, c, hands);
   if (o.call.outputs.empty()) {
     assert_policy_holds(policy, noise, o, c, mode, seed);
     return;

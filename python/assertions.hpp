@@ -22,6 +22,7 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                         std::optional<double> tolerance, const std::string& precision,
                         py::handle noise_length, py::handle extra_poses, py::handle scalars,
                         py::handle rng, py::handle reset, py::handle action_format,
-                        py::handle state_format, py::handle outputs, const Setup& setup);
+                        py::handle state_format, py::handle outputs, py::handle hands,
+                        const Setup& setup);
 
 }  // namespace handcentric::python

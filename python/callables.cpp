@@ -1,5 +1,6 @@
 #include "callables.hpp"
 
+#include "hands.hpp"
 #include "pose_layouts.hpp"
 
 #include <algorithm>
@@ -33,6 +34,8 @@ py::kwargs extras_kwargs(const std::vector<const Scene*>& scenes, const CallOpti
   py::dict poses, scalars;
   const Scene& first = *scenes.front();
   for (std::size_t i = 0; i < first.extra_poses.size(); ++i) {
+    // The other hands' poses go in history= (hands.hpp), not here.
+    if (first.extra_poses[i].first.rfind(kHandPosePrefix, 0) == 0) continue;
     poses[py::str(first.extra_poses[i].first)] = for_callable(
         extra_pose_in(scenes, i, options.stacked, options.state_format), options.arrays);
   }
@@ -311,19 +314,19 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
     for (std::size_t i = 0; i < observations.size(); ++i) {
       const Scene& o = *observations[i];
       const std::vector<const Scene*> one = {&o};
-      py::object result = watched(call(
-          policy_, for_callable(history_in(one, false, options_.state_format), kind),
-          for_callable(array_of(o.hand_points), kind), for_callable(array_of(o.world_points), kind),
-          for_callable(array_of(*noises[i]), kind), **kwargs(one)));
+      py::object result = watched(call(policy_, history_argument(one, options_),
+                                       for_callable(array_of(o.hand_points), kind),
+                                       for_callable(array_of(o.world_points), kind),
+                                       for_callable(array_of(*noises[i]), kind), **kwargs(one)));
       out.push_back(chunks(std::move(result), one).front());
     }
     return out;
   }
-  py::object result = watched(
-      call(policy_, for_callable(history_in(observations, true, options_.state_format), kind),
-           for_callable(stacked_hand_points(observations), kind),
-           for_callable(stacked_world_points(observations), kind),
-           for_callable(stacked_vectors(noises), kind), **kwargs(observations)));
+  py::object result =
+      watched(call(policy_, history_argument(observations, options_),
+                   for_callable(stacked_hand_points(observations), kind),
+                   for_callable(stacked_world_points(observations), kind),
+                   for_callable(stacked_vectors(noises), kind), **kwargs(observations)));
   return chunks(std::move(result), observations);
 }
 

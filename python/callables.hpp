@@ -43,6 +43,8 @@ struct CallOptions {
   /// callable hands the checks ("" when the policy returns its chunk alone).
   std::vector<NamedOutput> outputs;
   std::string output;
+  /// hands=: the hands' names, the first the audit's own hand (hands.hpp); empty: one hand.
+  std::vector<std::string> hands;
 };
 
 /// images={view: array} as a callable receives them for `scenes` (one: (C, h, w); stacked:

@@ -49,6 +49,7 @@
 #include "handcentric/props/verdict.hpp"
 #include "handcentric/sim/demos.hpp"
 #include "arrays.hpp"
+#include "hands.hpp"
 #include "assertions.hpp"
 #include "callables.hpp"
 #include "options.hpp"
@@ -117,7 +118,7 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
                       const std::string& precision, py::handle noise_length, py::handle extra_poses,
                       py::handle scalars, py::handle rng, py::handle reset,
                       py::handle action_format, py::handle state_format, py::handle outputs,
-                      const Setup& setup) {
+                      py::handle hands, const Setup& setup) {
   require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -128,7 +129,8 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   set_policy_call(o, c, rng, reset, action_format, state_format, "audit_policy");
   ProgressLine progress("audit_policy", o.quiet);
   c.progress = std::ref(progress);
-  o.call.outputs = outputs_from(outputs);
+  o.call.outputs = outputs_from(outputs, hands.is_none());
+  set_hands(o, c, hands);
   if (o.call.outputs.empty()) {
     const props::Classification result =
         props::classify_policy(batched_policy(policy, noise, o), c);
@@ -315,10 +317,10 @@ rectified flow's (eq. 5).
          std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
          py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
          py::handle reset, py::handle action_format, py::handle state_format, py::handle outputs,
-         HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle hands, HANDCENTRIC_SETUP_PARAMETERS) {
         return audit_policy(std::move(policy), groups, views, cases, seed, tolerance, precision,
                             noise, extra_poses, scalars, rng, reset, action_format, state_format,
-                            outputs, HANDCENTRIC_SETUP_VALUE);
+                            outputs, hands, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
       py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
@@ -326,7 +328,7 @@ rectified flow's (eq. 5).
       py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
       py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
-      py::arg("outputs") = py::none(), HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("outputs") = py::none(), py::arg("hands") = py::none(), HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
 Returns one policy of `audit --json`.
@@ -344,6 +346,9 @@ poses it is given (history, extra_poses): "matrix" (default, (..., 4, 4)), "pos_
 history (H+1, w). outputs={"hand": "pose", "gripper": "invariant"}: the policy returns a dict;
 each pose entry must move with g, each invariant entry (numbers of any shape) must not change;
 each check of the result carries its "output", and "outputs" gives each one's summary.
+hands=("left", "right"): history is a dict {hand: (H+1, 4, 4)} and the policy's dict holds one
+chunk per hand, each a "pose" output (verdicts per hand); the hands after the first are drawn
+as extra poses "hand:<name>" that move with g.
 )doc") +
        kSetupDoc)
           .c_str());
@@ -380,10 +385,10 @@ Every view in `views` must hold.
          py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
          const std::string& precision, py::handle noise, py::handle extra_poses, py::handle scalars,
          py::handle rng, py::handle reset, py::handle action_format, py::handle state_format,
-         py::handle outputs, HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle outputs, py::handle hands, HANDCENTRIC_SETUP_PARAMETERS) {
         assert_equivariant(std::move(policy), group, mode, views, cases, seed, tolerance, precision,
                            noise, extra_poses, scalars, rng, reset, action_format, state_format,
-                           outputs, HANDCENTRIC_SETUP_VALUE);
+                           outputs, hands, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("group"), py::kw_only(), py::arg("mode") = "pointwise",
       py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
@@ -391,14 +396,14 @@ Every view in `views` must hold.
       py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
       py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
-      py::arg("outputs") = py::none(), HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("outputs") = py::none(), py::arg("hands") = py::none(), HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Raise AssertionError unless policy(g o, n) = g policy(o, n) under `group`.
 
 The error carries the shrunk witness.
 mode "pointwise" (default: the same noise n for o and g o; Theorem 1's guarantee, which
 implies the law's), "distribution" (independent noise: the laws compared) or "both".
 Every view in `views` must hold, and with outputs= every output. rng=, reset=, action_format=,
-state_format= and outputs= as in audit_policy; a policy that draws its
+state_format=, outputs= and hands= as in audit_policy; a policy that draws its
 own random numbers without rng= raises OwnRandomnessError for "pointwise" and "both".
 )doc") +
        kSetupDoc)

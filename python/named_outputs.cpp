@@ -8,7 +8,7 @@ std::string to_string(OutputKind kind) {
   return kind == OutputKind::pose ? "pose" : "invariant";
 }
 
-std::vector<NamedOutput> outputs_from(py::handle outputs) {
+std::vector<NamedOutput> outputs_from(py::handle outputs, bool need_pose) {
   if (outputs.is_none()) return {};
   if (!py::isinstance<py::dict>(outputs)) {
     throw DtypeError(
@@ -38,7 +38,7 @@ std::vector<NamedOutput> outputs_from(py::handle outputs) {
     }
     out.push_back(output);
   }
-  if (!any_pose) {
+  if (need_pose && !any_pose) {
     throw InvalidArgument(
         "outputs= names no \"pose\" output; a policy's dict holds its chunk of "
         "poses beside its invariant outputs (e.g. {\"hand\": \"pose\", "

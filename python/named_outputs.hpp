@@ -29,9 +29,9 @@ struct NamedOutput {
 std::string to_string(OutputKind kind);
 
 /// outputs= checked: None gives none (the policy returns its chunk alone); else a dict
-/// {name: "pose" or "invariant"} with at least one pose entry, refused in one line naming the
-/// value otherwise.
-std::vector<NamedOutput> outputs_from(py::handle outputs);
+/// {name: "pose" or "invariant"}, with at least one pose entry when `need_pose` (not with hands=,
+/// which adds one per hand), refused in one line naming the value otherwise.
+std::vector<NamedOutput> outputs_from(py::handle outputs, bool need_pose);
 
 /// The entry `name` of a policy's result `result`, which must be a dict whose keys are exactly
 /// the names of `outputs` (a key outputs= does not name, or a name the dict lacks, is refused
