@@ -49,6 +49,7 @@
 #include "handcentric/props/verdict.hpp"
 #include "handcentric/sim/demos.hpp"
 #include "arrays.hpp"
+#include "closed_loop.hpp"
 #include "hands.hpp"
 #include "assertions.hpp"
 #include "callables.hpp"
@@ -118,7 +119,8 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
                       const std::string& precision, py::handle noise_length, py::handle extra_poses,
                       py::handle scalars, py::handle rng, py::handle reset,
                       py::handle action_format, py::handle state_format, py::handle outputs,
-                      py::handle hands, const Setup& setup) {
+                      py::handle hands, py::handle episodes, py::handle episode_length,
+                      const Setup& setup) {
   require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -131,9 +133,10 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   c.progress = std::ref(progress);
   o.call.outputs = outputs_from(outputs, hands.is_none());
   set_hands(o, c, hands);
+  const auto loop = closed_loop_from(episodes, episode_length);
   if (o.call.outputs.empty()) {
-    const props::Classification result =
-        props::classify_policy(batched_policy(policy, noise, o), c);
+    props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
+    if (loop) add_closed_loop(result, policy, noise, o, c, *loop);
     py::dict report = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
     add_inputs(report, o);
     return report;
@@ -146,8 +149,9 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   for (const NamedOutput& output : o.call.outputs) {
     CommonOptions one = o;
     one.call.output = output.name;
-    const props::Classification result =
-        props::classify_policy(batched_policy(policy, noise, one), c);
+    props::Classification result = props::classify_policy(batched_policy(policy, noise, one), c);
+    // The closed loop executes the first pose output: its verdicts go with that output's.
+    if (loop && report.empty()) add_closed_loop(result, policy, noise, o, c, *loop);
     py::dict part = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
     for (auto check : part["checks"]) {
       check["output"] = output.name;
@@ -317,10 +321,11 @@ rectified flow's (eq. 5).
          std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
          py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
          py::handle reset, py::handle action_format, py::handle state_format, py::handle outputs,
-         py::handle hands, HANDCENTRIC_SETUP_PARAMETERS) {
+         py::handle hands, py::handle episodes, py::handle episode_length,
+         HANDCENTRIC_SETUP_PARAMETERS) {
         return audit_policy(std::move(policy), groups, views, cases, seed, tolerance, precision,
                             noise, extra_poses, scalars, rng, reset, action_format, state_format,
-                            outputs, hands, HANDCENTRIC_SETUP_VALUE);
+                            outputs, hands, episodes, episode_length, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
       py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
@@ -328,7 +333,9 @@ rectified flow's (eq. 5).
       py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
       py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
-      py::arg("outputs") = py::none(), py::arg("hands") = py::none(), HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("outputs") = py::none(), py::arg("hands") = py::none(),
+      py::arg("episodes") = py::none(), py::arg("episode_length") = py::none(),
+      HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
 Returns one policy of `audit --json`.
@@ -349,6 +356,10 @@ each check of the result carries its "output", and "outputs" gives each one's su
 hands=("left", "right"): history is a dict {hand: (H+1, 4, 4)} and the policy's dict holds one
 chunk per hand, each a "pose" output (verdicts per hand); the hands after the first are drawn
 as extra poses "hand:<name>" that move with g.
+episodes=N, episode_length=T (default 16): closed-loop checks too (mode "closed_loop"): for
+each group and view, N episodes, each two rollouts of T steps from o and g o with the same noise,
+reset= called once at the start of each (the policy keeps its state through the episode), the
+first pose of each answer executed; the executed poses must agree with g step by step.
 )doc") +
        kSetupDoc)
           .c_str());

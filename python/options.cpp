@@ -58,14 +58,13 @@ int cases_of(py::handle cases) {
   return bounded_integer(cases, "cases", 1, props::kMaxCases, "handcentric.MAX_CASES");
 }
 
-/// An optional integer keyword in [low, high] (None: not given).
+}  // namespace
+
 std::optional<int> optional_integer(py::handle value, const char* name, long long low,
                                     long long high, const char* bound) {
   if (value.is_none()) return std::nullopt;
   return bounded_integer(value, name, low, high, bound);
 }
-
-}  // namespace
 
 /// ImportError, at once, unless NumPy imports: every argument of a callable under audit is a
 /// NumPy array, and without NumPy no case could run (an audit used to report every cell failed

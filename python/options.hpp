@@ -87,6 +87,11 @@ void require_numpy(const char* function);
 /// `noise` in [1, MAX_NOISE].
 int noise_of(py::handle noise);
 
+/// An optional integer keyword `name` in [low, high] (None: not given); ValueError / TypeError
+/// naming the value and `bound` (how the caller spells the upper bound).
+std::optional<int> optional_integer(py::handle value, const char* name, long long low,
+                                    long long high, const char* bound);
+
 /// The camera rig of cameras=, image_size=, channels= and floor= (None when cameras=None), its
 /// images per batch bounded (2**26 float32 numbers) before anything is allocated.
 std::shared_ptr<const props::CameraRig> camera_rig_of(const Setup& setup,

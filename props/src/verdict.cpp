@@ -66,7 +66,15 @@ std::string to_string(Component component) {
 }
 
 std::string to_string(Mode mode) {
-  return mode == Mode::pointwise ? "pointwise" : "distribution";
+  switch (mode) {
+    case Mode::pointwise:
+      return "pointwise";
+    case Mode::distribution:
+      return "distribution";
+    case Mode::closed_loop:
+      return "closed_loop";
+  }
+  return "pointwise";
 }
 
 std::vector<View> parse_views(const std::vector<std::string>& names, const std::string& option,

@@ -28,7 +28,8 @@ enum class Component { actions, observation, flow_input, flow_target, policy };
 /// pointwise: f(g * s) = f(s) for each case, with fixed noise eps and time t.
 /// distribution: the law of f(s, eps), eps ~ N(0, I), equals the law of f(g * s, eps)
 /// (distribution.hpp says how that is decided).
-enum class Mode { pointwise, distribution };
+/// closed_loop: a stateful policy's executed poses over whole episodes (checks/closed_loop.hpp).
+enum class Mode { pointwise, distribution, closed_loop };
 
 /// How an in-distribution verdict was decided (pointwise checks compare values: `compared`).
 ///   exact_gaussian: the component is affine in eps on every case (checked), so its law is the
@@ -43,7 +44,7 @@ enum class Method { compared, exact_gaussian, energy_test, partly_exact };
 
 /// "actions", "observation", "flow_input", "flow_target", "policy".
 std::string to_string(Component component);
-/// "pointwise", "distribution".
+/// "pointwise", "distribution", "closed_loop".
 std::string to_string(Mode mode);
 /// The views `names` name, each "eye_in_hand" or "third_person", or "all" for both; InvalidArgument
 /// naming the option `option` ("views", "view") in the caller's spelling for an unknown name or

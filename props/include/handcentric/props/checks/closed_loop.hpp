@@ -1,0 +1,43 @@
+#pragma once
+// The closed-loop audit of a policy that keeps state between calls (an action queue, temporal
+// ensembling, an observation buffer): is the executed trajectory of g o_1..g o_T the g-image of
+// that of o_1..o_T?
+//
+// An episode: a scene drawn as the checks draw theirs (its hand history, and its points as
+// objects fixed in the world: the world points, and the eye-in-hand points placed in the world at
+// T_0), and a g of the group. Two rollouts of T steps each, each started afresh
+// (ClosedLoopOptions::start_episode, e.g. the policy's reset): one from the scene, one from g
+// times it. At each step the policy is asked once (past any cache: its state is the point) with
+// the step's noise, the same on both sides; the first pose of what it returns is executed: the
+// hand moves there, the history takes it as T_0, and the eye-in-hand points are the objects seen
+// from the new hand frame (the world points, in the third-person view, stay as they are). The
+// executed poses are compared step by step, B_t against g A_t, by |R_a - R_b|_F + |p_a - p_b|,
+// within REL (1 + L) with L the largest translation of either rollout and its scene; a larger
+// difference that is at most 8 times the rollout's own response to a rounding-level
+// perturbation of its scene (and that response rounding-sized) is rounding, as in check.hpp.
+// A "yes" says so for the episodes run: a breaking that needs more steps, or a state the
+// episodes never reach, is not seen (the verdict's cases are its episodes).
+#include <functional>
+
+#include "handcentric/props/checks/check.hpp"
+#include "handcentric/props/noisy_policy.hpp"
+#include "handcentric/props/verdict.hpp"
+
+namespace handcentric::props {
+
+struct ClosedLoopOptions {
+  int episodes = 20;  ///< 1 to kMaxCases
+  int steps = 16;     ///< the episode's length T, 1 to 10000
+  /// Called before each rollout (the policy's reset); may be empty.
+  std::function<void()> start_episode;
+};
+
+/// The closed-loop verdict of `policy` under `group` (mode closed_loop, component policy): its
+/// cases are the episodes with g far from the identity; a failure's witness is the episode's
+/// scene and g, before/after g A_t and B_t flattened as [p, r(R)] at the first step that
+/// differs, its detail naming the episode and the step. InvalidArgument for episodes or steps
+/// out of range.
+Verdict check_policy_closed_loop(const NoisyPolicy& policy, Group group,
+                                 const CheckOptions& options, const ClosedLoopOptions& loop);
+
+}  // namespace handcentric::props
