@@ -354,6 +354,26 @@ def test_the_table_and_the_json_name_the_break():
     assert back["first_break"] == "fc2" and back["modules"][2]["name"] == "fc2"
 
 
+WORLD_BIAS_POLICY = MlpPolicy("world_bias")
+UNNORMALIZED = HAND_CENTRIC + [("unnormalize", unnormalize_world)]
+CLI_OPTIONS = ["--group", "se3", "--cases", "6", "--batch-size", "8", "--array", "torch",
+               "--history", str(H), "--hand-points", str(POINTS), "--noise", str(NOISE),
+               "--quiet"]
+
+
+def test_python_m_handcentric_locate_prints_the_table_and_the_json(capsys):
+    from handcentric import __main__ as cli
+    assert cli.main(["locate", "test_locate:WORLD_BIAS_POLICY", "--module", "net"]
+                    + CLI_OPTIONS) == 0
+    assert ">> fc2[0]" in capsys.readouterr().out
+    assert cli.main(["locate", "test_locate:UNNORMALIZED", "--kinds", "poses,poses,poses,"
+                     "poses,poses", "--json"] + CLI_OPTIONS) == 0
+    assert json.loads(capsys.readouterr().out)["first_break"] == "unnormalize"
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["locate", "test_locate:WORLD_BIAS_POLICY"] + CLI_OPTIONS)
+    assert stop.value.code == 2 and "--module" in capsys.readouterr().err
+
+
 # Bad input: one line naming the value.
 
 def one_line(excinfo):
