@@ -1,9 +1,11 @@
 #pragma once
-// The audit's own cases asked of a policy for handcentric.locate (python/handcentric/locate.py),
-// which watches the policy's insides (a torch module's submodules, a pipeline's stages) while the
-// policy answers them. The cases (scene o, g), the noise, the rounding perturbations, the calls
-// (arrays, batches, cameras, rng=, reset=) are those of audit_policy with the same arguments:
-// drawn by props::drawn_cases from the same options, asked through the same PythonPolicy.
+// The questions handcentric.locate and handcentric.lie_derivatives ask of a policy while they
+// watch its insides (a torch module's submodules, a pipeline's stages;
+// python/handcentric/locate.py). The scenes are the audit's own: locate's the cases of a
+// pointwise check (props::drawn_cases), the Lie derivative's the profiles' scenes
+// (props::profile_cases), both from the audit's options; the noise, the rounding perturbations
+// and the calls (arrays, batches, cameras, rng=, reset=) are those of audit_policy with the same
+// arguments, asked through the same PythonPolicy.
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
@@ -38,5 +40,17 @@ py::dict locate_cases(py::object policy, py::object on_ask, const std::string& g
                       std::optional<double> tolerance, const std::string& precision,
                       py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
                       py::handle reset, const Setup& setup);
+
+/// The questions of a layerwise Lie derivative at the identity (docs/AUDIT.md, "Profiles"): the
+/// profile's scenes for `group` in `view` (props::profile_cases on the audit's setup, `scenes`
+/// of them from `seed`, each with its unit axis and direction), asked moved by the transforms
+/// of size +step and -step along them (props::profile_transform), batch by batch: on_ask("plus",
+/// case_numbers, about) and then on_ask("minus", ...), `about` a list of {g, length_scale} per
+/// scene. Returns the policy's name, group, view, seed, step, scenes and unit_roundoff.
+py::dict lie_derivative_cases(py::object policy, py::object on_ask, const std::string& group,
+                              const std::string& view, int scenes, std::uint64_t seed, double step,
+                              const std::string& precision, py::handle noise,
+                              py::handle extra_poses, py::handle scalars, py::handle rng,
+                              py::handle reset, const Setup& setup);
 
 }  // namespace handcentric::python

@@ -398,6 +398,24 @@ policy's fixed noise and the laws' samples.
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
       HANDCENTRIC_SETUP_ARGUMENTS,
       "The audit's pointwise cases asked of a policy for handcentric.locate (python/locate.hpp).");
+  m.def(
+      "_lie_derivative_cases",
+      [](py::object policy, py::object on_ask, const std::string& group, const std::string& view,
+         int scenes, std::uint64_t seed, double step, const std::string& precision,
+         py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
+         py::handle reset, HANDCENTRIC_SETUP_PARAMETERS) {
+        return lie_derivative_cases(std::move(policy), std::move(on_ask), group, view, scenes, seed,
+                                    step, precision, noise, extra_poses, scalars, rng, reset,
+                                    HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("policy"), py::arg("on_ask"), py::kw_only(), py::arg("group") = "se3",
+      py::arg("view") = "eye_in_hand", py::arg("scenes") = 16, py::arg("seed") = 1,
+      py::arg("step") = 1e-3, py::arg("precision") = "float64",
+      py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
+      py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      HANDCENTRIC_SETUP_ARGUMENTS,
+      "The questions of handcentric.lie_derivatives: the profile's scenes moved by +-step "
+      "(python/locate.hpp).");
 #undef HANDCENTRIC_SETUP_PARAMETERS
 #undef HANDCENTRIC_SETUP_VALUE
 #undef HANDCENTRIC_SETUP_ARGUMENTS

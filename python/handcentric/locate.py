@@ -101,16 +101,16 @@ class _Recorder:
         self.counts = {}
         self.reduce = None  # called with the asks of one batch once it is complete
         self.rules = None  # called with the tolerance rules before the first question
-        self.about = {}  # case -> {g, length_scale, near_identity}
+        self.about = {}  # (label, case) -> {g, length_scale, ...} of the questions that say
 
     def on_ask(self, label, cases, about):
         if label == "rules":
             self.rules(about)
             return
-        if label == "o":
+        if label in ("o", "plus"):  # the first question of a batch: the one before is done
             self.flush()
-            for case, c in zip(cases, about):
-                self.about[case] = c
+        for case, c in zip(cases, about or ()):
+            self.about[label, case] = c
         self.asks.append(_Ask(label, cases))
 
     def flush(self):
@@ -270,7 +270,7 @@ class _Decider:
     """Decides every watched output, batch by batch, as the audit decides a pointwise case."""
 
     def __init__(self, about, kinds_of, describe):
-        self.about = about  # case -> {g, length_scale, near_identity}
+        self.about = about  # ("o", case) -> {g, length_scale, near_identity}
         self.kinds_of = kinds_of
         self.describe = describe
         self.rel = self.u = self.multiple = self.coupling = None
@@ -315,8 +315,8 @@ class _Decider:
             by_label.setdefault(ask.label, []).append(ask)
         (o,), (g_o,) = by_label["o"], by_label["g_o"]
         for case in o.cases:
-            g = np.asarray(self.about[case]["g"])
-            L = float(self.about[case]["length_scale"])
+            g = np.asarray(self.about["o", case]["g"])
+            L = float(self.about["o", case]["length_scale"])
             a_rows, b_rows = o.rows[case], g_o.rows[case]
             for key in list(a_rows) + [k for k in b_rows if k not in a_rows]:
                 row = self.row(key)
@@ -389,101 +389,200 @@ def locate(policy=None, module=None, *, stages=None, kinds=None, group="se3", vi
     kind's, its name, or None), "witness" (that row's case, g, error, tolerance), "chunk" (the
     policy's own pointwise verdict on the same cases) and the rules used ("tolerance").
     """
-    np = _np()
-    if (stages is None) == (module is None):
-        raise ValueError("locate takes module= (a torch module the policy calls) or stages= (a "
-                         "list of (name, callable)), exactly one of them")
-    if stages is not None:
-        if policy is not None:
-            raise ValueError("locate(stages=...) builds the policy from its stages: leave the "
-                             "policy out")
-        stages = list(stages)
-        names = []
-        for item in stages:
-            if (not isinstance(item, (tuple, list)) or len(item) != 2
-                    or not isinstance(item[0], str) or not callable(item[1])):
-                raise TypeError("stages must be (name, callable) pairs, got %r" % (item,))
-            if item[0] in names:
-                raise ValueError("stages: the name %r is used twice" % item[0])
-            names.append(item[0])
-        if not names:
-            raise ValueError("stages is empty: give at least one (name, callable)")
-        if isinstance(kinds, (list, tuple)):
-            if len(kinds) != len(names):
-                raise ValueError("kinds has %d entries for %d stages" % (len(kinds), len(names)))
-            kinds = dict(zip(names, kinds))
-        kinds = dict(kinds or {})
-        for name in kinds:
-            if name not in names:
-                raise ValueError("kinds names %r, which is not a stage (stages: %s)"
-                                 % (name, ", ".join(names)))
-        known = names
-        what = "stage"
-    else:
-        if not callable(policy):
-            raise TypeError("policy must be callable, got a %s" % type(policy).__name__)
-        if not hasattr(module, "named_modules") or not hasattr(module, "register_forward_hook"):
-            raise TypeError("module must be a torch.nn.Module, got a %s" % type(module).__name__)
-        known = [name for name, _ in module.named_modules()]
-        kinds = dict(kinds or {})
-        for name in kinds:
-            if name not in known:
-                raise ValueError("kinds names %r, which is not a submodule of %s (see its "
-                                 "named_modules())" % (name, type(module).__name__))
-        what = "module"
-    for name, kind in kinds.items():
-        _check_kind(kind, "%s %r" % (what, name))
+    watch = _Watch(policy, module, stages, kinds, setup, "locate")
+    decider = _Decider(watch.recorder.about, watch.kind_of, watch.describe)
+    watch.recorder.reduce = decider  # each batch decided once answered, its arrays then dropped
+    watch.recorder.rules = decider.set_rules
+    asked = watch.run(_core._locate_cases, group=group, view=view, cases=cases, seed=seed,
+                      tolerance=tolerance, precision=precision, noise=noise,
+                      extra_poses=extra_poses, scalars=scalars, rng=rng, reset=reset, **setup)
+    return _result(asked, watch.recorder.order, decider, watch.what)
 
-    def describe(key):
+
+class _Watch:
+    """The policy with its insides watched: module= (a forward hook on every submodule) or
+    stages= (the pipeline run stage by stage), `kinds` checked, every output recorded by a
+    _Recorder while the audit's questions are asked."""
+
+    def __init__(self, policy, module, stages, kinds, setup, caller):
+        if (stages is None) == (module is None):
+            raise ValueError("%s takes module= (a torch module the policy calls) or stages= (a "
+                             "list of (name, callable)), exactly one of them" % caller)
+        self.module = module
+        if stages is not None:
+            if policy is not None:
+                raise ValueError("%s(stages=...) builds the policy from its stages: leave the "
+                                 "policy out" % caller)
+            self.stages = list(stages)
+            names = []
+            for item in self.stages:
+                if (not isinstance(item, (tuple, list)) or len(item) != 2
+                        or not isinstance(item[0], str) or not callable(item[1])):
+                    raise TypeError("stages must be (name, callable) pairs, got %r" % (item,))
+                if item[0] in names:
+                    raise ValueError("stages: the name %r is used twice" % item[0])
+                names.append(item[0])
+            if not names:
+                raise ValueError("stages is empty: give at least one (name, callable)")
+            if isinstance(kinds, (list, tuple)):
+                if len(kinds) != len(names):
+                    raise ValueError("kinds has %d entries for %d stages"
+                                     % (len(kinds), len(names)))
+                kinds = dict(zip(names, kinds))
+            self.kinds = dict(kinds or {})
+            for name in self.kinds:
+                if name not in names:
+                    raise ValueError("kinds names %r, which is not a stage (stages: %s)"
+                                     % (name, ", ".join(names)))
+            self.what = "stage"
+        else:
+            if not callable(policy):
+                raise TypeError("policy must be callable, got a %s" % type(policy).__name__)
+            if (not hasattr(module, "named_modules")
+                    or not hasattr(module, "register_forward_hook")):
+                raise TypeError("module must be a torch.nn.Module, got a %s"
+                                % type(module).__name__)
+            known = [name for name, _ in module.named_modules()]
+            self.kinds = dict(kinds or {})
+            for name in self.kinds:
+                if name not in known:
+                    raise ValueError("kinds names %r, which is not a submodule of %s (see its "
+                                     "named_modules())" % (name, type(module).__name__))
+            self.what = "module"
+            self.policy = policy
+        for name, kind in self.kinds.items():
+            _check_kind(kind, "%s %r" % (self.what, name))
+        self.recorder = _Recorder(setup.get("batch_size") is not None,
+                                  strict_rows=stages is not None, describe=self.describe)
+
+    def kind_of(self, name):
+        return self.kinds.get(name, "features")
+
+    def describe(self, key):
         name, call = key
-        return "%s %r%s" % (what, name, " (call %d)" % call if call else "")
+        return "%s %r%s" % (self.what, name, " (call %d)" % call if call else "")
 
-    stacked = setup.get("batch_size") is not None
-    recorder = _Recorder(stacked, strict_rows=stages is not None, describe=describe)
-    handles = []
-    if stages is not None:
-        def answer(*args, **kwargs):
-            value = stages[0][1](*args, **kwargs)
-            recorder.record(stages[0][0], value)
-            for name, stage in stages[1:]:
-                value = _spread(stage, value)
-                recorder.record(name, value)
-            return value
-        answer.__qualname__ = "stages " + " > ".join(names)
-        inner = answer
-    else:
-        inner = policy
-        for name, sub in module.named_modules():
-            def hook(_module, _inputs, output, name=name):
-                recorder.record(name, output)
-            handles.append(_register_hook(sub, name, hook))
+    def run(self, questions, **options):
+        """questions(watched policy, on_ask, **options), the hooks on only while it runs."""
+        recorder = self.recorder
+        handles = []
+        if self.what == "stage":
+            stages = self.stages
 
-    def watched(*args, **kwargs):
-        recorder.begin_call(args, kwargs)
+            def answer(*args, **kwargs):
+                value = stages[0][1](*args, **kwargs)
+                recorder.record(stages[0][0], value)
+                for name, stage in stages[1:]:
+                    value = _spread(stage, value)
+                    recorder.record(name, value)
+                return value
+            answer.__qualname__ = "stages " + " > ".join(name for name, _ in stages)
+            inner = answer
+        else:
+            inner = self.policy
+            for name, sub in self.module.named_modules():
+                def hook(_module, _inputs, output, name=name):
+                    recorder.record(name, output)
+                handles.append(_register_hook(sub, name, hook))
+
+        def watched(*args, **kwargs):
+            recorder.begin_call(args, kwargs)
+            try:
+                return inner(*args, **kwargs)
+            finally:
+                recorder.end_call()
+        watched.__qualname__ = getattr(inner, "__qualname__", type(inner).__qualname__)
         try:
-            return inner(*args, **kwargs)
+            asked = questions(watched, recorder.on_ask, **options)
+            recorder.flush()
         finally:
-            recorder.end_call()
-    watched.__qualname__ = getattr(inner, "__qualname__", type(inner).__qualname__)
+            for handle in handles:
+                handle.remove()
+        if self.what == "module" and not recorder.order:
+            raise ValueError(
+                "module=%s was not called while the policy %s answered: it is not part of the "
+                "policy's forward pass (pass the torch module the policy calls)"
+                % (type(self.module).__name__, asked["policy"]))
+        return asked
 
-    decider = _Decider(recorder.about, lambda name: kinds.get(name, "features"), describe)
-    recorder.reduce = decider  # each batch decided once answered, its arrays then dropped
-    recorder.rules = decider.set_rules
-    try:
-        asked = _core._locate_cases(
-            watched, recorder.on_ask, group=group, view=view, cases=cases, seed=seed,
-            tolerance=tolerance, precision=precision, noise=noise, extra_poses=extra_poses,
-            scalars=scalars, rng=rng, reset=reset, **setup)
-        recorder.flush()
-    finally:
-        for handle in handles:
-            handle.remove()
-    if module is not None and not recorder.order:
-        raise ValueError(
-            "module=%s was not called while the policy %s answered: it is not part of the "
-            "policy's forward pass (pass the torch module the policy calls)"
-            % (type(module).__name__, asked["policy"]))
-    return _result(asked, recorder.order, decider, what)
+
+def _undo(g, leaves):
+    """g^-1 applied to the poses among an output's arrays (the others kept)."""
+    np = _np()
+    inverse = np.linalg.inv(g)
+    return [np.matmul(inverse, x) if _is_poses(x) else x for x in leaves]
+
+
+class _Slopes:
+    """The layerwise Lie derivative at the identity, batch by batch: per output and scene,
+    D(a(g_h o), a(g_-h o)) / (2 h (1 + c)), as the profiles compute a policy's slope."""
+
+    def __init__(self, about, kind_of, step):
+        self.about, self.kind_of, self.step = about, kind_of, step
+        self.slopes = {}  # key -> [slope per scene]
+
+    def __call__(self, asks):
+        np = _np()
+        by_label = {ask.label: ask for ask in asks}
+        plus, minus = by_label["plus"], by_label["minus"]
+        for case in plus.cases:
+            g_plus = np.asarray(self.about["plus", case]["g"])
+            g_minus = np.asarray(self.about["minus", case]["g"])
+            L = max(self.about["plus", case]["length_scale"],
+                    self.about["minus", case]["length_scale"])
+            a_rows, b_rows = plus.rows[case], minus.rows[case]
+            for key in list(a_rows) + [k for k in b_rows if k not in a_rows]:
+                slopes = self.slopes.setdefault(key, [])
+                if key not in a_rows or key not in b_rows:
+                    slopes.append(float("inf"))
+                    continue
+                a, b = a_rows[key], b_rows[key]
+                if self.kind_of(key[0]) == "poses":
+                    # g_h^-1 A(g_h o) against g_-h^-1 A(g_-h o): 0 for an equivariant output.
+                    a, b = _undo(g_plus, a), _undo(g_minus, b)
+                    scale = _largest([L] + [_pose_reach(a), _pose_reach(b)])
+                    d = _difference(a, b, poses=True)
+                else:
+                    scale = _largest([_inf_norm(a), _inf_norm(b)])
+                    d = _difference(a, b)
+                slopes.append(_largest([d / (2.0 * self.step * (_SCALE_FLOOR + scale))]))
+
+
+def lie_derivatives(policy=None, module=None, *, stages=None, kinds=None, group="se3",
+                    view="eye_in_hand", scenes=16, seed=1, step=1e-3, precision="float64",
+                    noise=256, extra_poses=(), scalars=(), rng=None, reset=None, **setup):
+    """The layerwise Lie derivative at the identity (Gruver et al. 2023) of every module or
+    stage that locate() watches (the same module=, stages= and kinds=): on the profiles' scenes
+    (docs/AUDIT.md, "Profiles": `scenes` scenes from `seed`, each with its unit generator X),
+    the central difference |a(exp(hX) o) - a(exp(-hX) o)|_inf / (2 h (1 + c)) of each output
+    (for "poses" outputs, exp(-+hX) A(exp(+-hX) o) compared pose by pose), c the output's size.
+    Returns {"modules": [{name, call, kind, median, max, moves}], "first_moving": name or None,
+    ...}: a row moves when its largest slope is above sqrt(u) (a central difference of rounding
+    is about u (1 + c) / h, 1e-13 at float64 with h = 1e-3)."""
+    watch = _Watch(policy, module, stages, kinds, setup, "lie_derivatives")
+    slopes = _Slopes(watch.recorder.about, watch.kind_of, step)
+    watch.recorder.reduce = slopes
+    asked = watch.run(_core._lie_derivative_cases, group=group, view=view, scenes=scenes,
+                      seed=seed, step=step, precision=precision, noise=noise,
+                      extra_poses=extra_poses, scalars=scalars, rng=rng, reset=reset, **setup)
+    np = _np()
+    floor = asked["unit_roundoff"] ** 0.5
+    rows = []
+    for key in watch.recorder.order:
+        values = slopes.slopes.get(key, [])
+        if not values:
+            continue
+        largest = _largest(values)
+        rows.append(OrderedDict(name=key[0], call=key[1], kind=watch.kind_of(key[0]),
+                                median=float(np.median(values)), max=largest,
+                                moves=not (largest <= floor)))
+    first = next((r for r in rows if r["moves"]), None)
+    out = OrderedDict((k, asked[k]) for k in ("policy", "group", "view", "seed", "step",
+                                                "scenes"))
+    out["floor"] = floor
+    out["modules"] = rows
+    out["first_moving"] = first["name"] if first is not None else None
+    return out
 
 
 def _register_hook(module, name, hook):

@@ -3,8 +3,10 @@ hundred weights) with one planted fault each, located at the module or stage tha
 a world-frame bias added in the second layer, a normalizer fit in world coordinates placed
 before the hand frame, an encoder branch on a camera fixed in the world, batch norm in training
 mode, an un-normalizer that adds the world mean back after the decoder; a block called at every
-sampling step gets a row per call. Mutant twins (test_mutant_*): a hook that skips a module, a
-stage marked with the wrong kind. Bad input: one line naming the value."""
+sampling step gets a row per call. The layerwise Lie derivative at the identity agrees on
+every fault but batch norm. Mutant twins (test_mutant_*): a hook that skips a module, a stage
+marked with the wrong kind, a Lie derivative that does not move the poses back. Bad input: one
+line naming the value."""
 import importlib
 import json
 
@@ -372,6 +374,67 @@ def test_python_m_handcentric_locate_prints_the_table_and_the_json(capsys):
     with pytest.raises(SystemExit) as stop:
         cli.main(["locate", "test_locate:WORLD_BIAS_POLICY"] + CLI_OPTIONS)
     assert stop.value.code == 2 and "--module" in capsys.readouterr().err
+
+
+# Beside the Lie derivative: the same models, the layerwise slope at the identity along the
+# profiles' generators.
+
+def planted(fault):
+    """(policy or None, module or None, stages or None, kinds, extra keywords) of a fault."""
+    if fault in ("hand_centric", "world_bias", "batch_norm"):
+        policy = MlpPolicy(None if fault == "hand_centric" else fault)
+        return dict(policy=policy, module=policy.net), {}
+    if fault == "camera":
+        policy = CameraPolicy()
+        return dict(policy=policy, module=policy.net), dict(
+            view="third_person", world_points=2, cameras=("eye_in_hand", "third_person"),
+            image_size=(32, 24), channels="depth")
+    if fault == "normalize":
+        stages = [("normalize", normalize_world)] + [s for s in HAND_CENTRIC
+                                                     if s[0] != "normalize"]
+    elif fault == "unnormalize":
+        stages = UNNORMALIZED
+    else:
+        stages = HAND_CENTRIC
+    return dict(stages=stages, kinds=["poses"] * len(stages)), {}
+
+
+def both_ways(fault):
+    target, extra = planted(fault)
+    options = dict(SHAPES, group="se3", batch_size=8, array="torch", **extra)
+    with torch.no_grad():
+        located = handcentric.locate(cases=6, **target, **options)
+        slopes = handcentric.lie_derivatives(scenes=6, **target, **options)
+    return located, slopes
+
+
+def agree(located, slopes):
+    """The first break is the first output whose slope is not zero, and the outputs that break
+    are those whose slope is not zero."""
+    broken = [(r["name"], r["call"]) for r in located["modules"] if r["breaks"]]
+    moving = [(r["name"], r["call"]) for r in slopes["modules"] if r["moves"]]
+    return located["first_break"] == slopes["first_moving"] and broken == moving
+
+
+@pytest.mark.parametrize("fault", ["hand_centric", "hand_centric_stages", "world_bias",
+                                   "normalize", "unnormalize", "camera"])
+def test_the_layerwise_lie_derivative_agrees_on_every_planted_fault(fault):
+    located, slopes = both_ways(fault)
+    assert agree(located, slopes)
+    assert [r["name"] for r in located["modules"]] == [r["name"] for r in slopes["modules"]]
+
+
+def test_batch_norm_coupling_is_where_the_two_disagree():
+    located, slopes = both_ways("batch_norm")
+    assert located["first_break"] == "bn" and slopes["first_moving"] is None
+    assert max(r["max"] for r in slopes["modules"]) < 1e-9
+
+
+def test_mutant_a_lie_derivative_that_does_not_move_the_poses_back_disagrees(monkeypatch):
+    monkeypatch.setattr(locate_module, "_undo", lambda g, leaves: leaves)
+    located, slopes = both_ways("hand_centric_stages")
+    assert not agree(located, slopes)
+    assert slopes["first_moving"] == "to_hand"  # it passes T_0 on: moves with g
 
 
 # Bad input: one line naming the value.
