@@ -195,6 +195,39 @@ def test_batch_norm_in_training_mode_is_named_as_coupling_the_rows():
                                  array="torch", **SHAPES)
 
 
+class DrawsItsOwnNoise(MlpPolicy):
+    """Adds torch.randn to the hidden layer (as a sampler that draws its own noise does)."""
+
+    def __init__(self):
+        super().__init__()
+        self.net.act1.register_forward_hook(lambda m, i, out: out + 0.1 * torch.randn_like(out))
+
+
+def test_a_policy_that_draws_its_own_noise_is_seeded_alike_for_o_and_g_o():
+    policy = DrawsItsOwnNoise()
+    assert run(policy, rng="torch")["first_break"] is None
+    unseeded = run(policy)  # other draws for g o than for o: act1 is where they enter
+    assert unseeded["first_break"] == "act1"
+
+
+def test_a_float32_pipeline_holds_at_float32_rounding_and_not_at_float64s():
+    """The hand frame taken in float32: o and g o differ by float32 rounding (1e-7 relative),
+    which the float64 floor calls a break at the first layer and precision="float32" does not:
+    the audit's own rule (docs/AUDIT.md, "Tolerances and rounding")."""
+    net = Mlp().float()
+
+    def policy(history, hand_points, world_points, noise):
+        x = hand_frame(history.float(), hand_points.float(), noise.float())
+        return decode(history[:, 0], net(x, None).double())
+
+    with torch.no_grad():
+        assert handcentric.locate(policy, module=net, precision="float32", group="se3", cases=6,
+                                  batch_size=8, array="torch", **SHAPES)["first_break"] is None
+        at_float64 = handcentric.locate(policy, module=net, group="se3", cases=6, batch_size=8,
+                                        array="torch", **SHAPES)
+    assert at_float64["first_break"] == "fc1" and at_float64["modules"][0]["error"] < 1e-6
+
+
 class TwoCameras(torch.nn.Module):
     """An encoder per camera, their features joined: the hand camera's branch sees an image
     that g leaves alone, the world camera's one that g moves."""
