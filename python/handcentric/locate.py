@@ -389,6 +389,7 @@ def locate(policy=None, module=None, *, stages=None, kinds=None, group="se3", vi
     kind's, its name, or None), "witness" (that row's case, g, error, tolerance), "chunk" (the
     policy's own pointwise verdict on the same cases) and the rules used ("tolerance").
     """
+    _one_group_and_view(group, view)
     watch = _Watch(policy, module, stages, kinds, setup, "locate")
     decider = _Decider(watch.recorder.about, watch.kind_of, watch.describe)
     watch.recorder.reduce = decider  # each batch decided once answered, its arrays then dropped
@@ -397,6 +398,12 @@ def locate(policy=None, module=None, *, stages=None, kinds=None, group="se3", vi
                       tolerance=tolerance, precision=precision, noise=noise,
                       extra_poses=extra_poses, scalars=scalars, rng=rng, reset=reset, **setup)
     return _result(asked, watch.recorder.order, decider, watch.what)
+
+
+def _one_group_and_view(group, view):
+    if not isinstance(group, str) or not isinstance(view, str):
+        raise ValueError("locate looks at one group and one view at a time, got group=%r and "
+                         "view=%r" % (group, view))
 
 
 class _Watch:
@@ -559,6 +566,7 @@ def lie_derivatives(policy=None, module=None, *, stages=None, kinds=None, group=
     Returns {"modules": [{name, call, kind, median, max, moves}], "first_moving": name or None,
     ...}: a row moves when its largest slope is above sqrt(u) (a central difference of rounding
     is about u (1 + c) / h, 1e-13 at float64 with h = 1e-3)."""
+    _one_group_and_view(group, view)
     watch = _Watch(policy, module, stages, kinds, setup, "lie_derivatives")
     slopes = _Slopes(watch.recorder.about, watch.kind_of, step)
     watch.recorder.reduce = slopes
@@ -663,8 +671,13 @@ def locate_text(result):
             mark, width, label, r["kind"], r["verdict"], _number(r["error"]),
             "" if r["case"] is None else r["case"]))
     if first is not None:
-        lines.append("witness: case %d, g = %s, error %s (divided by 1 + the output's size)" % (
-            first["case"], " ".join("%.6g" % x for x in first["g"][:12]), _number(first["error"])))
+        np = _np()
+        g = np.asarray(first["g"]).reshape(4, 4)
+        vector = lambda v: "[%s]" % ", ".join("%.6g" % x for x in v)  # noqa: E731
+        lines.append("witness: %s[%d] in case %d, g: r = %s, p = %s; error %s (divided by 1 + "
+                     "the output's size)" % (first["name"] or "(root)", first["call"],
+                                             first["case"], vector(_core.so3_log(g[:3, :3])),
+                                             vector(g[:3, 3]), _number(first["error"])))
     chunk = result["chunk"]
     lines.append("the policy's chunk: %s (error %s%s)" % (
         "equivariant" if chunk["equivariant"] else "NOT equivariant", _number(chunk["error"]),

@@ -383,7 +383,7 @@ def test_an_unnormalizer_adding_the_world_mean_after_the_decoder_is_located():
 def test_the_table_and_the_json_name_the_break():
     result = run(MlpPolicy("world_bias"))
     text = handcentric.locate_text(result)
-    assert ">> fc2[0]" in text and "neither" in text and "witness: case 1" in text
+    assert ">> fc2[0]" in text and "neither" in text and "witness: fc2[0] in case 1, g: r = [" in text
     assert "NOT equivariant" in text
     back = json.loads(handcentric.locate_json(result))
     assert back["first_break"] == "fc2" and back["modules"][2]["name"] == "fc2"
@@ -492,6 +492,18 @@ def test_an_unknown_kind_or_module_is_refused(kinds, message):
     with pytest.raises(ValueError, match=message) as e:
         handcentric.locate(policy, module=policy.net, kinds=kinds, cases=2, array="torch",
                            **SHAPES)
+    assert one_line(e)
+
+
+@pytest.mark.parametrize("kw, message", [
+    (dict(group="se4"), "se4"),
+    (dict(group="all"), "one group and one view"),
+    (dict(view=("eye_in_hand", "third_person")), "one group and one view"),
+])
+def test_a_bad_group_or_view_is_refused_in_one_line(kw, message):
+    policy = MlpPolicy()
+    with pytest.raises(ValueError, match=message) as e:
+        handcentric.locate(policy, module=policy.net, cases=2, array="torch", **SHAPES, **kw)
     assert one_line(e)
 
 
