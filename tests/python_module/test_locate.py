@@ -141,16 +141,30 @@ def test_mutant_a_hook_that_skips_a_module_misplaces_the_break(monkeypatch):
     assert not world_bias_is_located()
 
 
+class FarFromTheOrigin(MlpPolicy):
+    """Pushed 1 cm along world x when the hand is more than 2 m out along x: broken only on
+    some of the cases, so the number of the first broken case says whose cases they are."""
+
+    @torch.no_grad()
+    def __call__(self, history, hand_points, world_points, noise):
+        chunk = super().__call__(history, hand_points, world_points, noise).clone()
+        chunk[:, :, 0, 3] += 0.01 * (history[:, 0, 0, 3] > 2.0).double()[:, None]
+        return chunk
+
+
 def test_the_cases_are_the_audits_own():
     """The policy's own verdict on locate's cases breaks at the case where audit_policy's
-    pointwise check first fails, with the same seed (the audit's numbering, from 1)."""
-    policy = MlpPolicy("world_bias")
-    audit = handcentric.audit_policy(policy, groups="rotation", views="eye_in_hand", cases=20,
-                                     seed=5, batch_size=8, array="torch", **SHAPES)
+    pointwise check first fails, with the same seed (the audit's numbering, from 1): case 17
+    here, 16 cases that hold before it."""
+    policy = FarFromTheOrigin()
+    audit = handcentric.audit_policy(policy, groups="translation", views="eye_in_hand",
+                                     cases=20, seed=1, batch_size=8, array="torch", **SHAPES)
     pointwise = next(c for c in audit["checks"] if c["mode"] == "pointwise")
-    result = run(policy, group="rotation", cases=20, seed=5)
-    assert not pointwise["equivariant"]
-    assert result["chunk"]["case"] == pointwise["failed_at_case"]
+    result = run(policy, group="translation", cases=20, seed=1)
+    assert not pointwise["equivariant"] and pointwise["failed_at_case"] == 17
+    assert result["chunk"]["case"] == 17 and result["first_break"] is None  # outside the net
+    # Cases from elsewhere (here the next seed's) would not pass this check: the first is broken.
+    assert run(policy, group="translation", cases=20, seed=2)["chunk"]["case"] == 1
 
 
 def test_a_block_called_at_every_step_gets_a_row_per_call():
