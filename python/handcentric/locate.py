@@ -688,6 +688,25 @@ def locate_text(result):
     return "\n".join(lines)
 
 
+def locate_figure(result, stem):
+    """Draws the result of locate() with the project's chart library: stem.png and stem.svg,
+    log10 of each row's error (divided by 1 + the output's size) in execution order, the floor
+    REL dashed and the first break with a marker of its own; the legend names the rows. Returns
+    the two paths. The drawing is the extension handcentric._figure, imported here only."""
+    import importlib
+    figure = importlib.import_module(__package__ + "._figure")
+    rows = result["modules"]
+    labels = ["%s[%d] %s" % (r["name"] or "(root)", r["call"], r["verdict"]) for r in rows]
+    first = next((i for i, r in enumerate(rows) if r["breaks"]), None)
+    title = "locate %s under %s: %s" % (
+        result["policy"], result["group"],
+        "first break at %s[%d]" % (rows[first]["name"] or "(root)", rows[first]["call"])
+        if first is not None else "no break")
+    figure.locate_figure(labels, [float(r["error"]) for r in rows], first,
+                         result["tolerance"]["relative"], title, str(stem))
+    return str(stem) + ".png", str(stem) + ".svg"
+
+
 def locate_json(result, **dumps):
     """The result of locate() as JSON text: infinite and NaN errors written as the strings
     "inf" and "nan", as the audit's JSON writes them."""

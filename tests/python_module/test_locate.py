@@ -484,6 +484,31 @@ def test_mutant_a_lie_derivative_that_does_not_move_the_poses_back_disagrees(mon
     assert slopes["first_moving"] == "to_hand"  # it passes T_0 on: moves with g
 
 
+VERMILLION = "rgb(83.529412%,36.862745%,0%)"  # chart_colour(1) in Cairo's SVG: the first break
+
+
+def first_break_is_marked(result, stem):
+    """The figure's SVG draws a mark in the first break's colour exactly when there is one."""
+    png, svg = handcentric.locate_figure(result, stem)
+    with open(png, "rb") as f:
+        assert f.read(8) == b"\x89PNG\r\n\x1a\n"
+    with open(svg) as f:
+        return (VERMILLION in f.read()) == (result["first_break"] is not None)
+
+
+def test_the_figure_marks_the_first_break(tmp_path):
+    assert first_break_is_marked(run(MlpPolicy("world_bias")), tmp_path / "bias")
+    assert first_break_is_marked(run(MlpPolicy()), tmp_path / "hand_centric")
+
+
+def test_mutant_a_figure_that_does_not_mark_the_break_is_caught(monkeypatch, tmp_path):
+    figure = importlib.import_module("handcentric._figure")
+    draw = figure.locate_figure
+    monkeypatch.setattr(figure, "locate_figure", lambda labels, errors, first, *rest: draw(
+        labels, errors, None, *rest))
+    assert not first_break_is_marked(run(MlpPolicy("world_bias")), tmp_path / "bias")
+
+
 # Bad input: one line naming the value.
 
 def one_line(excinfo):
