@@ -386,7 +386,8 @@ def locate(policy=None, module=None, *, stages=None, kinds=None, group="se3", vi
     kind, verdict "invariant" / "equivariant" / "neither" / "coupled", breaks, error (the largest
     error divided by 1 + the activation's size), case (of the first break), shape,
     rounding_response), "first_break" (the first row in execution order whose verdict is not its
-    kind's, its name, or None), "witness" (that row's case, g, error, tolerance), "chunk" (the
+    kind's, its name, or None), "witness" (that row's case and g, and there its error, the
+    tolerance it exceeded and the output's size c: case_error, tolerance, scale), "chunk" (the
     policy's own pointwise verdict on the same cases) and the rules used ("tolerance").
     """
     _one_group_and_view(group, view)
@@ -611,9 +612,15 @@ def _result(asked, order, decider, what):
     witness = None
     if first is not None:
         g = next(c["g"] for c in asked["cases"] if c["case"] == first["case"])
+        row = decider.rows[first["name"], first["call"]]
+        broken = {"coupled": row.coupling_break, "invariant": row.equivariant_break}.get(
+            first["verdict"], row.equivariant_break if row.kind == "poses" else row.invariant_break)
+        # In that case: the error and the tolerance it exceeded (REL (1 + c), or the preflight's
+        # for coupling), absolute, and the output's size c.
         witness = OrderedDict(name=first["name"], call=first["call"], verdict=first["verdict"],
                               case=first["case"], g=np.asarray(g).ravel().tolist(),
-                              error=first["error"])
+                              error=first["error"], case_error=broken[1], tolerance=broken[2],
+                              scale=broken[3])
     # The policy's own answer on the same cases: the audit's distance and floor.
     chunk_error, chunk_case = 0.0, None
     for c in asked["cases"]:
@@ -674,10 +681,12 @@ def locate_text(result):
         np = _np()
         g = np.asarray(first["g"]).reshape(4, 4)
         vector = lambda v: "[%s]" % ", ".join("%.6g" % x for x in v)  # noqa: E731
-        lines.append("witness: %s[%d] in case %d, g: r = %s, p = %s; error %s (divided by 1 + "
-                     "the output's size)" % (first["name"] or "(root)", first["call"],
-                                             first["case"], vector(_core.so3_log(g[:3, :3])),
-                                             vector(g[:3, 3]), _number(first["error"])))
+        lines.append("witness: %s[%d] in case %d, g: r = %s, p = %s; there error %s > "
+                     "tolerance %s, the output's size c = %s" % (
+                         first["name"] or "(root)", first["call"], first["case"],
+                         vector(_core.so3_log(g[:3, :3])), vector(g[:3, 3]),
+                         _number(first["case_error"]), _number(first["tolerance"]),
+                         _number(first["scale"])))
     chunk = result["chunk"]
     lines.append("the policy's chunk: %s (error %s%s)" % (
         "equivariant" if chunk["equivariant"] else "NOT equivariant", _number(chunk["error"]),
