@@ -397,7 +397,8 @@ def test_an_unnormalizer_adding_the_world_mean_after_the_decoder_is_located():
 def test_the_table_and_the_json_name_the_break():
     result = run(MlpPolicy("world_bias"))
     text = handcentric.locate_text(result)
-    assert ">> fc2[0]" in text and "neither" in text and "witness: fc2[0] in case 1, g: r = [" in text
+    assert ">> fc2[0]" in text and "neither" in text
+    assert "witness: fc2[0] in case 1, g: r = [" in text and "> tolerance 1.44e-09" in text
     assert "NOT equivariant" in text
     back = json.loads(handcentric.locate_json(result))
     assert back["first_break"] == "fc2" and back["modules"][2]["name"] == "fc2"
