@@ -401,6 +401,11 @@ def locate(policy=None, module=None, *, stages=None, kinds=None, group="se3", vi
     return _result(asked, watch.recorder.order, decider, watch.what)
 
 
+# The audit's keywords that locate and lie_derivatives pass on (python/options.hpp, Setup).
+_SETUP = ("batch_size", "array", "device", "quiet", "history", "hand_points", "world_points",
+          "chunk", "cameras", "image_size", "channels", "floor", "workspace", "observations")
+
+
 def _one_group_and_view(group, view):
     if not isinstance(group, str) or not isinstance(view, str):
         raise ValueError("locate looks at one group and one view at a time, got group=%r and "
@@ -416,6 +421,9 @@ class _Watch:
         if (stages is None) == (module is None):
             raise ValueError("%s takes module= (a torch module the policy calls) or stages= (a "
                              "list of (name, callable)), exactly one of them" % caller)
+        for key in setup:
+            if key not in _SETUP:
+                raise TypeError("%s() got an unexpected keyword argument %r" % (caller, key))
         self.module = module
         if stages is not None:
             if policy is not None:

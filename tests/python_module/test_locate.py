@@ -539,10 +539,11 @@ def test_an_unknown_kind_or_module_is_refused(kinds, message):
     (dict(group="se4"), "se4"),
     (dict(group="all"), "one group and one view"),
     (dict(view=("eye_in_hand", "third_person")), "one group and one view"),
+    (dict(batchsize=8), "unexpected keyword argument 'batchsize'"),
 ])
 def test_a_bad_group_or_view_is_refused_in_one_line(kw, message):
     policy = MlpPolicy()
-    with pytest.raises(ValueError, match=message) as e:
+    with pytest.raises((ValueError, TypeError), match=message) as e:
         handcentric.locate(policy, module=policy.net, cases=2, array="torch", **SHAPES, **kw)
     assert one_line(e)
 
