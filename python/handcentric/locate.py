@@ -24,6 +24,10 @@ place of the scene's length:
 REL and u are the audit's for `precision` (or `tolerance`); a NaN fails every comparison.
 Not done here: the audit's step 3 (moving a failing case off the case to tell a bin edge from a
 breaking), so a network that bins or thresholds (argmax, rounding) can show a break at an edge.
+
+Beside it: lie_derivatives(...), the layerwise Lie derivative at the identity on the profiles'
+scenes (_core._lie_derivative_cases); locate_text, locate_json and locate_figure (the extension
+handcentric._figure), the result as a table, as JSON and as a figure.
 """
 
 from collections import OrderedDict
