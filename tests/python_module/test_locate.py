@@ -502,6 +502,20 @@ def test_the_figure_marks_the_first_break(tmp_path):
     assert first_break_is_marked(run(MlpPolicy()), tmp_path / "hand_centric")
 
 
+def test_drawing_leaves_the_audits_own_errors_alone(tmp_path):
+    """handcentric._figure translates no exception of _core's (pybind11 shares translators
+    between modules): after a figure, a wrong shape is still ShapeError, a wrong dtype still
+    TypeError; and a figure that cannot be written is an OSError naming its path."""
+    handcentric.locate_figure(run(MlpPolicy()), tmp_path / "figure")
+    with pytest.raises(handcentric.ShapeError):
+        handcentric.audit(lambda history, chunk, hand, world: np.zeros((3, 4)), cases=2,
+                          quiet=True)
+    with pytest.raises(TypeError, match="dtype <U1"):
+        handcentric.audit(lambda history, chunk, hand, world: ["a"], cases=2, quiet=True)
+    with pytest.raises(OSError, match="no_such_folder"):
+        handcentric.locate_figure(run(MlpPolicy()), tmp_path / "no_such_folder" / "figure")
+
+
 def test_mutant_a_figure_that_does_not_mark_the_break_is_caught(monkeypatch, tmp_path):
     figure = importlib.import_module("handcentric._figure")
     draw = figure.locate_figure
