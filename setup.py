@@ -1,7 +1,7 @@
 """`pip install .`: the package handcentric (python/handcentric/), its extension handcentric._core
 built by the project's own CMake build (target handcentric_python, python/CMakeLists.txt) for
-the Python running pip, and the plug-in helper, the package handcentric_plugin
-(python/handcentric_plugin/).
+the Python running pip, with handcentric._figure (the drawings, built with it), and the plug-in
+helper, the package handcentric_plugin (python/handcentric_plugin/).
 
     python3 -m venv --system-site-packages venv           # Debian's NumPy and setuptools
     venv/bin/pip install --no-build-isolation .           # offline
@@ -32,6 +32,7 @@ from setuptools.command.build_ext import build_ext
 ROOT = os.path.dirname(os.path.abspath(__file__))
 BUILD_BASE = os.path.join("build", "python-wheel")  # relative to ROOT, pip's working directory
 TARGET = "handcentric_python"
+FIGURE = "_figure"  # the second extension, built by TARGET's dependency handcentric_figure
 INSTALL_DEPS = "bash scripts/install-deps.sh"
 
 
@@ -67,7 +68,8 @@ class FreshBuild(build):
 
 
 class CMakeBuild(build_ext):
-    """Builds the one extension with CMake and copies it where setuptools packs it."""
+    """Builds the extension with CMake and copies it, and handcentric._figure, where setuptools
+    packs them."""
 
     def build_extension(self, ext):
         reuse = os.environ.get("HANDCENTRIC_CMAKE_BUILD_DIR")
@@ -101,6 +103,15 @@ class CMakeBuild(build_ext):
         destination = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(destination), exist_ok=True)
         shutil.copyfile(built, destination)
+        # handcentric._figure, the drawings (python/CMakeLists.txt), built with the module and
+        # packed beside it.
+        figure = os.path.join(os.path.dirname(built),
+                              FIGURE + sysconfig.get_config_var("EXT_SUFFIX"))
+        if not os.path.isfile(figure):
+            sys.exit("setup.py: %s has no %s beside the module" % (build_dir,
+                                                                 os.path.basename(figure)))
+        shutil.copyfile(figure, os.path.join(os.path.dirname(destination),
+                                             os.path.basename(figure)))
 
 
 os.makedirs(os.path.join(ROOT, BUILD_BASE), exist_ok=True)

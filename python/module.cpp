@@ -56,6 +56,7 @@
 #include "options.hpp"
 #include "pose_layouts.hpp"
 #include "equivariance_profile.hpp"
+#include "locate.hpp"
 
 namespace handcentric::python {
 namespace {
@@ -453,6 +454,42 @@ policy's fixed noise and the laws' samples.
 )doc") +
        kSetupDoc)
           .c_str());
+  // handcentric.locate's questions (python/handcentric/locate.py); not public on its own.
+  m.def(
+      "_locate_cases",
+      [](py::object policy, py::object on_ask, const std::string& group, const std::string& view,
+         py::handle cases, std::uint64_t seed, std::optional<double> tolerance,
+         const std::string& precision, py::handle noise, py::handle extra_poses, py::handle scalars,
+         py::handle rng, py::handle reset, HANDCENTRIC_SETUP_PARAMETERS) {
+        return locate_cases(std::move(policy), std::move(on_ask), group, view, cases, seed,
+                            tolerance, precision, noise, extra_poses, scalars, rng, reset,
+                            HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("policy"), py::arg("on_ask"), py::kw_only(), py::arg("group") = "se3",
+      py::arg("view") = "eye_in_hand", py::arg("cases") = 100, py::arg("seed") = 1,
+      py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
+      py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
+      py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      HANDCENTRIC_SETUP_ARGUMENTS,
+      "The audit's pointwise cases asked of a policy for handcentric.locate (python/locate.hpp).");
+  m.def(
+      "_lie_derivative_cases",
+      [](py::object policy, py::object on_ask, const std::string& group, const std::string& view,
+         int scenes, std::uint64_t seed, double step, const std::string& precision,
+         py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
+         py::handle reset, HANDCENTRIC_SETUP_PARAMETERS) {
+        return lie_derivative_cases(std::move(policy), std::move(on_ask), group, view, scenes, seed,
+                                    step, precision, noise, extra_poses, scalars, rng, reset,
+                                    HANDCENTRIC_SETUP_VALUE);
+      },
+      py::arg("policy"), py::arg("on_ask"), py::kw_only(), py::arg("group") = "se3",
+      py::arg("view") = "eye_in_hand", py::arg("scenes") = 16, py::arg("seed") = 1,
+      py::arg("step") = 1e-3, py::arg("precision") = "float64",
+      py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
+      py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      HANDCENTRIC_SETUP_ARGUMENTS,
+      "The questions of handcentric.lie_derivatives: the profile's scenes moved by +-step "
+      "(python/locate.hpp).");
 #undef HANDCENTRIC_SETUP_PARAMETERS
 #undef HANDCENTRIC_SETUP_VALUE
 #undef HANDCENTRIC_SETUP_ARGUMENTS

@@ -22,5 +22,10 @@ del importlib
 from ._core import *  # noqa: F401,F403  (every public name of the extension)
 from ._core import __version__  # noqa: F401  (a dunder: not part of `import *`)
 
-# Derived from the extension, so that a function added to _core is exported without an edit here.
-__all__ = sorted(name for name in dir(_core) if not name.startswith("_"))
+from .locate import (lie_derivatives, locate, locate_figure,  # noqa: E402  (on top of _core)
+                     locate_json, locate_text)
+
+# Derived from the extension, so that a function added to _core is exported without an edit here;
+# and the functions written in Python (locate.py).
+__all__ = sorted([name for name in dir(_core) if not name.startswith("_")]
+                 + ["lie_derivatives", "locate", "locate_figure", "locate_json", "locate_text"])

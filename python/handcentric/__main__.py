@@ -88,8 +88,9 @@ def _load_module(spec):
         raise  # the module exists and failed to import something itself: its traceback
 
 
-def load_callable(text):
-    """The callable named by MODULE:FUNCTION; BadTarget with a one-line reason otherwise."""
+def load_attribute(text):
+    """The object named by MODULE:NAME (NAME may be dotted); BadTarget with a one-line reason
+    otherwise."""
     module_name, colon, attribute = text.rpartition(":")
     if not colon or not module_name or not attribute:
         raise BadTarget("%r is not MODULE:FUNCTION" % text)
@@ -99,6 +100,12 @@ def load_callable(text):
             value = getattr(value, part)
         except AttributeError:
             raise BadTarget("%s has no %r" % (module_name, attribute)) from None
+    return value
+
+
+def load_callable(text):
+    """The callable named by MODULE:FUNCTION; BadTarget with a one-line reason otherwise."""
+    value = load_attribute(text)
     if not callable(value):
         raise BadTarget("%s is not callable" % text)
     return value
@@ -181,7 +188,67 @@ def make_parser():
     policy.add_argument("--reset", metavar="MODULE:FUNCTION",
                         help="a function of no arguments called before every call of the policy "
                              "(reset=; e.g. a policy's reset, for one that keeps state)")
+    where = commands.add_parser(
+        "locate", help="where a policy breaks the symmetry (handcentric.locate)",
+        description="The first module of a torch policy, or the first stage of a pipeline, "
+                    "whose output is not invariant (not equivariant for outputs declared "
+                    "poses), on the audit's pointwise cases (docs/AUDIT.md, \"Localizing a "
+                    "break\"). MODULE:NAME is a policy with --module, or a list of (name, "
+                    "callable) stages.")
+    common(where, "a policy (history, hand_points, world_points, noise) -> (K, 4, 4) with "
+                  "--module, or a list of (name, callable) stages")
+    where.add_argument("--module", metavar="ATTRIBUTE",
+                       help="the torch module the policy calls, as an attribute of the policy "
+                            "(e.g. net, or model.encoder)")
+    where.add_argument("--kinds", metavar="KINDS",
+                       help="features (invariant, the default) or poses (world-frame poses, "
+                            "equivariant): NAME=KIND,... or, for stages, one KIND per stage "
+                            "(poses,poses,features)")
+    where.add_argument("--noise", type=_bounded(1, handcentric.MAX_NOISE), metavar="N",
+                       help="standard normals per call, 1 to %d" % handcentric.MAX_NOISE)
+    where.add_argument("--rng", choices=("torch", "numpy", "generator"),
+                       help="seed the policy's own draws alike for o and g o (rng=)")
     return parser
+
+
+def _kinds(text):
+    """--kinds: NAME=KIND,... as a dict, or KIND,KIND,... as a list; None when not given."""
+    if not text:
+        return None
+    items = [item.strip() for item in text.split(",")]
+    if all("=" in item for item in items):
+        return dict(item.split("=", 1) for item in items)
+    if any("=" in item for item in items):
+        raise BadTarget("--kinds mixes NAME=KIND and KIND: %r" % text)
+    return items
+
+
+def _locate(args, keywords):
+    """handcentric.locate on the target: a policy with --module, else a list of stages."""
+    for option in ("groups", "views"):
+        if option in keywords:
+            if len(keywords[option]) != 1:
+                raise BadTarget("locate looks at one %s at a time, got %s"
+                                % (option[:-1], " ".join(keywords[option])))
+            keywords[option[:-1]] = keywords.pop(option)[0]
+    if args.json not in (None, "-"):
+        raise BadTarget("locate writes its JSON to stdout: --json > %s" % args.json)
+    kinds = _kinds(args.kinds)
+    target = load_attribute(args.target)
+    if args.module:
+        if not callable(target):
+            raise BadTarget("%s is not callable" % args.target)
+        module = target
+        for part in args.module.split("."):
+            try:
+                module = getattr(module, part)
+            except AttributeError:
+                raise BadTarget("%s has no attribute %r" % (args.target, args.module)) from None
+        return handcentric.locate(target, module=module, kinds=kinds, **keywords)
+    if callable(target) or not isinstance(target, (list, tuple)):
+        raise BadTarget("%s is a policy: name its torch module with --module, or give a list "
+                        "of (name, callable) stages" % args.target)
+    return handcentric.locate(stages=target, kinds=kinds, **keywords)
 
 
 def _keywords(args):
@@ -234,8 +301,10 @@ def main(argv=None):
     parser = make_parser()
     args = parser.parse_args(argv)
     try:
-        target = load_callable(args.target)
         keywords = _keywords(args)
+        if args.command == "locate":
+            return _print_location(_locate(args, keywords), args)
+        target = load_callable(args.target)
         if args.command == "audit":
             for option in ("observation", "decode"):
                 if getattr(args, option):
@@ -269,6 +338,19 @@ def main(argv=None):
         with open(args.json, "w") as out:
             json.dump(result, out, indent=1)
             out.write("\n")
+    return 0
+
+
+def _print_location(result, args):
+    """locate's table, or with --json its JSON, on stdout."""
+    try:
+        if args.json == "-":
+            sys.stdout.write(handcentric.locate_json(result, indent=1) + "\n")
+        else:
+            sys.stdout.write(handcentric.locate_text(result) + "\n")
+        sys.stdout.flush()
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
     return 0
 
 

@@ -58,12 +58,15 @@ def venv():
 def test_the_package_is_imported_from_the_venvs_site_packages(venv):
     found = venv.python_json(
         "import json, importlib.metadata, handcentric, handcentric._core, handcentric_plugin\n"
+        "import handcentric._figure\n"
         "print(json.dumps({'package': handcentric.__file__, 'core': handcentric._core.__file__,\n"
+        "    'figure': handcentric._figure.__file__,\n"
         "    'helper': handcentric_plugin.__file__, 'version': handcentric.__version__,\n"
         "    'metadata': importlib.metadata.version('handcentric'),\n"
         "    'all': handcentric.__all__}))")
     assert found["package"] == os.path.join(venv.site, "handcentric", "__init__.py")
     assert os.path.dirname(found["core"]) == os.path.join(venv.site, "handcentric")
+    assert os.path.dirname(found["figure"]) == os.path.join(venv.site, "handcentric")
     assert found["helper"] == os.path.join(venv.site, "handcentric_plugin", "__init__.py")
     assert found["version"] == found["metadata"]  # the wheel's version is the module's (CMake's)
     for name in ("audit", "audit_policy", "assert_invariant", "assert_equivariant", "decode",
