@@ -111,7 +111,7 @@ Questions questions(py::object policy, py::object on_ask, const std::string& gro
   q.o = common_options(py::str(group), py::str(view), cases, seed, tolerance, precision,
                        extra_poses, scalars, setup);
   q.c = classifier_for(q.o);
-  set_policy_call(q.o, q.c, rng, reset, "locate");
+  set_policy_call(q.o, q.c, rng, reset, py::str("matrix"), py::str("matrix"), "locate");
   if (q.o.audit.groups.size() != 1 || q.o.audit.views.size() != 1) {
     throw InvalidArgument("locate looks at one group and one view at a time, got group='" + group +
                           "' and view='" + view + "'");
