@@ -199,10 +199,10 @@ TEST_CASE("euler_angles_lie_in_the_ranges_scipy_documents", "[unit]") {
 
 TEST_CASE("a_vector_that_contradicts_its_layout_is_refused_with_its_numbers", "[unit]") {
   Eigen::VectorXd q(7);
-  q << 0, 0, 0, 0.1, 0.2, 0.3, 1.2;  // norm 1.27
+  q << 0, 0, 0, 0.1, 0.2, 0.3, 1.2;  // norm 1.257
   HC_CHECK_THROWS(
       decode_pose(q, parse_pose_format("pos_quat_xyzw", "k"), "a[3]"), InvalidArgument,
-      Catch::Contains("a[3] =") && Catch::Contains("norm 1.27") && Catch::Contains("normalize"));
+      Catch::Contains("a[3] =") && Catch::Contains("norm 1.257") && Catch::Contains("normalize"));
   Eigen::VectorXd six(9);
   six << 0, 0, 0, 1, 0, 0, 0.3, 1, 0;  // dot product 0.3
   HC_CHECK_THROWS(decode_pose(six, parse_pose_format("pos_rot6d_rows", "k"), "a"), InvalidArgument,
