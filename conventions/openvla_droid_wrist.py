@@ -12,9 +12,8 @@ Source   openvla/openvla@c8f03f48af692657d3060c19588038c7220e9af9:
          prismatic/vla/datasets/rlds/oxe/utils/droid_utils.py:droid_wristact_transform
          (velocity = action_dict cartesian_velocity, wrist_in_robot_frame = cartesian_position;
          droid_cartesian_velocity.py in this folder).
-Config   no shipped config: droid_wristact_transform is in no entry of
-         OXE_STANDARDIZATION_TRANSFORMS (transforms.py), whose droid entry is
-         droid_baseact_transform (droid_cartesian_velocity.py)
+Config   no shipped config (its caller droid_wristact_transform is in no entry of
+         OXE_STANDARDIZATION_TRANSFORMS)
 Formula  v_k = [(p_k - p_{k-1}) / 0.075, euler_xyz(R_k R_{k-1}^T) / 0.15]
          a_k = [R_{k-1}^T v_k[:3], rows(R_{k-1}^T euler_matrix(v_k[3:]) R_{k-1})]
          observation: DROID's proprio, [p_0, euler_xyz(R_0)]

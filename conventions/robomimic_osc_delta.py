@@ -15,9 +15,12 @@ Source   ARISE-Initiative/robosuite@1063bbdd3b871039c4250899b8c4fc6f2eedeede:
          ARISE-Initiative/robosuite@0d1977bc524cd052c6b839160b70734488b60d1c:
          robosuite/robots/single_arm.py:SingleArm.get_observations
          (`eef_quat` = `T.convert_quat(self.sim.data.get_body_xquat(self.robot_model.eef_name),
-         to="xyzw")`: MuJoCo's body quaternion, whose sign is not normalized).
-Config   robomimic's robosuite datasets of delta actions (robosuite 1.4 and earlier: world frame);
-         robosuite 1.5 with input_ref_frame "world"
+         to="xyzw")`: MuJoCo's body quaternion, whose sign is not normalized). Without
+         abs_action, Diffusion Policy passes these actions on as they are,
+         real-stanford/diffusion_policy@5ba07ac6661db573af695b419a7947ecb704690f:
+         diffusion_policy/dataset/robomimic_replay_image_dataset.py:_convert_actions
+Config   robomimic's delta-action datasets (robosuite 1.4: world frame), as Diffusion Policy's
+         task configs with abs_action False train on them; robosuite 1.5 with input_ref_frame world
 Formula  actions      a_k = [(p_k - p_{k-1}) / 0.05, r(R_k R_{k-1}^T) / 0.5]  (r: rotation vector)
          observation  robomimic's low-dim proprio: robot0_eef_pos and robot0_eef_quat of the hand
                       now (x, y, z, w)

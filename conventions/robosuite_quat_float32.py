@@ -16,8 +16,8 @@ Source   huggingface/lerobot@7427f31801f944f5ec9ce53cda02862ce7d1638b:
          (`abs_rot = T.quat2axisangle(T.mat2quat(abs_ori))`). The observation as robosuite gives
          it, ARISE-Initiative/robosuite@0d1977bc524cd052c6b839160b70734488b60d1c:
          robosuite/robots/single_arm.py:SingleArm.get_observations
-Config   no shipped config encodes steps with it (delta_to_abs_action and LeRobot's X-VLA LIBERO
-         postprocessor apply it to absolute orientations); a delta command written this way
+Config   no shipped config on steps (robosuite's delta_to_abs_action and LeRobot's X-VLA LIBERO
+         postprocessor, make_xvla_libero_pre_post_processors, apply it to absolute orientations)
 Formula  q = float32 (x, y, z, w) of R_k R_{k-1}^T, w >= 0;  w' = min(w, 1);
          d = sqrt(1 - w'^2) in float32;  v = 0 if d = 0, else (x, y, z) 2 acos(w') / d;
          actions      a_k = [(p_k - p_{k-1}) / 0.05, v / 0.5]
