@@ -14,7 +14,7 @@ Source   peract/peract@02fb87681c5a47be9dbf20141bedb836ee2d3ef9:
          `disc[disc == int(360 / resolution)] = 0`. Scene bounds [-0.3, -0.5, 0.6, 0.7, 0.5,
          1.6] (conf/config.yaml), voxel_sizes [100] and rotation_resolution 5
          (conf/method/PERACT_BC.yaml).
-Config   PerAct conf/config.yaml with method PERACT_BC
+Config   PerAct conf/method/PERACT_BC.yaml (method=PERACT_BC; conf/config.yaml defaults to C2FARM)
 Formula  a_k = [voxel(p_k), bins(R_k)] for each pose of the chunk (PerAct predicts one next key
          pose; applied here to each); observation: the same of the hand now.
 Assumed  positions outside the bounds keep
