@@ -14,6 +14,9 @@ rot6d_rows     the first two ROWS of R, flattened (PyTorch3D's matrix_to_rotatio
 rot6d_columns  the first two COLUMNS of R (Zhou et al., "On the Continuity of Rotation
                Representations in Neural Networks", CVPR 2019, the definition of the paper).
 quaternion_xyzw  unit quaternion (x, y, z, w) with w >= 0.
+step_rotations, osc_world_step, pose_rotvec  the step rotations R_k R_{k-1}^T, robosuite's
+               OSC_POSE world-frame delta command, and [p, r(R)] (a position and a rotation
+               vector), which several rows share.
 """
 import os
 import sys
@@ -95,6 +98,25 @@ def steps(history, chunk):
     return poses[:, :-1], poses[:, 1:]
 
 
+def step_rotations(history, chunk):
+    """R_k R_{k-1}^T, k = 1..K: each step's rotation in the world frame, (B,K,3,3)."""
+    before, after = steps(history, chunk)
+    return after[..., :3, :3] @ np.swapaxes(before[..., :3, :3], -1, -2)
+
+
+def osc_world_step(history, chunk):
+    """robosuite's OSC_POSE delta command, world frame, default output ranges: the position step
+    / 0.05 and the rotation vector of R_k R_{k-1}^T / 0.5, two (B,K,3) stacks."""
+    before, after = steps(history, chunk)
+    return ((after[..., :3, 3] - before[..., :3, 3]) / 0.05,
+            rotvec(step_rotations(history, chunk)) / 0.5)
+
+
+def pose_rotvec(T):
+    """[p, r(R)] of a stack of poses, (..., 6): a position and a rotation vector."""
+    return np.concatenate([T[..., :3, 3], rotvec(T[..., :3, :3])], axis=-1)
+
+
 def flat(*arrays):
     """Each (B, ...) array flattened to (B, -1) and joined: one action or observation row per
     scene."""
@@ -102,6 +124,8 @@ def flat(*arrays):
     return np.concatenate([np.reshape(a, (B, -1)) for a in arrays], axis=1)
 
 
-def serve(encode_batch):
-    """Every plug-in of this folder answers batched requests, base64-encoded."""
-    hp.serve(encode_batch, batched=True, batch_size=256)
+def serve(encode_batch, extra_poses=()):
+    """Every plug-in of this folder answers batched requests, base64-encoded; extra_poses names
+    the world-frame poses (a robot's base, an episode's start) that move with g, which
+    encode_batch then gets as the keywords extra_poses={name: (B,4,4)} and scalars={}."""
+    hp.serve(encode_batch, batched=True, batch_size=256, extra_poses=tuple(extra_poses))

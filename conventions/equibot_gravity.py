@@ -3,11 +3,16 @@
 directions of its history, and the gravity direction, which a global transform of the scene
 does not move.
 
-Source   yjy0625/equibot (commit a5ee2e1), equibot/policies/agents/equibot_policy.py,
-         _convert_state_to_vec: "state format for 7d actions: eef_pos, eef_rot_x, eef_rot_z,
-         gravity_dir, gripper_pose", `vec_state_dir = torch.cat([dir1, dir2, gravity_dir])`;
-         _convert_action_to_vec: "rotation actions are always treated as relative axis-angle
-         rotation", the position and axis-angle steps handed to the network as 3-vectors.
+Source   yjy0625/equibot@dc70059191beb29903d78fc4d0193392be5134fc:
+         equibot/policies/agents/equibot_policy.py:EquiBotPolicy._convert_state_to_vec
+         "state format for 7d actions: eef_pos, eef_rot_x, eef_rot_z, gravity_dir,
+         gripper_pose", `vec_state_dir = torch.cat([dir1, dir2, gravity_dir], dim=2)`;
+         yjy0625/equibot@dc70059191beb29903d78fc4d0193392be5134fc:
+         equibot/policies/agents/equibot_policy.py:EquiBotPolicy._convert_action_to_vec
+         "rotation actions are always treated as relative axis-angle rotation", the position
+         and axis-angle steps handed to the network as 3-vectors.
+Config   EquiBot equibot/policies/configs/base.yaml (dof 7, ac_mode rel) with agent equibot
+         (*_mobile_equibot.yaml)
 Formula  (this project's reading) EquiBot's SIM(3)-equivariant network sees these vectors; what
          it can be invariant to is what they are invariant to in the hand's frame at T_0:
          actions      a_k = [R_0^T (p_k - p_{k-1}), R_0^T r(R_k R_{k-1}^T)]

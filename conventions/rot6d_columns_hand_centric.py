@@ -4,11 +4,18 @@ representation as Zhou et al. define it), beside UMI's and LeRobot's first two R
 
 Source   Zhou, Barnes, Lu, Yang, Li, "On the Continuity of Rotation Representations in Neural
          Networks", CVPR 2019, Sec. 4: the 6D representation is the first two columns of the
-         matrix. The codebases read here take rows instead: PyTorch3D's matrix_to_rotation_6d
-         (`matrix[..., :2, :]`, whose docstring cites Zhou et al.), copied by UMI's
-         mat_to_rot6d, robomimic's axis_angle_to_rot_6d (robomimic/utils/torch_utils.py),
-         LeRobot's matrix_to_rotation_6d and OpenVLA's rotmat_to_rot6d. No codebase that takes
-         columns was found in the index; this row is the paper's definition.
+         matrix. The codebases read here take rows instead:
+         facebookresearch/pytorch3d@9381c4016376345bb795b97c45a6c2de66db354a:
+         pytorch3d/transforms/rotation_conversions.py:matrix_to_rotation_6d
+         (`matrix[..., :2, :]`, whose docstring cites Zhou et al.), copied by
+         real-stanford/universal_manipulation_interface@d095ba9590df789df5189eea5ee7e431689038a6:
+         umi/common/pose_util.py:mat_to_rot6d
+         and by LeRobot's matrix_to_rotation_6d and OpenVLA's rotmat_to_rot6d. LeRobot's X-VLA
+         takes columns, of absolute rotations:
+         huggingface/lerobot@7427f31801f944f5ec9ce53cda02862ce7d1638b:
+         src/lerobot/policies/xvla/processor_xvla.py:LiberoProcessorStep._mat_to_rotate6d
+         (`col1 = rot_mats[:, :3, 0]`); no codebase read takes columns of a hand-centric rotation.
+Config   no shipped config (the paper's definition, on the hand-centric chunk)
 Formula  actions      a_k = [R_0^T (p_k - p_0), columns(R_0^T R_k)]
          observation  the same of each history pose; world points in the hand frame
 Theory   rows or columns, both encode the invariant matrix T_0^-1 T_k: invariant under all of

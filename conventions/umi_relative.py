@@ -1,9 +1,14 @@
 #!/usr/bin/env python3
 """UMI, pose_rep 'relative': each pose in the frame of the hand now (hand-centric).
 
-Source   real-stanford/universal_manipulation_interface (commit c34ba9c),
-         diffusion_policy/common/pose_repr_util.py, convert_pose_mat_rep(..., pose_rep='relative'):
-         `out = np.linalg.inv(base_pose_mat) @ pose_mat`; then pose10d (rows of R).
+Source   real-stanford/universal_manipulation_interface@d095ba9590df789df5189eea5ee7e431689038a6:
+         diffusion_policy/common/pose_repr_util.py:convert_pose_mat_rep
+         (pose_rep 'relative'): `out = np.linalg.inv(base_pose_mat) @ pose_mat`; then pose10d
+         (rows of R),
+         real-stanford/universal_manipulation_interface@d095ba9590df789df5189eea5ee7e431689038a6:
+         umi/common/pose_util.py:mat_to_pose10d
+Config   UMI diffusion_policy/config/task/umi.yaml, task/umi_bimanual.yaml (both reprs relative;
+         the pipeline as they train it: umi_trained.py)
 Formula  actions      a_k = [R_0^T (p_k - p_0), rows(R_0^T R_k)]   (T_0^-1 T_k)
          observation  the same of each history pose; eye-in-hand points as they are; world points
                       in the hand frame, R_0^T (q - p_0)

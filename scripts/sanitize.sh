@@ -115,6 +115,7 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^the_tabulated_detectable_shift_is_the_simulated_one|'\
 '^anisotropic_world_noise_through_a_curve|^without_the_exact_split_and_the_scale_test|'\
 '^conventions_committed_table_is_up_to_date|^mutant_conventions_a_changed_formula|'\
+'^mutant_conventions_a_base_that_stays_put|'\
 '^policy_exec_audits_a_plugin_on_recorded_observations|'\
 '^a_batched_policy_audit_is_the_unbatched_one_bit|^a_map_whose_answer_depends_on_its_batch|'\
 '^a_batched_exec_audit_gives_the_unbatched_json|^a_batched_policy_exec_audit_gives_the_unbatched|'\

@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
+#include <regex>
 #include <sstream>
 
 #include "handcentric/core/errors.hpp"
@@ -130,7 +132,24 @@ TableCell injectivity_cell(const ConventionAudit& c) {
   return cell;
 }
 
-Table summary_table(const std::vector<ConventionAudit>& conventions, props::View view) {
+// The commits a row was read at, each once, in the order its Source cites them:
+// `owner/repo@1234567` (the section above the table gives the 40 digits).
+TableCell commit_cell(const ConventionAudit& c) {
+  TableCell cell;
+  std::vector<std::string> shown;
+  for (const ConventionCitation& citation : c.citations) {
+    const std::string short_form = citation.repo + "@" + citation.commit.substr(0, 7);
+    if (std::find(shown.begin(), shown.end(), short_form) != shown.end()) continue;
+    if (!cell.text.empty()) cell.text.push_back(plain(", "));
+    cell.text.push_back(code(short_form));
+    shown.push_back(short_form);
+  }
+  if (cell.text.empty()) cell.text.push_back(plain("-"));
+  return cell;
+}
+
+Table summary_table(const std::vector<ConventionAudit>& conventions, props::View view,
+                    const ConventionsOptions& options) {
   Table table;
   table.id = "conventions-" + props::to_string(view);
   table.kind = "conventions";
@@ -140,8 +159,12 @@ Table summary_table(const std::vector<ConventionAudit>& conventions, props::View
   table.columns = {"convention"};
   for (props::Group group : props::all_groups()) table.columns.push_back(props::to_string(group));
   table.columns.push_back("injective");
-  // The Expect lines speak of the eye-in-hand view (Theorem 1's setting).
-  if (view == props::View::eye_in_hand) table.columns.push_back("as expected");
+  // The Expect lines speak of the eye-in-hand view (Theorem 1's setting); that table also says
+  // where each row comes from.
+  if (view == props::View::eye_in_hand) {
+    for (const char* column : {"as expected", "used by", "commit", "plug-in"})
+      table.columns.push_back(column);
+  }
   for (const ConventionAudit& c : conventions) {
     std::vector<TableCell> row;
     TableCell name;
@@ -155,47 +178,78 @@ Table summary_table(const std::vector<ConventionAudit>& conventions, props::View
                         ? verdict_cell(true, "", "", "")
                         : verdict_cell(false, std::to_string(c.mismatches.size()) + " differ", "",
                                        "#conventions-" + c.name));
+      row.push_back(text_cell(c.used_by.empty() ? "-" : c.used_by));
+      row.push_back(commit_cell(c));
+      TableCell plugin;
+      plugin.text.push_back(plain(c.name + ".py", options.plugin_links + c.name + ".py"));
+      row.push_back(std::move(plugin));
     }
     table.rows.push_back(std::move(row));
   }
   return table;
 }
 
-// A docstring as the page shows it: its opening paragraph, then one item per paragraph that
-// starts with a word at the margin (Source, Formula, Assumed, Theory, Expect), that word in bold
-// and its lines joined. Not verbatim (<pre>): the page keeps <pre> for commands.
-void docstring_blocks(const std::string& docstring, std::vector<Block>& blocks) {
+// A docstring's parts: its opening paragraph, then one item per paragraph that starts with a
+// word at the margin (Source, Config, Formula, Assumed, Theory, Expect), each item that word and
+// its lines joined by spaces (but for a citation broken after a colon: ends_inside_citation).
+struct DocstringParts {
+  std::string opening;
+  std::vector<std::pair<std::string, std::string>> items;  // (keyword, body)
+};
+
+// Whether `text` ends inside a citation broken after one of its colons: its last word holds
+// "@COMMIT:" and ends with ':'. A citation longer than a line goes on over the next ones, joined
+// without a space ("owner/repo@COMMIT:" then "path:function").
+bool ends_inside_citation(const std::string& text) {
+  static const std::regex kCommit("@[0-9a-f]{40}:");
+  const std::size_t space = text.find_last_of(' ');
+  const std::string word = space == std::string::npos ? text : text.substr(space + 1);
+  return !word.empty() && word.back() == ':' && std::regex_search(word, kCommit);
+}
+
+DocstringParts split_docstring(const std::string& docstring) {
+  static const char* const kKeywords[] = {"Source",  "Config", "Formula",
+                                          "Assumed", "Theory", "Expect"};
+  DocstringParts out;
   std::istringstream lines(docstring);
-  std::string line, opening;
-  List items;
+  std::string line;
   auto add = [](std::string& to, const std::string& text) {
     const std::size_t start = text.find_first_not_of(' ');
     if (start == std::string::npos) return;
-    if (!to.empty()) to += ' ';
+    if (!to.empty() && !ends_inside_citation(to)) to += ' ';
     to += text.substr(start);
-  };
-  std::string keyword, body;
-  auto close = [&] {
-    if (!keyword.empty()) items.items.push_back({bold(keyword), plain(" " + body)});
-    keyword.clear();
-    body.clear();
   };
   while (std::getline(lines, line)) {
     if (!line.empty() && line.front() != ' ') {
       const std::size_t space = line.find(' ');
       const std::string word = line.substr(0, space);
-      if (word == "Source" || word == "Formula" || word == "Assumed" || word == "Theory" ||
-          word == "Expect") {
-        close();
-        keyword = word;
-        add(body, space == std::string::npos ? "" : line.substr(space));
+      if (std::find(std::begin(kKeywords), std::end(kKeywords), word) != std::end(kKeywords)) {
+        out.items.emplace_back(word, "");
+        add(out.items.back().second, space == std::string::npos ? "" : line.substr(space));
         continue;
       }
     }
-    add(keyword.empty() ? opening : body, line);
+    add(out.items.empty() ? out.opening : out.items.back().second, line);
   }
-  close();
-  blocks.push_back(Paragraph{{plain(opening)}});
+  return out;
+}
+
+// The body of a docstring's paragraph `keyword` (empty when it has none).
+std::string docstring_paragraph(const std::string& docstring, const std::string& keyword) {
+  for (const auto& [word, body] : split_docstring(docstring).items) {
+    if (word == keyword) return body;
+  }
+  return "";
+}
+
+// A docstring as the page shows it: its opening paragraph, then its keyword paragraphs as a
+// list, each keyword in bold. Not verbatim (<pre>): the page keeps <pre> for commands.
+void docstring_blocks(const std::string& docstring, std::vector<Block>& blocks) {
+  const DocstringParts parts = split_docstring(docstring);
+  List items;
+  for (const auto& [word, body] : parts.items)
+    items.items.push_back({bold(word), plain(" " + body)});
+  blocks.push_back(Paragraph{{plain(parts.opening)}});
   blocks.push_back(std::move(items));
 }
 
@@ -285,6 +339,41 @@ std::string convention_title(const std::string& docstring) {
   std::string first = docstring.substr(0, docstring.find("\n\n"));
   std::replace(first.begin(), first.end(), '\n', ' ');
   return first.substr(0, first.find(": "));
+}
+
+std::vector<ConventionCitation> convention_citations(const std::string& path,
+                                                     const std::string& docstring) {
+  // owner/repo@COMMIT:path:function, the commit in full; a path holds no ':' or space.
+  static const std::regex kCitation(
+      R"(([A-Za-z0-9][A-Za-z0-9_.-]*/[A-Za-z0-9][A-Za-z0-9_.-]*)@([0-9a-f]{40}):([^:\s`]+):)"
+      R"(([A-Za-z_][A-Za-z0-9_.]*))");
+  const std::string source = docstring_paragraph(docstring, "Source");
+  std::vector<ConventionCitation> out;
+  for (auto it = std::sregex_iterator(source.begin(), source.end(), kCitation);
+       it != std::sregex_iterator(); ++it) {
+    std::string function = (*it)[4].str();
+    while (!function.empty() && function.back() == '.') function.pop_back();  // a full stop
+    out.push_back({(*it)[1].str(), (*it)[2].str(), (*it)[3].str(), function});
+  }
+  if (out.empty()) {
+    throw InvalidArgument("the plug-in '" + path +
+                          "' cites no code in its Source paragraph; write each place read as "
+                          "owner/repo@COMMIT:path:function (a line may end after one of its "
+                          "colons), COMMIT the 40 hex digits of the version read "
+                          "(conventions/README.md)");
+  }
+  return out;
+}
+
+std::string convention_used_by(const std::string& path, const std::string& docstring) {
+  const std::string body = docstring_paragraph(docstring, "Config");
+  if (body.empty()) {
+    throw InvalidArgument("the plug-in '" + path +
+                          "' has no Config paragraph; name the shipped configurations that "
+                          "select its pipeline, or write 'no shipped config' "
+                          "(conventions/README.md)");
+  }
+  return body;
 }
 
 std::vector<std::string> convention_plugins(const std::string& folder) {
@@ -417,7 +506,10 @@ std::vector<ConventionAudit> audit_conventions(const ConventionsOptions& options
     c.name = path.stem().string();
     c.description = convention_docstring(plugins[i], read_plugin_text(plugins[i]));
     c.title = convention_title(c.description);
-    // The Expect line is read before minutes of auditing, so that a typo fails at once.
+    // The citations, the Config paragraph and the Expect line are read before minutes of
+    // auditing, so that a typo fails at once.
+    c.citations = convention_citations(plugins[i], c.description);
+    c.used_by = convention_used_by(plugins[i], c.description);
     (void)expected_groups(plugins[i], c.description, props::Component::actions);
     (void)expected_groups(plugins[i], c.description, props::Component::observation);
     if (options.progress)
@@ -450,8 +542,14 @@ std::vector<Section> conventions_sections(const std::vector<ConventionAudit>& co
       {bold("injective"), plain(": whether two different chunks can give one action vector; "
                                 "\"no loss found\" means no collision in the searches (the "
                                 "plug-ins do not decode, so nothing proves the converse).")},
+      {bold("used by"),
+       plain(": the shipped configurations that train the row's pipeline (\"no shipped config\" "
+             "when none does, \"not on main\" when the code is on another branch only); "
+             "commit: the versions read, each cited in full in the row's Source as "
+             "owner/repo@COMMIT:path:function; plug-in: the row's file in conventions/.")},
   }});
-  for (props::View view : kConventionViews) top.blocks.push_back(summary_table(conventions, view));
+  for (props::View view : kConventionViews)
+    top.blocks.push_back(summary_table(conventions, view, options));
   std::vector<Section> out = {std::move(top)};
   for (const ConventionAudit& c : conventions) out.push_back(convention_section(c));
   return out;

@@ -190,6 +190,11 @@ std::vector<Section> conventions_page_sections(const ReportPageOptions& page) {
   ConventionsOptions options;
   options.folder = page.conventions;
   options.python = page.python;
+  // The plug-in column links each file from where the page is written.
+  std::filesystem::path folder = std::filesystem::absolute(options.folder).lexically_normal();
+  if (folder.filename().empty()) folder = folder.parent_path();  // "conventions/"
+  const std::filesystem::path out = std::filesystem::absolute(page.out).lexically_normal();
+  options.plugin_links = folder.lexically_relative(out).generic_string() + "/";
   if (!std::filesystem::is_directory(options.folder)) {
     Section note = section("conventions", "Public pose conventions, audited");
     note.blocks.push_back(

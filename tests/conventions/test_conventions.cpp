@@ -19,8 +19,9 @@ using namespace handcentric::experiments;
 namespace {
 
 const char* const kRelativeDoc =
-    "The built-in relative representation.\n\nSource   this library, core/\nTheory   translation "
-    "only.\nExpect   actions: translation; observation: none";
+    "The built-in relative representation.\n\nSource   this library, "
+    "owner/lib@0123456789abcdef0123456789abcdef01234567:core/relative.cpp:encode\nConfig   the "
+    "default\nTheory   translation only.\nExpect   actions: translation; observation: none";
 
 // The built-in `relative` (actions p_k - p_0 and r(R_0^T R_k): translation-invariant only),
 // classified at a small size: what a plug-in's audit gives, without a process.
@@ -42,6 +43,9 @@ ConventionAudit relative_convention(const std::string& doc) {
   c.name = "relative";
   c.title = "The built-in relative representation.";
   c.description = doc;
+  c.used_by = "the default";
+  c.citations = {
+      {"owner/lib", "0123456789abcdef0123456789abcdef01234567", "core/relative.cpp", "encode"}};
   c.result = relative_audit();
   c.mismatches = expectation_mismatches("relative.py", doc, c.result);
   return c;
@@ -57,6 +61,46 @@ TEST_CASE("conventions_docstring_is_read_and_must_cite_its_source_and_theory", "
                     Catch::Contains("'a.py' has no docstring"));
   CHECK_THROWS_WITH(convention_docstring("a.py", "\"\"\"Title.\nTheory y\n\"\"\""),
                     Catch::Contains("without a 'Source' paragraph"));
+}
+
+TEST_CASE("conventions_source_cites_repo_commit_path_and_function", "[unit]") {
+  const std::string commit = "0123456789abcdef0123456789abcdef01234567";
+  const std::string doc = "T\n\nSource   a/b@" + commit + ":src/x.py:f: `x = 1`;\n         " +
+                          "c-d/e.f@" + commit + ":p/q.py:Class.method.\nTheory   t";
+  const std::vector<ConventionCitation> cited = convention_citations("a.py", doc);
+  REQUIRE(cited.size() == 2);
+  CHECK(cited[0].repo == "a/b");
+  CHECK(cited[0].commit == commit);
+  CHECK(cited[0].path == "src/x.py");
+  CHECK(cited[0].function == "f");
+  CHECK(cited[1].repo == "c-d/e.f");
+  CHECK(cited[1].function == "Class.method");
+  // A citation longer than a line breaks after its colons, and reads (and shows) unbroken.
+  const std::string broken = "T\n\nSource   a/b@" + commit + ":\n         src/x.py:\n" +
+                             "         f, read there\nTheory   t";
+  const std::vector<ConventionCitation> joined = convention_citations("a.py", broken);
+  REQUIRE(joined.size() == 1);
+  CHECK(joined[0].path == "src/x.py");
+  CHECK(joined[0].function == "f");
+  // Planted faults: a short commit, or no function, is not a citation; nor is one outside the
+  // Source paragraph.
+  CHECK_THROWS_WITH(convention_citations("a.py", "T\nSource   a/b@0123456:src/x.py:f\n"),
+                    Catch::Contains("'a.py' cites no code in its Source paragraph"));
+  CHECK_THROWS_WITH(convention_citations("a.py", "T\nSource   a/b@" + commit + ":src/x.py\n"),
+                    Catch::Contains("40 hex digits"));
+  CHECK_THROWS(convention_citations(
+      "a.py", "T\nSource   a paper\nTheory   a/b@" + commit + ":src/x.py:f\n"));
+}
+
+TEST_CASE("conventions_config_paragraph_is_the_used_by_column", "[unit]") {
+  CHECK(convention_used_by("a.py",
+                           "T\nSource s\nConfig   pi0_libero,\n         pi0_fast_libero"
+                           "\nTheory t") == "pi0_libero, pi0_fast_libero");
+  CHECK(convention_used_by("a.py", "T\nConfig   no shipped config\n") == "no shipped config");
+  CHECK_THROWS_WITH(convention_used_by("a.py", "T\nSource s\nTheory t"),
+                    Catch::Contains("'a.py' has no Config paragraph"));
+  CHECK_THROWS_WITH(convention_used_by("a.py", "T\nConfig\nTheory t"),
+                    Catch::Contains("'a.py' has no Config paragraph"));
 }
 
 TEST_CASE("conventions_expect_line_names_the_groups_or_says_what_is_wrong", "[unit]") {
@@ -97,7 +141,10 @@ TEST_CASE("conventions_table_links_each_no_to_its_witness_row", "[unit]") {
   // One row per view table, the convention's section with its docstring, and a witness row
   // anchored for the link of each NO (to_markdown checks that every "#id" link has its id).
   CHECK_THAT(markdown, Catch::Contains("| convention | translation | rotation | se2 | se3 | c8 | "
-                                       "injective | as expected |"));
+                                       "injective | as expected | used by | commit | plug-in |"));
+  // Where the row comes from: its configurations, its commit, a link to its plug-in.
+  CHECK_THAT(markdown, Catch::Contains("| the default | `owner/lib@0123456` | "
+                                       "[relative.py](../conventions/relative.py) |"));
   CHECK_THAT(markdown,
              Catch::Contains("[NO](#conventions-relative-actions-rotation-pointwise-eye_in_hand)"));
   CHECK_THAT(
@@ -105,7 +152,8 @@ TEST_CASE("conventions_table_links_each_no_to_its_witness_row", "[unit]") {
       Catch::Contains("| <a id=\"conventions-relative-actions-rotation-pointwise-eye_in_hand\">"
                       "</a> actions, rotation, eye-in-hand |"));
   CHECK_THAT(markdown, Catch::Contains("- **Expect** actions: translation; observation: none\n"));
-  CHECK_THAT(markdown, Catch::Contains("- **Source** this library, core/\n"));
+  CHECK_THAT(markdown, Catch::Contains("- **Source** this library, owner/lib@"));
+  CHECK_THAT(markdown, Catch::Contains("- **Config** the default\n"));
   // Deterministic: the same results give the same bytes.
   CHECK(markdown == conventions_markdown({relative_convention(kRelativeDoc)}, options));
   // A convention against its theory shows in the table.
@@ -139,6 +187,9 @@ TEST_CASE("conventions_plugins_are_the_python_files_not_starting_with_underscore
                              std::istreambuf_iterator<char>());
     const std::string doc = convention_docstring(path, source);
     CHECK_NOTHROW(expected_groups(path, doc, props::Component::actions));
+    // ...cites each place read with its full commit, and names the configurations using it.
+    CHECK_NOTHROW(convention_citations(path, doc));
+    CHECK_NOTHROW(convention_used_by(path, doc));
   }
   CHECK(std::is_sorted(plugins.begin(), plugins.end()));
   CHECK_THROWS_WITH(convention_plugins("/nonexistent/conventions"),

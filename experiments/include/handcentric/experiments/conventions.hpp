@@ -4,7 +4,8 @@
 // it follows) audited through the --exec pipe with a fixed seed, and the verdicts written as one
 // row per convention: per group, in the eye-in-hand and third-person views, the actions
 // pointwise, the flow target in distribution and the observation pointwise, each NO linked to
-// its witness; and whether the map keeps the chunk's information (injectivity, resolution).
+// its witness; whether the map keeps the chunk's information (injectivity, resolution); and
+// where each row comes from (the configurations using it, the commits read, its plug-in).
 //
 // The same results give the Markdown file (conventions_markdown, which a test keeps equal to
 // docs/CONVENTIONS.md) and the report page's section (conventions_sections).
@@ -30,14 +31,25 @@ struct ConventionsOptions {
   int cases = kConventionsCases;
   std::uint64_t seed = 1;
   double timeout = 30.0;  ///< seconds per scene of a request (props::PipeRepresentation)
+  /// Where the table's plug-in column links each row's file to: this prefix and NAME.py
+  /// (docs/CONVENTIONS.md sits one folder below conventions/).
+  std::string plugin_links = "../conventions/";
   /// Called before each plug-in's audit (name, 1-based index, count): a progress line.
   std::function<void(const std::string& name, int index, int count)> progress;
 };
 
+/// One place a row's formula was read, as its Source paragraph writes it:
+/// `owner/repo@COMMIT:path:function`, COMMIT the 40 hex digits of the version read.
+struct ConventionCitation {
+  std::string repo, commit, path, function;
+};
+
 struct ConventionAudit {
-  std::string name;         ///< the file's stem, e.g. "umi_relative"
-  std::string title;        ///< convention_title of the docstring
-  std::string description;  ///< the whole docstring: source, formula, theory
+  std::string name;                           ///< the file's stem, e.g. "umi_relative"
+  std::string title;                          ///< convention_title of the docstring
+  std::string description;                    ///< the whole docstring: source, formula, theory
+  std::vector<ConventionCitation> citations;  ///< convention_citations of the docstring
+  std::string used_by;                        ///< convention_used_by of the docstring
   props::Classification result;
   /// Where the audit disagrees with the docstring's "Expect" line, one sentence each (empty:
   /// the verdicts are what the theory says).
@@ -68,6 +80,19 @@ std::vector<std::string> expectation_mismatches(const std::string& path,
 
 /// A docstring's title: its first paragraph up to the first ": " ("UMI, pose_rep 'abs'").
 std::string convention_title(const std::string& docstring);
+
+/// The citations of a docstring's Source paragraph, in order: every
+/// `owner/repo@COMMIT:path:function`, COMMIT 40 hex digits; one longer than a line may break
+/// after any of its colons and go on at the next line's indentation. Throws
+/// InvalidArgument naming the file and the form when the paragraph has none (a short commit or a
+/// missing function is not a citation).
+std::vector<ConventionCitation> convention_citations(const std::string& path,
+                                                     const std::string& docstring);
+
+/// A docstring's Config paragraph, its lines joined: the shipped configurations that select the
+/// pipeline ("no shipped config" when none does; "not on main" when the code is only on another
+/// branch). Throws InvalidArgument naming the file when the paragraph is missing or empty.
+std::string convention_used_by(const std::string& path, const std::string& docstring);
 
 /// Audits every plug-in of options.folder (all groups, both views, pointwise and in
 /// distribution, injectivity), each in its own process. Throws InvalidArgument for bad
