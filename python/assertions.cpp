@@ -67,11 +67,12 @@ void assert_invariant(py::object fn, const std::string& group, const std::string
   require_numpy("assert_invariant");
   if (!PyCallable_Check(fn.ptr())) throw DtypeError("fn must be callable, got a " + type_name(fn));
   const props::Component component = component_of(component_name);
-  const CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
-                                         extra_poses, scalars, setup);
+  CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
+                                   extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
   ProgressLine progress("assert_invariant", o.quiet);
   c.progress = std::ref(progress);
+  o.call.asked = [&progress](std::size_t rows) { progress.asked(rows); };
   props::Classification result;
   if (component == props::Component::observation) {
     // fn is the observation function; the actions are never asked for.
@@ -174,6 +175,7 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
   set_policy_call(o, c, rng, reset, action_format, state_format, "assert_equivariant");
   ProgressLine progress("assert_equivariant", o.quiet);
   c.progress = std::ref(progress);
+  o.call.asked = [&progress](std::size_t rows) { progress.asked(rows); };
   o.call.outputs = outputs_from(outputs, hands.is_none());
   set_hands(o, c, hands);
   if (o.call.outputs.empty()) {

@@ -138,6 +138,7 @@ std::vector<Eigen::VectorXd> PythonRepresentation::encode(const py::object& fn, 
                                                           const std::vector<const Scene*>& scenes,
                                                           const std::string& what) const {
   const ArrayKind& kind = options_.arrays;
+  if (options_.asked) options_.asked(scenes.size());
   if (options_.stacked) {
     py::object result = with_chunk ? call(fn, for_callable(stacked_history(scenes), kind),
                                           for_callable(stacked_chunk(scenes), kind),
@@ -184,6 +185,7 @@ std::vector<RigidTransform> PythonRepresentation::decode_in_scene(const Eigen::V
     throw InvalidArgument(name_ + " has no decode function: pass decode= to audit it");
   const ArrayKind& kind = options_.arrays;
   const std::vector<const Scene*> one = {&observation};
+  if (options_.asked) options_.asked(1);
   CallOptions single = options_;
   single.stacked = false;
   py::object result =
@@ -254,6 +256,7 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
   const ArrayKind& kind = options_.arrays;
+  if (options_.asked) options_.asked(observations.size());
   if (!options_.reset.is_none()) (void)call(options_.reset);
   py::kwargs seeded;
   if (!options_.rng.empty()) {
@@ -301,13 +304,31 @@ std::vector<std::vector<RigidTransform>> PythonPolicy::call_once(
       return chunks_from(chunk_only(std::move(result)), rows.size(), options_.stacked,
                          options_.action_format, what);
     }
-    const std::string entry_what = what + "['" + options_.output + "']";
-    const py::object entry = output_entry(result, options_.outputs, options_.output, what);
-    for (const NamedOutput& o : options_.outputs) {
-      if (o.name == options_.output && o.kind == OutputKind::invariant)
+    const auto one_output = [&](const NamedOutput& o) {
+      const std::string entry_what = what + "['" + o.name + "']";
+      const py::object entry = output_entry(result, options_.outputs, o.name, what);
+      if (o.kind == OutputKind::invariant)
         return invariant_as_poses(entry, rows, options_.stacked, entry_what);
+      return chunks_from(entry, rows.size(), options_.stacked, options_.action_format, entry_what);
+    };
+    const auto named =
+        std::find_if(options_.outputs.begin(), options_.outputs.end(),
+                     [&](const NamedOutput& o) { return o.name == options_.output; });
+    if (named == options_.outputs.end())
+      throw InvalidArgument("no output named '" + options_.output + "' in outputs=");
+    std::vector<std::vector<RigidTransform>> out = one_output(*named);
+    if (options_.executed_output.empty() || options_.executed_output == options_.output) return out;
+    const auto executed =
+        std::find_if(options_.outputs.begin(), options_.outputs.end(),
+                     [&](const NamedOutput& o) { return o.name == options_.executed_output; });
+    if (executed == options_.outputs.end())
+      throw InvalidArgument("no output named '" + options_.executed_output + "' in outputs=");
+    const std::vector<std::vector<RigidTransform>> moves = one_output(*executed);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      if (moves[i].empty()) throw InvalidArgument(what + " has an empty chunk to execute");
+      out[i].insert(out[i].begin(), moves[i].front());
     }
-    return chunks_from(entry, rows.size(), options_.stacked, options_.action_format, entry_what);
+    return out;
   };
   if (!options_.stacked) {
     std::vector<std::vector<RigidTransform>> out;

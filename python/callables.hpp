@@ -11,6 +11,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,8 +44,15 @@ struct CallOptions {
   /// callable hands the checks ("" when the policy returns its chunk alone).
   std::vector<NamedOutput> outputs;
   std::string output;
+  /// The closed loop's pose output, when it is not `output`: the first pose of its chunk goes
+  /// ahead of `output`'s chunk, so that the loop executes it and compares `output`
+  /// (props::ClosedLoopOptions::compared_from).
+  std::string executed_output;
   /// hands=: the hands' names, the first the audit's own hand (hands.hpp); empty: one hand.
   std::vector<std::string> hands;
+  /// Told the number of observations of every call before it is made (the audit's progress
+  /// line, options.hpp's ProgressLine), or empty.
+  std::function<void(std::size_t)> asked;
 };
 
 /// images={view: array} as a callable receives them for `scenes` (one: (C, h, w); stacked:

@@ -27,11 +27,15 @@ void add_closed_loop(props::Classification& result, const py::object& policy, in
                      props::ClosedLoopOptions loop) {
   CommonOptions one = o;
   one.call.reset = py::none();  // once per rollout (start_episode), not before every call
+  // With outputs=, the first pose output is executed and o.call.output is compared: an invariant
+  // output (a gripper width) can read the state the loop builds up as much as a pose can.
   for (const NamedOutput& output : o.call.outputs) {
-    if (output.kind == OutputKind::pose) {
-      one.call.output = output.name;
-      break;
+    if (output.kind != OutputKind::pose) continue;
+    if (output.name != o.call.output) {
+      one.call.executed_output = output.name;
+      loop.compared_from = 1;
     }
+    break;
   }
   const py::object reset = o.call.reset;
   if (!reset.is_none()) {
@@ -48,7 +52,12 @@ void add_closed_loop(props::Classification& result, const py::object& policy, in
   for (const props::View view : o.audit.views) {
     const props::CheckOptions check = props::with_view(c.check, view);
     for (const props::Group group : o.audit.groups) {
-      result.verdicts.push_back(props::check_policy_closed_loop(*batched, group, check, loop));
+      props::Verdict verdict = props::check_policy_closed_loop(*batched, group, check, loop);
+      if (!one.call.executed_output.empty()) {
+        verdict.note += std::string(verdict.note.empty() ? "" : "; ") + one.call.executed_output +
+                        " executed, " + o.call.output + " compared";
+      }
+      result.verdicts.push_back(std::move(verdict));
     }
   }
 }

@@ -19,7 +19,8 @@ namespace handcentric::python {
 std::optional<props::ClosedLoopOptions> closed_loop_from(py::handle episodes,
                                                          py::handle episode_length);
 
-/// The closed-loop verdicts of `policy` for every group and view of o, appended to `result`.
+/// The closed-loop verdicts of `policy` for every group and view of o, appended to `result`; with
+/// outputs=, those of o.call.output, the first pose output executed.
 void add_closed_loop(props::Classification& result, const py::object& policy, int noise,
                      const CommonOptions& o, const props::ClassifierOptions& c,
                      props::ClosedLoopOptions loop);

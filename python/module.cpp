@@ -102,12 +102,13 @@ py::dict audit(py::object actions, py::object observation, py::handle groups, py
       throw DtypeError(std::string(what) + " must be callable or None, got a " + type_name(fn));
     }
   }
-  const CommonOptions o =
+  CommonOptions o =
       common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars, setup);
+  ProgressLine progress("audit", o.quiet);
+  o.call.asked = [&progress](std::size_t rows) { progress.asked(rows); };
   auto representation = batched_representation(actions, observation, decode, o);
   props::ClassifierOptions c = classifier_for(o);
   c.observation = representation->has_observation();
-  ProgressLine progress("audit", o.quiet);
   c.progress = std::ref(progress);
   const props::Classification result = props::classify_representation(representation, c);
   py::dict report = json_loads(props::audit_json({result}))["representations"][py::int_(0)];
@@ -132,6 +133,7 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   set_policy_call(o, c, rng, reset, action_format, state_format, "audit_policy");
   ProgressLine progress("audit_policy", o.quiet);
   c.progress = std::ref(progress);
+  o.call.asked = [&progress](std::size_t rows) { progress.asked(rows); };
   o.call.outputs = outputs_from(outputs, hands.is_none());
   set_hands(o, c, hands);
   const auto loop = closed_loop_from(episodes, episode_length);
@@ -151,8 +153,8 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
     CommonOptions one = o;
     one.call.output = output.name;
     props::Classification result = props::classify_policy(batched_policy(policy, noise, one), c);
-    // The closed loop executes the first pose output: its verdicts go with that output's.
-    if (loop && report.empty()) add_closed_loop(result, policy, noise, o, c, *loop);
+    // The closed loop executes the first pose output and compares this one.
+    if (loop) add_closed_loop(result, policy, noise, one, c, *loop);
     py::dict part = json_loads(props::policy_audit_json({result}))["policies"][py::int_(0)];
     for (auto check : part["checks"]) {
       check["output"] = output.name;

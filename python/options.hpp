@@ -112,9 +112,10 @@ void set_policy_call(CommonOptions& o, props::ClassifierOptions& c, py::handle r
                      py::handle reset, py::handle action_format, py::handle state_format,
                      const std::string& caller);
 
-/// Prints "handcentric.audit_policy: 12 of 20 checks, 6.1 s, about 4 s left" on stderr (the
-/// same line again on a terminal, a new line at most every 5 s otherwise) once an audit has run
-/// for 3 s, and lets a pending Ctrl-C stop it between checks too.
+/// Prints "handcentric.audit_policy: 12 of 20 checks, 51200 rows asked (830 rows/s), 61.7 s,
+/// about 41 s left" on stderr (the same line again on a terminal, a new line at most every 5 s
+/// otherwise) once an audit has run for 3 s, while its checks run and as each ends, and lets a
+/// pending Ctrl-C stop it between checks too.
 class ProgressLine {
  public:
   ProgressLine(std::string function, bool quiet)
@@ -129,24 +130,18 @@ class ProgressLine {
     } catch (...) {
     }
   }
+  /// A check finished: `done` of `total`.
   void operator()(int done, int total) {
     if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-    if (quiet_) return;
-    const double elapsed = seconds_since(start_);
-    if (elapsed < after_ || done <= 0) return;
-    if (!printed_) tty_ = py::module_::import("sys").attr("stderr").attr("isatty")().cast<bool>();
-    if (printed_ && seconds_since(last_) < (tty_ ? 1.0 : 5.0) && done < total) return;
-    const double left = elapsed / done * (total - done);
-    std::ostringstream line;
-    line.precision(2);
-    line << std::fixed << (tty_ ? "\r" : "") << "handcentric." << function_ << ": " << done
-         << " of " << total << " checks, " << std::setprecision(1) << elapsed << " s"
-         << (done < total ? ", about " + std::to_string(static_cast<long>(left + 0.5)) + " s left"
-                          : std::string(", done"))
-         << (tty_ ? "   " : "\n");
-    write(line.str());
-    printed_ = true;
-    last_ = Clock::now();
+    done_ = done;
+    total_ = total;
+    show(done >= total);
+  }
+  /// The callable is about to be asked about `rows` more observations (CallOptions::asked): a
+  /// long check shows its progress before it ends.
+  void asked(std::size_t rows) {
+    rows_ += rows;
+    show(false);
   }
 
  private:
@@ -159,11 +154,45 @@ class ProgressLine {
     err.attr("write")(text);
     err.attr("flush")();
   }
+  // "handcentric.audit_policy: 3 of 20 checks, 12416 rows asked (830 rows/s), 15.0 s, about 85 s
+  // left": the time left from the checks done so far (none before the first ends).
+  void show(bool last) {
+    if (quiet_) return;
+    const double elapsed = seconds_since(start_);
+    if (elapsed < after_ || (done_ <= 0 && rows_ == 0)) return;
+    if (!printed_) tty_ = py::module_::import("sys").attr("stderr").attr("isatty")().cast<bool>();
+    if (printed_ && seconds_since(last_) < (tty_ ? 1.0 : 5.0) && !last) return;
+    std::ostringstream line;
+    line << std::fixed << std::setprecision(1) << (tty_ ? "\r" : "") << "handcentric." << function_
+         << ": ";
+    if (total_ > 0) {
+      line << done_ << " of " << total_ << " checks";
+    } else {
+      line << "first check";  // the count of checks is known once one has ended
+    }
+    if (rows_ > 0) {
+      line << ", " << rows_ << " rows asked (" << static_cast<long>(rows_ / elapsed + 0.5)
+           << " rows/s)";
+    }
+    line << ", " << elapsed << " s";
+    if (total_ > 0 && done_ >= total_) {
+      line << ", done";
+    } else if (done_ > 0) {
+      const double left = elapsed / done_ * (total_ - done_);
+      line << ", about " << static_cast<long>(left + 0.5) << " s left";
+    }
+    line << (tty_ ? "   " : "\n");
+    write(line.str());
+    printed_ = true;
+    last_ = Clock::now();
+  }
   std::string function_;
   bool quiet_;
   Clock::time_point start_, last_;
   bool printed_ = false, tty_ = false;
   double after_ = 3.0;
+  int done_ = 0, total_ = 0;
+  std::size_t rows_ = 0;
 };
 
 /// The callables as the checks see them (props/batch.hpp): answers cached, and batched when the

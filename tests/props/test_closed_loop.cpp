@@ -35,7 +35,31 @@ class SteppingPolicy final : public props::NoisyPolicy {
   mutable int steps_ = 0;
 };
 
-props::ClosedLoopOptions loop_of(const SteppingPolicy& policy, int episodes, int steps) {
+// Executes 1 cm along its own x each step; returns a second pose after it, 2 cm along its own x
+// plus `world_drift` along world x times its step count (a planned pose, never executed, that
+// reads a state kept in world coordinates).
+class PlanningPolicy final : public props::NoisyPolicy {
+ public:
+  explicit PlanningPolicy(double world_drift) : world_drift_(world_drift) {}
+  std::string name() const override { return "planning"; }
+  Eigen::Index noise_dimension() const override { return 2; }
+  std::vector<RigidTransform> act(const Scene& o, const Eigen::VectorXd& /*noise*/) const override {
+    ++steps_;
+    const RigidTransform& T0 = o.world_T_hand_history.front();
+    const RigidTransform planned =
+        RigidTransform::from_translation(Eigen::Vector3d(world_drift_ * steps_, 0, 0)) * T0 *
+        RigidTransform::from_translation(Eigen::Vector3d(0.02, 0, 0));
+    return {T0 * RigidTransform::from_translation(Eigen::Vector3d(0.01, 0, 0)), planned};
+  }
+  void reset() const { steps_ = 0; }
+
+ private:
+  double world_drift_;
+  mutable int steps_ = 0;
+};
+
+template <class Policy>
+props::ClosedLoopOptions loop_of(const Policy& policy, int episodes, int steps) {
   props::ClosedLoopOptions loop;
   loop.episodes = episodes;
   loop.steps = steps;
@@ -95,4 +119,31 @@ TEST_CASE("closed_loop_episodes_and_steps_out_of_range_are_refused", "[unit]") {
   CHECK_THROWS_AS(
       props::check_policy_closed_loop(policy, props::Group::se3, options, loop_of(policy, 2, 0)),
       InvalidArgument);
+}
+
+TEST_CASE("a_planned_pose_never_executed_is_compared_too", "[unit]") {
+  // The chunk is compared whole, as the pointwise checks compare it: a second pose that reads a
+  // world-frame state breaks the map o -> chunk even though the executed first pose holds.
+  // Planted fault (run by hand): comparing the executed pose alone says yes here.
+  const auto options = props::options_for(props::View::eye_in_hand);
+  const PlanningPolicy drifting(0.001);
+  const props::Verdict v = props::check_policy_closed_loop(drifting, props::Group::rotation,
+                                                           options, loop_of(drifting, 4, 4));
+  REQUIRE_FALSE(v.invariant);
+  REQUIRE(v.witness);
+  CHECK_THAT(v.witness->detail, Catch::Contains("returns pose 2 of the chunk compared"));
+  // With the executed pose handed ahead of another output's chunk (compared_from 1), the second
+  // pose is the first one compared.
+  props::ClosedLoopOptions behind = loop_of(drifting, 4, 4);
+  behind.compared_from = 1;
+  const props::Verdict w =
+      props::check_policy_closed_loop(drifting, props::Group::rotation, options, behind);
+  REQUIRE_FALSE(w.invariant);
+  CHECK_THAT(w.witness->detail, Catch::Contains("returns pose 1 of the chunk compared"));
+  const PlanningPolicy steady(0.0);
+  CHECK(props::check_policy_closed_loop(steady, props::Group::se3, options, loop_of(steady, 4, 4))
+            .invariant);
+  behind.compared_from = 2;
+  CHECK_THROWS_AS(props::check_policy_closed_loop(steady, props::Group::se3, options, behind),
+                  InvalidArgument);
 }

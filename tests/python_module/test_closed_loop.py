@@ -103,3 +103,43 @@ def test_episode_arguments_are_checked():
     with pytest.raises(ValueError, match="episode_length"):
         handcentric.audit_policy(policy, episodes=2, episode_length=0, reset=policy.reset,
                                  quiet=True)
+
+
+class GripperFromWorldMotion:
+    """The hand steps 5 cm along its own z (hand-centric); the gripper width is the x component
+    of the hand's world displacement since the last call (0 after reset): a state kept in world
+    coordinates that only an invariant output reads."""
+
+    def reset(self):
+        self.previous = None
+
+    def __call__(self, history, hand_points, world_points, noise):
+        world_T_hand = history[0]
+        moved = np.zeros(3) if self.previous is None else world_T_hand[:3, 3] - self.previous
+        self.previous = world_T_hand[:3, 3].copy()
+        hand_T_target = np.eye(4)
+        hand_T_target[:3, 3] = [0.0, 0.0, 0.05]
+        return {"hand": (world_T_hand @ hand_T_target)[None], "gripper": np.array([moved[0]])}
+
+
+def test_every_output_is_compared_in_the_closed_loop_and_blamed_by_name():
+    # Every single call holds (the first call after reset reads no motion); the rollouts from o
+    # and g o command different widths. The hand is executed and holds; the gripper is NO.
+    # Planted fault (run by hand): a closed loop of the executed pose output alone gave the
+    # gripper no closed-loop row and the report's closed-loop summary yes.
+    policy = GripperFromWorldMotion()
+    report = handcentric.audit_policy(policy, groups=["rotation"], views=["eye_in_hand"],
+                                      cases=20, episodes=4, episode_length=4, reset=policy.reset,
+                                      history=0, outputs={"hand": "pose", "gripper": "invariant"},
+                                      quiet=True)
+    loops = {c["output"]: c for c in report["checks"] if c["mode"] == "closed_loop"}
+    assert loops["hand"]["equivariant"] is True
+    assert loops["gripper"]["equivariant"] is False
+    assert loops["gripper"]["note"] == "hand executed, gripper compared"
+    # Step 1 reads no motion (fresh after reset): the widths part at step 2.
+    assert "at step 2 of 4 the policy returns pose 1 of the chunk compared" in \
+        loops["gripper"]["witness"]["detail"]
+    assert report["summary"]["eye_in_hand"]["closed_loop"]["rotation"] is False
+    gripper = report["outputs"]["gripper"]["summary"]["eye_in_hand"]
+    assert gripper["closed_loop"]["rotation"] is False
+    assert all(c["equivariant"] for c in report["checks"] if c["mode"] != "closed_loop")

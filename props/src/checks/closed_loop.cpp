@@ -3,6 +3,9 @@
 #include <rapidcheck.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
 #include <random>
 
 #include "handcentric/core/errors.hpp"
@@ -35,22 +38,23 @@ std::vector<Eigen::Vector3d> objects_of(const Scene& scene) {
   return objects;
 }
 
-/// One rollout of `steps` steps from `start`: the executed poses.
-std::vector<RigidTransform> rollout(const NoisyPolicy& policy, const Scene& start, int steps,
-                                    const std::vector<Eigen::VectorXd>& noises,
-                                    const ClosedLoopOptions& loop) {
+/// One rollout of `steps` steps from `start`: the chunk returned at each step, whose first pose
+/// is executed.
+std::vector<std::vector<RigidTransform>> rollout(const NoisyPolicy& policy, const Scene& start,
+                                                 int steps,
+                                                 const std::vector<Eigen::VectorXd>& noises,
+                                                 const ClosedLoopOptions& loop) {
   const std::vector<Eigen::Vector3d> objects = objects_of(start);
   const std::size_t seen_in_hand = start.hand_points.size();
   Scene scene = start;
-  std::vector<RigidTransform> executed;
+  std::vector<std::vector<RigidTransform>> returned;
   if (loop.start_episode) loop.start_episode();
   for (int t = 0; t < steps; ++t) {
     const std::vector<const Scene*> one = {&scene};
     const std::vector<const Eigen::VectorXd*> noise = {&noises[static_cast<std::size_t>(t)]};
-    const std::vector<RigidTransform> chunk = policy.act_fresh(one, noise).front();
-    if (chunk.empty()) throw InvalidArgument(policy.name() + " returned an empty chunk");
-    const RigidTransform next = chunk.front();
-    executed.push_back(next);
+    returned.push_back(policy.act_fresh(one, noise).front());
+    if (returned.back().empty()) throw InvalidArgument(policy.name() + " returned an empty chunk");
+    const RigidTransform next = returned.back().front();
     // The hand moves to the executed pose: it is T_0 now, the history shifts by one.
     scene.world_T_hand_history.insert(scene.world_T_hand_history.begin(), next);
     scene.world_T_hand_history.pop_back();
@@ -59,12 +63,30 @@ std::vector<RigidTransform> rollout(const NoisyPolicy& policy, const Scene& star
     for (std::size_t i = 0; i < seen_in_hand; ++i)
       scene.hand_points[i] = hand_T_world * objects[start.world_points.size() + i];
   }
-  return executed;
+  return returned;
 }
 
-double rollout_scale(const Scene& scene, const std::vector<RigidTransform>& poses) {
+/// The largest pose_distance(b[k], g a[k]) over two chunks returned at one step, and the pose k
+/// where it is (infinite when their lengths differ: a chunk is compared whole, as the pointwise
+/// checks compare it, not only the pose executed).
+std::pair<double, std::size_t> chunk_error(const std::vector<RigidTransform>& b,
+                                           const RigidTransform& g,
+                                           const std::vector<RigidTransform>& a,
+                                           std::size_t compared_from) {
+  if (a.size() != b.size()) return {std::numeric_limits<double>::infinity(), compared_from};
+  std::pair<double, std::size_t> worst{0.0, compared_from};
+  for (std::size_t k = compared_from; k < a.size(); ++k) {
+    const double d = pose_distance(b[k], g * a[k]);
+    if (std::isnan(d)) return {d, k};
+    if (d > worst.first) worst = {d, k};
+  }
+  return worst;
+}
+
+double rollout_scale(const Scene& scene, const std::vector<std::vector<RigidTransform>>& chunks) {
   double L = length_scale(scene);
-  for (const RigidTransform& T : poses) L = std::max(L, T.translation().norm());
+  for (const std::vector<RigidTransform>& chunk : chunks)
+    for (const RigidTransform& T : chunk) L = std::max(L, T.translation().norm());
   return L;
 }
 
@@ -79,6 +101,10 @@ Verdict check_policy_closed_loop(const NoisyPolicy& policy, Group group,
   if (loop.steps < 1 || loop.steps > 10000) {
     throw InvalidArgument("episode_length=" + std::to_string(loop.steps) +
                           " is out of range: 1 to 10000 steps");
+  }
+  if (loop.compared_from > 1) {
+    throw InvalidArgument("compared_from=" + std::to_string(loop.compared_from) +
+                          ": at most one executed pose precedes the chunk compared");
   }
   Verdict verdict;
   verdict.component = Component::policy;
@@ -102,16 +128,18 @@ Verdict check_policy_closed_loop(const NoisyPolicy& policy, Group group,
           options.noise_seed + 1000003ULL * static_cast<unsigned>(e) + static_cast<unsigned>(t)));
     }
     const Scene moved = g * start;
-    const std::vector<RigidTransform> a = rollout(policy, start, loop.steps, noises, loop);
-    const std::vector<RigidTransform> b = rollout(policy, moved, loop.steps, noises, loop);
+    const auto a = rollout(policy, start, loop.steps, noises, loop);
+    const auto b = rollout(policy, moved, loop.steps, noises, loop);
     double L = std::max(rollout_scale(start, a), rollout_scale(moved, b));
     const double floor = options.relative_tolerance * (1.0 + L);
-    std::vector<double> errors;
+    std::vector<std::pair<double, std::size_t>> errors;  // per step: the error and its pose
     double worst = 0.0;
     for (int t = 0; t < loop.steps; ++t) {
       const std::size_t k = static_cast<std::size_t>(t);
-      errors.push_back(pose_distance(b[k], g * a[k]));
-      worst = std::isnan(errors.back()) ? errors.back() : std::max(worst, errors.back());
+      errors.push_back(chunk_error(b[k], g, a[k], loop.compared_from));
+      const double e = errors.back().first;
+      worst = std::isnan(e) || std::isnan(worst) ? std::numeric_limits<double>::quiet_NaN()
+                                                 : std::max(worst, e);
     }
     const bool near = near_identity(g, start);
     if (!near)
@@ -123,12 +151,14 @@ Verdict check_policy_closed_loop(const NoisyPolicy& policy, Group group,
     // Above the floor: the rollout's own response to rounding of its start.
     const Scene nudged =
         rounding_perturbation(start, options.unit_roundoff, perturb, options.shape.planar);
-    const std::vector<RigidTransform> a2 = rollout(policy, nudged, loop.steps, noises, loop);
+    const auto a2 = rollout(policy, nudged, loop.steps, noises, loop);
     double response = 0.0;
     for (int t = 0; t < loop.steps; ++t) {
+      const std::size_t k = static_cast<std::size_t>(t);
       const double d =
-          pose_distance(a2[static_cast<std::size_t>(t)], a[static_cast<std::size_t>(t)]);
-      response = std::isnan(d) ? d : std::max(response, d);
+          chunk_error(a2[k], RigidTransform::identity(), a[k], loop.compared_from).first;
+      response = std::isnan(d) || std::isnan(response) ? std::numeric_limits<double>::quiet_NaN()
+                                                       : std::max(response, d);
     }
     const bool rounding =
         worst <= kRoundingMultiple * response && response <= rounding_cap(options.unit_roundoff, L);
@@ -136,22 +166,31 @@ Verdict check_policy_closed_loop(const NoisyPolicy& policy, Group group,
     verdict.invariant = false;
     // The first step the rollouts part: where the breaking enters the loop.
     std::size_t first = 0;
-    while (first + 1 < errors.size() && errors[first] <= floor) ++first;
+    while (first + 1 < errors.size() && errors[first].first <= floor) ++first;
+    const std::size_t pose = errors[first].second;
+    const bool same_length = a[first].size() == b[first].size();
     Witness w;
     w.scene = start;
     w.g = g;
-    w.before = flat(g * a[first]);
-    w.after = flat(b[first]);
+    const std::size_t shown = same_length && pose < a[first].size() ? pose : 0;
+    w.before = flat(g * a[first][shown]);
+    w.after = flat(b[first][shown]);
     w.error = worst;
     w.tolerance = floor;
     w.length_scale = L;
     w.rounding_response = response;
-    w.detail = "closed loop, episode " + std::to_string(e) + " of " +
-               std::to_string(loop.episodes) + ": the executed pose at step " +
-               std::to_string(first + 1) + " of " + std::to_string(loop.steps) +
-               " differs from g times the first rollout's by " +
-               format_significant(errors[first], 4) + " (floor " + format_significant(floor, 3) +
-               "), the largest difference over the episode " + format_significant(worst, 4);
+    const std::string where =
+        !same_length ? "returns " + std::to_string(b[first].size()) + " poses instead of " +
+                           std::to_string(a[first].size())
+        : pose == 0 ? "executes a pose that differs"
+                    : "returns pose " + std::to_string(pose + 1 - loop.compared_from) +
+                          " of the chunk compared differing";
+    w.detail =
+        "closed loop, episode " + std::to_string(e) + " of " + std::to_string(loop.episodes) +
+        ": at step " + std::to_string(first + 1) + " of " + std::to_string(loop.steps) +
+        " the policy " + where + " from g times the first rollout's by " +
+        format_significant(errors[first].first, 4) + " (floor " + format_significant(floor, 3) +
+        "), the largest difference over the episode " + format_significant(worst, 4);
     verdict.witness = w;
     return verdict;
   }

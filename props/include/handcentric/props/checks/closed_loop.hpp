@@ -11,8 +11,10 @@
 // the step's noise, the same on both sides; the first pose of what it returns is executed: the
 // hand moves there, the history takes it as T_0, and the eye-in-hand points are the objects seen
 // from the new hand frame (the world points, in the third-person view, stay as they are). The
-// executed poses are compared step by step, B_t against g A_t, by |R_a - R_b|_F + |p_a - p_b|,
-// within REL (1 + L) with L the largest translation of either rollout and its scene; a larger
+// chunks returned are compared step by step and whole (the pose executed and every other, as the
+// pointwise checks compare a chunk), B_t against g A_t, pose by pose by |R_a - R_b|_F +
+// |p_a - p_b|, within REL (1 + L) with L the largest translation of either rollout and its
+// scene; chunks of different lengths differ; a larger
 // difference that is at most 8 times the rollout's own response to a rounding-level
 // perturbation of its scene (and that response rounding-sized) is rounding, as in check.hpp.
 // A "yes" says so for the episodes run: a breaking that needs more steps, or a state the
@@ -30,13 +32,17 @@ struct ClosedLoopOptions {
   int steps = 16;     ///< the episode's length T, 1 to 10000
   /// Called before each rollout (the policy's reset); may be empty.
   std::function<void()> start_episode;
+  /// The poses of each returned chunk before this index are executed, not compared: 1 when the
+  /// policy hands the loop the pose it executes (one of its outputs) ahead of another output's
+  /// chunk, which is the one compared.
+  std::size_t compared_from = 0;
 };
 
 /// The closed-loop verdict of `policy` under `group` (mode closed_loop, component policy): its
 /// cases are the episodes with g far from the identity; a failure's witness is the episode's
-/// scene and g, before/after g A_t and B_t flattened as [p, r(R)] at the first step that
-/// differs, its detail naming the episode and the step. InvalidArgument for episodes or steps
-/// out of range.
+/// scene and g, before/after the poses of g A_t and B_t that differ most, flattened as [p, r(R)],
+/// at the first step that differs, its detail naming the episode, the step and the pose.
+/// InvalidArgument for episodes or steps out of range.
 Verdict check_policy_closed_loop(const NoisyPolicy& policy, Group group,
                                  const CheckOptions& options, const ClosedLoopOptions& loop);
 
