@@ -60,6 +60,9 @@ def lerobot_policy(policy, *, state="observation.state", scalars=(), images=None
     scalars = tuple(scalars)
 
     def call(history, hand_points, world_points, noise, **keywords):
+        if isinstance(history, dict):
+            raise ValueError("lerobot_policy: a history per hand (%s): observation.state holds "
+                             "one hand; audit without hands=" % ", ".join(history))
         torch = _torch()
         as_dtype = getattr(torch, dtype)
 

@@ -93,3 +93,12 @@ def test_the_adapter_names_what_is_missing():
             np.zeros((1, 7)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(1))
     with pytest.raises(ValueError, match="history of shape"):
         call(np.zeros((1, 1, 4, 4)), None, None, None)
+    with pytest.raises(ValueError, match="a history per hand"):
+        call({"left": np.zeros((1, 7)), "right": np.zeros((1, 7))}, None, None, None)
+    too_wide = handcentric.lerobot_policy(HandCentricPolicy(), scalars=("gripper",),
+                                          images={"eye_in_hand": WRIST},
+                                          action={"hand": 7, "gripper": 2})
+    with pytest.raises(ValueError, match="8 numbers per action, action=.* adds up to 9"):
+        too_wide(np.r_[0, 0, 0, 1, 0, 0, 0.0][None], np.zeros((0, 3)), np.zeros((0, 3)),
+                 np.zeros(1), scalars={"gripper": 0.5},
+                 images={"eye_in_hand": np.zeros((4, 24, 32), dtype=np.float32)})
