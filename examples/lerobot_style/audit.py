@@ -35,9 +35,7 @@ def audit(policy, groups=("translation", "rotation", "se3"), cases=40, episodes=
 def table(report):
     lines = ["%-8s %-12s %-12s %-12s %s" % ("output", "group", "view", "mode", "verdict")]
     for check in report["checks"]:
-        verdict = "yes" if check["equivariant"] else "NO"
-        if check.get("equivariant") is None:
-            verdict = "-"
+        verdict = {True: "yes", False: "NO"}.get(check["equivariant"], "-")
         lines.append("%-8s %-12s %-12s %-12s %s" % (check.get("output", ""), check["group"],
                                                      check["view"], check["mode"], verdict))
     return "\n".join(lines)
