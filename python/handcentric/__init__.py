@@ -24,8 +24,10 @@ from ._core import __version__  # noqa: F401  (a dunder: not part of `import *`)
 
 from .locate import (lie_derivatives, locate, locate_figure,  # noqa: E402  (on top of _core)
                      locate_json, locate_text)
+from .lerobot import lerobot_policy  # noqa: E402
 
 # Derived from the extension, so that a function added to _core is exported without an edit here;
-# and the functions written in Python (locate.py).
+# and the functions written in Python (locate.py, lerobot.py).
 __all__ = sorted([name for name in dir(_core) if not name.startswith("_")]
-                 + ["lie_derivatives", "locate", "locate_figure", "locate_json", "locate_text"])
+                 + ["lie_derivatives", "locate", "locate_figure", "locate_json", "locate_text",
+                    "lerobot_policy"])
