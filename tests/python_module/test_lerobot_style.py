@@ -26,7 +26,8 @@ def test_the_hand_centric_policy_holds_under_se3_in_every_call_and_in_closed_loo
     assert verdicts(report) == {
         ("hand", "se3", "pointwise"): True, ("hand", "se3", "distribution"): True,
         ("hand", "se3", "closed_loop"): True,
-        ("gripper", "se3", "pointwise"): True, ("gripper", "se3", "distribution"): True}
+        ("gripper", "se3", "pointwise"): True, ("gripper", "se3", "distribution"): True,
+        ("gripper", "se3", "closed_loop"): True}
     # rng="torch" gave the policy's own draws a seed: pointwise verdicts, not only the law.
     assert report["preflight"]["repeatable"]
 
@@ -39,6 +40,8 @@ def test_world_frame_motion_in_the_observation_queue_is_no_in_closed_loop_only()
                    episodes=3, episode_length=6)
     seen = verdicts(report)
     assert seen.pop(("hand", "rotation", "closed_loop")) is False
+    # The gripper comes from the same network, which reads the displacement: NO too.
+    assert seen.pop(("gripper", "rotation", "closed_loop")) is False
     assert seen == {("hand", "rotation", "pointwise"): True,
                     ("hand", "rotation", "distribution"): True,
                     ("gripper", "rotation", "pointwise"): True,
