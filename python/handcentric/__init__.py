@@ -25,7 +25,20 @@ from ._core import __version__  # noqa: F401  (a dunder: not part of `import *`)
 from .locate import (lie_derivatives, locate, locate_figure,  # noqa: E402  (on top of _core)
                      locate_json, locate_text)
 
+_DETECT = ("DetectError", "detect_convention", "detect_text", "load_episodes")
+
+
+def __getattr__(name):
+    """detect.py's names, imported when first used: it imports NumPy, which importing the
+    package does not."""
+    if name in _DETECT:
+        from . import detect
+        return getattr(detect, name)
+    raise AttributeError("module %r has no attribute %r" % (__name__, name))
+
+
 # Derived from the extension, so that a function added to _core is exported without an edit here;
-# and the functions written in Python (locate.py).
+# and the functions written in Python (locate.py, detect.py).
 __all__ = sorted([name for name in dir(_core) if not name.startswith("_")]
-                 + ["lie_derivatives", "locate", "locate_figure", "locate_json", "locate_text"])
+                 + ["lie_derivatives", "locate", "locate_figure", "locate_json", "locate_text"]
+                 + list(_DETECT))
