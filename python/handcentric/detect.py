@@ -353,8 +353,8 @@ def _verdict(best, folder):
                        "observation): translation %s | rotation %s | se2 %s | se3 %s | c8 %s | "
                        "injective: %s" % tuple(plain[1:7]))
                 break
-    return "%s: %s%s" % (best["convention"], expect[0] if expect else "",
-                         ("; " + row) if row else "")
+    theory = "expected " + expect[0][len("Expect"):].strip() if expect else ""
+    return "; ".join(part for part in ("%s: %s" % (best["convention"], theory), row) if part)
 
 
 def _strip_links(cell):
@@ -478,6 +478,46 @@ def _flag_declared(merged, declared):
     found["flags"].append("declared, but %s fits better" % best["convention"])
 
 
+def layout_encoder(name):
+    """(encode_batch, extra pose names) of a layout candidate "LAYOUT FRAME MODE" (or "LAYOUT
+    hand") as a plug-in of conventions/ would write it, for the audit of the best fit: the
+    actions of a chunk, each pose k against pose k-1 (k = 1..K, pose 0 the hand now) in the
+    steps; the observation the hand now in the same layout and frame, with the points in that
+    frame (the hand's for "hand"). The base, when named, is an extra pose that moves with g."""
+    parts = name.split()
+    layout, frame = parts[0], parts[1]
+    mode = "hand" if frame == "hand" else (parts[2] if len(parts) == 3 else None)
+    if layout not in LAYOUTS or mode not in MODES or frame not in ("world", "base", "hand"):
+        raise DetectError("%r is no layout candidate; write LAYOUT FRAME MODE, e.g. "
+                          "'pos_euler_xyz world step' or 'pos_quat_wxyz hand'" % name)
+
+    def encode_batch(history, chunk, hand_points, world_points, extra_poses=None, scalars=None):
+        B, K = chunk.shape[:2]
+        world_T_frame = extra_poses["base"] if frame == "base" else np.broadcast_to(np.eye(4),
+                                                                                   (B, 4, 4))
+        if frame == "hand":
+            world_T_frame = history[:, 0]
+        frame_T_world = _rigid_inverse(world_T_frame)[:, None]
+        poses = frame_T_world @ np.concatenate([history[:, :1], chunk], axis=1)
+        before, after = poses[:, :-1], poses[:, 1:]
+        if mode in ("absolute", "hand"):
+            actions = formats.encode(after, layout)
+        elif mode == "step":
+            step = _pose(after[..., :3, :3] @ np.swapaxes(before[..., :3, :3], -1, -2),
+                         after[..., :3, 3] - before[..., :3, 3])
+            actions = formats.encode(step, layout)
+        else:
+            actions = formats.encode(after, layout) - formats.encode(before, layout)
+        points = (frame_T_world[:, 0, :3, :3] @ np.swapaxes(world_points, 1, 2) +
+                  frame_T_world[:, 0, :3, 3:])
+        observation = np.concatenate([formats.encode(poses[:, 0], layout),
+                                      hand_points.reshape(B, -1),
+                                      np.swapaxes(points, 1, 2).reshape(B, -1)], axis=1)
+        return actions.reshape(B, -1), observation
+
+    return encode_batch, (("base",) if frame == "base" else ())
+
+
 def detect_text(ranking, count=10):
     """The ranking as lines: rank, candidate, residuals, flags; then the best fit's verdict."""
     lines = ["rank  residual_m  residual_rad  convention"]
@@ -502,7 +542,16 @@ def main(argv=None, prog="handcentric conventions --detect"):
     parser.add_argument("--declared")
     parser.add_argument("--top", type=int, default=10)
     parser.add_argument("--json", action="store_true")
+    parser.add_argument("--best-out", metavar="PATH",
+                        help="also write the best fit's name to PATH (for the command's audit)")
+    parser.add_argument("--serve", action="store_true",
+                        help="FILE is a layout candidate's name: serve it as a plug-in")
     args = parser.parse_args(argv)
+    if args.serve:
+        from handcentric_plugin import serve
+        encode_batch, extra = layout_encoder(args.file)
+        serve(encode_batch, batched=True, batch_size=256, extra_poses=extra)
+        return 0
     try:
         state, action, episode, world_T_base = load_episodes(args.file)
         ranking = detect_convention(state, action, episode, world_T_base=world_T_base,
@@ -510,6 +559,9 @@ def main(argv=None, prog="handcentric conventions --detect"):
     except DetectError as e:
         print(str(e), file=sys.stderr)
         return 1
+    if args.best_out:
+        with open(args.best_out, "w") as out:
+            out.write(ranking[0]["convention"] + "\n")
     if args.json:
         print(json.dumps(ranking[:args.top], indent=1))
     else:

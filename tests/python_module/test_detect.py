@@ -150,18 +150,28 @@ def test_a_misdeclared_euler_order_is_named():
     assert misdeclared_euler_order_is_named()
 
 
+class SwappedEuler:
+    """formats with the Euler layouts of one direction (encode or decode) read extrinsic for
+    intrinsic and back ("pos_euler_xyz" as "pos_euler_XYZ"): the classic bug."""
+    width, FORMATS = staticmethod(formats.width), formats.FORMATS
+
+    def __init__(self, direction):
+        self.direction = direction
+
+    def _call(self, direction, value, name):
+        if direction == self.direction and name.startswith("pos_euler_"):
+            name = "pos_euler_" + name[len("pos_euler_"):].swapcase()
+        return getattr(formats, direction)(value, name)
+
+    def encode(self, T, name):
+        return self._call("encode", T, name)
+
+    def decode(self, v, name):
+        return self._call("decode", v, name)
+
+
 def test_mutant_euler_axes_read_extrinsic_for_intrinsic(monkeypatch):
-    class SwappedCase:
-        """formats with "pos_euler_xyz" decoded as "pos_euler_XYZ" and back: the classic bug."""
-        width, encode, FORMATS = formats.width, formats.encode, formats.FORMATS
-
-        @staticmethod
-        def decode(v, name):
-            if name.startswith("pos_euler_"):
-                name = "pos_euler_" + name[len("pos_euler_"):].swapcase()
-            return formats.decode(v, name)
-
-    monkeypatch.setattr(detect_module, "formats", SwappedCase)
+    monkeypatch.setattr(detect_module, "formats", SwappedEuler("decode"))
     assert not misdeclared_euler_order_is_named()
 
 
@@ -278,3 +288,35 @@ def test_python_m_handcentric_conventions_detect(tmp_path):
                           str(tmp_path / "absent.npz"), "--plugins", PLUGINS],
                          capture_output=True, text=True)
     assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "no such file" in bad.stderr
+
+
+def served_as_recorded(layout, frame, mode):
+    """The layout candidate served for the command's audit (detect.layout_encoder) writes, for a
+    one-step chunk, the numbers the detector decodes."""
+    state, episode = episodes(seed=5, count=1, length=6)
+    world_T_base = WORLD_T_BASE if frame == "base" else np.eye(4)
+    name = "%s %s" % (layout, "hand" if mode == "hand" else frame + " " + mode)
+    encode_batch, extra = detect_module.layout_encoder(name)
+    B = len(state) - 1
+    no_points = np.zeros((B, 0, 3))
+    served, _ = encode_batch(state[:-1, None], state[1:, None], no_points, no_points,
+                             extra_poses={"base": np.broadcast_to(world_T_base, (B, 4, 4))},
+                             scalars={})
+    recorded = recorded_in_layout(layout, frame, mode, state, episode, world_T_base)[:-1]
+    return extra == (("base",) if frame == "base" else ()) and np.allclose(served, recorded,
+                                                                          atol=1e-12)
+
+
+@pytest.mark.parametrize("layout,frame,mode", LAYOUT_CASES)
+def test_a_layout_is_served_as_it_is_detected(layout, frame, mode):
+    assert served_as_recorded(layout, frame, mode)
+
+
+def test_mutant_a_served_euler_layout_with_its_axes_swapped(monkeypatch):
+    monkeypatch.setattr(detect_module, "formats", SwappedEuler("encode"))
+    assert not served_as_recorded("pos_euler_xyz", "world", "absolute")
+
+
+def test_a_bad_layout_name_is_refused():
+    with pytest.raises(handcentric.DetectError, match="LAYOUT FRAME MODE"):
+        detect_module.layout_encoder("pos_euler_xyz sideways")
