@@ -372,7 +372,7 @@ def _strip_links(cell):
 
 
 def detect_convention(state, action, episode, *, world_T_base=None, plugins=None, declared=None,
-                      top=None):
+                      top=None, max_steps=2000):
     """Rank every convention of conventions/ and every pose layout (frames world, base, hand;
     absolute, step or component-wise) by how well its decoding of each recorded action
     reproduces the next recorded pose.
@@ -381,7 +381,8 @@ def detect_convention(state, action, episode, *, world_T_base=None, plugins=None
     (consecutive records of one episode are steps); world_T_base (4, 4) adds the base frame;
     plugins the folder of convention plug-ins (default: the source tree's conventions/);
     declared a layout or candidate name the user believes the data are in (flagged when the data
-    contradict it); top keeps the first entries only.
+    contradict it); top keeps the first entries only; max_steps bounds the steps fitted (evenly
+    spaced over the records: the numerical decodings cost about a second per 1000 steps).
 
     Returns a list, best first, of dicts: convention (a row's name or "LAYOUT FRAME MODE"),
     kind ("convention" or "layout"), residual_m and residual_rad (mean over steps), flags (list
@@ -393,6 +394,8 @@ def detect_convention(state, action, episode, *, world_T_base=None, plugins=None
     if folder is None or not os.path.isdir(folder):
         raise DetectError("no folder of convention plug-ins at %r; pass plugins= (the "
                           "repository's conventions/)" % (folder,))
+    if len(pairs) > max_steps:
+        pairs = pairs[np.unique(np.linspace(0, len(pairs) - 1, max_steps).astype(int))]
     world_T_now, world_T_next, a = state[pairs], state[pairs + 1], action[pairs]
     first_of_episode = {}
     for i, e in enumerate(episode):
