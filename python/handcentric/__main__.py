@@ -233,7 +233,7 @@ def _detect(args):
     from . import detect
     argv = [args.detect] + (["--plugins", args.plugins] if args.plugins else []) + \
         (["--declared", args.declared] if args.declared else []) + \
-        (["--json"] if args.json else [])
+        (["--json"] if args.json else []) + ["--audit"]
     return detect.main(argv, prog=PROG + " conventions --detect")
 
 

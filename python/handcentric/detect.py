@@ -372,7 +372,7 @@ def _strip_links(cell):
 
 
 def detect_convention(state, action, episode, *, world_T_base=None, plugins=None, declared=None,
-                      top=None, max_steps=2000):
+                      top=None, max_steps=2000, audit=False):
     """Rank every convention of conventions/ and every pose layout (frames world, base, hand;
     absolute, step or component-wise) by how well its decoding of each recorded action
     reproduces the next recorded pose.
@@ -382,7 +382,9 @@ def detect_convention(state, action, episode, *, world_T_base=None, plugins=None
     plugins the folder of convention plug-ins (default: the source tree's conventions/);
     declared a layout or candidate name the user believes the data are in (flagged when the data
     contradict it); top keeps the first entries only; max_steps bounds the steps fitted (evenly
-    spaced over the records: the numerical decodings cost about a second per 1000 steps).
+    spaced over the records: the numerical decodings cost about a second per 1000 steps);
+    audit=True audits a best fit that is a layout (audit_layout, the compiled extension) into its
+    entry's "audit".
 
     Returns a list, best first, of dicts: convention (a row's name or "LAYOUT FRAME MODE"),
     kind ("convention" or "layout"), residual_m and residual_rad (mean over steps), flags (list
@@ -454,6 +456,8 @@ def detect_convention(state, action, episode, *, world_T_base=None, plugins=None
         _flag_declared(merged, declared)
     best = merged[0]
     best["verdict"] = _verdict(best, folder)
+    if audit and best["kind"] == "layout":
+        best["audit"] = audit_layout(best["convention"])
     for entry in merged:
         del entry["_key"], entry["_steps"]
     return merged[:top] if top else merged
@@ -521,6 +525,31 @@ def layout_encoder(name):
     return encode_batch, (("base",) if frame == "base" else ())
 
 
+def audit_layout(name, cases=50, seed=1):
+    """The eye-in-hand verdict row of a layout candidate, audited in process by
+    handcentric.audit (the compiled extension) as the command audits it through the pipe: per
+    group, actions (pointwise) · target law (in distribution) · observation (pointwise)."""
+    import handcentric
+    encode_batch, extra = layout_encoder(name)
+
+    def actions(history, chunk, hand_points, world_points, **poses):
+        return encode_batch(history, chunk, hand_points, world_points, **poses)[0]
+
+    def observation(history, hand_points, world_points, **poses):
+        # The observation does not read the chunk: the hand now stands in for it.
+        return encode_batch(history, history[:, :1], hand_points, world_points, **poses)[1]
+
+    result = handcentric.audit(actions, observation, views=("eye_in_hand",), cases=cases,
+                               seed=seed, extra_poses=extra, batch_size=256, quiet=True)
+    cells = {(c["component"], c["mode"], c["group"]): "yes" if c["invariant"] else "NO"
+             for c in result["checks"]}
+    return " | ".join(
+        "%s %s" % (group, " · ".join(cells.get(key + (group,), "-") for key in (
+            ("actions", "pointwise"), ("flow_target", "distribution"),
+            ("observation", "pointwise"))))
+        for group in handcentric.GROUPS)
+
+
 def detect_text(ranking, count=10):
     """The ranking as lines: rank, candidate, residuals, flags; then the best fit's verdict."""
     lines = ["rank  residual_m  residual_rad  convention"]
@@ -532,6 +561,9 @@ def detect_text(ranking, count=10):
         lines.extend("                              ! " + flag for flag in entry["flags"])
     lines.append("best fit: %s" % ranking[0]["convention"])
     lines.append("verdict: %s" % ranking[0]["verdict"])
+    if "audit" in ranking[0]:
+        lines.append("audit of %s (eye-in-hand, 50 cases per cell; actions · target law · "
+                     "observation): %s" % (ranking[0]["convention"], ranking[0]["audit"]))
     return "\n".join(lines)
 
 
@@ -547,6 +579,8 @@ def main(argv=None, prog="handcentric conventions --detect"):
     parser.add_argument("--json", action="store_true")
     parser.add_argument("--best-out", metavar="PATH",
                         help="also write the best fit's name to PATH (for the command's audit)")
+    parser.add_argument("--audit", action="store_true",
+                        help="audit a best-fitting layout in process (the compiled extension)")
     parser.add_argument("--serve", action="store_true",
                         help="FILE is a layout candidate's name: serve it as a plug-in")
     args = parser.parse_args(argv)
@@ -558,7 +592,8 @@ def main(argv=None, prog="handcentric conventions --detect"):
     try:
         state, action, episode, world_T_base = load_episodes(args.file)
         ranking = detect_convention(state, action, episode, world_T_base=world_T_base,
-                                    plugins=args.plugins, declared=args.declared)
+                                    plugins=args.plugins, declared=args.declared,
+                                    audit=args.audit)
     except DetectError as e:
         print(str(e), file=sys.stderr)
         return 1

@@ -5,14 +5,13 @@ input is a one-line DetectError naming the value. Mutant twins (test_mutant_*): 
 with the history and the chunk swapped, a step composed on the wrong side, Euler axes read
 extrinsic for intrinsic, no component-wise flag, no finiteness check."""
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 import handcentric
 from handcentric import detect as detect_module
+from handcentric.__main__ import main
 from handcentric_plugin import formats
 
 PLUGINS = os.path.normpath(os.path.join(os.path.dirname(os.path.realpath(__file__)), os.pardir,
@@ -272,22 +271,22 @@ def test_files_missing_keys_or_unreadable(tmp_path):
             handcentric.load_episodes(str(tmp_path / name))
 
 
-def test_python_m_handcentric_conventions_detect(tmp_path):
+def test_python_m_handcentric_conventions_detect(tmp_path, capsys):
+    """`python -m handcentric conventions --detect` (its main, in process): the ranking, the
+    best fit's audit, and a bad file as one line on stderr, exit 1."""
     state, episode = episodes()
-    action = recorded_in_layout("pos_euler_xyz", "world", "component-wise", state, episode)
+    action = recorded_in_layout("pos_quat_xyzw", "world", "hand", state, episode)
     path = tmp_path / "episodes.jsonl"
     path.write_text("".join('{"state": %s, "action": %s, "episode": %d}\n'
                             % (s.tolist(), a.tolist(), e)
                             for s, a, e in zip(state, action, episode)))
-    done = subprocess.run([sys.executable, "-m", "handcentric", "conventions", "--detect",
-                           str(path), "--plugins", PLUGINS], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
-    assert "best fit: pos_euler_xyz world component-wise" in done.stdout
-    assert "component-wise" in done.stdout.split("best fit")[0]
-    bad = subprocess.run([sys.executable, "-m", "handcentric", "conventions", "--detect",
-                          str(tmp_path / "absent.npz"), "--plugins", PLUGINS],
-                         capture_output=True, text=True)
-    assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "no such file" in bad.stderr
+    assert main(["conventions", "--detect", str(path), "--plugins", PLUGINS]) == 0
+    out = capsys.readouterr().out
+    assert "best fit: pos_quat_xyzw hand" in out
+    assert "audit of pos_quat_xyzw hand (eye-in-hand" in out and "se3 yes · yes · yes" in out
+    assert main(["conventions", "--detect", str(tmp_path / "absent.npz")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no such file" in err
 
 
 def served_as_recorded(layout, frame, mode):
@@ -320,3 +319,29 @@ def test_mutant_a_served_euler_layout_with_its_axes_swapped(monkeypatch):
 def test_a_bad_layout_name_is_refused():
     with pytest.raises(handcentric.DetectError, match="LAYOUT FRAME MODE"):
         detect_module.layout_encoder("pos_euler_xyz sideways")
+
+
+def base_layout_audits_invariant():
+    """A layout in the frame of a base that moves with g: every cell yes (the command's
+    audit of a best fit, in process)."""
+    row = detect_module.audit_layout("pos_rot6d_rows base absolute", cases=10)
+    return all(cell.split(" ", 1)[1] == "yes · yes · yes" for cell in row.split(" | "))
+
+
+def test_a_layout_in_a_base_that_moves_with_g_audits_invariant():
+    assert base_layout_audits_invariant()
+
+
+def test_mutant_a_base_that_stays_put(monkeypatch):
+    encoder = detect_module.layout_encoder
+
+    def fixed_base(name):
+        encode_batch, extra = encoder(name)
+
+        def encode(history, chunk, hand_points, world_points, extra_poses=None, scalars=None):
+            base = np.broadcast_to(WORLD_T_BASE, (len(history), 4, 4))
+            return encode_batch(history, chunk, hand_points, world_points, {"base": base})
+        return encode, extra
+
+    monkeypatch.setattr(detect_module, "layout_encoder", fixed_base)
+    assert not base_layout_audits_invariant()
