@@ -210,7 +210,8 @@ void add_conventions_command(CLI::App& app, int& exit_code) {
                   "exit 1, naming the first differing line, unless FILE is what the audit gives");
   cmd->add_option("--detect", options->detect,
                   "rank every convention and pose layout by how well it decodes recorded "
-                  "episodes (FILE.npz or FILE.jsonl: state (N,4,4), action (N,d), episode (N,))");
+                  "episodes (FILE.npz or FILE.jsonl: state (N,4,4), action (N,d), episode (N,)); "
+                  "print the ranking and the best fit's verdict row");
   cmd->add_option("--declared", options->declared,
                   "with --detect: the layout the data are believed in, flagged when they "
                   "contradict it (e.g. pos_euler_xyz)");
