@@ -66,7 +66,8 @@ fi
 #    plug-ins, runs for minutes under ASan). The library code they drive runs
 #    under the sanitizers in the unit tests (the recorded observations' in test_recorded.cpp),
 #    and the command's refusals of bad input (the short `*_cli_*` tests) stay in, but for the
-#    one that needs a whole table's output (table1_cli_an_existing_run_needs_resume);
+#    one that needs a whole table's output (table1_cli_an_existing_run_needs_resume), and those of
+#    `conventions --detect` that audit a layout through a plug-in (and their mutants);
 #  - three statistical tests of the audit on random networks (the energy test's fallback, a
 #    decoder that forgets R0, Theorem 1 pointwise and in law): 134 s under ASan; the same code
 #    paths run in shorter tests of the run (the energy test's detectable shift, the world-delta
@@ -115,7 +116,8 @@ end_to_end='^policy_unit_suite_on_|^policy_exec_audits_a_whole_policy|^expect_ga
 '^the_tabulated_detectable_shift_is_the_simulated_one|'\
 '^anisotropic_world_noise_through_a_curve|^without_the_exact_split_and_the_scale_test|'\
 '^conventions_committed_table_is_up_to_date|^mutant_conventions_a_changed_formula|'\
-'^mutant_conventions_a_base_that_stays_put|'\
+'^mutant_conventions_a_base_that_stays_put|^mutant_conventions_detect_|'\
+'^conventions_cli_detect_names_a_misdeclared|^conventions_cli_detect_flags_a_component_wise|'\
 '^policy_exec_audits_a_plugin_on_recorded_observations|'\
 '^a_batched_policy_audit_is_the_unbatched_one_bit|^a_map_whose_answer_depends_on_its_batch|'\
 '^a_batched_exec_audit_gives_the_unbatched_json|^a_batched_policy_exec_audit_gives_the_unbatched|'\

@@ -26,8 +26,21 @@ from .locate import (lie_derivatives, locate, locate_figure,  # noqa: E402  (on 
                      locate_json, locate_text)
 from .lerobot import lerobot_policy  # noqa: E402
 
+_DETECT = ("DetectError", "detect_convention", "detect_text", "load_episodes")
+
+
+def __getattr__(name):
+    """detect.py's names, imported when first used: it imports NumPy, which importing the
+    package does not."""
+    if name in _DETECT:
+        from . import detect
+        return getattr(detect, name)
+    raise AttributeError("module %r has no attribute %r" % (__name__, name))
+
+
 # Derived from the extension, so that a function added to _core is exported without an edit here;
-# and the functions written in Python (locate.py, lerobot.py).
+# and the functions written in Python (locate.py, lerobot.py, detect.py).
 __all__ = sorted([name for name in dir(_core) if not name.startswith("_")]
                  + ["lie_derivatives", "locate", "locate_figure", "locate_json", "locate_text",
-                    "lerobot_policy"])
+                    "lerobot_policy"]
+                 + list(_DETECT))

@@ -3,6 +3,7 @@ Python, from the shell.
 
     python -m handcentric audit my_repr.py:actions --observation my_repr.py:observation
     python -m handcentric audit-policy my_package.policies:policy --group se3 --cases 500
+    python -m handcentric conventions --detect episodes.npz
 
 MODULE:FUNCTION names the callable: MODULE is a dotted module name (importable from the current
 directory or sys.path) or the path of a .py file (its folder is put on sys.path, so that it
@@ -208,7 +209,32 @@ def make_parser():
                        help="standard normals per call, 1 to %d" % handcentric.MAX_NOISE)
     where.add_argument("--rng", choices=("torch", "numpy", "generator"),
                        help="seed the policy's own draws alike for o and g o (rng=)")
+    conventions = commands.add_parser(
+        "conventions", help="which convention recorded episodes are in "
+                            "(handcentric.detect_convention)",
+        description="Rank every convention of conventions/ and every pose layout by how well "
+                    "it decodes recorded episodes, as `handcentric conventions --detect` does.")
+    conventions.add_argument("--detect", metavar="FILE", required=True,
+                             help="a .npz (arrays state, action, episode) or .jsonl (one "
+                                  "object per line with those keys)")
+    conventions.add_argument("--plugins", metavar="DIR",
+                             help="the folder of convention plug-ins (default: the source "
+                                  "tree's conventions/)")
+    conventions.add_argument("--declared", metavar="LAYOUT",
+                             help="the layout the data are believed in (flagged if they "
+                                  "contradict it)")
+    conventions.add_argument("--json", action="store_true",
+                             help="the ranking as JSON (the dicts detect_convention returns)")
     return parser
+
+
+def _detect(args):
+    """`conventions --detect`: the ranking, or a bad input as one line and exit 1."""
+    from . import detect
+    argv = [args.detect] + (["--plugins", args.plugins] if args.plugins else []) + \
+        (["--declared", args.declared] if args.declared else []) + \
+        (["--json"] if args.json else []) + ["--audit"]
+    return detect.main(argv, prog=PROG + " conventions --detect")
 
 
 def _kinds(text):
@@ -300,6 +326,8 @@ def summary_lines(result):
 def main(argv=None):
     parser = make_parser()
     args = parser.parse_args(argv)
+    if args.command == "conventions":
+        return _detect(args)
     try:
         keywords = _keywords(args)
         if args.command == "locate":
