@@ -12,6 +12,11 @@ Two policies, both hand-centric (Theorem 1: equivariant for any weights):
            actions (position + 6D rows) are decoded in float64, T_k = T_0 [GS(6D), p].
   trivial  affine in its noise: T_k = T_0 [R_k, c_k + 0.01 n_k] with fixed R_k, c_k and n_k
            the k-th triple of the noise, asked with 256 noise numbers (the default) and 144.
+The UNet runs in float32, so its audits pass precision="float32" (docs/AUDIT.md, "Tolerances
+and rounding"): at the default float64 floor, 1e-9 (1 + L), the network's own float32 rounding,
+which differs with the batch a row rides in (o and g o are asked in different batches),
+is a "NO" pointwise, and each failing check then shrinks its witness one row per call
+(--unet-precision float64 shows it). The trivial policy is float64 and audited at float64.
 Each is audited, batch_size=256, array="torch", on scenes of one shape (history=1,
 hand_points=3, world_points=4), by
   assert_equivariant(policy, "se3")     pointwise, both views (it returns no report)
@@ -325,13 +330,13 @@ def measure(name, policy, noise, audit, cases, **options):
     return row
 
 
-def suite(name, policy, noise, cases, quick=False):
+def suite(name, policy, noise, cases, quick=False, **options):
     """The three audits; --quick asks a UNet for its pointwise one only (the other two ask it
     thousands of rows even at 20 cases, in-distribution cells running at least 10)."""
-    runs = [measure(name, policy, noise, "assert_equivariant", cases)]
+    runs = [measure(name, policy, noise, "assert_equivariant", cases, **options)]
     if not quick or name == "trivial":
-        runs += [measure(name, policy, noise, "audit_policy", cases, groups=("se3",)),
-                 measure(name, policy, noise, "audit_policy", cases)]
+        runs += [measure(name, policy, noise, "audit_policy", cases, groups=("se3",), **options),
+                 measure(name, policy, noise, "audit_policy", cases, **options)]
     return runs
 
 
@@ -340,6 +345,8 @@ def main():
     parser.add_argument("--quick", action="store_true", help="a tiny smoke configuration")
     parser.add_argument("--json", metavar="FILE", help="write the numbers there")
     parser.add_argument("--only", choices=("unet", "trivial"))
+    parser.add_argument("--unet-precision", default="float32", choices=("float32", "float64"),
+                        help="the audits' precision= for the UNet (default float32)")
     parser.add_argument("--threads", type=int, default=2,
                         help="torch's threads (default 2; --quick: 1)")
     args = parser.parse_args()
@@ -361,7 +368,8 @@ def main():
         unet = (UnetPolicy((8, 16, 32), embed=16) if args.quick
                 else UnetPolicy((64, 128, 256)))
         print("unet: %d parameters" % unet.parameters(), flush=True)
-        runs += suite("unet", unet, UNET_NOISE, cases, args.quick)
+        runs += suite("unet", unet, UNET_NOISE, cases, args.quick,
+                      precision=args.unet_precision)
     out = {"quick": args.quick, "loadavg_before": before, "loadavg_after": load(),
            "shape": SHAPE, "cases": cases, "batch_size": 256,
            "torch_threads": torch.get_num_threads(), "runs": runs}
