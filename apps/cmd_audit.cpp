@@ -46,6 +46,7 @@ struct AuditCommandOptions {
   std::string workspace, witness_dir, observations;
   bool json = false;
   bool pointwise = false;
+  bool test_law = false;
   bool floor = false;
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
@@ -114,6 +115,7 @@ int run_audit(const AuditCommandOptions& options) {
   const bool all_groups = has_all(options.groups), all_views = has_all(options.views);
   audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
   audit.seed = options.seed;
+  audit.test_law = options.test_law;
   audit.precision = props::parse_precision(options.precision);
   audit.relative_tolerance = options.tolerance;
   if (!options.workspace.empty()) audit.workspace = props::Workspace::parse(options.workspace);
@@ -234,6 +236,10 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   auto* pointwise = cmd->add_flag(
       "--pointwise", options->pointwise,
       "--model only: the pointwise cells alone, no in-distribution ones (Table 1's audit)");
+  auto* test_law = cmd->add_flag(
+      "--test-law", options->test_law,
+      "a whole policy: run the in-distribution tests on every cell, also where the pointwise "
+      "check holds (by default such a cell's law follows from it: docs/AUDIT.md)");
   auto* exec =
       cmd->add_option("--exec", options->exec,
                       "audit a representation written in any language: COMMAND speaks JSON Lines "
@@ -253,6 +259,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   policy_exec->excludes(repr)->excludes(model);
   model->excludes(repr);
   pointwise->needs(model);
+  test_law->excludes(pointwise)->excludes(repr)->excludes(exec);
   auto* profile = cmd->add_option(
       "--profile", options->profile,
       "GROUP: how far from equivariant, the error against the size of g (rad, m or the C8 "

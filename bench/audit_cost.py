@@ -32,11 +32,14 @@ assert_equivariant decides the same pointwise cases (the same seed and classifie
 in-distribution checks off), so its guarantee is that of the se3 audit's pointwise checks.
 
 Where the rows go. Each row is attributed from what the policy is given, which is exact and
-costs nothing: the view from the world points (the eye-in-hand view has none), the mode from the
-noise (the pointwise checks and the preflight ask with the audit's one fixed noise vector, the
-first row the policy ever sees; the in-distribution checks with zero and unit vectors, their
-affine probes, or with fresh draws), the preflight as the first calls (27 rows in 7 calls and
-6 rows in 2 more when batched, docs/AUDIT.md). The group cannot be read from a row: the checks
+costs nothing: the view from the world points (the eye-in-hand view has none), the preflight
+as the first calls (27 rows in 7 calls and 6 rows in 2 more when batched, docs/AUDIT.md), the
+mode from the order and the noise (a view's in-distribution checks run after its pointwise ones
+and begin with an affine probe, the zero noise vector; their rows are those probes, zero and
+unit vectors, or fresh draws). A pointwise "yes" gives the cell's law (method
+"from_pointwise", docs/AUDIT.md), so by default the in-distribution checks ask rows only where
+the pointwise check fails; each audit_policy is also run with test_law=True, which tests every
+cell's law, the audit as it was before. The group cannot be read from a row: the checks
 of one view and mode run one group after another and share cached answers (every check draws
 its scenes from the same seed, so a(o, n) asked by one group is not asked again by the next).
 The trivial policy is cheap, so it is also audited one group at a time, which gives each
@@ -236,19 +239,21 @@ class Counting:
 
     def __init__(self, policy):
         self.policy = policy
-        self.fixed = None        # the pointwise noise: the preflight's, the first row asked
-        self.calls = []          # per call: {(view, kind): rows}
+        self.law_started = set()  # the views whose in-distribution checks have begun
+        self.calls = []           # per call: {(view, kind): rows}
 
     def __call__(self, history, hand_points, world_points, noise):
-        if self.fixed is None:
-            self.fixed = noise[0].clone()
         view = "third_person" if world_points.shape[1] > 0 else "eye_in_hand"
         ones = (noise == 1).sum(1) == 1
         unit = ones & ((noise != 0).sum(1) == 1)
         zero = (noise == 0).all(1)
-        fixed = (noise == self.fixed).all(1)
-        kinds = {"fixed": int(fixed.sum()), "probe": int((zero | unit).sum())}
-        kinds["draw"] = noise.shape[0] - kinds["fixed"] - kinds["probe"]
+        probes = int((zero | unit).sum())
+        # The in-distribution checks of a view begin with an affine probe (zero noise) and run
+        # after its pointwise checks: before the first probe a row is pointwise, after it a draw.
+        if probes and len(self.calls) >= PREFLIGHT_CALLS:
+            self.law_started.add(view)
+        rest = "draw" if view in self.law_started else "pointwise"
+        kinds = {"probe": probes, rest: noise.shape[0] - probes}
         self.calls.append({(view, kind): n for kind, n in kinds.items() if n})
         return self.policy(history, hand_points, world_points, noise)
 
@@ -265,7 +270,7 @@ class Counting:
             else:
                 named = {}
                 for (view, kind), rows in call.items():
-                    mode = "pointwise" if kind == "fixed" else "distribution"
+                    mode = "pointwise" if kind == "pointwise" else "distribution"
                     key = "%s, %s" % (view, mode)
                     named[key] = named.get(key, 0) + rows
                     if mode == "distribution":
@@ -335,8 +340,10 @@ def suite(name, policy, noise, cases, quick=False, **options):
     thousands of rows even at 20 cases, in-distribution cells running at least 10)."""
     runs = [measure(name, policy, noise, "assert_equivariant", cases, **options)]
     if not quick or name == "trivial":
-        runs += [measure(name, policy, noise, "audit_policy", cases, groups=("se3",), **options),
-                 measure(name, policy, noise, "audit_policy", cases, **options)]
+        for law in ({}, {"test_law": True}):
+            runs += [measure(name, policy, noise, "audit_policy", cases, groups=("se3",),
+                             **law, **options),
+                     measure(name, policy, noise, "audit_policy", cases, **law, **options)]
     return runs
 
 

@@ -64,22 +64,25 @@ py::dict about_case(const std::pair<Scene, RigidTransform>& c) {
 }
 
 /// What both kinds of questions set up: the audit's options for one group and one view, the
-/// policy as the audit calls it, and the fixed noise; ask() tells on_ask, then asks.
+/// policy as the audit calls it, and the fixed noise (the profile's); ask() tells on_ask, then
+/// asks, each row with its own noise when `noises` are given (the pointwise cases').
 struct Questions {
   CommonOptions o;
   props::ClassifierOptions c;
   props::CheckOptions check;
   std::unique_ptr<PythonPolicy> policy;
+  int noise_length = 0;
   Eigen::VectorXd noise;
   py::object on_ask;
 
-  std::vector<std::vector<RigidTransform>> ask(const char* label,
-                                               const std::vector<std::size_t>& indices,
-                                               const std::vector<const Scene*>& scenes,
-                                               py::object about = py::none()) const {
+  std::vector<std::vector<RigidTransform>> ask(
+      const char* label, const std::vector<std::size_t>& indices,
+      const std::vector<const Scene*>& scenes, py::object about = py::none(),
+      const std::vector<const Eigen::VectorXd*>* noises = nullptr) const {
     (void)on_ask(label, numbers_of(indices), about);
-    const std::vector<const Eigen::VectorXd*> noises(scenes.size(), &noise);
-    return policy->act_batch(scenes, noises);
+    if (noises) return policy->act_batch(scenes, *noises);
+    const std::vector<const Eigen::VectorXd*> fixed(scenes.size(), &noise);
+    return policy->act_batch(scenes, fixed);
   }
   std::size_t batch_size() const {
     return o.batch_size ? static_cast<std::size_t>(*o.batch_size) : 1;
@@ -117,6 +120,7 @@ Questions questions(py::object policy, py::object on_ask, const std::string& gro
                           "' and view='" + view + "'");
   }
   q.check = props::with_view(q.c.check, q.view());
+  q.noise_length = noise_length;
   q.noise = props::fixed_noise(noise_length, q.check.noise_seed);
   q.policy = std::make_unique<PythonPolicy>(policy, noise_length, q.o.call);
   q.on_ask = std::move(on_ask);
@@ -135,7 +139,13 @@ py::dict locate_cases(py::object policy, py::object on_ask, const std::string& g
   const props::CheckOptions& check = q.check;
   const std::vector<std::pair<Scene, RigidTransform>> drawn = props::drawn_cases(check, q.group());
   std::vector<const Scene*> drawn_scenes;
-  for (const auto& [scene, g] : drawn) drawn_scenes.push_back(&scene);
+  // Each case's own noise, as the audit's pointwise check draws it.
+  std::vector<Eigen::VectorXd> noise_of_case;
+  for (const auto& [scene, g] : drawn) {
+    drawn_scenes.push_back(&scene);
+    noise_of_case.push_back(
+        props::fixed_noise(q.noise_length, props::pointwise_noise_seed(check, scene, g)));
+  }
   std::vector<std::vector<RigidTransform>> chunk_o(drawn.size()), chunk_g_o(drawn.size());
   // The rules first, then each question; "o" carries its cases' g and length scale, so that
   // the caller can decide a batch as soon as its questions are answered.
@@ -153,7 +163,9 @@ py::dict locate_cases(py::object policy, py::object on_ask, const std::string& g
       for (const std::size_t k : indices) each.append(about_case(drawn[k]));
       about = each;
     }
-    return q.ask(label, indices, scenes, about);
+    std::vector<const Eigen::VectorXd*> noises;
+    for (const std::size_t k : indices) noises.push_back(&noise_of_case[k]);
+    return q.ask(label, indices, scenes, about, &noises);
   };
   bool first = true;
   for (const std::vector<std::size_t>& batch : batches_of(drawn_scenes, q.batch_size())) {

@@ -122,7 +122,7 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
                       py::handle scalars, py::handle rng, py::handle reset,
                       py::handle action_format, py::handle state_format, py::handle outputs,
                       py::handle hands, py::handle episodes, py::handle episode_length,
-                      const Setup& setup) {
+                      bool test_law, const Setup& setup) {
   require_numpy("audit_policy");
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
@@ -130,6 +130,7 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   CommonOptions o =
       common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars, setup);
   props::ClassifierOptions c = classifier_for(o);
+  c.law_from_pointwise = !test_law;
   set_policy_call(o, c, rng, reset, action_format, state_format, "audit_policy");
   ProgressLine progress("audit_policy", o.quiet);
   c.progress = std::ref(progress);
@@ -324,11 +325,12 @@ rectified flow's (eq. 5).
          std::uint64_t seed, std::optional<double> tolerance, const std::string& precision,
          py::handle noise, py::handle extra_poses, py::handle scalars, py::handle rng,
          py::handle reset, py::handle action_format, py::handle state_format, py::handle outputs,
-         py::handle hands, py::handle episodes, py::handle episode_length,
+         py::handle hands, py::handle episodes, py::handle episode_length, bool test_law,
          HANDCENTRIC_SETUP_PARAMETERS) {
         return audit_policy(std::move(policy), groups, views, cases, seed, tolerance, precision,
                             noise, extra_poses, scalars, rng, reset, action_format, state_format,
-                            outputs, hands, episodes, episode_length, HANDCENTRIC_SETUP_VALUE);
+                            outputs, hands, episodes, episode_length, test_law,
+                            HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
       py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
@@ -338,7 +340,7 @@ rectified flow's (eq. 5).
       py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
       py::arg("outputs") = py::none(), py::arg("hands") = py::none(),
       py::arg("episodes") = py::none(), py::arg("episode_length") = py::none(),
-      HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("test_law") = false, HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Audit a whole policy (eq. 4) pointwise and in distribution.
 
 Returns one policy of `audit --json`.
@@ -363,6 +365,10 @@ episodes=N, episode_length=T (default 16): closed-loop checks too (mode "closed_
 each group and view, N episodes, each two rollouts of T steps from o and g o with the same noise,
 reset= called once at the start of each (the policy keeps its state through the episode), the
 first pose of each answer executed; the executed poses must agree with g step by step.
+Each pointwise case draws its own noise (the same for o and g o), so a policy that passed the
+preflight and holds pointwise holds in law too: such a cell's in-distribution verdict says
+method "from_pointwise" and asks nothing more. test_law=True runs the in-distribution tests on
+every cell.
 )doc") +
        kSetupDoc)
           .c_str());

@@ -140,6 +140,8 @@ std::string method_label(const Verdict& verdict) {
       return "partly exact";
     case props::Method::energy_test:
       return "test";
+    case props::Method::from_pointwise:
+      return "from pointwise";
     case props::Method::compared:
       break;
   }

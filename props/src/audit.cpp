@@ -140,8 +140,9 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
            spelling.with_value("precision", precision);
   };
   classifier.check.seed = options.seed;
-  // One seed for everything the audit draws: the cases, a policy's fixed noise, the laws' draws.
+  // One seed for everything the audit draws: the cases, a policy's noise per case, the laws'.
   classifier.check.noise_seed = options.seed;
+  classifier.law_from_pointwise = !options.test_law;
   classifier.check.relative_tolerance = audit_relative_tolerance(options);
   classifier.check.unit_roundoff = probe_unit_roundoff(options.precision);
   classifier.check.output_unit_roundoff = unit_roundoff(options.precision);

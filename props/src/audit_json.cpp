@@ -85,6 +85,7 @@ nlohmann::json witness_json(const Witness& w, Method method) {
   if (method != Method::energy_test && w.length_scale > 0.0) out["length_scale"] = w.length_scale;
   if (w.rounding_response > 0.0) out["rounding_response"] = w.rounding_response;
   if (w.off_case) out["off_case"] = true;
+  if (w.noise_seed) out["noise_seed"] = *w.noise_seed;
   return out;
 }
 

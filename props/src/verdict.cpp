@@ -105,6 +105,8 @@ std::string to_string(Method method) {
       return "energy_test";
     case Method::partly_exact:
       return "partly_exact";
+    case Method::from_pointwise:
+      return "from_pointwise";
   }
   return "?";
 }

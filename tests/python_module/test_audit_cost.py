@@ -27,6 +27,7 @@ def test_every_audit_of_both_policies_ran_and_held(quick):
     seen = {(r["policy"], r["audit"], json.dumps(r["options"])) for r in quick["runs"]}
     assert ("trivial", "audit_policy", "{}") in seen
     assert ("trivial", "audit_policy", json.dumps({"groups": ["se3"]})) in seen
+    assert ("trivial", "audit_policy", json.dumps({"groups": ["se3"], "test_law": True})) in seen
     assert ("unet", "assert_equivariant", json.dumps({"precision": "float32"})) in seen
     assert all(r["held"] is True for r in quick["runs"])
 
@@ -54,6 +55,20 @@ def test_the_guarantees_are_those_the_reports_state(quick):
         # The worst pointwise "yes" is the one with the fewest far cases: 1 - 0.01^(1/n).
         n = g["pointwise_cases_min"]
         assert g["detectable_frequency"] == pytest.approx(1 - 0.01 ** (1 / n))
-        # Affine in its noise: the trivial policy's laws are compared exactly, no test's power.
-        assert g["distribution_methods"] == ["exact_gaussian"]
+        # It holds pointwise, so its laws follow from that; tested, they are compared exactly
+        # (affine in its noise): no test's power either way.
+        tested = run["options"].get("test_law", False)
+        assert g["distribution_methods"] == ["exact_gaussian" if tested else "from_pointwise"]
         assert g["detectable_shift"] is None and g["detectable_scale_ratio"] is None
+
+
+def test_a_law_from_the_pointwise_yes_asks_no_row_of_its_own(quick):
+    runs = {(r["audit"], json.dumps(r["options"])): r for r in quick["runs"]
+            if r["policy"] == "trivial"}
+    for groups in (None, ["se3"]):
+        options = {"groups": groups} if groups else {}
+        derived = runs[("audit_policy", json.dumps(options))]
+        tested = runs[("audit_policy", json.dumps(dict(options, test_law=True)))]
+        assert not any("distribution" in k for k in derived["where"])
+        assert any("distribution" in k for k in tested["where"])
+        assert derived["rows"] < tested["rows"]

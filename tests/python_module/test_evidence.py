@@ -284,10 +284,11 @@ def test_a_failing_cell_says_on_which_case_it_failed():
 
 def test_a_deterministic_policy_is_never_yes_pointwise_beside_no_in_distribution():
     """One story per report. A policy pushed 5 cm along world x only where its hand is within
-    0.8 m of (1, 0, 0): 4 cases per check miss that ball on most seeds. Where the in-distribution
-    check hits it and the pointwise one did not, the pointwise check is run again at the law's
-    witness with the same noise, and both cells say NO on that evidence. (Without the recheck,
-    seeds 1 and 7 give pointwise "yes" beside in-distribution "NO".)"""
+    0.8 m of (1, 0, 0): 4 cases per check miss that ball on most seeds. By default a pointwise
+    "yes" gives the law (from_pointwise). With test_law=True, where the in-distribution check
+    hits the ball and the pointwise one did not, the pointwise check is run again at the law's
+    witness, and both cells say NO on that evidence. (Without the recheck, seeds 1 and 7 give
+    pointwise "yes" beside in-distribution "NO".)"""
     from policies import make_policy
     base = make_policy()
 
@@ -298,11 +299,17 @@ def test_a_deterministic_policy_is_never_yes_pointwise_beside_no_in_distribution
         return chunk
     rechecked = 0
     for seed in range(1, 9):
-        report = handcentric.audit_policy(spot, groups=["translation"], views=["eye_in_hand"],
-                                          cases=4, seed=seed, quiet=True)
-        cells = {c["mode"]: c for c in report["checks"]}
-        assert not (cells["pointwise"]["equivariant"] and not cells["distribution"]["equivariant"])
-        if "the in-distribution check's" in cells["pointwise"].get("note", ""):
-            rechecked += 1
-            assert cells["pointwise"]["witness"] is not None
+        for test_law in (False, True):
+            report = handcentric.audit_policy(spot, groups=["translation"],
+                                              views=["eye_in_hand"], cases=4, seed=seed,
+                                              quiet=True, test_law=test_law)
+            cells = {c["mode"]: c for c in report["checks"]}
+            point, law = cells["pointwise"], cells["distribution"]
+            assert not (point["equivariant"] and not law["equivariant"])
+            if not test_law:
+                assert (law["method"] == "from_pointwise") == point["equivariant"]
+            if "the in-distribution check's" in point.get("note", ""):
+                assert test_law
+                rechecked += 1
+                assert point["witness"] is not None
     assert rechecked == 2  # seeds 1 and 7

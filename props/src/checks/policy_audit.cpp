@@ -81,19 +81,56 @@ void agree_on_the_evidence(const NoisyPolicy& policy, Group group, const CheckOp
     point = std::move(rechecked);  // its note names where its witness came from (check.cpp)
   } else {
     add_note(law,
-             "the pointwise check holds at this witness with the audit's fixed noise; the "
+             "the pointwise check holds at this witness with the case's own noise; the "
              "laws differ over other noise values there");
   }
 }
 
+/// The in-distribution verdict that a pointwise "yes" gives a policy that is a function of its
+/// inputs (the top of policy_audit.hpp): nothing more is asked of the policy.
+Verdict law_from_pointwise(const Verdict& point) {
+  Verdict law;
+  law.component = point.component;
+  law.group = point.group;
+  law.mode = Mode::distribution;
+  law.view = point.view;
+  law.method = Method::from_pointwise;
+  law.invariant = true;
+  law.max_error = point.max_error;
+  law.cases = point.cases;
+  law.near_identity_cases = point.near_identity_cases;
+  law.discontinuities = point.discontinuities;
+  law.seed = point.seed;
+  law.relative_tolerance = point.relative_tolerance;
+  // The pointwise check's own note (where its cases came from, a precision) holds here too.
+  law.note = (point.note.empty() ? "" : point.note + "; ") +
+             "from the pointwise check: a function of its inputs (the preflight) that held at " +
+             std::to_string(point.cases) +
+             " cases, each with its own noise, is equivariant in law but on a share of the " +
+             "(observation, noise) draws below " +
+             format_significant(detectable_frequency(point.cases), 2) +
+             " (99% confidence); no in-distribution test was run";
+  return law;
+}
+
 }  // namespace
+
+std::uint64_t pointwise_noise_seed(const CheckOptions& options, const Scene& scene,
+                                   const RigidTransform& g) {
+  return case_noise_seed(options.noise_seed, scene,
+                         options.shape.recorded != nullptr ? &g : nullptr);
+}
 
 Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options) {
-  const Eigen::VectorXd noise = fixed_noise(policy.noise_dimension(), options.noise_seed);
   const double poses = output_pose_tolerance(
       options.output_unit_roundoff > 0.0 ? options.output_unit_roundoff : options.unit_roundoff);
   auto run_case = [&](const Scene& scene, const RigidTransform& g) {
+    // Each case its own noise, the same for o and g o (and the case's moves off it).
+    const std::uint64_t noise_seed = pointwise_noise_seed(options, scene, g);
+    const Eigen::VectorXd noise = policy.noise_dimension() > 0
+                                      ? fixed_noise(policy.noise_dimension(), noise_seed)
+                                      : Eigen::VectorXd();
     detail::PointwiseSides sides;
     sides.compare = [&](const Scene& s, Witness& witness) {
       const std::vector<RigidTransform> g_a =
@@ -108,7 +145,9 @@ Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                     detail::checked_act(policy, b, noise, poses));
     };
     sides.ask = [&](const Scene& s) { (void)policy.act(s, noise); };
-    return detail::decide_pointwise(sides, scene, g, options);
+    detail::CaseOutcome outcome = detail::decide_pointwise(sides, scene, g, options);
+    outcome.witness.noise_seed = noise_seed;
+    return outcome;
   };
   return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,
                            options.cases, kShrinkBudget);
@@ -173,8 +212,15 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
     if (!options.in_distribution) continue;
     const std::size_t first_pointwise =
         out.verdicts.size() - (pointwise ? options.groups.size() : 0);
+    // The preflight found a function of its inputs: a pointwise "yes" is one in law too.
+    const bool derive = pointwise && options.law_from_pointwise && out.preflight.has_value();
     for (std::size_t k = 0; k < options.groups.size(); ++k) {
       const Group group = options.groups[k];
+      if (derive && out.verdicts[first_pointwise + k].invariant) {
+        out.verdicts.push_back(law_from_pointwise(out.verdicts[first_pointwise + k]));
+        tick();
+        continue;
+      }
       // The pointwise witness of this group is one more case (CheckOptions::extra_cases).
       const auto with_witness = [&witnesses, k](CheckOptions o) {
         o.extra_cases = witnesses[k];

@@ -46,8 +46,11 @@ struct AuditOptions {
   std::vector<Group> groups = all_groups();
   std::vector<View> views = {View::eye_in_hand, View::third_person};
   int cases = kDefaultCases;  ///< pointwise cases per cell
-  /// Seeds everything the audit draws: the cases, a policy's fixed noise, the laws' draws.
+  /// Seeds everything the audit draws: the cases, a policy's noise per case, the laws' draws.
   std::uint64_t seed = 1;
+  /// A whole policy's in-distribution tests on every cell (--test-law); by default a cell whose
+  /// pointwise check holds takes its law from it (policy_audit.hpp, Method::from_pointwise).
+  bool test_law = false;
   Precision precision = Precision::float64;
   /// REL of the tolerance REL * (1 + L); 0 = from `precision` (precision_relative_tolerance).
   double relative_tolerance = 0.0;

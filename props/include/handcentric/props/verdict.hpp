@@ -40,7 +40,10 @@ enum class Mode { pointwise, distribution, closed_loop };
 ///   energy_test   : some case had no coordinate compared exactly; the energy, paired mean and
 ///                   scale tests decided, and a "yes" only means no difference was found
 ///                   (detectable_shift, detectable_scale_ratio).
-enum class Method { compared, exact_gaussian, energy_test, partly_exact };
+///   from_pointwise: a whole policy's law, from its pointwise "yes" at independent noise per
+///                   case (policy_audit.hpp): nothing more was asked; it could miss what the
+///                   pointwise "yes" could (detectable_frequency of its cases).
+enum class Method { compared, exact_gaussian, energy_test, partly_exact, from_pointwise };
 
 /// "actions", "observation", "flow_input", "flow_target", "policy".
 std::string to_string(Component component);
@@ -51,7 +54,7 @@ std::string to_string(Mode mode);
 /// none.
 std::vector<View> parse_views(const std::vector<std::string>& names, const std::string& option,
                               const Spelling& spelling = kCommandLineSpelling);
-/// "compared", "exact_gaussian", "energy_test", "partly_exact".
+/// "compared", "exact_gaussian", "energy_test", "partly_exact", "from_pointwise".
 std::string to_string(Method method);
 
 /// A counterexample: the scene, g, and the two outputs compared.
@@ -73,7 +76,10 @@ struct Witness {
   /// difference having persisted there: a symmetry breaking, not a bin edge
   bool off_case = false;
   double p_value = 1.0;  ///< tests: 3 x the smallest of their p-values (exact laws: 1)
-  std::string detail;    ///< exact law: which moment differs and by how much
+  /// A policy's pointwise witness: its noise is fixed_noise(noise dimension, noise_seed), the
+  /// noise of the case drawn (policy_audit.hpp, pointwise_noise_seed), for both o and g o.
+  std::optional<std::uint64_t> noise_seed;
+  std::string detail;  ///< exact law: which moment differs and by how much
 };
 
 struct Verdict {

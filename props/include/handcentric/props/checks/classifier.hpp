@@ -34,6 +34,10 @@ struct ClassifierOptions {
   bool observation = true;  ///< check the observation (off for a plug-in that sends none)
   bool flow = true;         ///< check the flow of a representation
   bool in_distribution = true;
+  /// A whole policy's in-distribution verdict from its pointwise "yes" when the preflight found
+  /// it a function of its inputs (policy_audit.hpp, Method::from_pointwise); false runs the
+  /// in-distribution tests on every cell.
+  bool law_from_pointwise = true;
   bool injectivity = true;      ///< run check_injectivity on a representation
   int injectivity_cases = 200;  ///< chunk pairs it tries (on third-person scenes)
   /// When a cell fails at a tolerance below a lower precision's rounding, re-check it there

@@ -4,7 +4,8 @@
 // equivariance in its encoder, its noise, its sampler or its decoder even when its
 // representation is right, so the thing shipped is audited as a black box:
 //
-//   pointwise       : the same noise n for o and g o; the chunks are compared pose by pose
+//   pointwise       : the same noise n for o and g o, n drawn afresh for each case
+//                     (pointwise_noise_seed); the chunks are compared pose by pose
 //                     (distance |R_a - R_b|_F + |p_a - p_b|) within REL (1 + L). Theorem 1: the
 //                     outer hand-centric policy passes for any network.
 //   in distribution : n ~ N(0, I) drawn independently: the law of g a(o, n) against the law of
@@ -15,6 +16,16 @@
 //                     equivariant in distribution under rotations, not pointwise; one that adds
 //                     noise with per-axis scales in the world frame is neither.
 // Both views and all groups, as for representations (classifier.hpp).
+//
+// The law from the pointwise check (classify_policy, Method::from_pointwise): a policy that is a
+// function of its inputs (the preflight) and holds pointwise on cases (o, n) drawn with
+// independent noise holds in law: g a(o, N) and a(g o, N) are then one map of the same N, within
+// the pointwise tolerance but on the (o, n) draws where it fails, whose share a pointwise "yes"
+// bounds (detectable_frequency: below 4.6 / cases with 99% confidence). So the in-distribution
+// check runs only where the pointwise check fails (isotropic world noise: NO pointwise, yes in
+// law), or where the preflight did not run or found the policy's own randomness, or when asked
+// (ClassifierOptions::law_from_pointwise = false). The tests would add power only against a
+// violation on fewer draws than that share but large enough to move a mean.
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
@@ -28,9 +39,16 @@
 
 namespace handcentric::props {
 
-/// eq. (4) pointwise: a(g o, n) = g a(o, n) with n the first noise_dimension() normals of
-/// mt19937_64(options.noise_seed). The witness's before/after are g a(o) and a(g o), each pose
-/// flattened to [p, r(R)].
+/// The noise seed of the pointwise case (scene, g) under `options`: from the scene alone, which
+/// no other case of a check shares (so the checks of other groups ask o with the same noise,
+/// one row for all), and from g too when the scenes are recorded observations, which the cases
+/// of a check share (each case its own noise still). case_noise_seed of noisy_policy.hpp.
+std::uint64_t pointwise_noise_seed(const CheckOptions& options, const Scene& scene,
+                                   const RigidTransform& g);
+
+/// eq. (4) pointwise: a(g o, n) = g a(o, n) with n = fixed_noise(noise_dimension(),
+/// pointwise_noise_seed(options, o, g)), its own draw for each case. The witness's before/after are
+/// g a(o) and a(g o), each pose flattened to [p, r(R)].
 Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options = {});
 
@@ -41,7 +59,8 @@ Verdict check_policy_distribution(const NoisyPolicy& policy, Group group,
                                   const DistributionOptions& distribution = {});
 
 /// Both modes, options.views and options.groups (component Component::policy; the verdict's
-/// `invariant` means equivariant), with the float32 note of classifier.hpp.
+/// `invariant` means equivariant), with the float32 note of classifier.hpp; an in-distribution
+/// verdict from the pointwise one where that holds (the top of this file).
 Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
                                const ClassifierOptions& options = {});
 
