@@ -33,13 +33,15 @@ std::string view_heading(View view, bool recorded) {
 
 // "yes 3.1e-15" / "NO  2.0e+00": the mark and the largest error (in distribution: the larger
 // difference of the laws' moments, or the energy distance, marked '~' when tests decided all or
-// part of the cell).
+// part of the cell, '=' when it follows from the pointwise cell).
 std::string cell_text(const Verdict& verdict) {
   const std::string error = format_scientific(verdict.max_error, 1);
+  const char* mark = verdict.method == Method::energy_test || verdict.method == Method::partly_exact
+                         ? "~"
+                     : verdict.method == Method::from_pointwise ? "="
+                                                                : "";
   return std::string(verdict.invariant ? "yes " : "NO  ") +
-         std::string(error.size() < 8 ? 8 - error.size() : 0, ' ') + error +
-         (verdict.method == Method::energy_test || verdict.method == Method::partly_exact ? "~"
-                                                                                          : "");
+         std::string(error.size() < 8 ? 8 - error.size() : 0, ' ') + error + mark;
 }
 
 std::string cell_name(const Verdict& verdict) {
@@ -238,7 +240,9 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
             any = true;
             row += " | " + pad(cell_text(*verdict), kCell);
             if (!verdict->invariant && verdict->witness) failing.push_back(verdict);
-            if (!verdict->note.empty()) noted.push_back(verdict);
+            // A law from its pointwise cell: one line below for all of them.
+            if (!verdict->note.empty() && verdict->method != Method::from_pointwise)
+              noted.push_back(verdict);
           }
           if (any) out << row << "\n";
         }
@@ -284,6 +288,19 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
       }
       out << " (the largest over the cells; per cell in the JSON's detectable_shift and "
              "detectable_scale_ratio); smaller differences can hide\n";
+    }
+    // The laws taken from their pointwise cells (policy_audit.hpp), marked =.
+    const auto derived =
+        std::count_if(classification.verdicts.begin(), classification.verdicts.end(),
+                      [](const Verdict& v) { return v.method == Method::from_pointwise; });
+    if (derived > 0) {
+      out << "  note: " << derived
+          << " in-distribution 'yes' cell(s) (marked =) follow from their pointwise cell: the "
+             "policy is a function of its inputs (the preflight) and each case drew its own "
+             "noise, so its laws agree but on the share of draws the pointwise 'yes' could miss "
+             "(below); no in-distribution test was run ("
+          << options.spelling.option("test_law") << (options.spelling.command_line ? "" : "=True")
+          << " runs them)\n";
     }
     // What the pointwise "yes" cells could have missed (verdict.hpp: detectable_frequency).
     int fewest_cases = 0;

@@ -41,8 +41,10 @@ void print_audit_header(std::ostream& out, const AuditOptions& audit, bool polic
          "Gaussian laws' means and covariances, else (marked ~: decided wholly or partly by the "
          "energy, paired mean and scale tests at level "
       << used.distribution.family_alpha
-      << " per cell) the energy distance of the tested coordinates (a statistic, not a length). "
-         "Rules: docs/AUDIT.md\n\n";
+      << " per cell) the energy distance of the tested coordinates (a statistic, not a length)"
+      << (policies ? "; marked =: a law that follows from the pointwise cell (the same number)"
+                   : "")
+      << ". Rules: docs/AUDIT.md\n\n";
 }
 
 }  // namespace handcentric::props

@@ -488,6 +488,34 @@ TEST_CASE("a_policy_clipping_world_positions_is_no_in_distribution_wherever_it_i
   }
 }
 
+// A policy's law follows from its pointwise "yes" (method from_pointwise, marked = in the text,
+// asking nothing more); --test-law runs the tests on every cell; it is for policies only.
+TEST_CASE("a_policy_law_follows_from_its_pointwise_yes_unless_test_law", "[unit]") {
+  const std::string audit = test::cli() + " audit --policy-exec '" +
+                            test::test_plugin("policy_hand_centric.py", "") +
+                            "' --cases 30 --group se3 --view eye_in_hand";
+  const auto methods = [](const std::string& json) {
+    std::vector<std::string> out;
+    const auto parsed = nlohmann::json::parse(json);
+    for (const auto& check : parsed.at("policies").at(0).at("checks"))
+      if (check.at("mode") == "distribution") out.push_back(check.at("method"));
+    return out;
+  };
+  const auto derived = test::run_command(audit + " --json");
+  REQUIRE(derived.exit_code == 0);
+  CHECK(methods(derived.out) == std::vector<std::string>{"from_pointwise"});
+  const auto tested = test::run_command(audit + " --json --test-law");
+  REQUIRE(tested.exit_code == 0);
+  CHECK(methods(tested.out) == std::vector<std::string>{"energy_test"});  // a network of n
+  const auto text = test::run_command(audit);
+  CHECK_THAT(text.out, Contains("(marked =) follow from their pointwise cell") &&
+                           Contains("--test-law runs them"));
+  const auto representation =
+      test::run_command(test::cli() + " audit --repr hand_centric --cases 5 --test-law");
+  CHECK(representation.exit_code != 0);
+  CHECK_THAT(representation.err, Contains("--test-law"));
+}
+
 TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[unit]") {
   const auto pass = test::run_command(
       test::cli() + " audit --repr hand_centric --cases 30 --expect se3,actions:c8");
