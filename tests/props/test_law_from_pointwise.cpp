@@ -63,6 +63,36 @@ class IsotropicWorldNoise final : public props::NoisyPolicy {
   }
 };
 
+// A flow whose target is the hand-frame step of the chunk (invariant) minus eps, plus T_0's
+// world position where eps_0 > 1: a flow of a plug-in's own that takes a world-frame branch on
+// 16% of its noise.
+class FlowBreaksAtSomeNoise final : public FlowTarget {
+ public:
+  std::string name() const override { return "flow_breaks_at_some_noise"; }
+  Eigen::Index noise_dimension(const Scene&) const override { return 3; }
+  FlowSample operator()(const Scene& s, const Eigen::VectorXd& eps, double t) const override {
+    const RigidTransform& world_T_hand0 = s.world_T_hand0();
+    const Eigen::Vector3d hand0_p1 =
+        world_T_hand0.inverse() * s.world_T_hand_chunk.front().translation();
+    Eigen::Vector3d target = hand0_p1 - eps;
+    if (eps(0) > 1.0) target += world_T_hand0.translation();
+    return {t * hand0_p1 + (1.0 - t) * eps, target};
+  }
+};
+
+// The same fault in a policy of the seed interface (ChunkPolicy): a world push on the seeds
+// that are 0 mod 5.
+class SeedBreaks final : public ChunkPolicy {
+ public:
+  std::string name() const override { return "seed_breaks"; }
+  std::vector<RigidTransform> act(const Scene& o, std::uint64_t seed) const override {
+    const RigidTransform& world_T_hand0 = o.world_T_hand0();
+    Eigen::Vector3d world_p = world_T_hand0 * Eigen::Vector3d(0.02, 0.0, 0.0);
+    if (seed % 5 == 0) world_p += Eigen::Vector3d(0.05, 0.0, 0.0);
+    return {RigidTransform::unchecked(world_T_hand0.rotation().matrix(), world_p)};
+  }
+};
+
 props::ClassifierOptions one_cell(Group group) {
   props::ClassifierOptions options;
   options.views = {props::View::eye_in_hand};
@@ -190,4 +220,31 @@ TEST_CASE("without_the_preflight_the_law_is_tested", "[property]") {
   REQUIRE(c.verdicts.size() == 2);
   CHECK(c.verdicts[1].invariant);
   CHECK(c.verdicts[1].method == props::Method::exact_gaussian);
+}
+
+// The flows' pointwise rows and the seed interface's check draw each case's noise too: with one
+// eps (one seed) for every case these faults pass whenever it misses their branch, as it does
+// here (checked, so the test says which it exercises).
+TEST_CASE("a_flow_or_a_seeded_policy_that_breaks_at_some_noise_is_found_pointwise", "[property]") {
+  props::CheckOptions options = props::eye_in_hand_options();
+  options.cases = 100;
+  REQUIRE(props::fixed_noise(3, options.noise_seed)(0) < 1.0);
+  const auto flow = std::make_shared<FlowBreaksAtSomeNoise>();
+  const props::Verdict v = props::check_flow_invariance(flow, props::Component::flow_target,
+                                                        Group::translation, options);
+  CHECK_FALSE(v.invariant);
+  REQUIRE(v.witness);
+  REQUIRE(v.witness->noise_seed);
+  CHECK(props::fixed_noise(3, *v.witness->noise_seed)(0) > 1.0);
+  CHECK(props::check_flow_invariance(flow, props::Component::flow_input, Group::se3, options)
+            .invariant);
+
+  REQUIRE(options.noise_seed % 5 != 0);
+  const SeedBreaks seeded;
+  const props::Verdict s = props::check_equivariance(seeded, Group::rotation, options);
+  CHECK_FALSE(s.invariant);
+  REQUIRE(s.witness);
+  CHECK(*s.witness->noise_seed % 5 == 0);
+  CHECK(props::recompute_equivariance_error(seeded, *s.witness, 0) == s.witness->error);
+  CHECK(props::check_equivariance(seeded, Group::translation, options).invariant);
 }

@@ -193,20 +193,61 @@ SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint
   };
 }
 
+std::uint64_t pointwise_noise_seed(const CheckOptions& options, const Scene& scene,
+                                   const RigidTransform& g) {
+  return case_noise_seed(options.noise_seed, scene,
+                         options.shape.recorded != nullptr ? &g : nullptr);
+}
+
+namespace {
+
+/// The case (scene, g) of an invariance check of f: f(s) against f(g s), as check.hpp decides it.
+detail::CaseOutcome decide_invariance(const SceneFunction& f, const Scene& scene,
+                                      const RigidTransform& g, const CheckOptions& options) {
+  detail::PointwiseSides sides;
+  sides.compare = [&f, &g](const Scene& s, Witness& witness) {
+    witness.before = f(s);
+    witness.after = f(g * s);
+    witness.error = detail::inf_distance(witness.before, witness.after);
+  };
+  sides.response = [&f](const Scene& a, const Scene& b) {
+    return detail::inf_distance(f(a), f(b));
+  };
+  sides.ask = [&f](const Scene& s) { (void)f(s); };
+  return detail::decide_pointwise(sides, scene, g, options);
+}
+
+}  // namespace
+
+Verdict check_flow_invariance(std::shared_ptr<const FlowTarget> target, Component component,
+                              Group group, const CheckOptions& options) {
+  if (!target) throw InvalidArgument("check_flow_invariance needs a flow target, got null");
+  if (component != Component::flow_input && component != Component::flow_target) {
+    throw InvalidArgument("check_flow_invariance checks flow_input or flow_target, got " +
+                          to_string(component));
+  }
+  const bool input = component == Component::flow_input;
+  const double t = options.flow_time;
+  auto run_case = [&](const Scene& scene, const RigidTransform& g) {
+    // Each case its own eps, the same for s and g s (and the case's moves off it).
+    const std::uint64_t noise_seed = pointwise_noise_seed(options, scene, g);
+    const Eigen::VectorXd eps = fixed_noise(target->noise_dimension(scene), noise_seed);
+    const SceneFunction f = [&](const Scene& s) {
+      FlowSample example = (*target)(s, eps, t);
+      return input ? std::move(example.input) : std::move(example.target);
+    };
+    detail::CaseOutcome outcome = decide_invariance(f, scene, g, options);
+    outcome.witness.noise_seed = noise_seed;
+    return outcome;
+  };
+  return detail::run_check(run_case, component, group, Mode::pointwise, options, options.cases,
+                           kPointwiseShrinkBudget);
+}
+
 Verdict check_invariance(const SceneFunction& f, Component component, Group group,
                          const CheckOptions& options) {
   auto run_case = [&f, &options](const Scene& scene, const RigidTransform& g) {
-    detail::PointwiseSides sides;
-    sides.compare = [&f, &g](const Scene& s, Witness& witness) {
-      witness.before = f(s);
-      witness.after = f(g * s);
-      witness.error = detail::inf_distance(witness.before, witness.after);
-    };
-    sides.response = [&f](const Scene& a, const Scene& b) {
-      return detail::inf_distance(f(a), f(b));
-    };
-    sides.ask = [&f](const Scene& s) { (void)f(s); };
-    return detail::decide_pointwise(sides, scene, g, options);
+    return decide_invariance(f, scene, g, options);
   };
   return detail::run_check(run_case, component, group, Mode::pointwise, options, options.cases,
                            kPointwiseShrinkBudget);
@@ -217,8 +258,9 @@ double recompute_error(const SceneFunction& f, const Witness& witness) {
 }
 
 Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOptions& options) {
-  const std::uint64_t noise_seed = options.noise_seed;
-  auto run_case = [&policy, noise_seed, &options](const Scene& scene, const RigidTransform& g) {
+  auto run_case = [&policy, &options](const Scene& scene, const RigidTransform& g) {
+    // Each case its own seed of the policy's noise, the same for o and g o.
+    const std::uint64_t noise_seed = pointwise_noise_seed(options, scene, g);
     detail::PointwiseSides sides;
     sides.compare = [&policy, &g, noise_seed](const Scene& s, Witness& witness) {
       const Equivariance both = both_sides(policy, s, g, noise_seed);
@@ -230,7 +272,9 @@ Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOp
       return detail::chunk_distance(policy.act(a, noise_seed), policy.act(b, noise_seed));
     };
     sides.ask = [&policy, noise_seed](const Scene& s) { (void)policy.act(s, noise_seed); };
-    return detail::decide_pointwise(sides, scene, g, options);
+    detail::CaseOutcome outcome = detail::decide_pointwise(sides, scene, g, options);
+    outcome.witness.noise_seed = noise_seed;
+    return outcome;
   };
   return detail::run_check(run_case, Component::policy, group, Mode::pointwise, options,
                            options.cases, kPointwiseShrinkBudget);
@@ -238,7 +282,8 @@ Verdict check_equivariance(const ChunkPolicy& policy, Group group, const CheckOp
 
 double recompute_equivariance_error(const ChunkPolicy& policy, const Witness& witness,
                                     std::uint64_t noise_seed) {
-  const Equivariance sides = both_sides(policy, witness.scene, witness.g, noise_seed);
+  const Equivariance sides =
+      both_sides(policy, witness.scene, witness.g, witness.noise_seed.value_or(noise_seed));
   return detail::chunk_distance(sides.g_a, sides.a_g);
 }
 

@@ -69,15 +69,12 @@ void classify_flow(const std::shared_ptr<const FlowTarget>& target,
   const CheckOptions check = with_view(options.check, view);
   std::vector<std::vector<std::pair<Scene, RigidTransform>>> witnesses;  // per component, group
   for (Component component : {Component::flow_input, Component::flow_target}) {
-    const auto f = [&](std::uint64_t noise_seed, double t) {
-      return component == Component::flow_input ? flow_input_of(target, noise_seed, t)
-                                                : flow_target_of(target, noise_seed, t);
-    };
     for (Group group : options.groups) {
-      const SceneFunction fn = f(check.noise_seed, check.flow_time);
-      out.verdicts.push_back(with_precision_note(
-          check_invariance(fn, component, group, check), options,
-          [&](const CheckOptions& o) { return check_invariance(fn, component, group, o); }));
+      out.verdicts.push_back(
+          with_precision_note(check_flow_invariance(target, component, group, check), options,
+                              [&](const CheckOptions& o) {
+                                return check_flow_invariance(target, component, group, o);
+                              }));
       witnesses.push_back(witness_cases(out.verdicts.back()));
       tick();
     }

@@ -115,12 +115,6 @@ Verdict law_from_pointwise(const Verdict& point) {
 
 }  // namespace
 
-std::uint64_t pointwise_noise_seed(const CheckOptions& options, const Scene& scene,
-                                   const RigidTransform& g) {
-  return case_noise_seed(options.noise_seed, scene,
-                         options.shape.recorded != nullptr ? &g : nullptr);
-}
-
 Verdict check_policy_equivariance(const NoisyPolicy& policy, Group group,
                                   const CheckOptions& options) {
   const double poses = output_pose_tolerance(

@@ -103,11 +103,27 @@ SceneFunction observation_of(std::shared_ptr<const Representation> representatio
 
 /// The flow target's network input (or regression target) at time t and a fixed eps: the
 /// first noise_dimension(scene) standard normals of mt19937_64(noise_seed). The same eps is
-/// used for s and g * s, so this is the pointwise question of App. A (eqs. 11, 16, 23, 29).
+/// used for s and g * s, so this is the pointwise question of App. A (eqs. 11, 16, 23, 29) at
+/// one eps (the profile's; the audit asks each case at its own: check_flow_invariance).
 SceneFunction flow_input_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed,
                             double t);
 SceneFunction flow_target_of(std::shared_ptr<const FlowTarget> target, std::uint64_t noise_seed,
                              double t);
+
+/// The noise seed of the pointwise case (scene, g) under `options`: from the scene alone, which
+/// no other case of a check shares (so the checks of other groups ask o with the same noise,
+/// one row for all), and from g too when the scenes are recorded observations, which the cases
+/// of a check share (each case its own noise still). case_noise_seed of noisy_policy.hpp. The
+/// pointwise checks of policies and of flows draw each case's noise from it.
+std::uint64_t pointwise_noise_seed(const CheckOptions& options, const Scene& scene,
+                                   const RigidTransform& g);
+
+/// A flow's `component` (flow_input or flow_target) pointwise: f(g s, eps, t) = f(s, eps, t)
+/// with t = options.flow_time and eps = fixed_noise(noise_dimension(s), pointwise_noise_seed(
+/// options, s, g)), its own draw for each case, the same on both sides (App. A's question, eqs.
+/// 11, 16, 23, 29, asked at many eps). The witness carries its noise_seed.
+Verdict check_flow_invariance(std::shared_ptr<const FlowTarget> target, Component component,
+                              Group group, const CheckOptions& options = {});
 
 /// f(g * s) = f(s) within pointwise_tolerance for g in `group`. `component` only labels the
 /// verdict.
@@ -118,12 +134,14 @@ Verdict check_invariance(const SceneFunction& f, Component component, Group grou
 double recompute_error(const SceneFunction& f, const Witness& witness);
 
 /// eq. (4): policy.act(g * o, s) = g * policy.act(o, s) within pointwise_tolerance, for the
-/// observations generated with options.shape and the noise seed options.noise_seed. The
-/// witness's before/after are g * a(o) and a(g * o), each pose flattened to [p, r(R)].
+/// observations generated with options.shape, s = pointwise_noise_seed(options, o, g) for each
+/// case (the witness's noise_seed). The witness's before/after are g * a(o) and a(g * o), each
+/// pose flattened to [p, r(R)].
 Verdict check_equivariance(const ChunkPolicy& policy, Group group,
                            const CheckOptions& options = {});
 
-/// max_k distance(a(g * o)_k, (g * a(o))_k) recomputed from a witness.
+/// max_k distance(a(g * o)_k, (g * a(o))_k) recomputed from a witness, at its noise_seed (a
+/// witness of check_equivariance has one), else at `noise_seed`.
 double recompute_equivariance_error(const ChunkPolicy& policy, const Witness& witness,
                                     std::uint64_t noise_seed);
 

@@ -39,13 +39,6 @@
 
 namespace handcentric::props {
 
-/// The noise seed of the pointwise case (scene, g) under `options`: from the scene alone, which
-/// no other case of a check shares (so the checks of other groups ask o with the same noise,
-/// one row for all), and from g too when the scenes are recorded observations, which the cases
-/// of a check share (each case its own noise still). case_noise_seed of noisy_policy.hpp.
-std::uint64_t pointwise_noise_seed(const CheckOptions& options, const Scene& scene,
-                                   const RigidTransform& g);
-
 /// eq. (4) pointwise: a(g o, n) = g a(o, n) with n = fixed_noise(noise_dimension(),
 /// pointwise_noise_seed(options, o, g)), its own draw for each case. The witness's before/after are
 /// g a(o) and a(g o), each pose flattened to [p, r(R)].
