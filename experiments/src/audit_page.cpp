@@ -197,12 +197,26 @@ AuditPart audit_part(const std::vector<props::Classification>& classifications,
       section.blocks.push_back(std::move(grid));
     }
     std::vector<Text> notes;
+    // The laws taken from their pointwise cells (policy_audit.hpp): one note for all of them.
+    int derived = 0;
     for (const Verdict& verdict : classification.verdicts) {
+      if (verdict.method == props::Method::from_pointwise) {
+        ++derived;
+        continue;
+      }
       if (!verdict.note.empty()) {
         notes.push_back({plain(row_label(verdict.component, verdict.mode) + " under " +
                                props::to_string(verdict.group) + ", " +
                                props::to_string(verdict.view) + ": " + verdict.note)});
       }
+    }
+    if (derived > 0) {
+      notes.push_back({plain(std::to_string(derived) +
+                             " in-distribution \"yes\" cell(s) marked \"from pointwise\" follow "
+                             "from their pointwise cell: the policy is a function of its inputs "
+                             "(the preflight) and each case drew its own noise, so its laws agree "
+                             "but on the share of draws the pointwise \"yes\" could miss (its "
+                             "detectable frequency); no in-distribution test was run")});
     }
     if (const auto& injectivity = classification.injectivity) {
       const std::string verdict = !injectivity->injective.has_value() ? "not decided"
