@@ -174,6 +174,12 @@ std::string format_witness(const Witness& witness) {
     out << "\nthis scene is the case drawn, moved off it by a small random amount: the "
            "difference persists there, so it is no bin edge or rounding";
   }
+  // The case's own noise (policy_audit.hpp): what a replay outside the audit needs.
+  if (witness.noise_seed) {
+    out << "\nnoise: the case's own, the same for both sides: noise_seed " << *witness.noise_seed
+        << " (the noise is props::fixed_noise(n, noise_seed), the first n normals of "
+           "mt19937_64(noise_seed); a policy that takes a seed gets noise_seed itself)";
+  }
   return out.str();
 }
 

@@ -118,6 +118,9 @@ TEST_CASE("a_policy_that_breaks_at_some_noise_values_is_found_pointwise", "[prop
   // The witness names its case's noise: the fault's branch was taken there.
   REQUIRE(v.witness->noise_seed);
   CHECK(props::fixed_noise(policy.noise_dimension(), *v.witness->noise_seed)(0) > 1.0);
+  // The text names it: what a replay outside the audit needs.
+  CHECK_THAT(props::format_witness(*v.witness),
+             Catch::Contains("noise_seed " + std::to_string(*v.witness->noise_seed)));
   // Translations leave the world push alone on both sides: equivariant at every noise.
   CHECK(props::check_policy_equivariance(policy, Group::translation, options).invariant);
 }

@@ -76,8 +76,9 @@ struct Witness {
   /// difference having persisted there: a symmetry breaking, not a bin edge
   bool off_case = false;
   double p_value = 1.0;  ///< tests: 3 x the smallest of their p-values (exact laws: 1)
-  /// A policy's pointwise witness: its noise is fixed_noise(noise dimension, noise_seed), the
-  /// noise of the case drawn (policy_audit.hpp, pointwise_noise_seed), for both o and g o.
+  /// A pointwise witness of a policy or a flow: its noise is fixed_noise(noise dimension,
+  /// noise_seed) (a seed-interface policy's: noise_seed itself), the noise of the case drawn
+  /// (check.hpp, pointwise_noise_seed), for both sides; format_witness prints it.
   std::optional<std::uint64_t> noise_seed;
   std::string detail;  ///< exact law: which moment differs and by how much
 };
