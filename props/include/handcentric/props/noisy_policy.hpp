@@ -60,12 +60,12 @@ class SeededPolicy final : public NoisyPolicy {
 /// (or a flow target) is asked with in the pointwise checks.
 Eigen::VectorXd fixed_noise(Eigen::Index n, std::uint64_t seed);
 
-/// The noise of one pointwise case of a policy: fixed_noise(n, s) with s hashed (FNV-1a) from the
-/// audit's seed and the scene's bytes (its held arrays by value), and g's when given: each case
-/// its own draw, o and g o sharing it, the same case the same noise in every run and every check
-/// that decides it. Independent draws over the cases are what let a pointwise "yes" speak for
-/// the law too (policy_audit.hpp, Method::from_pointwise); one noise for every case would test
-/// one n only. Which of the two the pointwise check uses: policy_audit.hpp, pointwise_noise_seed.
+/// The seed of one pointwise case's noise (a policy's or a flow's: fixed_noise(n, seed)), hashed
+/// (FNV-1a) from the audit's seed and the scene's bytes (its held arrays by value), and g's when
+/// given: each case its own draw, o and g o sharing it, the same case the same noise in every run
+/// and every check that decides it. Independent draws over the cases are what let a pointwise
+/// "yes" speak for the law too (policy_audit.hpp, Method::from_pointwise); one noise for every
+/// case would test one n only. Whether g counts: checks/check.hpp, pointwise_noise_seed.
 std::uint64_t case_noise_seed(std::uint64_t seed, const Scene& scene,
                               const RigidTransform* g = nullptr);
 
