@@ -39,6 +39,8 @@ struct AuditCommandOptions {
   std::vector<std::string> groups = {"all"};
   std::vector<std::string> views = {"all"};
   long long cases = props::kDefaultCases;  // wide: a value past the bound is named, not wrapped
+  double detect = 0.0;                     // --detect, when detect_given
+  bool detect_given = false;
   std::uint64_t seed = props::AuditOptions{}.seed;
   double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
@@ -105,6 +107,13 @@ int gate(const std::vector<props::Classification>& results,
 }
 
 int run_audit(const AuditCommandOptions& options) {
+  // CLI11 refuses --test-law beside --repr or --exec; with no source at all the audit is the
+  // built-ins', representations too.
+  if (options.test_law && options.policy_exec.empty() && options.model.empty()) {
+    throw InvalidArgument(
+        "--test-law is for a whole policy (--policy-exec COMMAND or --model FILE): the "
+        "built-in representations' laws are always tested; leave --test-law out");
+  }
   props::AuditOptions audit;
   audit.groups = props::parse_groups(options.groups, "group");
   audit.views = props::parse_views(options.views, "view");
@@ -114,6 +123,10 @@ int run_audit(const AuditCommandOptions& options) {
   };
   const bool all_groups = has_all(options.groups), all_views = has_all(options.views);
   audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
+  if (options.detect_given) {
+    audit.cases = props::cases_to_detect(options.detect);
+    audit.detect = options.detect;
+  }
   audit.seed = options.seed;
   audit.test_law = options.test_law;
   audit.precision = props::parse_precision(options.precision);
@@ -191,9 +204,16 @@ void add_audit_command(CLI::App& app, int& exit_code) {
                   "one or both of eye_in_hand (no world points: Theorem 1's setting) and "
                   "third_person (1-8 world points that move with g), or all")
       ->capture_default_str();
-  cmd->add_option("--cases", options->cases,
-                  "cases per pointwise check, at most 10^7 (in distribution: max(10, cases/100))")
-      ->capture_default_str();
+  auto* cases = cmd->add_option("--cases", options->cases,
+                                "cases per pointwise check, at most 10^7 (in distribution: max(10, "
+                                "cases/100))")
+                    ->capture_default_str();
+  auto* detect = cmd->add_option(
+      "--detect", options->detect,
+      "FREQUENCY: instead of --cases, as many cases as find a breaking on that share of the "
+      "(scene, g) draws with 99% probability, e.g. 0.01 (459 cases; the default 1000 finds "
+      "0.0046)");
+  detect->excludes(cases);
   cmd->add_option("--seed", options->seed,
                   "seeds all the audit draws (the cases, a policy's fixed noise, the "
                   "in-distribution draws): the same seed gives the same verdicts and witnesses")
@@ -271,9 +291,10 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--profile-sizes", options->profile_sizes,
                   "with --profile: the sizes of g, e.g. 0.01,0.1,1 (default: the group's grid)")
       ->delimiter(',');
-  profile->needs(out)->excludes(json)->excludes(pointwise);
+  profile->needs(out)->excludes(json)->excludes(pointwise)->excludes(detect);
   out->needs(profile);
-  cmd->callback([options, &exit_code] {
+  cmd->callback([options, detect, &exit_code] {
+    options->detect_given = detect->count() > 0;
     exit_code = options->profile.empty() ? run_audit(*options)
                                          : run_audit_profile(profile_command(*options));
   });
