@@ -41,6 +41,8 @@ struct AuditCommandOptions {
   long long cases = props::kDefaultCases;  // wide: a value past the bound is named, not wrapped
   double detect = 0.0;                     // --detect, when detect_given
   bool detect_given = false;
+  int episodes = 0;  // --episodes: the closed loop of a --policy-exec plug-in (0: none)
+  int episode_length = props::ClosedLoopOptions{}.steps;
   std::uint64_t seed = props::AuditOptions{}.seed;
   double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
@@ -77,8 +79,9 @@ void write_witness_images(const std::string& dir, const props::Classification& r
   for (const props::Verdict& verdict : result.verdicts) {
     if (!verdict.witness) continue;
     const std::string stem =
-        dir + "/" + props::to_string(verdict.component) + "_" + props::to_string(verdict.group) +
-        "_" + props::to_string(verdict.mode) + "_" + props::to_string(verdict.view) + "_";
+        dir + "/" + (result.output ? result.output->name + "_" : std::string()) +
+        props::to_string(verdict.component) + "_" + props::to_string(verdict.group) + "_" +
+        props::to_string(verdict.mode) + "_" + props::to_string(verdict.view) + "_";
     const Scene& o = verdict.witness->scene;
     const Scene moved = verdict.witness->g * o;
     const std::vector<CameraImage> before = props::render_views(o, rig);
@@ -143,15 +146,22 @@ int run_audit(const AuditCommandOptions& options) {
   const std::vector<props::ExpectedSymmetry> expectations =
       props::parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
-  const props::PluginAuditSetup plugin{options.timeout, options.extra_poses, options.scalars};
+  props::PluginAuditSetup plugin{options.timeout, options.extra_poses, options.scalars, {}};
+  if (options.episodes > 0) {
+    plugin.closed_loop = props::ClosedLoopOptions{};
+    plugin.closed_loop->episodes = options.episodes;
+    plugin.closed_loop->steps = options.episode_length;
+  }
   std::vector<props::Classification> results;
+  std::optional<props::PolicyInterface> interface;  // a policy plug-in's
   bool policies = false, planar_model = false;
   if (!options.exec.empty()) {
     results.push_back(props::audit_representation_plugin(options.exec, audit, plugin));
   } else if (!options.policy_exec.empty()) {
     const props::PolicyPluginAudit audited =
         props::audit_policy_plugin(options.policy_exec, audit, plugin);
-    results.push_back(audited.result);
+    results = audited.results;
+    interface = audited.interface;
     policies = true;
     if (!options.witness_dir.empty()) {
       if (!audited.cameras) {
@@ -160,7 +170,8 @@ int run_audit(const AuditCommandOptions& options) {
             "hello declares no \"cameras\"; declare them, or leave --witness-dir "
             "out");
       }
-      write_witness_images(options.witness_dir, results.back(), *audited.cameras);
+      for (const props::Classification& result : results)
+        write_witness_images(options.witness_dir, result, *audited.cameras);
     }
   } else if (!options.model.empty()) {
     if (plugin_names)
@@ -177,10 +188,13 @@ int run_audit(const AuditCommandOptions& options) {
     results = props::audit_builtins(options.representations, audit);
   }
   if (options.json) {
-    std::cout << (policies ? props::policy_audit_json(results) : props::audit_json(results));
+    std::cout << (policies ? props::policy_audit_json(results, interface ? &*interface : nullptr)
+                           : props::audit_json(results));
     return gate(results, expectations);
   }
   props::print_audit_header(std::cout, audit, policies);
+  if (interface && !props::describe(*interface).empty())
+    std::cout << props::describe(*interface) << "\n";
   props::print_audit(std::cout, results, audit);
   if (planar_model && all_groups) std::cout << "\n" << experiments::kPlanarModelNote << "\n";
   return gate(results, expectations);
@@ -268,6 +282,17 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       cmd->add_option("--policy-exec", options->policy_exec,
                       "audit a whole policy written in any language (eq. 4): COMMAND answers the "
                       "world chunk for an observation and a noise vector (docs/AUDIT.md)");
+  auto* episodes = cmd->add_option(
+      "--episodes", options->episodes,
+      "with --policy-exec: also the closed loop, N episodes of two rollouts each (o_1..o_T and "
+      "g o_1..g o_T, the first pose executed at every step), for a plug-in that keeps state "
+      "between calls (its hello's \"episodes\": docs/AUDIT.md)");
+  episodes->check(CLI::Range(1, props::kMaxCases));
+  cmd->add_option("--episode-length", options->episode_length,
+                  "with --episodes: the steps T of each rollout, 1 to 10000")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str()
+      ->needs(episodes);
   auto* model =
       cmd->add_option("--model", options->model, "audit a trained model of this library (eq. 4)");
   auto* floor = cmd->add_flag(
@@ -277,6 +302,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   floor->needs(model);
   exec->excludes(repr)->excludes(policy_exec)->excludes(model);
   policy_exec->excludes(repr)->excludes(model);
+  episodes->needs(policy_exec);
   model->excludes(repr);
   pointwise->needs(model);
   test_law->excludes(pointwise)->excludes(repr)->excludes(exec);
@@ -291,7 +317,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--profile-sizes", options->profile_sizes,
                   "with --profile: the sizes of g, e.g. 0.01,0.1,1 (default: the group's grid)")
       ->delimiter(',');
-  profile->needs(out)->excludes(json)->excludes(pointwise)->excludes(detect);
+  profile->needs(out)->excludes(json)->excludes(pointwise)->excludes(detect)->excludes(episodes);
   out->needs(profile);
   cmd->callback([options, detect, &exit_code] {
     options->detect_given = detect->count() > 0;

@@ -19,7 +19,9 @@ std::string pad(const std::string& text, std::size_t width) {
 }
 
 std::string row_label(Component component, Mode mode) {
-  return to_string(component) + (mode == Mode::distribution ? " (in distribution)" : "");
+  return to_string(component) + (mode == Mode::distribution  ? " (in distribution)"
+                                 : mode == Mode::closed_loop ? " (closed loop)"
+                                                             : "");
 }
 
 std::string view_heading(View view, bool recorded) {
@@ -246,7 +248,7 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
           << pad("component", kLabel);
       for (Group group : options.groups) out << " | " << pad(to_string(group), kCell);
       out << "\n";
-      for (Mode mode : {Mode::pointwise, Mode::distribution}) {
+      for (Mode mode : {Mode::pointwise, Mode::distribution, Mode::closed_loop}) {
         for (Component component :
              {Component::actions, Component::observation, Component::flow_input,
               Component::flow_target, Component::policy}) {
