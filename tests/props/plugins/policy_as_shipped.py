@@ -77,11 +77,11 @@ def two_hands(history, hand_points, noise):
     L = hp.formats.decode(history["left"], LAYOUT)
     R = hp.formats.decode(history["right"], LAYOUT)
     left_in_right = hp.pose_vector(hp.relative_pose(L[0], R[0]))  # UMI's robot1_eef_pos_wrt0
-    left, _ = plan(L[0], left_in_right, hand_points, noise)
+    left, gripper = plan(L[0], left_in_right, hand_points, noise)
     feature = -left_in_right
     if FAULT == "right_world_x":
         feature = feature + np.array([R[0][0, 3], 0, 0, 0, 0, 0])
-    right, gripper = plan(R[0], feature, hand_points, noise[::-1])
+    right, _ = plan(R[0], feature, hand_points, noise[::-1])
     return {"left": hp.formats.encode(left, LAYOUT), "right": hp.formats.encode(right, LAYOUT),
             "gripper": gripper}
 
