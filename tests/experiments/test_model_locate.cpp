@@ -14,11 +14,14 @@
 //   no_rounding   the rounding rule left out (floor only): unchanged here (float32 layers of an
 //                 invariant input are the same bits), so it is not one of the mutants.
 #include <catch2/catch.hpp>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "../policy/fixtures.hpp"
 #include "handcentric/experiments/layer_fault.hpp"
+#include "handcentric/experiments/locate_page.hpp"
 #include "handcentric/experiments/model_locate.hpp"
+#include "handcentric/policy/model_file.hpp"
 #include "handcentric/policy/trainer.hpp"
 
 using namespace handcentric;
@@ -140,4 +143,34 @@ TEST_CASE("locate_watches_an_image_models_encoder_and_finds_a_bias_in_its_second
   REQUIRE(biased.first_break() != nullptr);
   CHECK(biased.first_break()->name == "encoder.conv2");
   CHECK(biased.layers[1].verdict == "invariant");
+}
+
+// The report's section (locate_page.hpp): the two models side by side, the planted fault's first
+// break marked on its row, every hand-centric cell a yes, and the page's rules kept (a NO cell
+// links to the witnesses). Mutant (mutant_locate.sh page_mark): the fault's column never marked.
+TEST_CASE("report_section_puts_the_planted_fault_beside_the_hand_centric_model", "[unit]") {
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / "locate_page.hcm";
+  policy::save_model(*small_model("hand_centric"), file.string());
+  const std::vector<experiments::Section> sections =
+      experiments::locate_sections(file.string(), "a test model", props::Group::se3, kCases, 1);
+  std::filesystem::remove(file);
+  REQUIRE(sections.size() == 2);
+  CHECK(sections[0].id == "locate");
+  CHECK(sections[1].id == "locate-witness");
+  const auto* table = std::get_if<experiments::Table>(&sections[0].blocks.at(1));
+  REQUIRE(table != nullptr);
+  int marked = 0;
+  for (const auto& row : table->rows) {
+    CHECK(row[2].mark == experiments::Mark::yes);  // the hand-centric model
+    if (row[3].detail.find("FIRST BREAK") == std::string::npos) continue;
+    ++marked;
+    CHECK(row[0].text.at(0).text == "▶ mlp.layer2[0]");
+    CHECK(row[3].mark == experiments::Mark::no);
+    CHECK(row[3].link == "#locate-witness");
+  }
+  CHECK(marked == 1);
+  experiments::Document document;
+  document.title = "locate";
+  document.sections = sections;
+  CHECK_NOTHROW(experiments::check(document));
 }
