@@ -29,16 +29,16 @@ plant() {  # prints three lines: the file, the sed expression, the ctest regex
     skip_conv) printf '%s\n' 'policy/src/conv_encoder.cpp' \
       's|^    watch_layer("encoder.conv",.*|    // skipped|' "${unit}watches_an_image" ;;
     outer_first) printf '%s\n' 'policy/src/layer_watch.cpp' \
-      's|for (auto it = now.rbegin(); it != now.rend(); ++it)|for (auto it = now.begin(); it != now.end(); ++it)|' \
+      's|now.rbegin(); it != now.rend();|now.begin(); it != now.end();|' \
       "${unit}finds_a_world" ;;
     chunk_kind) printf '%s\n' 'experiments/src/model_locate.cpp' \
       's|key == kChunkKey ? LayerKind::poses : LayerKind::features|LayerKind::features|' \
       "${unit}watches_every|${cli}a_hand_centric_3d" ;;
     self_compare) printf '%s\n' 'experiments/src/model_locate.cpp' \
-      's|const double error = feature_difference(a, b);|const double error = feature_difference(a, a);|' \
+      's|error = feature_difference(a, b);|error = feature_difference(a, a);|' \
       "${unit}finds|${cli}with_the_table|${cli}an_absolute" ;;
     no_refusal) printf '%s\n' 'apps/cmd_audit.cpp' \
-      's|^  if (options.locate) check_locate_options(options);|  // not refused|' \
+      's|^  if (options.locate) check_locate_options|  if (false) check_locate_options|' \
       "${cli}without_a_model" ;;
     page_mark) printf '%s\n' 'experiments/src/locate_page.cpp' \
       's|located_layer_cell(y, &y == first_b)|located_layer_cell(y, false)|' "report_section" ;;
@@ -51,7 +51,8 @@ for m in "${mutants[@]}"; do
   [ ${#planted[@]} -eq 3 ] || exit 2
   file=${planted[0]} expr=${planted[1]} regex=${planted[2]}
   cp "$src/$file" "$src/$file.orig"
-  trap 'mv "$src/$file.orig" "$src/$file"' EXIT INT TERM
+  # Restored with a new time stamp: make must rebuild what the mutant built.
+  trap 'mv "$src/$file.orig" "$src/$file"; touch "$src/$file"' EXIT INT TERM
   sed -i "$expr" "$src/$file"
   if cmp -s "$src/$file" "$src/$file.orig"; then
     echo "mutant $m: the sed changed nothing in $file (the source moved on)"; status=1
@@ -63,8 +64,10 @@ for m in "${mutants[@]}"; do
     echo "mutant $m: caught (ctest -R '$regex' fails)"
   fi
   mv "$src/$file.orig" "$src/$file"
+  touch "$src/$file"
   trap - EXIT INT TERM
 done
-make -C "$build" -j2 handcentric test_experiments >/dev/null 2>&1 || { echo "rebuild failed"; exit 1; }
+make -C "$build" -j2 handcentric test_experiments >/dev/null 2>&1 ||
+  { echo "rebuild failed"; exit 1; }
 [ $status -eq 0 ] && echo "all mutants caught"
 exit $status
