@@ -85,11 +85,12 @@ LayerAnswer ask_watched(const props::NoisyPolicy& policy, const Scene& scene,
   return answer;
 }
 
-/// The larger_or_nan of the two; NaN wins (no comparison passes on it).
+/// The larger of the two; NaN wins (no comparison passes on it).
 double larger_or_nan(double m, double x) {
   return x <= m ? m : x;
 }
 
+/// |a|_inf, the output's size c.
 double output_size(const LayerOutput& a) {
   double m = 0.0;
   for (Eigen::Index i = 0; i < a.values.size(); ++i)
