@@ -9,6 +9,7 @@
 //   handcentric audit --policy-exec 'python3 my_policy.py' --expect se3
 //   handcentric audit --model hc.model
 //   handcentric audit --model image.model --floor   # the hand camera sees the table too
+//   handcentric audit --model hc.model --locate --group se3   # the first layer that breaks
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -20,6 +21,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/experiments/model_audit.hpp"
+#include "handcentric/experiments/model_locate.hpp"
 #include "handcentric/experiments/witness_panel.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -52,6 +54,7 @@ struct AuditCommandOptions {
   bool pointwise = false;
   bool test_law = false;
   bool floor = false;
+  bool locate = false;  // --locate (model_locate.hpp)
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
   std::string profile, out;  // --profile GROUP --out DIR (audit_profile.hpp)
@@ -109,7 +112,41 @@ int gate(const std::vector<props::Classification>& results,
   return failures.empty() ? 0 : 1;
 }
 
+// --locate: refused in one line, naming the fix, with what it cannot honour.
+void check_locate_options(const AuditCommandOptions& options) {
+  if (options.model.empty()) {
+    throw InvalidArgument(
+        "--locate looks inside a trained model of this library: give --model FILE (a Python "
+        "policy: handcentric.locate, docs/AUDIT.md \"Localizing a break\")");
+  }
+  const std::pair<bool, const char*> unhonoured[] = {
+      {!options.expect.empty(), "--expect (a gate: run it without --locate)"},
+      {!options.witness_dir.empty(), "--witness-dir (the witness is printed)"},
+      {options.test_law, "--test-law (locate asks pointwise cases only)"},
+      {options.pointwise, "--pointwise (locate is pointwise already)"},
+      {!options.extra_poses.empty() || !options.scalars.empty(),
+       "--extra-poses and --scalars (a model reads neither)"}};
+  for (const auto& [given, flag] : unhonoured) {
+    if (given)
+      throw InvalidArgument(std::string("--locate cannot honour ") + flag + ": leave it out");
+  }
+}
+
+// --model M --locate: one table per group (or one JSON document), exit 0 whatever it finds.
+int run_locate(const AuditCommandOptions& options, props::AuditOptions& audit, bool named_groups) {
+  const std::vector<experiments::ModelLocation> located =
+      experiments::locate_model(options.model, options.model, audit, named_groups, options.floor);
+  if (options.json) {
+    std::cout << experiments::locate_json(located);
+    return 0;
+  }
+  for (std::size_t i = 0; i < located.size(); ++i)
+    std::cout << (i ? "\n" : "") << experiments::locate_text(located[i]);
+  return 0;
+}
+
 int run_audit(const AuditCommandOptions& options) {
+  if (options.locate) check_locate_options(options);
   // CLI11 refuses --test-law beside --repr or --exec; with no source at all the audit is the
   // built-ins', representations too.
   if (options.test_law && options.policy_exec.empty() && options.model.empty()) {
@@ -143,6 +180,7 @@ int run_audit(const AuditCommandOptions& options) {
       audit.views = {props::View::eye_in_hand};
   }
   (void)props::audit_relative_tolerance(audit);  // validates --tolerance before anything runs
+  if (options.locate) return run_locate(options, audit, !all_groups);
   const std::vector<props::ExpectedSymmetry> expectations =
       props::parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
@@ -299,6 +337,11 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       "--floor", options->floor,
       "--model of an image policy of the 3D task: its hand camera also sees a table fixed in the "
       "world (z <= 0), which g does not move with the scene");
+  cmd->add_flag("--locate", options->locate,
+                "--model only: where the model breaks the symmetry, layer by layer (each "
+                "layer's output invariant, the decoded chunk equivariant, on the audit's "
+                "pointwise cases), the first layer that breaks with its witness (docs/AUDIT.md, "
+                "\"Localizing a break\")");
   floor->needs(model);
   exec->excludes(repr)->excludes(policy_exec)->excludes(model);
   policy_exec->excludes(repr)->excludes(model);
@@ -321,6 +364,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   out->needs(profile);
   cmd->callback([options, detect, &exit_code] {
     options->detect_given = detect->count() > 0;
+    if (options->locate && !options->profile.empty())
+      throw InvalidArgument("--locate cannot honour --profile: run them one at a time");
     exit_code = options->profile.empty() ? run_audit(*options)
                                          : run_audit_profile(profile_command(*options));
   });
