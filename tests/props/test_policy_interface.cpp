@@ -130,6 +130,10 @@ TEST_CASE("a_layout_the_numbers_contradict_is_an_error_naming_the_pose", "[unit]
   CHECK(bad.exit_code != 0);
   CHECK_THAT(bad.err, Contains("\"outputs\"[\"hand\"][0]") && Contains("norm 1.5") &&
                           Contains("pos_quat_xyzw"));
+  // Mutant: the lengths of invariant outputs not checked (their poses compared instead: NO).
+  const auto length = test::run_command(shipped_audit("gripper_length", flags));
+  CHECK(length.exit_code != 0);
+  CHECK_THAT(length.err, Contains("output \"gripper\" 3 numbers after 4"));
   const auto undeclared = test::run_command(shipped_audit("undeclared", flags));
   CHECK(undeclared.exit_code != 0);
   CHECK_THAT(undeclared.err, Contains("action_format="));
