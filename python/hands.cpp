@@ -27,14 +27,17 @@ void set_hands(CommonOptions& o, props::ClassifierOptions& c, py::handle hands) 
     throw InvalidArgument("hands= names " + std::to_string(names.size()) +
                           " hand; with one hand leave hands= out (its history is an array)");
   }
-  if (o.audit.observations) {
-    throw InvalidArgument(
-        "hands= with observations= is not supported: recorded observations "
-        "carry one hand's history; audit the hands on drawn scenes");
-  }
   o.call.hands = names;
-  for (std::size_t h = 1; h < names.size(); ++h)
-    c.check.shape.extra_pose_names.push_back(kHandPosePrefix + names[h]);
+  if (o.audit.observations) {
+    // Every hand's history as recorded, the first hand's the scenes' own.
+    o.audit.observations = std::make_shared<const props::RecordedObservations>(
+        props::recorded_with_hands(*o.audit.observations, names));
+    c.check.shape.recorded = o.audit.observations;
+    o.call.hands_recorded = true;
+  } else {
+    for (std::size_t h = 1; h < names.size(); ++h)
+      c.check.shape.extra_pose_names.push_back(kHandPosePrefix + names[h]);
+  }
   // Each hand a pose output, first; the rest of outputs= after them.
   std::vector<NamedOutput> outputs;
   for (const std::string& hand : names) outputs.push_back({hand, OutputKind::pose});
@@ -57,11 +60,17 @@ py::object history_argument(const std::vector<const Scene*>& rows, const CallOpt
   out[py::str(options.hands.front())] =
       for_callable(history_in(rows, options.stacked, options.state_format), kind);
   for (std::size_t h = 1; h < options.hands.size(); ++h) {
-    // Scenes whose history is this hand's: S_k = S_0 T_0^-1 T_k (hands.hpp).
+    // Scenes whose history is this hand's: as recorded, or S_k = S_0 T_0^-1 T_k (hands.hpp).
     std::vector<Scene> moved;
     moved.reserve(rows.size());
     const std::string pose_name = kHandPosePrefix + options.hands[h];
     for (const Scene* s : rows) {
+      if (options.hands_recorded) {
+        Scene other;
+        other.world_T_hand_history = props::recorded_hand_history(*s, options.hands[h]);
+        moved.push_back(std::move(other));
+        continue;
+      }
       const auto found = std::find_if(s->extra_poses.begin(), s->extra_poses.end(),
                                       [&](const auto& p) { return p.first == pose_name; });
       if (found == s->extra_poses.end())
