@@ -130,8 +130,8 @@ TEST_CASE("a_queue_of_hand_centric_chunks_holds_on_recorded_episodes", "[unit]")
 }
 
 TEST_CASE("each_recorded_episode_is_replayed_in_order_by_fresh_policies_with_one_g", "[unit]") {
-  // Mutants seen failing here (run by hand, reverted): the episodes concatenated into one (two
-  // resets instead of six); the g side not reset; one g per step.
+  // Mutants seen failing here (run by hand, reverted): the observations read as one episode
+  // (RecordedObservations::episodes()); the g side not reset; one g per step.
   const EpisodeQueuePolicy policy;
   const auto data = recorded_episodes(3, 5);
   (void)props::check_policy_recorded_episodes(policy, props::Group::se3, recorded_on(data),

@@ -53,7 +53,7 @@ def loops(report):
 def test_a_world_frame_running_sum_passes_single_calls_and_is_no_on_recorded_episodes():
     # Mutants seen failing here (run by hand, reverted): a reset before every step of the replay
     # (props/src/checks/recorded_episodes.cpp: the sum stays zero, the loop says yes); the
-    # episodes concatenated into one (the witness names no recorded episode 7).
+    # recorded observations read as one episode (RecordedObservations::episodes()).
     policy = RunningSum()
     report = handcentric.audit_policy(policy, groups=["translation"], cases=30,
                                       observations=recorded(), episodes=3, reset=policy.reset,

@@ -28,8 +28,9 @@ def two_hands(count=16, seed=4):
 
 
 def test_each_hand_history_reaches_the_policy_as_recorded():
-    # Mutant seen failing here (run by hand, reverted): python/hands.cpp handing the right hand
-    # the history drawn from the left hand's motion (S_0 T_0^-1 T_k) instead of its recorded one.
+    # Mutants seen failing here (run by hand, reverted): python/hands.cpp handing the right hand
+    # the history drawn from the left hand's motion (S_0 T_0^-1 T_k) instead of its recorded
+    # one; or its recorded one in the left hand's frame (T_0^-1 S_k).
     data = two_hands(4)
     seen = []
 
@@ -57,8 +58,10 @@ def test_the_right_hand_in_the_left_frame_holds_on_recorded_two_hand_observation
 
 
 def test_reading_the_right_hand_world_x_is_no_under_translation_on_recorded_observations():
-    # Mutant seen failing here (run by hand, reverted): the same as above (the right hand in the
-    # left hand's frame reads no world position: the NO turns yes).
+    # Mutant seen failing here (run by hand, reverted): python/hands.cpp's set_hands returning
+    # once the recorded histories are set, before each hand becomes a "pose" output (no verdict
+    # on the right hand). The right hand handed in the left hand's frame (T_0^-1 S_k) does not
+    # turn this NO: that chunk is not equivariant either; the test above sees that mutant.
     report = handcentric.audit_policy(bimanual("right_world_x"), groups=["translation"],
                                       cases=40, observations=two_hands(), hands=HANDS, quiet=True)
     verdicts = {(c["output"], c["mode"]): c["equivariant"] for c in report["checks"]}
