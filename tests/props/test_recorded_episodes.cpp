@@ -112,6 +112,13 @@ props::ClosedLoopOptions replaying(const Policy& policy, int episodes) {
   return loop;
 }
 
+// The closed-loop verdict of `policy` on `episodes` recorded episodes of `steps` observations.
+template <class Policy>
+props::Verdict replayed(const Policy& policy, props::Group group, int episodes, int steps) {
+  return props::check_policy_closed_loop(
+      policy, group, recorded_on(recorded_episodes(episodes, steps)), replaying(policy, episodes));
+}
+
 }  // namespace
 
 TEST_CASE("a_queue_of_hand_centric_chunks_holds_on_recorded_episodes", "[unit]") {
@@ -119,9 +126,7 @@ TEST_CASE("a_queue_of_hand_centric_chunks_holds_on_recorded_episodes", "[unit]")
   // (its queue carries the last episode's chunk over); one g drawn per step instead of per
   // episode (a queued pose planned under one g is compared under another).
   const EpisodeQueuePolicy policy;
-  const auto data = recorded_episodes(3, 7);
-  const props::Verdict v = props::check_policy_closed_loop(policy, props::Group::se3,
-                                                           recorded_on(data), replaying(policy, 3));
+  const props::Verdict v = replayed(policy, props::Group::se3, 3, 7);
   CHECK(v.invariant);
   CHECK(v.mode == props::Mode::closed_loop);
   CHECK(v.cases + v.near_identity_cases == 3);
@@ -155,9 +160,7 @@ TEST_CASE("a_running_sum_of_world_positions_is_no_on_recorded_episodes", "[unit]
   // Mutant seen failing here (run by hand, reverted): a reset before every step of the replay
   // (each call fresh, the sum always zero) says yes.
   const RunningSumPolicy policy;
-  const auto data = recorded_episodes(3, 6);
-  const props::Verdict v = props::check_policy_closed_loop(policy, props::Group::translation,
-                                                           recorded_on(data), replaying(policy, 3));
+  const props::Verdict v = replayed(policy, props::Group::translation, 3, 6);
   REQUIRE_FALSE(v.invariant);
   REQUIRE(v.witness);
   CHECK_THAT(v.witness->detail, Catch::Contains("closed loop, recorded episode 11 (2 of 3, "
