@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/props/audit.hpp"
 #include "handcentric/props/checks/check.hpp"
 #include "handcentric/props/checks/closed_loop.hpp"
 #include "handcentric/props/checks/recorded_episodes.hpp"
@@ -194,6 +195,17 @@ TEST_CASE("recorded_episodes_that_cannot_be_replayed_are_refused", "[unit]") {
                     Catch::Contains("log line 4 'episode' is 1.5; an episode index is an integer"));
 }
 
+TEST_CASE("the_command_line_refuses_episodes_and_hands_it_would_misread", "[unit]") {
+  // handcentric audit asks single observations of one hand: an episode index or one history
+  // per hand is refused in one line, not silently ignored.
+  props::AuditOptions options;
+  options.cases = 10;
+  options.observations = recorded_episodes(2, 3);
+  CHECK_THROWS_WITH(props::audit_builtins({"hand_centric"}, options),
+                    Catch::Contains("carry an 'episode' index, which only the closed loop of "
+                                    "handcentric.audit_policy(..., episodes=N) replays"));
+}
+
 TEST_CASE("json_lines_carry_episodes_and_one_history_per_hand", "[unit]") {
   const std::string eye = "[[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]";
   const std::string right = "[[1,0,0,0.3],[0,1,0,0],[0,0,1,0],[0,0,0,1]]";
@@ -215,4 +227,8 @@ TEST_CASE("json_lines_carry_episodes_and_one_history_per_hand", "[unit]") {
   CHECK(props::recorded_hand_history(s, "right").empty());
   CHECK_THROWS_WITH(props::recorded_with_hands(data, {"left", "middle"}),
                     Catch::Contains("record the histories of (left, right)"));
+  std::stringstream one_hand(R"({"history": {"left": [)" + eye + "]}}\n");
+  CHECK_THROWS_WITH(props::observations_from_json_lines(one_hand, "one.jsonl"),
+                    Catch::Contains("one.jsonl line 1 has one history per hand for one hand, "
+                                    "'left': with one hand give 'history' as an array"));
 }

@@ -70,6 +70,20 @@ def test_reading_the_right_hand_world_x_is_no_under_translation_on_recorded_obse
     assert "hand:right" in str(witness)
 
 
+def test_recorded_two_hand_episodes_replay_in_closed_loop_with_verdicts_per_hand():
+    data = two_hands(8)
+    for i, d in enumerate(data):
+        d["episode"] = i // 4
+    common = dict(groups=["translation"], cases=20, observations=data, hands=HANDS, episodes=2,
+                  quiet=True)
+    holds = handcentric.audit_policy(bimanual(), **common)
+    assert all(c["equivariant"] for c in holds["checks"] if c["mode"] == "closed_loop")
+    fails = handcentric.audit_policy(bimanual("right_world_x"), **common)
+    loops = {c["output"]: c for c in fails["checks"] if c["mode"] == "closed_loop"}
+    assert loops["left"]["equivariant"] and not loops["right"]["equivariant"]
+    assert "recorded episode 0 (1 of 2" in loops["right"]["witness"]["detail"]
+
+
 def test_an_npz_with_one_history_array_per_hand_gives_the_dicts_verdicts(tmp_path):
     data = two_hands(8)
     np.savez(tmp_path / "two.npz",

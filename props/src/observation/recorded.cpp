@@ -168,6 +168,10 @@ Scene recorded_observation(const std::map<std::string, RecordedPart>& parts,
                             " (extra_poses, scalars and held by name)");
     }
   }
+  if (hands.size() == 1)
+    throw InvalidArgument(where + " has one history per hand for one hand, '" +
+                          hands.front().first +
+                          "': with one hand give 'history' as an array (H+1, 4, 4)");
   if (has_history && !hands.empty())
     throw InvalidArgument(where + " has both 'history' and 'history/" + hands.front().first +
                           "': record one history, or one per hand {hand: (H+1, 4, 4)}");
