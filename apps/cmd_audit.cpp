@@ -9,6 +9,7 @@
 //   handcentric audit --policy-exec 'python3 my_policy.py' --expect se3
 //   handcentric audit --model hc.model
 //   handcentric audit --model image.model --floor   # the hand camera sees the table too
+//   handcentric audit --model hc.model --locate --group se3   # the first layer that breaks
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -20,6 +21,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/experiments/model_audit.hpp"
+#include "handcentric/experiments/model_locate.hpp"
 #include "handcentric/experiments/witness_panel.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -39,6 +41,10 @@ struct AuditCommandOptions {
   std::vector<std::string> groups = {"all"};
   std::vector<std::string> views = {"all"};
   long long cases = props::kDefaultCases;  // wide: a value past the bound is named, not wrapped
+  double detect = 0.0;                     // --detect, when detect_given
+  bool detect_given = false;
+  int episodes = 0;  // --episodes: the closed loop of a --policy-exec plug-in (0: none)
+  int episode_length = props::ClosedLoopOptions{}.steps;
   std::uint64_t seed = props::AuditOptions{}.seed;
   double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
@@ -48,6 +54,7 @@ struct AuditCommandOptions {
   bool pointwise = false;
   bool test_law = false;
   bool floor = false;
+  bool locate = false;  // --locate (model_locate.hpp)
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
   std::string profile, out;  // --profile GROUP --out DIR (audit_profile.hpp)
@@ -75,8 +82,9 @@ void write_witness_images(const std::string& dir, const props::Classification& r
   for (const props::Verdict& verdict : result.verdicts) {
     if (!verdict.witness) continue;
     const std::string stem =
-        dir + "/" + props::to_string(verdict.component) + "_" + props::to_string(verdict.group) +
-        "_" + props::to_string(verdict.mode) + "_" + props::to_string(verdict.view) + "_";
+        dir + "/" + (result.output ? result.output->name + "_" : std::string()) +
+        props::to_string(verdict.component) + "_" + props::to_string(verdict.group) + "_" +
+        props::to_string(verdict.mode) + "_" + props::to_string(verdict.view) + "_";
     const Scene& o = verdict.witness->scene;
     const Scene moved = verdict.witness->g * o;
     const std::vector<CameraImage> before = props::render_views(o, rig);
@@ -104,7 +112,48 @@ int gate(const std::vector<props::Classification>& results,
   return failures.empty() ? 0 : 1;
 }
 
+// --locate: refused in one line, naming the fix, with what it cannot honour.
+void check_locate_options(const AuditCommandOptions& options) {
+  if (options.model.empty()) {
+    throw InvalidArgument(
+        "--locate looks inside a trained model of this library: give --model FILE (a Python "
+        "policy: handcentric.locate, docs/AUDIT.md \"Localizing a break\")");
+  }
+  const std::pair<bool, const char*> unhonoured[] = {
+      {!options.expect.empty(), "--expect (a gate: run it without --locate)"},
+      {!options.witness_dir.empty(), "--witness-dir (the witness is printed)"},
+      {options.test_law, "--test-law (locate asks pointwise cases only)"},
+      {options.pointwise, "--pointwise (locate is pointwise already)"},
+      {!options.extra_poses.empty() || !options.scalars.empty(),
+       "--extra-poses and --scalars (a model reads neither)"}};
+  for (const auto& [given, flag] : unhonoured) {
+    if (given)
+      throw InvalidArgument(std::string("--locate cannot honour ") + flag + ": leave it out");
+  }
+}
+
+// --model M --locate: one table per group (or one JSON document), exit 0 whatever it finds.
+int run_locate(const AuditCommandOptions& options, props::AuditOptions& audit, bool named_groups) {
+  const std::vector<experiments::ModelLocation> located =
+      experiments::locate_model(options.model, options.model, audit, named_groups, options.floor);
+  if (options.json) {
+    std::cout << experiments::locate_json(located);
+    return 0;
+  }
+  for (std::size_t i = 0; i < located.size(); ++i)
+    std::cout << (i ? "\n" : "") << experiments::locate_text(located[i]);
+  return 0;
+}
+
 int run_audit(const AuditCommandOptions& options) {
+  if (options.locate) check_locate_options(options);
+  // CLI11 refuses --test-law beside --repr or --exec; with no source at all the audit is the
+  // built-ins', representations too.
+  if (options.test_law && options.policy_exec.empty() && options.model.empty()) {
+    throw InvalidArgument(
+        "--test-law is for a whole policy (--policy-exec COMMAND or --model FILE): the "
+        "built-in representations' laws are always tested; leave --test-law out");
+  }
   props::AuditOptions audit;
   audit.groups = props::parse_groups(options.groups, "group");
   audit.views = props::parse_views(options.views, "view");
@@ -114,6 +163,10 @@ int run_audit(const AuditCommandOptions& options) {
   };
   const bool all_groups = has_all(options.groups), all_views = has_all(options.views);
   audit.cases = props::checked_cases(options.cases);  // 1 to props::kMaxCases
+  if (options.detect_given) {
+    audit.cases = props::cases_to_detect(options.detect);
+    audit.detect = options.detect;
+  }
   audit.seed = options.seed;
   audit.test_law = options.test_law;
   audit.precision = props::parse_precision(options.precision);
@@ -127,18 +180,26 @@ int run_audit(const AuditCommandOptions& options) {
       audit.views = {props::View::eye_in_hand};
   }
   (void)props::audit_relative_tolerance(audit);  // validates --tolerance before anything runs
+  if (options.locate) return run_locate(options, audit, !all_groups);
   const std::vector<props::ExpectedSymmetry> expectations =
       props::parse_expectations(options.expect);
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
-  const props::PluginAuditSetup plugin{options.timeout, options.extra_poses, options.scalars};
+  props::PluginAuditSetup plugin{options.timeout, options.extra_poses, options.scalars, {}};
+  if (options.episodes > 0) {
+    plugin.closed_loop = props::ClosedLoopOptions{};
+    plugin.closed_loop->episodes = options.episodes;
+    plugin.closed_loop->steps = options.episode_length;
+  }
   std::vector<props::Classification> results;
+  std::optional<props::PolicyInterface> interface;  // a policy plug-in's
   bool policies = false, planar_model = false;
   if (!options.exec.empty()) {
     results.push_back(props::audit_representation_plugin(options.exec, audit, plugin));
   } else if (!options.policy_exec.empty()) {
     const props::PolicyPluginAudit audited =
         props::audit_policy_plugin(options.policy_exec, audit, plugin);
-    results.push_back(audited.result);
+    results = audited.results;
+    interface = audited.interface;
     policies = true;
     if (!options.witness_dir.empty()) {
       if (!audited.cameras) {
@@ -147,7 +208,8 @@ int run_audit(const AuditCommandOptions& options) {
             "hello declares no \"cameras\"; declare them, or leave --witness-dir "
             "out");
       }
-      write_witness_images(options.witness_dir, results.back(), *audited.cameras);
+      for (const props::Classification& result : results)
+        write_witness_images(options.witness_dir, result, *audited.cameras);
     }
   } else if (!options.model.empty()) {
     if (plugin_names)
@@ -164,10 +226,13 @@ int run_audit(const AuditCommandOptions& options) {
     results = props::audit_builtins(options.representations, audit);
   }
   if (options.json) {
-    std::cout << (policies ? props::policy_audit_json(results) : props::audit_json(results));
+    std::cout << (policies ? props::policy_audit_json(results, interface ? &*interface : nullptr)
+                           : props::audit_json(results));
     return gate(results, expectations);
   }
   props::print_audit_header(std::cout, audit, policies);
+  if (interface && !props::describe(*interface).empty())
+    std::cout << props::describe(*interface) << "\n";
   props::print_audit(std::cout, results, audit);
   if (planar_model && all_groups) std::cout << "\n" << experiments::kPlanarModelNote << "\n";
   return gate(results, expectations);
@@ -191,9 +256,16 @@ void add_audit_command(CLI::App& app, int& exit_code) {
                   "one or both of eye_in_hand (no world points: Theorem 1's setting) and "
                   "third_person (1-8 world points that move with g), or all")
       ->capture_default_str();
-  cmd->add_option("--cases", options->cases,
-                  "cases per pointwise check, at most 10^7 (in distribution: max(10, cases/100))")
-      ->capture_default_str();
+  auto* cases = cmd->add_option("--cases", options->cases,
+                                "cases per pointwise check, at most 10^7 (in distribution: max(10, "
+                                "cases/100))")
+                    ->capture_default_str();
+  auto* detect = cmd->add_option(
+      "--detect", options->detect,
+      "FREQUENCY: instead of --cases, as many cases as find a breaking on that share of the "
+      "(scene, g) draws with 99% probability, e.g. 0.01 (459 cases; the default 1000 finds "
+      "0.0046)");
+  detect->excludes(cases);
   cmd->add_option("--seed", options->seed,
                   "seeds all the audit draws (the cases, a policy's fixed noise, the "
                   "in-distribution draws): the same seed gives the same verdicts and witnesses")
@@ -248,15 +320,32 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       cmd->add_option("--policy-exec", options->policy_exec,
                       "audit a whole policy written in any language (eq. 4): COMMAND answers the "
                       "world chunk for an observation and a noise vector (docs/AUDIT.md)");
+  auto* episodes = cmd->add_option(
+      "--episodes", options->episodes,
+      "with --policy-exec: also the closed loop, N episodes of two rollouts each (o_1..o_T and "
+      "g o_1..g o_T, the first pose executed at every step), for a plug-in that keeps state "
+      "between calls (its hello's \"episodes\": docs/AUDIT.md)");
+  episodes->check(CLI::Range(1, props::kMaxCases));
+  cmd->add_option("--episode-length", options->episode_length,
+                  "with --episodes: the steps T of each rollout, 1 to 10000")
+      ->check(CLI::Range(1, 10000))
+      ->capture_default_str()
+      ->needs(episodes);
   auto* model =
       cmd->add_option("--model", options->model, "audit a trained model of this library (eq. 4)");
   auto* floor = cmd->add_flag(
       "--floor", options->floor,
       "--model of an image policy of the 3D task: its hand camera also sees a table fixed in the "
       "world (z <= 0), which g does not move with the scene");
+  cmd->add_flag("--locate", options->locate,
+                "--model only: where the model breaks the symmetry, layer by layer (each "
+                "layer's output invariant, the decoded chunk equivariant, on the audit's "
+                "pointwise cases), the first layer that breaks with its witness (docs/AUDIT.md, "
+                "\"Localizing a break\")");
   floor->needs(model);
   exec->excludes(repr)->excludes(policy_exec)->excludes(model);
   policy_exec->excludes(repr)->excludes(model);
+  episodes->needs(policy_exec);
   model->excludes(repr);
   pointwise->needs(model);
   test_law->excludes(pointwise)->excludes(repr)->excludes(exec);
@@ -271,9 +360,12 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   cmd->add_option("--profile-sizes", options->profile_sizes,
                   "with --profile: the sizes of g, e.g. 0.01,0.1,1 (default: the group's grid)")
       ->delimiter(',');
-  profile->needs(out)->excludes(json)->excludes(pointwise);
+  profile->needs(out)->excludes(json)->excludes(pointwise)->excludes(detect)->excludes(episodes);
   out->needs(profile);
-  cmd->callback([options, &exit_code] {
+  cmd->callback([options, detect, &exit_code] {
+    options->detect_given = detect->count() > 0;
+    if (options->locate && !options->profile.empty())
+      throw InvalidArgument("--locate cannot honour --profile: run them one at a time");
     exit_code = options->profile.empty() ? run_audit(*options)
                                          : run_audit_profile(profile_command(*options));
   });

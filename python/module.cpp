@@ -82,6 +82,10 @@ py::dict cameras_dict(const props::CameraRig& rig) {
 
 // What the audit showed the callables besides random scenes: the cameras and the user's data.
 void add_inputs(py::dict& report, const CommonOptions& o) {
+  if (o.audit.detect) {
+    report["detect"] =
+        py::dict(py::arg("frequency") = *o.audit.detect, py::arg("cases") = o.audit.cases);
+  }
   if (o.call.cameras) report["cameras"] = cameras_dict(*o.call.cameras);
   if (o.audit.observations) {
     report["observations"] = py::dict(py::arg("source") = o.audit.observations->source,
@@ -278,17 +282,17 @@ PYBIND11_MODULE(_core, m) {
   py::handle batch_size, const std::string &array, py::handle device, bool quiet,            \
       py::handle history, py::handle hand_points, py::handle world_points, py::handle chunk, \
       py::handle cameras, py::handle image_size, const std::string &channels, bool floor,    \
-      py::handle workspace, py::handle observations
-#define HANDCENTRIC_SETUP_VALUE                                                        \
-  Setup{batch_size, array,   device,     quiet,    history, hand_points, world_points, \
-        chunk,      cameras, image_size, channels, floor,   workspace,   observations}
+      py::handle workspace, py::handle observations, py::handle detect
+#define HANDCENTRIC_SETUP_VALUE                                                                \
+  Setup{batch_size, array,      device,   quiet, history,   hand_points,  world_points, chunk, \
+        cameras,    image_size, channels, floor, workspace, observations, detect}
 #define HANDCENTRIC_SETUP_ARGUMENTS                                                               \
   py::arg("batch_size") = py::none(), py::arg("array") = "numpy", py::arg("device") = py::none(), \
   py::arg("quiet") = false, py::arg("history") = py::none(), py::arg("hand_points") = py::none(), \
   py::arg("world_points") = py::none(), py::arg("chunk") = py::none(),                            \
   py::arg("cameras") = py::none(), py::arg("image_size") = py::none(),                            \
   py::arg("channels") = "rgbd", py::arg("floor") = false, py::arg("workspace") = py::none(),      \
-  py::arg("observations") = py::none()
+  py::arg("observations") = py::none(), py::arg("detect") = py::none()
 
   m.def(
       "audit",
@@ -301,7 +305,7 @@ PYBIND11_MODULE(_core, m) {
                      HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("actions"), py::arg("observation") = py::none(), py::arg("groups") = all_groups,
-      py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+      py::arg("views") = both_views, py::arg("cases") = py::none(), py::arg("seed") = 1,
       py::arg("tolerance") = py::none(), py::arg("precision") = "float64", py::kw_only(),
       py::arg("decode") = py::none(), py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), HANDCENTRIC_SETUP_ARGUMENTS,
@@ -333,10 +337,10 @@ rectified flow's (eq. 5).
                             HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("groups") = all_groups, py::arg("views") = both_views,
-      py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
-      py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
-      py::arg("noise") = props::kPolicyNoise, py::kw_only(), py::arg("extra_poses") = py::tuple(),
-      py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),
+      py::arg("cases") = py::none(), py::arg("seed") = 1, py::arg("tolerance") = py::none(),
+      py::arg("precision") = "float64", py::arg("noise") = props::kPolicyNoise, py::kw_only(),
+      py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
+      py::arg("rng") = py::none(), py::arg("reset") = py::none(),
       py::arg("action_format") = "matrix", py::arg("state_format") = "matrix",
       py::arg("outputs") = py::none(), py::arg("hands") = py::none(),
       py::arg("episodes") = py::none(), py::arg("episode_length") = py::none(),
@@ -388,10 +392,9 @@ every cell.
       },
       py::arg("fn"), py::arg("group"), py::arg("component") = "actions", py::kw_only(),
       py::arg("observation") = py::none(), py::arg("views") = both_views,
-      py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
-      py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
-      py::arg("extra_poses") = py::tuple(), py::arg("scalars") = py::tuple(),
-      HANDCENTRIC_SETUP_ARGUMENTS,
+      py::arg("cases") = py::none(), py::arg("seed") = 1, py::arg("tolerance") = py::none(),
+      py::arg("precision") = "float64", py::arg("extra_poses") = py::tuple(),
+      py::arg("scalars") = py::tuple(), HANDCENTRIC_SETUP_ARGUMENTS,
       (std::string(R"doc(Raise AssertionError unless `component` is invariant under `group`.
 
 The error carries the shrunk witness.
@@ -415,7 +418,7 @@ Every view in `views` must hold.
                            outputs, hands, HANDCENTRIC_SETUP_VALUE);
       },
       py::arg("policy"), py::arg("group"), py::kw_only(), py::arg("mode") = "pointwise",
-      py::arg("views") = both_views, py::arg("cases") = props::kDefaultCases, py::arg("seed") = 1,
+      py::arg("views") = both_views, py::arg("cases") = py::none(), py::arg("seed") = 1,
       py::arg("tolerance") = py::none(), py::arg("precision") = "float64",
       py::arg("noise") = props::kPolicyNoise, py::arg("extra_poses") = py::tuple(),
       py::arg("scalars") = py::tuple(), py::arg("rng") = py::none(), py::arg("reset") = py::none(),

@@ -56,7 +56,24 @@ int bounded_integer(py::handle value, const char* name, long long low, long long
 constexpr long long kMaxSceneSize = 64;
 
 int cases_of(py::handle cases) {
+  if (cases.is_none()) return props::kDefaultCases;
   return bounded_integer(cases, "cases", 1, props::kMaxCases, "handcentric.MAX_CASES");
+}
+
+/// detect=: the frequency the case count is set from (props::cases_to_detect); None: none.
+std::optional<double> detect_of(py::handle detect, py::handle cases) {
+  if (detect.is_none()) return std::nullopt;
+  if (!cases.is_none()) {
+    throw InvalidArgument("cases=" + std::string(py::str(cases)) +
+                          " and detect=" + std::string(py::str(detect)) +
+                          " both set the number of cases; give one of them");
+  }
+  if (py::isinstance<py::bool_>(detect) || !PyNumber_Check(detect.ptr()) ||
+      py::isinstance<py::str>(detect)) {
+    throw DtypeError("detect must be a frequency in (0, 1), e.g. detect=0.01; got a " +
+                     type_name(detect));
+  }
+  return py::cast<double>(py::float_(py::reinterpret_borrow<py::object>(detect)));
 }
 
 }  // namespace
@@ -216,6 +233,9 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
                              py::handle scalars, const Setup& setup, RecordedUse use) {
   CommonOptions o;
   o.audit.cases = cases_of(cases);
+  o.audit.detect = detect_of(setup.detect, cases);
+  if (o.audit.detect)
+    o.audit.cases = props::cases_to_detect(*o.audit.detect, props::kPythonSpelling);
   o.audit.groups = groups_of(groups);
   o.audit.views = views_of(views);
   o.audit.seed = seed;

@@ -36,12 +36,16 @@ struct Setup {
   bool floor = false;
   py::handle workspace = py::none();
   py::handle observations = py::none();
+  py::handle detect = py::none();
 };
 
 /// The docstring part about Setup's keywords.
 inline constexpr const char* kSetupDoc = R"doc(
 Every keyword argument a callable receives: with extra_poses / scalars (names), extra_poses=
-{name: (4, 4)} and scalars={name: float}. cases: 1 to MAX_CASES (10**7).
+{name: (4, 4)} and scalars={name: float}. cases: 1 to MAX_CASES (10**7;
+None: 1000); or detect=f instead, e.g. detect=0.01: as many cases as find a breaking on a share
+f of the (scene, g) draws with 99% probability (ceil(ln 0.01 / ln(1 - f)), 459 for 0.01; the
+default 1000 cases find 0.0046).
 batch_size=B (1 to MAX_BATCH_SIZE): the callables are called on stacked arrays with a leading
 batch axis of at most B: history (B, H+1, 4, 4), chunk (B, K, 4, 4), hand_points (B, n, 3),
 world_points (B, m, 3), noise (B, d), each extra pose (B, 4, 4) and scalar (B,); they return

@@ -16,6 +16,7 @@
 #include "handcentric/experiments/document_html.hpp"
 #include "handcentric/experiments/document_markdown.hpp"
 #include "handcentric/experiments/flow_figure.hpp"
+#include "handcentric/experiments/locate_page.hpp"
 #include "handcentric/experiments/methods.hpp"
 #include "handcentric/experiments/model_profile.hpp"
 #include "handcentric/experiments/profile_plot.hpp"
@@ -271,6 +272,30 @@ Section profiles_section(const std::filesystem::path& dir, const std::vector<Cel
   return out;
 }
 
+// Table 1's hand-centric model (the largest demo count, the first training seed) and the same
+// model with a world-frame bias in its second layer, located under se2 (locate_page.hpp).
+std::vector<Section> locate_table1_sections(const std::filesystem::path& dir,
+                                            const std::vector<Cell>& cells, std::uint64_t seed) {
+  const Cell* model = nullptr;
+  for (const Cell& cell : cells) {
+    if (cell.method != "hand_centric") continue;
+    if (!model || cell.demos > model->demos ||
+        (cell.demos == model->demos && cell.train_seed < model->train_seed))
+      model = &cell;
+  }
+  if (!model) {
+    Section out = section("locate", "Where the symmetry breaks: a planted fault located");
+    out.blocks.push_back(Paragraph{
+        {plain("Table 1 ran no hand_centric row (--methods), so no model is located here; "),
+         code("handcentric audit --model M --locate"), plain(" locates any model file.")}});
+    return {std::move(out)};
+  }
+  return locate_sections(
+      (dir / "table1" / model->model_path()).string(),
+      "Table 1's hand-centric model at " + std::to_string(model->demos) + " demos",
+      props::Group::se2, kReportLocateCases, seed);
+}
+
 }  // namespace
 
 int write_report_page(const ReportPageOptions& page) {
@@ -334,6 +359,9 @@ int write_report_page(const ReportPageOptions& page) {
   sections.push_back(std::move(t1));
   std::fprintf(stderr, "report: the profiles of Table 1's models\n");
   sections.push_back(profiles_section(dir, table1_cells));
+  std::fprintf(stderr, "report: where the symmetry breaks\n");
+  for (Section& s : locate_table1_sections(dir, table1_cells, page.seed))
+    sections.push_back(std::move(s));
 
   Table2Options t2options;
   t2options.demos = page.table2_demos;

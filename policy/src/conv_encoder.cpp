@@ -10,6 +10,7 @@
 #include "handcentric/core/sampling.hpp"
 #include "handcentric/policy/binary_io.hpp"
 #include "handcentric/policy/errors.hpp"
+#include "handcentric/policy/layer_watch.hpp"
 #include "kernels/kernel_set.hpp"
 
 namespace handcentric::policy {
@@ -402,6 +403,7 @@ const ConvEncoder::Matrix& ConvEncoder::forward(const std::vector<const float*>&
       set.offset_gemm({product, padded.patch_offsets.data(),
                        padded.pixel_offsets.data() + static_cast<long>(at) * pixels});
     }
+    watch_layer("encoder.conv", static_cast<int>(l) + 1, activation_[l]);  // layer_watch.hpp
   }
   return activation_.back();
 }

@@ -4,6 +4,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/policy/binary_io.hpp"
+#include "handcentric/policy/layer_watch.hpp"
 
 namespace handcentric::policy {
 
@@ -90,9 +91,12 @@ Eigen::VectorXd LearnedPolicy::action_vector(const Scene& observation,
   } else {
     o = representation_->encode_observation(observation);
   }
+  watch_layer("observation", 0, o);  // layer_watch.hpp
   // Step 2: the head, with noise from the caller's seed.
   std::mt19937_64 rng(noise_seed);
-  const Eigen::VectorXd a = head_->sample_double(o, rng).col(0);
+  Eigen::MatrixXd sampled = head_->sample_double(o, rng);
+  watch_layer("action", 0, sampled);
+  const Eigen::VectorXd a = sampled.col(0);
   if (!a.allFinite()) {
     throw NonFiniteAction(
         name() +

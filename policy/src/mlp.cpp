@@ -6,6 +6,7 @@
 
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/sampling.hpp"
+#include "handcentric/policy/layer_watch.hpp"
 #include "kernels/kernel_set.hpp"
 
 namespace handcentric::policy {
@@ -265,8 +266,10 @@ void MlpT<Scalar>::infer(const Eigen::Ref<const Matrix>& input, Matrix& output,
     throw InvalidArgument("Mlp input has " + std::to_string(input.rows()) + " rows, expected " +
                           std::to_string(input_size()));
   }
+  // Each layer's output goes to this thread's watches, if any (layer_watch.hpp).
   if (layers() == 1) {
     affine<Scalar>(W(0), b(0), input, output);
+    watch_layer("mlp.layer", 1, output);
     return;
   }
   const bool fused = std::is_same_v<Scalar, float> && activation_ == Activation::silu;
@@ -274,11 +277,13 @@ void MlpT<Scalar>::infer(const Eigen::Ref<const Matrix>& input, Matrix& output,
   int current = 0;
   for (int l = 1; l < layers(); ++l) {
     if (!fused) activate(activation_, scratch[current], scratch[current]);
+    watch_layer("mlp.layer", l, scratch[current]);
     const bool hidden = l + 1 < layers();
     Matrix& next = hidden ? scratch[1 - current] : output;
     affine<Scalar>(W(l), b(l), scratch[current], next, fused && hidden);
     current = 1 - current;
   }
+  watch_layer("mlp.layer", layers(), output);
 }
 
 template class MlpT<float>;

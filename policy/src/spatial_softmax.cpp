@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "handcentric/core/errors.hpp"
+#include "handcentric/policy/layer_watch.hpp"
 
 namespace handcentric::policy {
 
@@ -63,6 +64,7 @@ const SpatialSoftmax::Matrix& SpatialSoftmax::forward(const Eigen::Ref<const Mat
         p[i * channels + c] = static_cast<float>(p[i * channels + c] * total[c]);
     }
   }
+  watch_layer("encoder.keypoints", 0, points_);  // layer_watch.hpp
   return points_;
 }
 

@@ -1,6 +1,7 @@
 #include "handcentric/props/audit.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -19,7 +20,9 @@ std::string pad(const std::string& text, std::size_t width) {
 }
 
 std::string row_label(Component component, Mode mode) {
-  return to_string(component) + (mode == Mode::distribution ? " (in distribution)" : "");
+  return to_string(component) + (mode == Mode::distribution  ? " (in distribution)"
+                                 : mode == Mode::closed_loop ? " (closed loop)"
+                                                             : "");
 }
 
 std::string view_heading(View view, bool recorded) {
@@ -116,6 +119,23 @@ int checked_cases(long long cases, const Spelling& spelling) {
                           " (10^7 cases already take hours per cell through a plug-in)");
   }
   return static_cast<int>(cases);
+}
+
+int cases_to_detect(double frequency, const Spelling& spelling) {
+  if (!(frequency > 0.0 && frequency < 1.0)) {
+    throw InvalidArgument(spelling.with_value("detect", format_shortest(frequency), false) +
+                          " is not a frequency in (0, 1); e.g. 0.01: a breaking on 1% of the "
+                          "(scene, g) draws is found with 99% probability");
+  }
+  // n draws miss a breaking of frequency f with probability (1 - f)^n <= 0.01. The 1e-9 keeps
+  // an exact quotient (f = 0.99: 1 draw) from rounding up to the next count.
+  const double needed = std::ceil(std::log(0.01) / std::log1p(-frequency) - 1e-9);
+  if (!(needed <= static_cast<double>(kMaxCases))) {
+    throw InvalidArgument(spelling.with_value("detect", format_shortest(frequency), false) +
+                          " needs " + format_fixed(needed, 0) + " cases, above the bound " +
+                          std::to_string(kMaxCases) + "; ask for a larger frequency");
+  }
+  return std::max(1, static_cast<int>(needed));
 }
 
 double audit_relative_tolerance(const AuditOptions& options) {
@@ -245,7 +265,7 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
           << pad("component", kLabel);
       for (Group group : options.groups) out << " | " << pad(to_string(group), kCell);
       out << "\n";
-      for (Mode mode : {Mode::pointwise, Mode::distribution}) {
+      for (Mode mode : {Mode::pointwise, Mode::distribution, Mode::closed_loop}) {
         for (Component component :
              {Component::actions, Component::observation, Component::flow_input,
               Component::flow_target, Component::policy}) {

@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "handcentric/core/format.hpp"
+
 namespace handcentric::props {
 namespace {
 
@@ -19,8 +21,13 @@ std::string precision_name(Precision precision) {
 void print_audit_header(std::ostream& out, const AuditOptions& audit, bool policies) {
   const double relative = audit_relative_tolerance(audit);  // validates the tolerance
   const ClassifierOptions used = classifier_options(audit);
-  out << "handcentric audit: " << audit.cases << " (scene, g) cases per pointwise cell, "
-      << used.distribution.cases << " per in-distribution cell, seed " << audit.seed
+  out << "handcentric audit: " << audit.cases << " (scene, g) cases per pointwise cell"
+      << (audit.detect
+              ? " (" + audit.spelling.with_value("detect", format_shortest(*audit.detect), false) +
+                    ": a breaking on that share of the draws is found with 99% "
+                    "probability)"
+              : std::string())
+      << ", " << used.distribution.cases << " per in-distribution cell, seed " << audit.seed
       << "; tolerance " << relative << " (1 + L)"
       << (audit.relative_tolerance > 0.0 ? " (--tolerance)"
           : audit.precision != Precision::float64

@@ -210,7 +210,8 @@ std::string audit_json(const std::vector<Classification>& classifications) {
 
 namespace handcentric::props {
 
-std::string policy_audit_json(const std::vector<Classification>& policies) {
+std::string policy_audit_json(const std::vector<Classification>& policies,
+                              const PolicyInterface* interface) {
   nlohmann::json out = nlohmann::json::array();
   for (const Classification& policy : policies) {
     nlohmann::json checks = nlohmann::json::array(), summary = nlohmann::json::object();
@@ -236,11 +237,30 @@ std::string policy_audit_json(const std::vector<Classification>& policies) {
       }
       add_rounding_fields(check, v);
       if (!v.note.empty()) check["note"] = v.note;
+      if (policy.output) {
+        check["output"] = policy.output->name;
+        check["kind"] = to_string(policy.output->kind);
+      }
       checks.push_back(check);
       summary[to_string(v.view)][to_string(v.mode)][to_string(v.group)] = v.invariant;
     }
     nlohmann::json entry = {{"name", policy.name}, {"summary", summary}, {"checks", checks}};
+    if (policy.output) {
+      entry["output"] = policy.output->name;
+      entry["kind"] = to_string(policy.output->kind);
+    }
     if (policy.preflight) entry["preflight"] = preflight_json(*policy.preflight);
+    if (interface != nullptr) {
+      nlohmann::json outputs = nlohmann::json::object();
+      for (const NamedOutput& o : interface->outputs) outputs[o.name] = to_string(o.kind);
+      entry["interface"] = {{"state_format", interface->state_format.name()},
+                            {"action_format", interface->action_format.name()},
+                            {"outputs", outputs},
+                            {"hands", interface->hands},
+                            {"rng", interface->rng.empty() ? nlohmann::json(nullptr)
+                                                           : nlohmann::json(interface->rng)},
+                            {"episodes", interface->episodes}};
+    }
     out.push_back(entry);
   }
   return nlohmann::json({{"policies", out}}).dump(2) + "\n";

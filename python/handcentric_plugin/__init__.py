@@ -85,7 +85,9 @@ The package, one job a module (standard library only; NumPy where said):
   codec     the base64 form of arrays (encoded batched lines), decoding and encoding
   batch     a batched line's scenes grouped by shape, stacked, and the results split per scene
   loop      serve(): the loop over stdin and the answer to each kind of request
-  policy    serve_policy(): a whole policy, its cameras, rng= and reset=
+  policy    serve_policy(): a whole policy, its cameras, rng= and reset= (episodes)
+  interface a policy's own interface on the wire: state_format=, action_format=, outputs=,
+            hands= (requests read in its layouts, per hand; answers written as its outputs)
   seeding   a policy's own generator seeded before a call (shared with handcentric's _rng)
   geometry  the SE(3) helpers above
   formats   pose layouts: 4x4 poses as the vectors shipped policies speak (quaternions, 6D,

@@ -40,13 +40,15 @@ def _held_shapes(value):
                         for name, a in value.items()))
 
 
-def _groups(items):
+def _groups(items, history_rows=None):
     """The indices of the items of each shape (numbers of poses and points, held arrays' shapes),
-    in the order each shape first appears."""
+    in the order each shape first appears. history_rows: a policy interface's count of history
+    rows (per hand), in place of the field's length."""
     groups = {}
     for i, item in enumerate(items):
-        groups.setdefault((tuple(_rows_of(item.get(key)) for key in _SHAPE_FIELDS),
-                           _held_shapes(item.get("held"))), []).append(i)
+        shape = tuple(history_rows(item) if key == "history" and history_rows is not None
+                      else _rows_of(item.get(key)) for key in _SHAPE_FIELDS)
+        groups.setdefault((shape, _held_shapes(item.get("held"))), []).append(i)
     return list(groups.values())
 
 
@@ -152,9 +154,12 @@ def _chunks(result, B, encoded=False):
     a = np.asarray(result)
     shaped = a.ndim == 4 and a.shape[2:] == (4, 4) or a.ndim == 3 and a.shape[2] == 16
     if a.dtype.kind not in "biuf" or not shaped or a.shape[0] != B or a.shape[1] == 0:
+        hint = ("; poses of %d numbers are a layout: declare it, serve_policy(..., "
+                "action_format=\"pos_quat_xyzw\") or the one the policy uses" % a.shape[-1]
+                if a.ndim == 3 and a.shape[-1] in (6, 7, 9) else "")
         raise _BadResult("the policy returned an array of shape %s and dtype %s for a batch of "
-                         "%d observations; it must be (%d, K, 4, 4)"
-                         % (a.shape, a.dtype, B, B))
+                         "%d observations; it must be (%d, K, 4, 4)%s"
+                         % (a.shape, a.dtype, B, B, hint))
     a = _rows(a, B, "chunk", "the policy").reshape(B, -1, 16)
     off = np.abs(a[:, :, 12:] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=2) > 1e-9
     if off.any():

@@ -23,7 +23,8 @@ from .protocol import (MAX_BATCH, _BadResult, _Malformed, _chunk, _die, _flatten
 
 def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=None,
           batched=False, batch_size=256, encoding="base64", stdin=None, stdout=None,
-          _policy=None, _noise=None, _cameras=None):
+          _policy=None, _noise=None, _cameras=None, _interface=None, _rng=None,
+          _episodes=False):
     """Answer the audit's requests until end of input (see the package docstring).
 
     encode(history, chunk, hand_points, world_points) -> actions | (actions, observation) | dict
@@ -52,11 +53,20 @@ def serve(encode, *, decode=None, flow=None, extra_poses=(), scalars=(), hello=N
     stdin = sys.stdin if stdin is None else stdin
     out = sys.stdout if stdout is None else stdout  # taken now: print() is redirected below
     server = _Server(encode, decode, flow, tuple(extra_poses), tuple(scalars),
-                     batch_size if batched else None, _policy, _cameras)
+                     batch_size if batched else None, _policy, _cameras, _interface)
     if hello is None:
         hello = server.declared or decode is not None or flow is not None or _noise is not None
+    # A policy with an interface (interface.py) is sent JSON numbers: no encoding offered.
     hello_body = _hello(server.extra_poses, server.scalars, decode is not None, flow is not None,
-                        _noise, _cameras, server.batch_size, encoding)
+                        _noise, _cameras, server.batch_size,
+                        encoding if _interface is None else None)
+    if _interface is not None:
+        hello_body.update(_interface.hello_fields())
+    if _rng is not None:
+        hello_body["rng"] = _rng
+    if _episodes:
+        hello_body["episodes"] = True
+    server.episodes = _episodes
     _loop(server, stdin, out, hello_body, hello)
 
 
@@ -136,11 +146,13 @@ class _Server:
     policy plug-in (serve_policy), and cameras the views its requests carry images of."""
 
     def __init__(self, encode, decode, flow, extra_poses, scalars, batch_size, policy,
-                 cameras):
+                 cameras, interface=None):
         self.encode, self.decode, self.flow = encode, decode, flow
         self.extra_poses, self.scalars = extra_poses, scalars
         self.declared = bool(extra_poses or scalars)
         self.batch_size, self.policy, self.cameras = batch_size, policy, cameras
+        self.interface = interface  # interface.py's _Interface of a policy, or None
+        self.episodes = False  # serve_policy's reset=: requests may carry "episode"
 
     def images_of(self, item, what):
         """The request's images, {view: float32 (C, h, w)}, checked against the hello's views."""
@@ -165,9 +177,12 @@ class _Server:
                                             ("float64", "float32", "uint8")), "held[%r]" % name)
                 for name, array in value.items()}
 
-    def call(self, function, request_id, args, named, images=None, held=None):
-        """function(*args, keywords); an exception in it prints its traceback and exits 1."""
+    def call(self, function, request_id, args, named, images=None, held=None, episode=None):
+        """function(*args, keywords); an exception in it prints its traceback and exits 1.
+        episode: the request's "episode", for serve_policy's reset= (not the user's keyword)."""
         kwargs = {"extra_poses": named[0], "scalars": named[1]} if self.declared else {}
+        if self.episodes:
+            kwargs["_episode"] = episode
         if images is not None:
             kwargs["images"] = images
         if held is not None:
@@ -186,15 +201,18 @@ class _Server:
     def answer(self, request):
         """The answer to one request of a single scene: a policy's, a decode's or encode's."""
         rid = request["id"]
-        history = _matrices(request, "history")
+        interface = self.interface
+        history = _matrices(request, "history") if interface is None else \
+            interface.history(request)
         hand_points = _points(request, "hand_points")
         world_points = _points(request, "world_points")
-        named = (_named(request, "extra_poses", self.extra_poses, _matrix),
+        named = (_named(request, "extra_poses", self.extra_poses,
+                        _matrix if interface is None else interface.pose),
                  _named(request, "scalars", self.scalars, _scalar))
         held = self.held_of(request, "request")
         scene = (history, hand_points, world_points)
         if self.policy is not None:
-            return {"id": rid, "chunk": self.policy_chunk(request, scene, named, held)}
+            return dict({"id": rid}, **self.policy_answer(request, scene, named, held))
         if "decode" in request:
             return {"id": rid, "chunk": self.decoded_chunk(request, scene, named, held)}
         chunk = _matrices(request, "chunk")
@@ -205,8 +223,9 @@ class _Server:
                                      len(reply["actions"]), named, held))
         return reply
 
-    def policy_chunk(self, request, scene, named, held):
-        """The policy's chunk for one observation, K lists of 16 numbers."""
+    def policy_answer(self, request, scene, named, held):
+        """The policy's answer for one observation: {"chunk": K lists of 16 numbers}, or as its
+        interface says (interface.py)."""
         rid = request["id"]
         if "noise" not in request:
             raise _Malformed("a policy plug-in needs 'noise' in every request (run it with "
@@ -216,16 +235,22 @@ class _Server:
             raise _Malformed("'noise' must be a non-empty list of numbers")
         noise = np.array(value, dtype=np.float64) if np is not None else [float(x) for x in value]
         images = self.images_of(request, "request") if self.cameras is not None else None
+        episode = request.get("episode")
+        interface = self.interface
         if self.batch_size is None:
-            return _chunk(self.call(self.policy, rid, scene + (noise,), named, images, held))
+            result = self.call(self.policy, rid, scene + (noise,), named, images, held, episode)
+            return {"chunk": _chunk(result)} if interface is None else interface.answer(result)
         # Batched: a batch of one.
-        stacked = tuple(a[None] for a in scene + (noise,))
+        stacked = tuple({k: v[None] for k, v in a.items()} if isinstance(a, dict) else a[None]
+                        for a in scene + (noise,))
         if images is not None:
             images = {view: image[None] for view, image in images.items()}
         if held is not None:
             held = {name: array[None] for name, array in held.items()}
-        return _chunks(self.call(self.policy, rid, stacked, _stack_named([named]), images, held),
-                       1)[0]
+        result = self.call(self.policy, rid, stacked, _stack_named([named]), images, held,
+                           episode)
+        return {"chunk": _chunks(result, 1)[0]} if interface is None else \
+            interface.answers(result, 1)[0]
 
     def decoded_chunk(self, request, scene, named, held):
         """decode's chunk for a decode request, K lists of 16 numbers."""
@@ -285,7 +310,8 @@ class _Server:
         if encoded:
             items = _decoded_items(items)
         answers = [None] * len(items)
-        for indices in _groups(items):
+        rows = self.interface.history_rows if self.interface is not None else None
+        for indices in _groups(items, rows):
             for i, answer in zip(indices, self.answer_group(rid, [items[i] for i in indices],
                                                             encoded, indices)):
                 answers[i] = answer
@@ -295,11 +321,14 @@ class _Server:
         """The answers to items of one shape, in order (encoded: their arrays encoded); at: the
         items' indices in the line, for messages."""
         B = len(items)
-        history = _stacked(items, "history", 16, (4, 4), at)
+        interface = self.interface
+        history = _stacked(items, "history", 16, (4, 4), at) if interface is None else \
+            interface.stacked_history(items, at)
         hand_points = _stacked(items, "hand_points", 3, (3,), at)
         world_points = _stacked(items, "world_points", 3, (3,), at)
         named = _stack_named([_item(at[i], lambda item: (
-            _named(item, "extra_poses", self.extra_poses, _pose),
+            _named(item, "extra_poses", self.extra_poses,
+                   _pose if interface is None else interface.pose),
             _named(item, "scalars", self.scalars, _scalar)), items[i]) for i in range(B)])
         held = None
         if "held" in items[0]:
@@ -313,7 +342,9 @@ class _Server:
                 images = {view: np.stack([e[view] for e in each])
                           for view in self.cameras["views"]}
             result = self.call(self.policy, rid, (history, hand_points, world_points, noise),
-                               named, images, held)
+                               named, images, held, items[0].get("episode"))
+            if interface is not None:
+                return interface.answers(result, B)
             return [{"chunk": c} for c in _chunks(result, B, encoded)]
         if any("decode" in item or "eps" in item or "t" in item for item in items):
             raise _Malformed("decode and flow requests are not batched")

@@ -11,12 +11,14 @@ import sys
 from ._numpy import np
 from .protocol import _die
 from .seeding import RNG_MODES, seed_before_call
+from .interface import _Interface
 from .loop import serve
 
 
 def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, batched=False,
                  batch_size=256, encoding="base64", cameras=None, rng=None, device=None,
-                 reset=None, stdin=None, stdout=None):
+                 reset=None, action_format=None, state_format=None, outputs=None, hands=None,
+                 stdin=None, stdout=None):
     """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
 
     policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
@@ -39,12 +41,31 @@ def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, 
     device: the torch device the policy draws on (e.g. "cuda"; None: the CPU), as
         audit_policy's device=: rng="generator" makes its torch.Generator there (torch refuses
         a CPU generator for a draw on a GPU). The other modes do not need it.
-    reset: a function of no arguments called before every call (e.g. LeRobot's policy.reset),
-        for a policy that keeps state between calls (an action queue, a history).
+    reset: a function of no arguments (e.g. LeRobot's policy.reset), for a policy that keeps
+        state between calls (an action queue, a history). The hello then declares "episodes":
+        a request of the audit's closed loop (`handcentric audit --episodes N`) carries
+        "episode": {"index", "step"}, and reset() runs at its step 0 only, so the policy keeps
+        its state through the episode; every other request is a call of its own, reset() first.
+    action_format, state_format: the layouts of the poses the policy returns and is given
+        (formats.py: "pos_quat_xyzw", "pos_rot6d_rows", "pos_euler_xyz", ...; default
+        "matrix"): history is then (H+1, w) ((B, H+1, w) batched), each extra pose (w,), and
+        the policy returns (K, w) ((B, K, w)). The audit decodes every pose and refuses one that
+        contradicts its layout (a quaternion off unit norm), naming it.
+    outputs: {"hand": "pose", "gripper": "invariant"}: the policy returns a dict of these; each
+        is audited on its own (a pose chunk moves with g, invariant numbers must not change).
+    hands: ("left", "right"): history is {hand: (H+1, w)} and the policy returns one chunk per
+        hand in its dict, under the hands' names (verdicts per hand).
+    With any of these four the requests carry JSON numbers (no base64 offer).
     extra_poses, scalars, hello, encoding, stdin, stdout: as for serve().
     """
+    interface = None
+    if action_format is not None or state_format is not None or outputs is not None \
+            or hands is not None:
+        interface = _Interface(state_format, action_format, outputs, hands)
+        hello = True
     if rng is not None or reset is not None:
         policy = _paired_policy(policy, rng, reset, batched, device)
+        hello = True
     if cameras is not None:
         if np is None:
             _die(1, "handcentric_plugin: serve_policy(..., cameras=...) needs NumPy, which does "
@@ -57,7 +78,8 @@ def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, 
         hello = True
     serve(None, extra_poses=extra_poses, scalars=scalars, hello=hello, batched=batched,
           batch_size=batch_size, encoding=encoding, stdin=stdin, stdout=stdout, _policy=policy,
-          _noise=noise, _cameras=cameras)
+          _noise=noise, _cameras=cameras, _interface=interface, _rng=rng,
+          _episodes=reset is not None)
 
 
 def _noise_seed(noise):
@@ -79,16 +101,17 @@ def _paired_policy(policy, rng, reset, batched, device=None):
         raise TypeError("reset must be a function of no arguments (e.g. policy.reset), got %r"
                         % (reset,))
 
-    def one_call(history, hand_points, world_points, noise, kwargs, seed_noise):
-        if reset is not None:
+    def one_call(history, hand_points, world_points, noise, kwargs, seed_noise, episode):
+        # A closed-loop request past its episode's first step keeps the state (no reset).
+        if reset is not None and not (isinstance(episode, dict) and episode.get("step", 0) > 0):
             reset()
         extra = (seed_before_call(rng, _noise_seed(seed_noise), device)
                  if rng is not None else {})
         return policy(history, hand_points, world_points, noise, **dict(kwargs, **extra))
 
-    def call(history, hand_points, world_points, noise, **kwargs):
+    def call(history, hand_points, world_points, noise, _episode=None, **kwargs):
         if rng is None or not batched:
-            return one_call(history, hand_points, world_points, noise, kwargs, noise)
+            return one_call(history, hand_points, world_points, noise, kwargs, noise, _episode)
 
         def row(value, i):
             return {k: row(v, i) for k, v in value.items()} if isinstance(value, dict) \
@@ -96,9 +119,13 @@ def _paired_policy(policy, rng, reset, batched, device=None):
 
         def as_numpy(x):  # a torch result, on any device, with or without grad
             return x.detach().cpu().numpy() if hasattr(x, "detach") else np.asarray(x)
-        chunks = [as_numpy(one_call(history[i:i + 1], hand_points[i:i + 1],
-                                      world_points[i:i + 1], noise[i:i + 1],
-                                      {k: row(v, i) for k, v in kwargs.items()}, noise[i]))
-                  for i in range(len(noise))]
-        return np.concatenate(chunks, axis=0)
+
+        def joined(parts):  # the rows' results, one batch again (a dict of outputs too)
+            if isinstance(parts[0], dict):
+                return {k: joined([p[k] for p in parts]) for k in parts[0]}
+            return np.concatenate([as_numpy(p) for p in parts], axis=0)
+        return joined([one_call(row(history, i), hand_points[i:i + 1], world_points[i:i + 1],
+                                noise[i:i + 1], {k: row(v, i) for k, v in kwargs.items()},
+                                noise[i], _episode)
+                       for i in range(len(noise))])
     return call

@@ -201,8 +201,11 @@ def _chunk(result):
     """decode's result -> K lists of 16 numbers, each the matrix of a rigid transform."""
     if np is not None and isinstance(result, np.ndarray) and result.shape[-2:] != (4, 4) \
             and not (result.ndim == 2 and result.shape[1] == 16):
-        raise _BadResult("decode returned an array of shape %s; it must be (K, 4, 4)"
-                         % (result.shape,))
+        hint = ("; poses of %d numbers are a layout: a policy declares it, serve_policy(..., "
+                "action_format=\"pos_quat_xyzw\") or the one it uses" % result.shape[-1]
+                if result.ndim == 2 and result.shape[-1] in (6, 7, 9) else "")
+        raise _BadResult("decode returned an array of shape %s; it must be (K, 4, 4)%s"
+                         % (result.shape, hint))
     flat = _flatten(result, "chunk")
     if not flat or len(flat) % 16:
         raise _BadResult("decode returned %d numbers; it must return K 4x4 matrices" % len(flat))

@@ -514,6 +514,38 @@ TEST_CASE("a_policy_law_follows_from_its_pointwise_yes_unless_test_law", "[unit]
       test::run_command(test::cli() + " audit --repr hand_centric --cases 5 --test-law");
   CHECK(representation.exit_code != 0);
   CHECK_THAT(representation.err, Contains("--test-law"));
+  // No source at all is the built-ins' audit: refused too (mutant: the check in run_audit
+  // removed -> exit 0).
+  const auto builtins = test::run_command(test::cli() + " audit --cases 5 --test-law");
+  CHECK(builtins.exit_code != 0);
+  CHECK_THAT(builtins.err, Contains("--test-law is for a whole policy"));
+}
+
+// --detect F: the cases that find a breaking on a share F of the draws with 99% probability,
+// said in the header; each cell draws that many (mutant: --detect parsed but not applied ->
+// 1000 cases). With --cases it is refused.
+TEST_CASE("detect_sets_the_cases_from_the_frequency_asked_for", "[unit]") {
+  const std::string audit =
+      test::cli() + " audit --repr hand_centric --group se3 --view eye_in_hand --detect 0.05";
+  const auto text = test::run_command(audit);
+  REQUIRE(text.exit_code == 0);
+  CHECK_THAT(text.out, Contains("90 (scene, g) cases per pointwise cell (--detect 0.05: "));
+  const auto json = test::run_command(audit + " --json");
+  REQUIRE(json.exit_code == 0);
+  const auto parsed = nlohmann::json::parse(json.out);
+  int pointwise = 0;
+  for (const auto& check : parsed.at("representations").at(0).at("checks")) {
+    if (check.at("mode") != "pointwise") continue;
+    ++pointwise;
+    CHECK(check.at("cases").get<int>() + check.at("near_identity_cases").get<int>() == 90);
+  }
+  CHECK(pointwise > 0);
+  const auto both = test::run_command(audit + " --cases 10");
+  CHECK(both.exit_code != 0);
+  CHECK_THAT(both.err, Contains("--detect"));
+  const auto bad = test::run_command(test::cli() + " audit --detect 0 --repr hand_centric");
+  CHECK(bad.exit_code != 0);
+  CHECK_THAT(bad.err, Contains("--detect 0 is not a frequency in (0, 1)"));
 }
 
 TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[unit]") {

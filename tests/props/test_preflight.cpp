@@ -3,9 +3,11 @@
 // verdict that blames g. Each planted policy is the equivariant StraightPolicy below with one
 // thing added; the StraightPolicy itself passes.
 #include <catch2/catch.hpp>
+#include <cmath>
 #include <memory>
 #include <random>
 
+#include "handcentric/props/audit.hpp"
 #include "handcentric/props/checks/policy_audit.hpp"
 #include "handcentric/props/checks/preflight.hpp"
 #include "run_command.hpp"
@@ -187,6 +189,25 @@ TEST_CASE("a_pointwise_yes_states_the_frequency_it_would_have_found", "[unit]") 
   // 99%: the chance that n draws all miss a set of frequency f is 1%.
   const double f = props::detectable_frequency(200);
   CHECK(std::pow(1.0 - f, 200) == Approx(0.01));
+}
+
+// --detect / detect=: the fewest cases whose "yes" states the frequency asked for (mutant: floor
+// for ceil -> 458 cases for 0.01, whose frequency is above 0.01, fails).
+TEST_CASE("detect_asks_the_fewest_cases_that_state_its_frequency", "[unit]") {
+  CHECK(props::cases_to_detect(0.01) == 459);
+  CHECK(props::cases_to_detect(0.001) == 4603);
+  CHECK(props::cases_to_detect(0.99) == 1);
+  for (const double f : {0.3, 0.05, 0.01, 0.0046, 1e-4}) {
+    const int n = props::cases_to_detect(f);
+    CHECK(props::detectable_frequency(n) <= f);
+    if (n > 1) CHECK(props::detectable_frequency(n - 1) > f);
+  }
+  for (const double bad : {0.0, 1.0, -0.1, std::nan(""), 1e-9}) {
+    CHECK_THROWS_AS(props::cases_to_detect(bad), InvalidArgument);
+    CHECK_THROWS_WITH(props::cases_to_detect(bad), Catch::Contains("--detect"));
+  }
+  CHECK_THROWS_WITH(props::cases_to_detect(2.0, props::kPythonSpelling),
+                    Catch::StartsWith("detect=2 is not a frequency"));
 }
 
 // Over the pipe: the plug-in's own draws cannot be seen, so answers that differ at every call are

@@ -72,3 +72,17 @@ def test_a_law_from_the_pointwise_yes_asks_no_row_of_its_own(quick):
         assert not any("distribution" in k for k in derived["where"])
         assert any("distribution" in k for k in tested["where"])
         assert derived["rows"] < tested["rows"]
+
+
+def test_detect_asks_the_cases_its_frequency_needs_and_no_more(quick):
+    runs = {(r["audit"], json.dumps(r["options"])): r for r in quick["runs"]
+            if r["policy"] == "trivial"}
+    for groups in (None, ["se3"]):
+        options = {"groups": groups} if groups else {}
+        default = runs[("audit_policy", json.dumps(options))]
+        detect = runs[("audit_policy", json.dumps(dict(options, detect=0.2)))]
+        # --quick's default is 20 cases, detect=0.2 asks 21: ln 0.01 / ln 0.8 = 20.6.
+        assert detect["guarantees"]["detect"] == {"frequency": 0.2, "cases": 21}
+        assert detect["guarantees"]["pointwise_drawn_min"] == 21
+        assert default["guarantees"]["pointwise_drawn_min"] == 20
+        assert detect["held"] is True

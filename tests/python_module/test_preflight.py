@@ -196,6 +196,30 @@ def test_a_pointwise_yes_says_what_it_could_have_missed():
     assert point["detectable_frequency"] == pytest.approx(4.6 / point["cases"], rel=0.05)
 
 
+def test_detect_sets_the_cases_from_the_frequency_asked_for():
+    # detect=0.05: ceil(ln 0.01 / ln 0.95) = 90 cases drawn per pointwise cell (far ones and
+    # those with g near the identity); mutant: detect= read but not applied -> 1000 cases.
+    asked = []
+
+    def counted(history, hand_points, world_points, noise):
+        asked.append(1)
+        return base(history, hand_points, world_points, noise)
+    report = handcentric.audit_policy(counted, groups=["se3"], views=["eye_in_hand"],
+                                      detect=0.05, quiet=True)
+    assert report["detect"] == {"frequency": 0.05, "cases": 90}
+    (point,) = [c for c in report["checks"] if c["mode"] == "pointwise"]
+    assert point["equivariant"]
+    assert point["cases"] + point["near_identity_cases"] == 90
+    assert len(asked) < 2 * 90 + 100  # o and g o per case, the preflight, no 1000 cases
+    for bad, error, match in [(dict(detect=0.01, cases=200), ValueError, "give one of them"),
+                              (dict(detect=1.5), ValueError, "detect=1.5 is not a frequency"),
+                              (dict(detect=1e-9), ValueError, "above the bound"),
+                              (dict(detect=True), TypeError, "detect must be a frequency"),
+                              (dict(detect="0.01"), TypeError, "detect must be a frequency")]:
+        with pytest.raises(error, match=match):
+            handcentric.audit_policy(base, groups=["se3"], quiet=True, **bad)
+
+
 def test_rng_and_reset_are_refused_by_name():
     with pytest.raises(ValueError, match="rng='cuda' is not a mode"):
         handcentric.audit_policy(base, rng="cuda", quiet=True)

@@ -33,13 +33,28 @@ const PluginCapabilities& PipePolicy::capabilities() const {
                                            policy_request_body(with_extras(probe), noise), true);
   PluginCapabilities capabilities;
   if (reply.hello) capabilities = *reply.hello;
+  // The hands after the first are drawn as extra poses "hand:<name>" (named_output.hpp); they
+  // travel in the request's "history", not in its "extra_poses".
+  std::vector<std::string> hand_poses;
+  for (std::size_t h = 1; h < capabilities.policy.hands.size(); ++h)
+    hand_poses.push_back(kHandPosePrefix + capabilities.policy.hands[h]);
+  capabilities.extra_pose_names = merged_names(capabilities.extra_pose_names, hand_poses);
   capabilities.extra_pose_names = merged_names(capabilities.extra_pose_names, forced_extra_poses_);
   capabilities.scalar_names = merged_names(capabilities.scalar_names, forced_scalars_);
   if (capabilities.noise == 0) capabilities.noise = kPolicyNoise;
   capabilities_ = capabilities;
-  if (reply.hello) reply = exchange_one(with_extras(probe), fixed_noise(capabilities.noise, 1));
-  chunk_length_ = reply.chunk.size();
+  const Scene asked = with_extras(probe);
+  if (reply.hello) reply = exchange_one(asked, fixed_noise(capabilities.noise, 1));
+  lengths_.clear();
+  for (const std::vector<RigidTransform>& output : remember({}, std::move(reply), asked, "probe"))
+    lengths_.push_back(output.size());
+  cache_.clear();  // the probe's answer was kept under an empty key
   return *capabilities_;
+}
+
+void PipePolicy::start_episode() const {
+  capabilities();
+  episode_ = EpisodeStep{episodes_started_++, 0};
 }
 
 Eigen::Index PipePolicy::noise_dimension() const {
@@ -60,7 +75,10 @@ std::string PipePolicy::key(const Scene& observation, const Eigen::VectorXd& noi
 
 std::string PipePolicy::request_body(const Scene& observation, const Eigen::VectorXd& noise,
                                      NumberEncoding encoding) const {
-  std::string body = policy_request_body(observation, noise, encoding);
+  const PolicyInterface* interface = capabilities_ ? &capabilities_->policy : nullptr;
+  std::string body =
+      policy_request_body(observation, noise, encoding, interface, episode_ ? &*episode_ : nullptr);
+  if (episode_) ++episode_->step;
   if (!capabilities_ || !capabilities_->cameras) return body;
   // Images always travel as base64 float32 arrays: a 64 x 48 RGB-D image is 49 KB so, ~150 KB
   // as JSON numbers.
@@ -81,52 +99,88 @@ std::string PipePolicy::request_body(const Scene& observation, const Eigen::Vect
 }
 
 PluginReply PipePolicy::exchange_one(const Scene& observation, const Eigen::VectorXd& noise) const {
+  const PolicyInterface* interface = &capabilities_->policy;
   if (capabilities_->batch == 0) {
-    return connection_.exchange(RequestKind::policy, request_body(observation, noise), false);
+    return connection_.exchange(RequestKind::policy, request_body(observation, noise), false,
+                                interface);
   }
   const NumberEncoding encoding = capabilities_->encoding;
   return std::move(connection_
                        .exchange_batch(RequestKind::policy,
-                                       {request_body(observation, noise, encoding)}, encoding)
+                                       {request_body(observation, noise, encoding)}, encoding,
+                                       interface)
                        .front());
 }
 
-const std::vector<RigidTransform>& PipePolicy::remember(std::string key, PluginReply reply,
-                                                        const std::string& where) const {
-  if (reply.chunk.size() != chunk_length_) {
-    connection_.fail(connection_.who() + " answered policy " + where + " with " +
-                     std::to_string(reply.chunk.size()) + " poses after " +
-                     std::to_string(chunk_length_) +
-                     " for the probe; the chunk length K must not change");
+PipePolicy::Answer PipePolicy::remember(std::string key, PluginReply reply,
+                                        const Scene& observation, const std::string& where) const {
+  const PolicyInterface& interface = capabilities_->policy;
+  Answer answer;
+  if (!interface.named()) {
+    answer.push_back(std::move(reply.chunk));
+  } else {
+    // Invariant numbers as poses at T_0 (named_output.hpp): the checks decide them as poses.
+    const RigidTransform& T0 = observation.world_T_hand_history.at(0);
+    for (std::size_t o = 0; o < interface.outputs.size(); ++o) {
+      OutputValue& value = reply.outputs.at(o);
+      answer.push_back(interface.outputs[o].kind == OutputKind::pose
+                           ? std::move(value.poses)
+                           : invariant_as_poses(value.numbers.data(),
+                                                static_cast<std::size_t>(value.numbers.size()),
+                                                T0));
+    }
   }
+  for (std::size_t o = 0; o < lengths_.size() && o < answer.size(); ++o) {
+    if (answer[o].size() == lengths_[o]) continue;
+    const std::string what =
+        interface.named() ? "output \"" + interface.outputs[o].name + "\" " : std::string();
+    connection_.fail(connection_.who() + " answered policy " + where + " with " + what +
+                     std::to_string(answer[o].size()) +
+                     (interface.named() ? " entries" : " poses") + " after " +
+                     std::to_string(lengths_[o]) +
+                     " for the probe; its length (the chunk length K) must not change");
+  }
+  if (episode_) return answer;                 // a step of a stateful rollout is no answer to keep
   if (cache_.size() > 200000) cache_.clear();  // bounded memory over long audits
-  return cache_.insert_or_assign(std::move(key), std::move(reply.chunk)).first->second;
+  return cache_.insert_or_assign(std::move(key), std::move(answer)).first->second;
 }
 
 std::vector<RigidTransform> PipePolicy::act(const Scene& observation,
                                             const Eigen::VectorXd& noise) const {
-  capabilities();
-  std::string request = key(observation, noise);
-  if (const auto hit = cache_.find(request); hit != cache_.end() && !past_cache_)
-    return hit->second;
-  PluginReply reply = exchange_one(observation, noise);
-  return remember(std::move(request), std::move(reply),
-                  "request " + std::to_string(connection_.last_id()));
+  return act_batch({&observation}, {&noise}).front();
 }
 
 std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
+  std::vector<std::vector<RigidTransform>> out;
+  for (Answer& answer : answers(observations, noises, false))
+    out.push_back(std::move(answer.front()));
+  return out;
+}
+
+std::vector<PipePolicy::Answer> PipePolicy::answers(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises, bool fresh) const {
   if (observations.size() != noises.size()) {
     throw InvalidArgument(name() + ": act_batch needs one noise vector per observation, got " +
                           std::to_string(noises.size()) + " for " +
                           std::to_string(observations.size()));
   }
   const int batch = batch_size();  // runs the handshake
-  std::vector<std::vector<RigidTransform>> out(observations.size());
-  if (batch == 0) {  // one request per observation, as act asks
-    for (std::size_t i = 0; i < observations.size(); ++i)
-      out[i] = act(*observations[i], *noises[i]);
+  fresh = fresh || episode_.has_value();
+  std::vector<Answer> out(observations.size());
+  if (batch == 0) {  // one request per observation
+    for (std::size_t i = 0; i < observations.size(); ++i) {
+      std::string request = key(*observations[i], *noises[i]);
+      if (const auto hit = cache_.find(request); hit != cache_.end() && !fresh) {
+        out[i] = hit->second;
+        continue;
+      }
+      PluginReply reply = exchange_one(*observations[i], *noises[i]);
+      out[i] = remember(std::move(request), std::move(reply), *observations[i],
+                        "request " + std::to_string(connection_.last_id()));
+    }
     return out;
   }
   // The inputs not cached, each once, in the order they come: a batched line may mix shapes
@@ -142,7 +196,7 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
   for (std::size_t i = 0; i < observations.size(); ++i) {
     const Scene& observation = *observations[i];
     std::string request = key(observation, *noises[i]);
-    if (const auto hit = cache_.find(request); hit != cache_.end() && !past_cache_) {
+    if (const auto hit = cache_.find(request); hit != cache_.end() && !fresh) {
       out[i] = hit->second;
       continue;
     }
@@ -162,15 +216,15 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
       bodies.push_back(request_body(*observations[i], *noises[i], encoding));
     }
     std::vector<PluginReply> replies =
-        connection_.exchange_batch(RequestKind::policy, bodies, encoding);
+        connection_.exchange_batch(RequestKind::policy, bodies, encoding, &capabilities_->policy);
     const std::string id = std::to_string(connection_.last_id());
     for (std::size_t j = from; j < to; ++j) {
       Missing& m = missing[order[j]];
-      const std::vector<RigidTransform>& chunk =
-          remember(std::move(m.key), std::move(replies[j - from]),
+      const Answer answer =
+          remember(std::move(m.key), std::move(replies[j - from]), *observations[m.first],
                    "request " + id + " (item " + std::to_string(j - from) + " of " +
                        std::to_string(to - from) + ")");
-      for (std::size_t i : m.at) out[i] = chunk;
+      for (std::size_t i : m.at) out[i] = answer;
     }
   }
   return out;
@@ -179,21 +233,68 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
 std::vector<std::vector<RigidTransform>> PipePolicy::act_fresh(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
-  past_cache_ = true;
-  try {
-    auto out = act_batch(observations, noises);
-    past_cache_ = false;
-    return out;
-  } catch (...) {
-    past_cache_ = false;
-    throw;
-  }
+  std::vector<std::vector<RigidTransform>> out;
+  for (Answer& answer : answers(observations, noises, true))
+    out.push_back(std::move(answer.front()));
+  return out;
 }
 
 std::shared_ptr<const NoisyPolicy> as_checked(std::shared_ptr<const PipePolicy> plugin) {
   const int batch = plugin->capabilities().batch;
   if (batch > 0) return std::make_shared<BatchedPolicy>(plugin, batch);
   return plugin;
+}
+
+PipeOutput::PipeOutput(std::shared_ptr<const PipePolicy> plugin, std::size_t output,
+                       std::optional<std::size_t> executed)
+    : plugin_(std::move(plugin)), output_(output), executed_(executed) {
+  const std::size_t count = std::max<std::size_t>(1, plugin_->capabilities().policy.outputs.size());
+  if (output_ >= count || (executed_ && *executed_ >= count))
+    throw InvalidArgument(plugin_->name() + " has " + std::to_string(count) + " outputs");
+  if (executed_ == output_) executed_.reset();
+}
+
+std::string PipeOutput::name() const {
+  const auto& outputs = plugin_->capabilities().policy.outputs;
+  return outputs.empty() ? plugin_->name()
+                         : plugin_->name() + ", output '" + outputs[output_].name + "'";
+}
+
+std::vector<RigidTransform> PipeOutput::select(const PipePolicy::Answer& answer) const {
+  if (!executed_) return answer.at(output_);
+  // The executed pose first, then the compared chunk (closed_loop.hpp, compared_from).
+  std::vector<RigidTransform> out{answer.at(*executed_).at(0)};
+  out.insert(out.end(), answer.at(output_).begin(), answer.at(output_).end());
+  return out;
+}
+
+std::vector<RigidTransform> PipeOutput::act(const Scene& observation,
+                                            const Eigen::VectorXd& noise) const {
+  return act_batch({&observation}, {&noise}).front();
+}
+
+std::vector<std::vector<RigidTransform>> PipeOutput::act_batch(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  std::vector<std::vector<RigidTransform>> out;
+  for (const PipePolicy::Answer& answer : plugin_->answers(observations, noises, false))
+    out.push_back(select(answer));
+  return out;
+}
+
+std::vector<std::vector<RigidTransform>> PipeOutput::act_batch_fresh(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  std::vector<std::vector<RigidTransform>> out;
+  for (const PipePolicy::Answer& answer : plugin_->answers(observations, noises, true))
+    out.push_back(select(answer));
+  return out;
+}
+
+std::shared_ptr<const NoisyPolicy> as_checked(std::shared_ptr<const PipeOutput> output) {
+  const int batch = output->plugin().capabilities().batch;
+  if (batch > 0) return std::make_shared<BatchedPolicy>(output, batch);
+  return output;
 }
 
 }  // namespace handcentric::props

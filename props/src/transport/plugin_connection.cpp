@@ -99,11 +99,11 @@ std::string PluginConnection::round_trip(const std::string& body, int scenes) {
 }
 
 PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body,
-                                       bool hello_allowed) {
+                                       bool hello_allowed, const PolicyInterface* interface) {
   const std::string line = round_trip(body, 1);
   PluginReply reply;
   try {
-    reply = parse_reply(line, last_id(), kind, who(), hello_allowed);
+    reply = parse_reply(line, last_id(), kind, who(), hello_allowed, interface);
   } catch (const PluginError& e) {
     fail(e.what());
   }
@@ -113,12 +113,13 @@ PluginReply PluginConnection::exchange(RequestKind kind, const std::string& body
 
 std::vector<PluginReply> PluginConnection::exchange_batch(RequestKind kind,
                                                           const std::vector<std::string>& bodies,
-                                                          NumberEncoding encoding) {
+                                                          NumberEncoding encoding,
+                                                          const PolicyInterface* interface) {
   const std::string line =
       round_trip(batch_request_body(bodies, encoding), static_cast<int>(bodies.size()));
   std::vector<PluginReply> replies;
   try {
-    replies = parse_batch_reply(line, last_id(), kind, who(), bodies.size());
+    replies = parse_batch_reply(line, last_id(), kind, who(), bodies.size(), interface);
   } catch (const PluginError& e) {
     fail(e.what());
   }

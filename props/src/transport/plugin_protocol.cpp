@@ -12,9 +12,13 @@
 #include "handcentric/props/transport/batch.hpp"
 #include "handcentric/props/tolerance.hpp"
 #include "../wire_arrays.hpp"
+#include "protocol_detail.hpp"
+#include "policy_wire.hpp"
 
 namespace handcentric::props {
-namespace {
+// Shared with policy_wire.cpp through protocol_detail.hpp (a named namespace: the unity build
+// puts both files in one translation unit).
+namespace protocol_detail {
 
 // The shortest text that reads back as the same double (std::to_chars): exact like "%.17g", and
 // several times faster, which matters when each request carries hundreds of numbers.
@@ -114,14 +118,21 @@ void append_vector(std::string& out, const Eigen::VectorXd& v, NumberEncoding en
 
 // History, points and extras: what every request carries. Scalars stay JSON numbers in every
 // encoding (one number each).
-void append_observation(std::string& out, const Scene& scene, NumberEncoding encoding) {
-  out += "\"history\": ";
-  append_poses(out, scene.world_T_hand_history, encoding);
+void append_observation(std::string& out, const Scene& scene, NumberEncoding encoding,
+                        const PolicyInterface* interface = nullptr) {
+  // A policy's own layout or hands: its history and extra poses as it declared them.
+  const bool as_declared = interface != nullptr && policy_wire::writes_poses(*interface);
+  if (as_declared) {
+    policy_wire::append_poses(out, scene, *interface, encoding);
+  } else {
+    out += "\"history\": ";
+    append_poses(out, scene.world_T_hand_history, encoding);
+  }
   out += ", \"hand_points\": ";
   append_points(out, scene.hand_points, encoding);
   out += ", \"world_points\": ";
   append_points(out, scene.world_points, encoding);
-  if (!scene.extra_poses.empty()) {
+  if (!scene.extra_poses.empty() && !as_declared) {
     out += ", \"extra_poses\": {";
     for (std::size_t i = 0; i < scene.extra_poses.size(); ++i) {
       if (i > 0) out += ", ";
@@ -257,15 +268,17 @@ bool read_flag(const nlohmann::json& hello, const char* field, int id, const std
 // A world-frame pose: 16 finite numbers, row-major, last row 0 0 0 1 and a rotation block within
 // kOutputPoseTolerance of a rotation. The block is then taken as it is (a float32 plug-in's is
 // orthonormal to ~1e-7 only); distances compare it.
-RigidTransform pose_from(const double* v, std::size_t k, const std::string& answered) {
+RigidTransform pose_from(const double* v, std::size_t k, const std::string& answered,
+                         const std::string& field) {
   if (v[12] != 0.0 || v[13] != 0.0 || v[14] != 0.0 || v[15] != 1.0) {
-    throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) +
+    throw PluginError(answered + " with " + field + "[" + std::to_string(k) +
                       "] that is not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)");
   }
   const Eigen::Matrix4d M = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(v);
   if (const std::string defect = pose_defect(M); !defect.empty()) {
-    throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) + "] " + format_matrix(M) +
-                      ": " + defect + "; answer world_T_hand poses [[R, p], [0, 0, 0, 1]]");
+    throw PluginError(answered + " with " + field + "[" + std::to_string(k) + "] " +
+                      format_matrix(M) + ": " + defect +
+                      "; answer world_T_hand poses [[R, p], [0, 0, 0, 1]]");
   }
   return RigidTransform::unchecked(M.topLeftCorner<3, 3>(), M.topRightCorner<3, 1>());
 }
@@ -273,10 +286,17 @@ RigidTransform pose_from(const double* v, std::size_t k, const std::string& answ
 RigidTransform read_pose(const nlohmann::json& value, std::size_t k, const std::string& answered) {
   const Eigen::VectorXd v = read_numbers(value, "chunk[" + std::to_string(k) + "]", answered);
   if (v.size() != 16) {
-    throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) +
-                      "] that is not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)");
+    const bool layout = v.size() == 6 || v.size() == 7 || v.size() == 9;
+    throw PluginError(answered + " with \"chunk\"[" + std::to_string(k) + "] of " +
+                      std::to_string(v.size()) +
+                      " numbers, not a 4x4 pose (16 numbers, row-major, last row 0 0 0 1)" +
+                      (layout ? "; a pose of " + std::to_string(v.size()) +
+                                    " numbers is a layout: declare it in the hello, e.g. "
+                                    "\"action_format\": \"pos_quat_xyzw\" (docs/AUDIT.md, "
+                                    "\"--exec\")"
+                              : std::string()));
   }
-  return pose_from(v.data(), k, answered);
+  return pose_from(v.data(), k, answered, "\"chunk\"");
 }
 
 // A decode or policy answer's chunk: a list of poses, or an encoded [K, 4, 4] array; empty when
@@ -293,7 +313,7 @@ std::vector<RigidTransform> read_chunk(const nlohmann::json& value, const std::s
                         "]; \"chunk\" has shape [K, 4, 4], K >= 1 world_T_hand poses");
     }
     for (std::size_t k = 0; k < array.shape[0]; ++k)
-      chunk.push_back(pose_from(array.values.data() + 16 * k, k, answered));
+      chunk.push_back(pose_from(array.values.data() + 16 * k, k, answered, "\"chunk\""));
     return chunk;
   }
   if (!value.is_array()) return chunk;
@@ -301,7 +321,9 @@ std::vector<RigidTransform> read_chunk(const nlohmann::json& value, const std::s
   return chunk;
 }
 
-}  // namespace
+}  // namespace protocol_detail
+
+using namespace protocol_detail;
 
 void require_distinct_names(const std::vector<std::string>& names, const std::string& flag) {
   std::set<std::string> seen;
@@ -363,11 +385,16 @@ std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& obs
 }
 
 std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise,
-                                NumberEncoding encoding) {
+                                NumberEncoding encoding, const PolicyInterface* interface,
+                                const EpisodeStep* episode) {
   std::string out;
-  append_observation(out, observation, encoding);
+  append_observation(out, observation, encoding, interface);
   out += ", \"noise\": ";
   append_vector(out, noise, encoding);
+  if (episode != nullptr) {
+    out += ", \"episode\": {\"index\": " + std::to_string(episode->index) +
+           ", \"step\": " + std::to_string(episode->step) + "}";
+  }
   return out;
 }
 
@@ -484,7 +511,7 @@ nlohmann::json parse_line(const std::string& line, int id, const std::string& wh
 // `answered` begins each message, which quotes the line (`line`), or else the item, written out
 // only then: a batch's items are not formatted again on the way in.
 PluginReply read_answer(const nlohmann::json& json, RequestKind kind, const std::string& answered,
-                        const std::string* line) {
+                        const std::string* line, const PolicyInterface* interface) {
   auto quoted = [&] {
     std::string out(1, '\'');
     out += one_line(line != nullptr ? *line : json.dump(), 120);
@@ -492,6 +519,12 @@ PluginReply read_answer(const nlohmann::json& json, RequestKind kind, const std:
     return out;
   };
   PluginReply reply;
+  if (kind == RequestKind::policy && interface != nullptr &&
+      policy_wire::reads_outputs(*interface)) {
+    reply.outputs = policy_wire::read_outputs(json, *interface, answered);
+    if (!interface->named()) reply.chunk = reply.outputs.front().poses;
+    return reply;
+  }
   if (kind == RequestKind::decode || kind == RequestKind::policy) {
     if (json.contains("chunk")) reply.chunk = read_chunk(json["chunk"], answered);
     if (reply.chunk.empty()) {
@@ -566,7 +599,7 @@ CameraRig read_cameras(const nlohmann::json& cameras, const std::string& answere
 }  // namespace
 
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
-                        bool hello_allowed) {
+                        bool hello_allowed, const PolicyInterface* interface) {
   const nlohmann::json json = parse_line(line, id, who);
   PluginReply reply;
   if (json.contains("hello")) {
@@ -617,14 +650,25 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
     }
     if (hello.contains("cameras") && !hello["cameras"].is_null())
       capabilities.cameras = read_cameras(hello["cameras"], reply_to(who, id));
+    capabilities.policy = policy_wire::read_interface(hello, reply_to(who, id));
+    if (hello.contains("outputs") && hello["outputs"].is_object()) {
+      // nlohmann::json sorts an object's keys; the hello's order says which pose output the
+      // closed loop executes (the first), so read it again in its own order.
+      // Parsed into a variable first: a range-for over a temporary's member would dangle.
+      const nlohmann::ordered_json ordered = nlohmann::ordered_json::parse(line);
+      std::vector<std::string> order;
+      for (const auto& item : ordered["hello"]["outputs"].items()) order.push_back(item.key());
+      policy_wire::order_outputs(capabilities.policy, order);
+    }
     reply.hello = capabilities;
     return reply;
   }
-  return read_answer(json, kind, reply_to(who, id), &line);
+  return read_answer(json, kind, reply_to(who, id), &line, interface);
 }
 
 std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, RequestKind kind,
-                                           const std::string& who, std::size_t count) {
+                                           const std::string& who, std::size_t count,
+                                           const PolicyInterface* interface) {
   const nlohmann::json json = parse_line(line, id, who);
   const std::string answered = who + " answered batched request " + std::to_string(id);
   const std::string form = "; answer {\"id\": " + std::to_string(id) +
@@ -650,7 +694,7 @@ std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, Requ
                         ", not an object; each item is what the single request's answer would "
                         "be, without the id, e.g. {\"actions\": [...]}");
     }
-    replies.push_back(read_answer(items[i], kind, item, nullptr));
+    replies.push_back(read_answer(items[i], kind, item, nullptr, interface));
   }
   return replies;
 }

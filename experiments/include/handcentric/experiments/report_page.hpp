@@ -2,8 +2,9 @@
 // The report as a page (`handcentric report --out DIR`): the audit's verdict grids with their
 // witnesses (report_audit.hpp, audit_page.hpp), the certificates (claims_page.hpp), the sim's
 // bar, the public conventions' table (conventions.hpp), Fig. 3, a quick Table 1 with its models'
-// profiles, Table 2 and Fig. 5 (results_page.hpp; fewer demo counts, trials and steps, said on
-// the page; `full`: the paper's grids). One document (document.hpp) rendered twice,
+// profiles and its hand-centric model located beside a planted fault (locate_page.hpp), Table 2
+// and Fig. 5 (results_page.hpp; fewer demo counts, trials and steps, said on the page; `full`:
+// the paper's grids). One document (document.hpp) rendered twice,
 // DIR/index.html and DIR/index.md, with its pictures and CLAIMS.md beside them.
 #include <cstdint>
 #include <string>

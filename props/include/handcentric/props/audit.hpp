@@ -46,6 +46,9 @@ struct AuditOptions {
   std::vector<Group> groups = all_groups();
   std::vector<View> views = {View::eye_in_hand, View::third_person};
   int cases = kDefaultCases;  ///< pointwise cases per cell
+  /// The frequency the cases were set from (--detect, detect=: cases_to_detect); none: `cases`
+  /// was given or is the default. Only the header says it; the cells state their own.
+  std::optional<double> detect;
   /// Seeds everything the audit draws: the cases, a policy's noise per case, the laws' draws.
   std::uint64_t seed = 1;
   /// A whole policy's in-distribution tests on every cell (--test-law); by default a cell whose
@@ -65,6 +68,13 @@ struct AuditOptions {
 /// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value
 /// and the bound, in one line. Wide enough to take an unchecked command-line number.
 int checked_cases(long long cases, const Spelling& spelling = kCommandLineSpelling);
+
+/// The fewest (scene, g) cases whose pointwise "yes" finds, with 99% probability, a breaking
+/// that occurs in at least `frequency` of the draws: ceil(ln 0.01 / ln(1 - frequency)) (459 for
+/// 0.01, 4603 for 0.001), the inverse of detectable_frequency (verdict.hpp) over all the draws.
+/// InvalidArgument naming --detect and the value for a frequency outside (0, 1) or one that
+/// needs more than kMaxCases cases.
+int cases_to_detect(double frequency, const Spelling& spelling = kCommandLineSpelling);
 
 /// The REL an audit uses: options.relative_tolerance if set, else the precision's. Throws
 /// InvalidArgument for a negative, non-finite or >= 1 tolerance.

@@ -8,8 +8,10 @@
 #include <vector>
 
 #include "handcentric/props/audit.hpp"
+#include "handcentric/props/checks/closed_loop.hpp"
 #include "handcentric/props/observation/camera_rig.hpp"
 #include "handcentric/props/transport/plugin_connection.hpp"
+#include "handcentric/props/transport/policy_interface.hpp"
 
 namespace handcentric::props {
 
@@ -19,6 +21,9 @@ struct PluginAuditSetup {
   /// Names of world-frame poses and of scalars sent with every scene, besides those its hello
   /// asks for (`--extra-poses`, `--scalars`).
   std::vector<std::string> extra_poses, scalars;
+  /// A policy's closed-loop audit beside its single calls (`--episodes`): each rollout is an
+  /// episode of its requests (policy_interface.hpp, "episodes"). None: single calls only.
+  std::optional<ClosedLoopOptions> closed_loop;
 };
 
 /// Audits the representation plug-in `command` (run by /bin/sh -c) under `audit`: its hello
@@ -29,15 +34,20 @@ struct PluginAuditSetup {
 Classification audit_representation_plugin(const std::string& command, const AuditOptions& audit,
                                            const PluginAuditSetup& setup = {});
 
-/// A whole policy's audit over the pipe, and the cameras its hello declares (the rig that
-/// rendered the images it was shown; none when it sees no cameras).
+/// A whole policy's audit over the pipe: one result per output its hello names (its hands, then
+/// its other outputs; one result when it answers a chunk), the cameras its hello declares (the
+/// rig that rendered the images it was shown; none when it sees no cameras) and the rest of
+/// its interface (layouts, rng, episodes).
 struct PolicyPluginAudit {
-  Classification result;
+  std::vector<Classification> results;
   std::optional<CameraRig> cameras;
+  PolicyInterface interface;
 };
 
 /// Audits the whole-policy plug-in `command` (eq. 4) as audit_representation_plugin does a
-/// representation (no flow target: a policy answers chunks).
+/// representation (no flow target: a policy answers chunks): each output as a map of its own
+/// (named_output.hpp), on the same cases; with setup.closed_loop, each output's closed-loop
+/// verdicts too, the first pose output executed.
 PolicyPluginAudit audit_policy_plugin(const std::string& command, const AuditOptions& audit,
                                       const PluginAuditSetup& setup = {});
 

@@ -21,6 +21,7 @@
 #include "handcentric/props/checks/distribution.hpp"
 #include "handcentric/props/checks/injectivity.hpp"
 #include "handcentric/props/checks/preflight.hpp"
+#include "handcentric/props/named_output.hpp"
 #include "handcentric/props/verdict.hpp"
 
 namespace handcentric::props {
@@ -62,6 +63,8 @@ struct Classification {
   std::vector<Verdict> verdicts;           ///< one per (view, component, mode, group) checked
   std::optional<Injectivity> injectivity;  ///< representations only
   std::optional<Preflight> preflight;      ///< whole policies, when ClassifierOptions::preflight
+  /// The policy output these verdicts are about, when it names several (named_output.hpp).
+  std::optional<NamedOutput> output;
 };
 
 /// `flow`: the flow to audit; null = the rectified flow of `representation` (eq. 5).

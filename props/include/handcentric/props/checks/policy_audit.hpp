@@ -34,6 +34,7 @@
 
 #include "handcentric/props/checks/check.hpp"
 #include "handcentric/props/checks/classifier.hpp"
+#include "handcentric/props/transport/policy_interface.hpp"
 #include "handcentric/props/checks/distribution.hpp"
 #include "handcentric/props/noisy_policy.hpp"
 
@@ -59,6 +60,9 @@ Classification classify_policy(std::shared_ptr<const NoisyPolicy> policy,
 
 /// {"policies": [{"name", "summary": {view: {mode: {group: bool}}}, "checks": [{"group",
 /// "mode", "view", "method", "equivariant", "max_error", "cases", "seed", "witness", ...}]}]}
-std::string policy_audit_json(const std::vector<Classification>& policies);
+/// With `interface` (a plug-in's, policy_interface.hpp), each entry also carries "interface":
+/// its state and action layouts, outputs, hands, rng and episodes.
+std::string policy_audit_json(const std::vector<Classification>& policies,
+                              const PolicyInterface* interface = nullptr);
 
 }  // namespace handcentric::props

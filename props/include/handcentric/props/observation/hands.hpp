@@ -3,7 +3,7 @@
 // its hand points are seen from it. Each other hand h is a set of world-frame extra poses, which
 // move with g as every pose of a scene does: "hand:h" its pose now, S_0, and, when its history is
 // recorded, "hand:h@-k" its pose k steps ago, S_-k. A drawn scene carries "hand:h" alone (the
-// other hand's history then follows the first hand's motion, python/hands.hpp).
+// other hand's history then follows the first hand's motion, named_output.hpp).
 //
 // Recorded observations with history = {hand: (H+1, 4, 4)} are read with every hand as such
 // extra poses (and the first hand in sorted order as the scene's history);
@@ -12,12 +12,10 @@
 #include <vector>
 
 #include "handcentric/core/scene.hpp"
+#include "handcentric/props/named_output.hpp"  // kHandPosePrefix, other_hand_history
 #include "handcentric/props/observation/recorded.hpp"
 
 namespace handcentric::props {
-
-/// The prefix of the extra poses that carry the hands ("hand:right").
-inline constexpr const char* kHandPosePrefix = "hand:";
 
 /// "hand:right" (steps_ago 0) or "hand:right@-2".
 std::string hand_pose_name(const std::string& hand, int steps_ago);

@@ -11,6 +11,8 @@
 // the hello, every request as a batched one (act() sends a batch of one).
 // Without "batch", act_batch asks one observation at a time, as act does. A hello that also
 // offers "encodings": ["base64"] gets the batched lines' arrays encoded (plugin_protocol.hpp).
+#include <memory>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -64,6 +66,20 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   const PluginCapabilities& capabilities() const;
   int requests_sent() const { return connection_.requests_sent(); }
 
+  /// Every output of an answer, in the interface's order (one when the plug-in answers a
+  /// "chunk"), each as poses: an invariant output's numbers embedded at the observation's T_0
+  /// (named_output.hpp).
+  using Answer = std::vector<std::vector<RigidTransform>>;
+  /// The answers to each (observation, noise), as act_batch asks them; `fresh`: past the cache.
+  std::vector<Answer> answers(const std::vector<const Scene*>& observations,
+                              const std::vector<const Eigen::VectorXd*>& noises, bool fresh) const;
+
+  /// A closed-loop rollout (policy_interface.hpp, "episodes"): from start_episode() on, each
+  /// request carries "episode": {"index", "step"} (a new index, steps from 0) and is asked
+  /// past the cache and not kept; end_episode() ends it.
+  void start_episode() const;
+  void end_episode() const { episode_.reset(); }
+
  private:
   Scene with_extras(const Scene& scene) const;
   /// The cache's key of (observation, noise), after checking both.
@@ -73,21 +89,58 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   /// A policy request, with the images of the hello's cameras when it declared some.
   std::string request_body(const Scene& observation, const Eigen::VectorXd& noise,
                            NumberEncoding encoding = NumberEncoding::text) const;
-  /// Checks the chunk length of the answer to `where` and caches it under `key`.
-  const std::vector<RigidTransform>& remember(std::string key, PluginReply reply,
-                                              const std::string& where) const;
+  /// The answer of `reply` to `observation` (Answer), its lengths checked against the probe's
+  /// (`where` names the request), cached under `key` unless in an episode.
+  Answer remember(std::string key, PluginReply reply, const Scene& observation,
+                  const std::string& where) const;
 
   std::vector<std::string> forced_extra_poses_, forced_scalars_;
   mutable PluginConnection connection_;
   mutable std::optional<PluginCapabilities> capabilities_;
   std::optional<Scene> probe_;  ///< use_probe()'s scene
-  mutable std::unordered_map<std::string, std::vector<RigidTransform>> cache_;
-  mutable bool past_cache_ = false;  ///< during act_fresh: no answer is taken from cache_
-  mutable std::size_t chunk_length_ = 0;
+  mutable std::unordered_map<std::string, Answer> cache_;
+  /// Each output's length in the probe's answer (poses; an invariant's too): it must not change.
+  mutable std::vector<std::size_t> lengths_;
+  mutable std::optional<EpisodeStep> episode_;
+  mutable int episodes_started_ = 0;
+};
+
+/// One output of a PipePolicy whose hello names its outputs (or hands), as the checks ask it;
+/// with `executed`, the closed loop's form: the first pose of output `executed` ahead of this
+/// output's chunk (ClosedLoopOptions::compared_from = 1), when the two differ.
+class PipeOutput final : public NoisyPolicy, public BatchPolicy {
+ public:
+  PipeOutput(std::shared_ptr<const PipePolicy> plugin, std::size_t output,
+             std::optional<std::size_t> executed = std::nullopt);
+  std::string name() const override;
+  Eigen::Index noise_dimension() const override { return plugin_->noise_dimension(); }
+  std::vector<RigidTransform> act(const Scene& observation,
+                                  const Eigen::VectorXd& noise) const override;
+  std::vector<std::vector<RigidTransform>> act_batch(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override;
+  std::vector<std::vector<RigidTransform>> act_batch_fresh(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override;
+  std::vector<std::vector<RigidTransform>> act_fresh(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises) const override {
+    return act_batch_fresh(observations, noises);
+  }
+  bool mixed_shapes() const override { return true; }
+  const PipePolicy& plugin() const { return *plugin_; }
+
+ private:
+  std::vector<RigidTransform> select(const PipePolicy::Answer& answer) const;
+  std::shared_ptr<const PipePolicy> plugin_;
+  std::size_t output_;
+  std::optional<std::size_t> executed_;
 };
 
 /// `plugin` as the checks ask it: in batched requests of its hello's size (BatchedPolicy) when it
 /// answers batches, else one observation per request. Runs the handshake if it has not run.
 std::shared_ptr<const NoisyPolicy> as_checked(std::shared_ptr<const PipePolicy> plugin);
+/// The same for one output.
+std::shared_ptr<const NoisyPolicy> as_checked(std::shared_ptr<const PipeOutput> output);
 
 }  // namespace handcentric::props

@@ -25,12 +25,15 @@ class PluginConnection {
   PluginConnection(std::string command, double timeout_seconds);
 
   /// Sends request `body` (the next id) and returns its parsed, validated answer.
-  PluginReply exchange(RequestKind kind, const std::string& body, bool hello_allowed);
+  /// A policy reply is read under `interface` when given (plugin_protocol.hpp, parse_reply).
+  PluginReply exchange(RequestKind kind, const std::string& body, bool hello_allowed,
+                       const PolicyInterface* interface = nullptr);
   /// Sends one batched request (plugin_protocol.hpp, "batch") holding `bodies`, each the body
   /// of a single request written in `encoding`, and returns the answers in their order. The
   /// deadline is the timeout times the number of scenes.
   std::vector<PluginReply> exchange_batch(RequestKind kind, const std::vector<std::string>& bodies,
-                                          NumberEncoding encoding);
+                                          NumberEncoding encoding,
+                                          const PolicyInterface* interface = nullptr);
   /// Throws PluginError(what + the stderr tail) and refuses further requests.
   [[noreturn]] void fail(const std::string& what);
 

@@ -32,6 +32,7 @@
 #include "handcentric/core/rigid_transform.hpp"
 #include "handcentric/core/scene.hpp"
 #include "handcentric/props/observation/camera_rig.hpp"
+#include "handcentric/props/transport/policy_interface.hpp"
 #include "handcentric/props/transport/subprocess.hpp"
 
 namespace handcentric::props {
@@ -59,6 +60,8 @@ struct PluginCapabilities {
   /// "channels": "rgbd", "floor": false}): each policy request then carries "images": {view:
   /// float32 array (C, h, w) in the base64 form}, rendered by this rig.
   std::optional<CameraRig> cameras;
+  /// A policy's layouts, outputs, hands, rng and episodes (policy_interface.hpp).
+  PolicyInterface policy;
 };
 
 /// The noise a policy request carries unless the plug-in's hello asks for another length.
@@ -83,8 +86,12 @@ std::string encode_request_body(const Scene& scene,
 /// The body of a decode request: the observation (no chunk) and the actions to decode.
 std::string decode_request_body(const Eigen::VectorXd& actions, const Scene& observation);
 /// The body of a policy request: the observation (no chunk) and the noise.
+/// With `interface`, its poses are written as it declares (policy_interface.hpp); with `episode`,
+/// the request carries "episode": {"index", "step"}.
 std::string policy_request_body(const Scene& observation, const Eigen::VectorXd& noise,
-                                NumberEncoding encoding = NumberEncoding::text);
+                                NumberEncoding encoding = NumberEncoding::text,
+                                const PolicyInterface* interface = nullptr,
+                                const EpisodeStep* episode = nullptr);
 /// The body of a batched request: "batch": [{body}, {body}, ...], each body as the single
 /// request's (written in `encoding`, which the line then names: "encoding": "base64").
 std::string batch_request_body(const std::vector<std::string>& bodies,
@@ -102,6 +109,9 @@ struct PluginReply {
   Eigen::VectorXd actions, observation, flow_input, flow_target;
   bool has_observation = false, has_flow = false;
   std::vector<RigidTransform> chunk;  ///< decode and policy replies
+  /// A policy reply read under a PolicyInterface with named outputs or an action layout: every
+  /// output, in the interface's order (`chunk` is the first when there is one output).
+  std::vector<OutputValue> outputs;
 };
 
 enum class RequestKind { encode, flow, decode, policy };
@@ -110,8 +120,9 @@ enum class RequestKind { encode, flow, decode, policy };
 /// in messages. Throws PluginError with a one-line message for anything else: not JSON, nested
 /// deeper than kMaxReplyDepth, a non-finite number, a wrong id, a missing field, a matrix that
 /// is not 16 finite numbers with last row 0 0 0 1.
+/// A policy reply is read under `interface` when given (its action layout, its outputs).
 PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const std::string& who,
-                        bool hello_allowed);
+                        bool hello_allowed, const PolicyInterface* interface = nullptr);
 /// Parses the reply to batched request `id` of `count` scenes: {"id", "batch": [answers]}, each
 /// answer checked as parse_reply checks one, a message naming the item. Each array of an answer
 /// may be JSON numbers or an encoded array (float64 of shape [n]; a chunk [K, 4, 4]). Throws
@@ -119,7 +130,8 @@ PluginReply parse_reply(const std::string& line, int id, RequestKind kind, const
 /// encoded array, malformed base64, a length that is not the shape's, a dtype other than
 /// float64, a shape other than the field's, or a non-finite number.
 std::vector<PluginReply> parse_batch_reply(const std::string& line, int id, RequestKind kind,
-                                           const std::string& who, std::size_t count);
+                                           const std::string& who, std::size_t count,
+                                           const PolicyInterface* interface = nullptr);
 
 /// Throws InvalidArgument naming `flag` for an empty or repeated name.
 void require_distinct_names(const std::vector<std::string>& names, const std::string& flag);
