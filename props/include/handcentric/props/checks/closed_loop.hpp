@@ -30,8 +30,8 @@
 namespace handcentric::props {
 
 struct ClosedLoopOptions {
-  int episodes = 20;  ///< 1 to kMaxCases
-  int steps = 16;     ///< the episode's length T, 1 to 10000
+  int episodes = 20;  ///< 1 to kMaxCases (recorded: 1 to the number recorded)
+  int steps = 16;     ///< the episode's length T, 1 to 10000 (recorded: not read)
   /// Called before each rollout (the policy's reset); may be empty.
   std::function<void()> start_episode;
   /// The poses of each returned chunk before this index are executed, not compared: 1 when the
