@@ -61,26 +61,11 @@ py::object history_argument(const std::vector<const Scene*>& rows, const CallOpt
       for_callable(history_in(rows, options.stacked, options.state_format), kind);
   for (std::size_t h = 1; h < options.hands.size(); ++h) {
     // Scenes whose history is this hand's: as recorded, or S_k = S_0 T_0^-1 T_k (hands.hpp).
-    std::vector<Scene> moved;
-    moved.reserve(rows.size());
-    const std::string pose_name = kHandPosePrefix + options.hands[h];
-    for (const Scene* s : rows) {
-      if (options.hands_recorded) {
-        Scene other;
-        other.world_T_hand_history = props::recorded_hand_history(*s, options.hands[h]);
-        moved.push_back(std::move(other));
-        continue;
-      }
-      const auto found = std::find_if(s->extra_poses.begin(), s->extra_poses.end(),
-                                      [&](const auto& p) { return p.first == pose_name; });
-      if (found == s->extra_poses.end())
-        throw InvalidArgument("the scene has no pose '" + pose_name + "' for hand " +
-                              options.hands[h]);
-      Scene other;
-      const RigidTransform S0_T_T0 = found->second * s->world_T_hand_history.front().inverse();
-      for (const RigidTransform& T : s->world_T_hand_history)
-        other.world_T_hand_history.push_back(S0_T_T0 * T);
-      moved.push_back(std::move(other));
+    std::vector<Scene> moved(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      moved[r].world_T_hand_history = options.hands_recorded
+                                          ? props::recorded_hand_history(*rows[r], options.hands[h])
+                                          : props::other_hand_history(*rows[r], options.hands[h]);
     }
     std::vector<const Scene*> pointers;
     for (const Scene& m : moved) pointers.push_back(&m);
