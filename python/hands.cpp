@@ -39,17 +39,7 @@ void set_hands(CommonOptions& o, props::ClassifierOptions& c, py::handle hands) 
       c.check.shape.extra_pose_names.push_back(kHandPosePrefix + names[h]);
   }
   // Each hand a pose output, first; the rest of outputs= after them.
-  std::vector<NamedOutput> outputs;
-  for (const std::string& hand : names) outputs.push_back({hand, OutputKind::pose});
-  for (const NamedOutput& declared : o.call.outputs) {
-    const bool is_hand = std::count(names.begin(), names.end(), declared.name) > 0;
-    if (is_hand && declared.kind != OutputKind::pose) {
-      throw InvalidArgument("outputs[\"" + declared.name + "\"] is '" + to_string(declared.kind) +
-                            "', but '" + declared.name + "' is a hand: its chunk is a \"pose\"");
-    }
-    if (!is_hand) outputs.push_back(declared);
-  }
-  o.call.outputs = outputs;
+  o.call.outputs = props::outputs_with_hands(names, o.call.outputs, "outputs");
 }
 
 py::object history_argument(const std::vector<const Scene*>& rows, const CallOptions& options) {

@@ -4,10 +4,6 @@
 
 namespace handcentric::python {
 
-std::string to_string(OutputKind kind) {
-  return kind == OutputKind::pose ? "pose" : "invariant";
-}
-
 std::vector<NamedOutput> outputs_from(py::handle outputs, bool need_pose) {
   if (outputs.is_none()) return {};
   if (!py::isinstance<py::dict>(outputs)) {
@@ -26,11 +22,9 @@ std::vector<NamedOutput> outputs_from(py::handle outputs, bool need_pose) {
     const std::string kind = py::isinstance<py::str>(item.second)
                                  ? std::string(py::str(item.second))
                                  : "a " + type_name(item.second);
-    if (kind == "pose") {
-      output.kind = OutputKind::pose;
-      any_pose = true;
-    } else if (kind == "invariant") {
-      output.kind = OutputKind::invariant;
+    if (const auto parsed = props::parse_output_kind(kind)) {
+      output.kind = *parsed;
+      any_pose = any_pose || *parsed == OutputKind::pose;
     } else {
       throw InvalidArgument("outputs[\"" + output.name + "\"] is '" + kind +
                             "'; an output is \"pose\" (a chunk of world-frame poses, which moves "
@@ -98,12 +92,8 @@ std::vector<std::vector<RigidTransform>> invariant_as_poses(
     require_finite(u, per_row, row);
     const RigidTransform& T0 =
         observations[static_cast<std::size_t>(i)]->world_T_hand_history.at(0);
-    std::vector<RigidTransform> poses;
-    for (py::ssize_t j = 0; j < per_row; j += 3) {
-      Eigen::Vector3d position = Eigen::Vector3d::Zero();
-      for (py::ssize_t d = 0; d < 3 && j + d < per_row; ++d) position(d) = u[j + d];
-      poses.push_back(T0 * RigidTransform::from_translation(position));
-    }
+    std::vector<RigidTransform> poses =
+        props::invariant_as_poses(u, static_cast<std::size_t>(per_row), T0);
     out.push_back(std::move(poses));
   }
   return out;

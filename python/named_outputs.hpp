@@ -1,32 +1,23 @@
 #pragma once
-// A policy that returns a dict of outputs (outputs={"hand": "pose", "gripper": "invariant"}):
-// each entry is audited as a map of its own, with the same observations, noise and seeds.
-//   pose       a chunk of world-frame poses (action_format= applies), which must move with g:
-//              a(g o) = g a(o);
-//   invariant  numbers of any shape per observation (a gripper width per step, a terminate
-//              flag), which must not change: u(g o) = u(o).
-// An invariant entry u is handed to the checks as the poses T_0 [I, u_3j..3j+2] (its numbers
-// three at a time as positions in the hand's frame at T_0, the last padded with zeros): g moves
-// T_0 to g T_0, so these poses move with g exactly when u is invariant, and a change of u by d
-// moves them by d. Every check of the equivariance audit then decides invariance as it is, in
-// both modes, with the output's own units as its errors.
+// outputs= of the Python module: a policy that returns a dict of outputs
+// (outputs={"hand": "pose", "gripper": "invariant"}), each entry audited as a map of its own
+// with the same observations, noise and seeds. What the kinds mean, and why an invariant entry
+// u goes to the checks as the poses T_0 [I, u]: props/named_output.hpp, the one definition,
+// which a policy plug-in's hello shares.
 #include <pybind11/pybind11.h>
 
 #include <string>
 #include <vector>
 
 #include "arrays.hpp"
+#include "handcentric/props/named_output.hpp"
 
 namespace handcentric::python {
 
-enum class OutputKind { pose, invariant };
-
-struct NamedOutput {
-  std::string name;
-  OutputKind kind = OutputKind::pose;
-};
-
-std::string to_string(OutputKind kind);
+// One definition with the plug-ins' hello (props/named_output.hpp).
+using props::NamedOutput;
+using props::OutputKind;
+using props::to_string;
 
 /// outputs= checked: None gives none (the policy returns its chunk alone); else a dict
 /// {name: "pose" or "invariant"}, with at least one pose entry when `need_pose` (not with hands=,
