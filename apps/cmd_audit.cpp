@@ -45,6 +45,7 @@ struct AuditCommandOptions {
   bool detect_given = false;
   int episodes = 0;  // --episodes: the closed loop of a --policy-exec plug-in (0: none)
   int episode_length = props::ClosedLoopOptions{}.steps;
+  bool episode_length_given = false;
   std::uint64_t seed = props::AuditOptions{}.seed;
   double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
@@ -186,6 +187,13 @@ int run_audit(const AuditCommandOptions& options) {
   const bool plugin_names = !options.extra_poses.empty() || !options.scalars.empty();
   props::PluginAuditSetup plugin{options.timeout, options.extra_poses, options.scalars, {}};
   if (options.episodes > 0) {
+    audit.closed_loop = true;  // recorded episodes (an 'episode' index) are then replayed
+    if (options.episode_length_given && audit.observations &&
+        !audit.observations->episode.empty()) {
+      throw InvalidArgument("--episode-length " + std::to_string(options.episode_length) +
+                            " with recorded episodes: each is replayed as long as recorded; "
+                            "leave --episode-length out");
+    }
     plugin.closed_loop = props::ClosedLoopOptions{};
     plugin.closed_loop->episodes = options.episodes;
     plugin.closed_loop->steps = options.episode_length;
@@ -326,11 +334,11 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       "g o_1..g o_T, the first pose executed at every step), for a plug-in that keeps state "
       "between calls (its hello's \"episodes\": docs/AUDIT.md)");
   episodes->check(CLI::Range(1, props::kMaxCases));
-  cmd->add_option("--episode-length", options->episode_length,
-                  "with --episodes: the steps T of each rollout, 1 to 10000")
-      ->check(CLI::Range(1, 10000))
-      ->capture_default_str()
-      ->needs(episodes);
+  auto* episode_length = cmd->add_option("--episode-length", options->episode_length,
+                                         "with --episodes: the steps T of each rollout, 1 to 10000")
+                             ->check(CLI::Range(1, 10000))
+                             ->capture_default_str()
+                             ->needs(episodes);
   auto* model =
       cmd->add_option("--model", options->model, "audit a trained model of this library (eq. 4)");
   auto* floor = cmd->add_flag(
@@ -362,8 +370,9 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       ->delimiter(',');
   profile->needs(out)->excludes(json)->excludes(pointwise)->excludes(detect)->excludes(episodes);
   out->needs(profile);
-  cmd->callback([options, detect, &exit_code] {
+  cmd->callback([options, detect, episode_length, &exit_code] {
     options->detect_given = detect->count() > 0;
+    options->episode_length_given = episode_length->count() > 0;
     if (options->locate && !options->profile.empty())
       throw InvalidArgument("--locate cannot honour --profile: run them one at a time");
     exit_code = options->profile.empty() ? run_audit(*options)

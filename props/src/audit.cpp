@@ -183,14 +183,14 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
 
 namespace {
 
-// The command line asks single observations of one hand: an episode index (read by the closed
-// loop) or one history per hand (read with hands=) would be silently misread; both are Python's.
-void require_single_calls(const RecordedObservations& data) {
-  if (!data.episode.empty())
+// The command line asks single observations of one hand: an episode index (read by a closed
+// loop, --episodes) or one history per hand (read with hands=) would be silently misread.
+void require_single_calls(const RecordedObservations& data, bool closed_loop) {
+  if (!data.episode.empty() && !closed_loop)
     throw InvalidArgument("the observations of " + data.source +
                           " carry an 'episode' index, which only the closed loop of "
-                          "handcentric.audit_policy(..., episodes=N) replays: leave 'episode' out "
-                          "here");
+                          "handcentric.audit_policy(..., episodes=N) replays (or of "
+                          "--policy-exec with --episodes N): leave 'episode' out here");
   if (!data.hands().empty())
     throw InvalidArgument("the observations of " + data.source +
                           " record one history per hand, which handcentric.audit_policy(..., "
@@ -201,7 +201,7 @@ void require_single_calls(const RecordedObservations& data) {
 // otherwise fill the missing ones with placeholders the data never had.
 void require_recorded_names(const AuditOptions& audit, const PluginCapabilities& capabilities) {
   if (!audit.observations) return;
-  require_single_calls(*audit.observations);
+  require_single_calls(*audit.observations, audit.closed_loop);
   const Scene& first = audit.observations->scenes.front();
   auto has = [](const auto& named, const std::string& name) {
     return std::any_of(named.begin(), named.end(), [&](const auto& n) { return n.first == name; });
@@ -235,7 +235,7 @@ ClassifierOptions plugin_classifier_options(const AuditOptions& options,
 
 std::vector<Classification> audit_builtins(const std::vector<std::string>& names,
                                            const AuditOptions& options) {
-  if (options.observations) require_single_calls(*options.observations);
+  if (options.observations) require_single_calls(*options.observations, false);
   const ClassifierOptions classifier = classifier_options(options);
   const std::vector<std::string> all = auditable_names();
   std::vector<Classification> out;

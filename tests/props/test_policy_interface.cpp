@@ -3,6 +3,8 @@
 // --policy-exec` and tests/props/plugins/policy_as_shipped.py, and the hello's and answers'
 // refusals through the protocol itself. Mutants each test was seen failing on are named above it.
 #include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -122,6 +124,39 @@ TEST_CASE("a_stateful_plugin_is_audited_in_closed_loop_over_episodes", "[unit]")
       test::cli() + " audit --episodes 2 --repr hand_centric --group se3 --cases 5");
   CHECK(without.exit_code != 0);
   CHECK_THAT(without.err, Contains("--episodes"));
+}
+
+// Recorded episodes (an 'episode' index in --observations) are the closed loop's episodes over
+// the pipe too, replayed as recorded (mutant: AuditOptions::closed_loop not set by --episodes
+// -> the data refused).
+TEST_CASE("recorded_episodes_are_replayed_over_the_pipe", "[unit]") {
+  const std::string path = std::filesystem::temp_directory_path() / "hc_recorded_episodes.jsonl";
+  {
+    std::ofstream out(path);
+    for (int e = 0; e < 2; ++e) {
+      for (int t = 0; t < 4; ++t) {
+        const double x = 0.1 * t + 0.3 * e, y = 0.05 * t;
+        out << "{\"history\": [[[1,0,0," << x << "],[0,1,0," << y << "],[0,0,1,0.2],[0,0,0,1]]], "
+            << "\"hand_points\": [[0.1, 0.0, 0.2]], \"episode\": " << e << "}\n";
+      }
+    }
+  }
+  const std::string flags = "--cases 10 --group translation --view eye_in_hand --observations " +
+                            path + " --episodes 2 --json";
+  const auto held = test::run_command(shipped_audit("--stateful", flags));
+  REQUIRE(held.exit_code == 0);
+  CHECK(verdicts_by_output(held.out, "translation").at("hand").at("closed_loop"));
+  const auto fault = test::run_command(shipped_audit("--stateful world_memory", flags));
+  REQUIRE(fault.exit_code == 0);
+  CHECK_FALSE(verdicts_by_output(fault.out, "translation").at("hand").at("closed_loop"));
+  const auto length = test::run_command(shipped_audit("--stateful", flags + " --episode-length 3"));
+  CHECK(length.exit_code != 0);
+  CHECK_THAT(length.err, Contains("replayed as long as recorded"));
+  const auto single = test::run_command(shipped_audit(
+      "--stateful", "--cases 10 --group translation --view eye_in_hand --observations " + path));
+  CHECK(single.exit_code != 0);
+  CHECK_THAT(single.err, Contains("--episodes N"));
+  std::filesystem::remove(path);
 }
 
 TEST_CASE("a_layout_the_numbers_contradict_is_an_error_naming_the_pose", "[unit]") {

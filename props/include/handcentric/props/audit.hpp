@@ -63,6 +63,10 @@ struct AuditOptions {
   std::optional<Workspace> workspace;
   /// Draw every scene from these (observation/recorded.hpp); none: random scenes.
   std::shared_ptr<const RecordedObservations> observations;
+  /// A closed loop runs beside the single calls (--episodes with --policy-exec): recorded
+  /// observations with an 'episode' index are then its episodes (recorded_episodes.hpp);
+  /// without one such data are refused.
+  bool closed_loop = false;
 };
 
 /// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value
