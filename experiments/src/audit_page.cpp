@@ -29,10 +29,6 @@ std::string vector_text(const Eigen::Vector3d& v) {
   return text + ")";
 }
 
-std::string row_label(Component component, Mode mode) {
-  return props::to_string(component) + (mode == Mode::distribution ? " (in distribution)" : "");
-}
-
 std::string view_title(View view) {
   return view == View::eye_in_hand ? "eye-in-hand view (no world points: Theorem 1's setting)"
                                    : "third-person view (1-8 world points that move with g)";
@@ -80,7 +76,7 @@ Section witness_section(const std::string& id, const std::string& name, const Ve
   Section section;
   section.id = id;
   section.level = 4;
-  section.title = "Witness: " + name + ", " + row_label(verdict.component, verdict.mode) +
+  section.title = "Witness: " + name + ", " + props::row_label(verdict.component, verdict.mode) +
                   " under " + props::to_string(verdict.group) + ", " +
                   props::to_string(verdict.view);
   if (!verdict.witness) {
@@ -164,9 +160,9 @@ AuditPart audit_part(const std::vector<props::Classification>& classifications,
       grid.caption = classification.name + ": " + view_title(view);
       grid.columns = {"component"};
       for (props::Group group : options.groups) grid.columns.push_back(props::to_string(group));
-      for (Mode mode : {Mode::pointwise, Mode::distribution}) {
+      for (Mode mode : {Mode::pointwise, Mode::distribution, Mode::closed_loop}) {
         for (Component component : kComponents) {
-          std::vector<TableCell> row = {text_cell(row_label(component, mode))};
+          std::vector<TableCell> row = {text_cell(props::row_label(component, mode))};
           bool any = false;
           for (props::Group group : options.groups) {
             const Verdict* verdict =
@@ -205,7 +201,7 @@ AuditPart audit_part(const std::vector<props::Classification>& classifications,
         continue;
       }
       if (!verdict.note.empty()) {
-        notes.push_back({plain(row_label(verdict.component, verdict.mode) + " under " +
+        notes.push_back({plain(props::row_label(verdict.component, verdict.mode) + " under " +
                                props::to_string(verdict.group) + ", " +
                                props::to_string(verdict.view) + ": " + verdict.note)});
       }

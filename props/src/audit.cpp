@@ -19,12 +19,6 @@ std::string pad(const std::string& text, std::size_t width) {
   return text.size() >= width ? text : text + std::string(width - text.size(), ' ');
 }
 
-std::string row_label(Component component, Mode mode) {
-  return to_string(component) + (mode == Mode::distribution  ? " (in distribution)"
-                                 : mode == Mode::closed_loop ? " (closed loop)"
-                                                             : "");
-}
-
 std::string view_heading(View view, bool recorded) {
   if (recorded) {
     return view == View::eye_in_hand
@@ -61,6 +55,12 @@ std::string indent(const std::string& text, const std::string& prefix) {
 }
 
 }  // namespace
+
+std::string row_label(Component component, Mode mode) {
+  return to_string(component) + (mode == Mode::distribution  ? " (in distribution)"
+                                 : mode == Mode::closed_loop ? " (closed loop)"
+                                                             : "");
+}
 
 std::vector<std::string> auditable_names() {
   std::vector<std::string> names = builtin_representation_names();

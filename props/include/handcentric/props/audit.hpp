@@ -69,6 +69,10 @@ struct AuditOptions {
   bool closed_loop = false;
 };
 
+/// The label of a verdict table's row: "policy", "policy (in distribution)", "policy (closed
+/// loop)" (the text tables and the report page).
+std::string row_label(Component component, Mode mode);
+
 /// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value
 /// and the bound, in one line. Wide enough to take an unchecked command-line number.
 int checked_cases(long long cases, const Spelling& spelling = kCommandLineSpelling);
