@@ -207,12 +207,7 @@ AuditPart audit_part(const std::vector<props::Classification>& classifications,
       }
     }
     if (derived > 0) {
-      notes.push_back({plain(std::to_string(derived) +
-                             " in-distribution \"yes\" cell(s) marked \"from pointwise\" follow "
-                             "from their pointwise cell: the policy is a function of its inputs "
-                             "(the preflight) and each case drew its own noise, so its laws agree "
-                             "but on the share of draws the pointwise \"yes\" could miss (its "
-                             "detectable frequency); no in-distribution test was run")});
+      notes.push_back({plain(props::derived_laws_note(derived, "marked 'from pointwise'"))});
     }
     if (const auto& injectivity = classification.injectivity) {
       const std::string verdict = !injectivity->injective.has_value() ? "not decided"

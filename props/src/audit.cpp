@@ -56,6 +56,14 @@ std::string indent(const std::string& text, const std::string& prefix) {
 
 }  // namespace
 
+std::string derived_laws_note(long count, const std::string& marked) {
+  return std::to_string(count) + " in-distribution 'yes' cell(s) " + marked +
+         " follow from their pointwise cell: the policy is a function of its inputs (the "
+         "preflight) and each case drew its own noise, so its laws agree but on the share of "
+         "draws the pointwise 'yes' could miss (its detectable frequency); no in-distribution "
+         "test was run";
+}
+
 std::string row_label(Component component, Mode mode) {
   return to_string(component) + (mode == Mode::distribution  ? " (in distribution)"
                                  : mode == Mode::closed_loop ? " (closed loop)"
@@ -331,11 +339,7 @@ void print_audit(std::ostream& out, const std::vector<Classification>& classific
         std::count_if(classification.verdicts.begin(), classification.verdicts.end(),
                       [](const Verdict& v) { return v.method == Method::from_pointwise; });
     if (derived > 0) {
-      out << "  note: " << derived
-          << " in-distribution 'yes' cell(s) (marked =) follow from their pointwise cell: the "
-             "policy is a function of its inputs (the preflight) and each case drew its own "
-             "noise, so its laws agree but on the share of draws the pointwise 'yes' could miss "
-             "(below); no in-distribution test was run ("
+      out << "  note: " << derived_laws_note(derived, "(marked =)") << " ("
           << options.spelling.option("test_law") << (options.spelling.command_line ? "" : "=True")
           << " runs them)\n";
     }

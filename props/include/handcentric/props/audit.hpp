@@ -73,6 +73,10 @@ struct AuditOptions {
 /// loop)" (the text tables and the report page).
 std::string row_label(Component component, Mode mode);
 
+/// The one note for a policy's in-distribution cells whose law follows from their pointwise
+/// "yes" (Method::from_pointwise): `count` of them, shown as `marked` ("(marked =)" in text).
+std::string derived_laws_note(long count, const std::string& marked);
+
 /// `cases` when 1 <= cases <= kMaxCases (run.hpp); else InvalidArgument naming --cases, the value
 /// and the bound, in one line. Wide enough to take an unchecked command-line number.
 int checked_cases(long long cases, const Spelling& spelling = kCommandLineSpelling);
