@@ -61,9 +61,10 @@ TEST_CASE("a_hand_centric_pipeline_breaks_at_no_stage", "[unit]") {
   CHECK(r.at("chunk").at("equivariant").get<bool>());
 }
 
-// Mutants: read_stage_values reading the answer's stages in its own (sorted) order instead of the
-// hello's (the first break reported at 'decode'); watched_stages skipping the first stage (the
-// break reported at 'to_hand').
+// Mutants: read_named (policy_wire.cpp) reading the stages in their sorted order, as
+// nlohmann::json keeps an answer's object, instead of the hello's (each row then holds another
+// stage's values: the shapes and the decoder's break); watched_stages skipping the first stage
+// (the first break reported at 'decode').
 TEST_CASE("a_normalizer_fit_in_world_coordinates_breaks_at_normalize", "[unit]") {
   const auto r = located_once("world_normalizer", "translation");
   CHECK(stage_names(r) ==
@@ -72,6 +73,8 @@ TEST_CASE("a_normalizer_fit_in_world_coordinates_breaks_at_normalize", "[unit]")
   CHECK(r.at("witness").at("name") == "normalize");
   CHECK(r.at("stages").at(0).at("kind") == "poses");
   CHECK(r.at("stages").at(0).at("case") == 1);
+  CHECK(r.at("stages").at(2).at("shape") == nlohmann::json({18, 1}));  // network: 3 poses of 6
+  CHECK(r.at("stages").at(3).at("shape") == nlohmann::json({16, 3}));  // decode: 3 poses
   CHECK_FALSE(stage_breaks(r, "to_hand"));  // a per-axis scale commutes with translations
   CHECK(stage_breaks(r, "decode"));         // downstream of the break
   CHECK_FALSE(r.at("chunk").at("equivariant").get<bool>());
@@ -81,8 +84,8 @@ TEST_CASE("a_normalizer_fit_in_world_coordinates_breaks_at_normalize", "[unit]")
   CHECK(batched == r);
 }
 
-// Mutant: the stages' kinds swapped in read_stages ("poses" read as features and back: the
-// decoder's poses, compared as features, break at 'decode' before 'unnormalize').
+// Mutant: locate_text's column header and summary kept as a model's "layer" (the table of a
+// plug-in's stages then says "layer").
 TEST_CASE("an_unnormalizer_adding_the_world_mean_breaks_at_unnormalize_under_rotation", "[unit]") {
   const auto moved = located_once("world_unnormalizer", "translation");
   CHECK(moved.at("first_break").is_null());  // adding a world offset commutes with translations
