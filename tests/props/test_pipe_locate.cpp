@@ -46,8 +46,9 @@ bool stage_breaks(const nlohmann::json& location, const std::string& name) {
 
 }  // namespace
 
-// Mutant: every stage taken as "features" in plugin_locate.cpp's watched_stages (the decoder's
-// world poses then break invariance: a break where there is none).
+// Mutants: every stage taken as "features" in plugin_locate.cpp's watched_stages (the decoder's
+// world poses then break invariance: a break where there is none); the interface's "stages" left
+// out of audit_json.cpp.
 TEST_CASE("a_hand_centric_pipeline_breaks_at_no_stage", "[unit]") {
   const auto r = located_once("", "se3");
   CHECK(r.at("watched") == "stages");
@@ -59,6 +60,15 @@ TEST_CASE("a_hand_centric_pipeline_breaks_at_no_stage", "[unit]") {
   for (const auto& row : r.at("stages")) CHECK_FALSE(row.at("breaks").get<bool>());
   CHECK(r.at("first_break").is_null());
   CHECK(r.at("chunk").at("equivariant").get<bool>());
+  // The audit itself asks no stages, and its JSON lists the declared ones.
+  const auto audit = test::run_command(test::cli() + " audit --policy-exec '" +
+                                       test::test_plugin("policy_stages.py") +
+                                       "' --group se3 --view eye_in_hand --cases 20 --json");
+  REQUIRE(audit.exit_code == 0);
+  const auto policy = nlohmann::json::parse(audit.out).at("policies").at(0);
+  CHECK(policy.at("interface").at("stages").at(3) ==
+        nlohmann::json({{"name", "decode"}, {"kind", "poses"}}));
+  CHECK(policy.at("checks").at(0).at("equivariant").get<bool>());
 }
 
 // Mutants: read_named (policy_wire.cpp) reading the stages in their sorted order, as
