@@ -62,6 +62,22 @@ def test_a_batched_line_answers_the_stages_of_the_items_that_ask():
     assert first["chunk"] == second["chunk"]
 
 
+# Mutant: policy.py's joined() without its pair branch (a batched rng= policy's (answer, stages)
+# rows are not joined back into one batch).
+def test_a_batched_policy_with_its_own_rng_returns_its_stages_row_by_row():
+    rng = np.random.default_rng(5)
+    history = matrices([random_pose(rng), random_pose(rng)])
+    line = {"id": 1, "protocol": 2, "batch": [policy_request(0, history, stages=True),
+                                              policy_request(0, history, stages=True)]}
+    for item in line["batch"]:
+        del item["id"], item["protocol"]
+    answers, status, err = serve_lines(staged_policy, [policy_request(0, history), line],
+                                       stages=STAGES, batched=True, batch_size=4, rng="numpy")
+    assert status == 0, err
+    first, second = answers[1]["batch"]
+    assert first["stages"] == second["stages"] and len(first["stages"]["decode"]) == 2
+
+
 @pytest.mark.parametrize("stages, says", [
     ([("a", "pose")], "kind 'pose'; a stage is \"poses\""),
     ([("a", "poses"), ("a", "features")], "names 'a' twice"),
