@@ -112,6 +112,15 @@ TEST_CASE("an_unnormalizer_adding_the_world_mean_breaks_at_unnormalize_under_rot
                            Contains("the policy's chunk: NOT equivariant"));
 }
 
+// Mutant: locate_plugin taking the answer's first output as the chunk (the gripper's widths,
+// invariant, passed as poses at T_0: an equivariant "chunk" beside the broken hand).
+TEST_CASE("a_plugin_with_named_outputs_has_its_first_pose_output_decided_as_its_chunk", "[unit]") {
+  const auto r = located_once("world_unnormalizer --outputs --batched", "se3");
+  CHECK(r.at("first_break") == "unnormalize");
+  CHECK_FALSE(r.at("chunk").at("equivariant").get<bool>());
+  CHECK(located_once("--outputs", "se3").at("chunk").at("equivariant").get<bool>());
+}
+
 TEST_CASE("locate_on_a_plugin_that_declares_no_stages_is_a_one_line_error", "[unit]") {
   const auto run = test::run_command(test::cli() + " audit --policy-exec '" +
                                      test::test_plugin("policy_hand_centric.py") +

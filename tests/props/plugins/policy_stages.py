@@ -18,6 +18,8 @@ argv picks a planted fault (locate must name its stage):
   world_unnormalizer the un-normalizer adds the world mean MU back after the decoder: equivariant
                      under translation, not under rotation: first break at 'unnormalize' (se3)
   --batched          served batched (the same numbers, row by row)
+  --outputs          answers named outputs, {"gripper": K widths (invariant), "hand": the chunk}
+                     (the gripper declared first: the chunk locate decides is the hand's)
 """
 import os
 import sys
@@ -28,7 +30,7 @@ import numpy as np  # noqa: E402
 import handcentric_plugin as hp  # noqa: E402
 
 ARGS = sys.argv[1:]
-FAULT = ([a for a in ARGS if a != "--batched"] or [""])[0]
+FAULT = ([a for a in ARGS if not a.startswith("--")] or [""])[0]
 K = 3
 RNG = np.random.default_rng(5)
 W1 = RNG.normal(size=(16, 6 + 6 + 8)) * 0.3
@@ -68,14 +70,19 @@ def policy(history, hand_points, world_points, noise):
         chunk = chunk.copy()
         chunk[:, :3, 3] += MU
     stages["unnormalize"] = chunk
+    if "--outputs" in ARGS:
+        return {"gripper": np.tanh(a[:K]), "hand": chunk}, stages
     return chunk, stages
 
 
 def policy_batch(history, hand_points, world_points, noise):
     rows = [policy(history[i], hand_points[i], world_points[i], noise[i])
             for i in range(len(noise))]
-    return (np.stack([r[0] for r in rows]),
-            {name: np.stack([r[1][name] for r in rows]) for name in rows[0][1]})
+    def stacked(values):
+        if isinstance(values[0], dict):
+            return {name: np.stack([v[name] for v in values]) for name in values[0]}
+        return np.stack(values)
+    return stacked([r[0] for r in rows]), stacked([r[1] for r in rows])
 
 
 def declared():
@@ -85,7 +92,10 @@ def declared():
 
 
 if __name__ == "__main__":
+    keywords = {"stages": declared()}
+    if "--outputs" in ARGS:
+        keywords["outputs"] = {"gripper": "invariant", "hand": "pose"}
     if "--batched" in ARGS:
-        hp.serve_policy(policy_batch, batched=True, batch_size=16, stages=declared())
+        hp.serve_policy(policy_batch, batched=True, batch_size=16, **keywords)
     else:
-        hp.serve_policy(policy, stages=declared())
+        hp.serve_policy(policy, **keywords)
