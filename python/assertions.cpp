@@ -169,7 +169,7 @@ void assert_equivariant(py::object policy, const std::string& group, const std::
                           "distribution (independent noise) or both");
   }
   CommonOptions o = common_options(py::str(group), views, cases, seed, tolerance, precision,
-                                   extra_poses, scalars, setup);
+                                   extra_poses, scalars, setup, {false, !hands.is_none()});
   props::ClassifierOptions c = classifier_for(o);
   c.in_distribution = mode != "pointwise";
   set_policy_call(o, c, rng, reset, action_format, state_format, "assert_equivariant");

@@ -50,6 +50,9 @@ struct CallOptions {
   std::string executed_output;
   /// hands=: the hands' names, the first the audit's own hand (hands.hpp); empty: one hand.
   std::vector<std::string> hands;
+  /// The other hands' histories are recorded (observations=), not drawn: read them from the
+  /// scene's "hand:h@-k" poses (props/observation/hands.hpp).
+  bool hands_recorded = false;
   /// Told the number of observations of every call before it is made (the audit's progress
   /// line, options.hpp's ProgressLine), or empty.
   std::function<void(std::size_t)> asked;

@@ -4,11 +4,16 @@
 
 namespace handcentric::python {
 
-std::optional<props::ClosedLoopOptions> closed_loop_from(py::handle episodes,
-                                                         py::handle episode_length) {
+std::optional<props::ClosedLoopOptions> closed_loop_from(
+    py::handle episodes, py::handle episode_length, const props::RecordedObservations* recorded) {
   const auto count =
       optional_integer(episodes, "episodes", 1, props::kMaxCases, "handcentric.MAX_CASES");
   const auto steps = optional_integer(episode_length, "episode_length", 1, 10000, "10000");
+  if (recorded && !recorded->episode.empty() && steps) {
+    throw InvalidArgument("episode_length=" + std::to_string(*steps) + " with the recorded " +
+                          "episodes of " + recorded->source +
+                          ": each is replayed as long as recorded; leave episode_length out");
+  }
   if (!count) {
     if (steps) {
       throw InvalidArgument("episode_length=" + std::to_string(*steps) +

@@ -11,13 +11,16 @@
 #include "options.hpp"
 #include "handcentric/props/checks/classifier.hpp"
 #include "handcentric/props/checks/closed_loop.hpp"
+#include "handcentric/props/observation/recorded.hpp"
 
 namespace handcentric::python {
 
 /// episodes= (None, or 1 to MAX_CASES) and episode_length= (1 to 10000) checked; nullopt when
-/// episodes is None.
-std::optional<props::ClosedLoopOptions> closed_loop_from(py::handle episodes,
-                                                         py::handle episode_length);
+/// episodes is None. With recorded episodes (`recorded` with an episode index, replayed as
+/// props/checks/recorded_episodes.hpp says) episodes= counts the recorded episodes replayed,
+/// from the first, and episode_length= is refused (each is as long as recorded).
+std::optional<props::ClosedLoopOptions> closed_loop_from(
+    py::handle episodes, py::handle episode_length, const props::RecordedObservations* recorded);
 
 /// The closed-loop verdicts of `policy` for every group and view of o, appended to `result`; with
 /// outputs=, those of o.call.output, the first pose output executed.

@@ -27,14 +27,17 @@ void set_hands(CommonOptions& o, props::ClassifierOptions& c, py::handle hands) 
     throw InvalidArgument("hands= names " + std::to_string(names.size()) +
                           " hand; with one hand leave hands= out (its history is an array)");
   }
-  if (o.audit.observations) {
-    throw InvalidArgument(
-        "hands= with observations= is not supported: recorded observations "
-        "carry one hand's history; audit the hands on drawn scenes");
-  }
   o.call.hands = names;
-  for (std::size_t h = 1; h < names.size(); ++h)
-    c.check.shape.extra_pose_names.push_back(kHandPosePrefix + names[h]);
+  if (o.audit.observations) {
+    // Every hand's history as recorded, the first hand's the scenes' own.
+    o.audit.observations = std::make_shared<const props::RecordedObservations>(
+        props::recorded_with_hands(*o.audit.observations, names));
+    c.check.shape.recorded = o.audit.observations;
+    o.call.hands_recorded = true;
+  } else {
+    for (std::size_t h = 1; h < names.size(); ++h)
+      c.check.shape.extra_pose_names.push_back(kHandPosePrefix + names[h]);
+  }
   // Each hand a pose output, first; the rest of outputs= after them.
   std::vector<NamedOutput> outputs;
   for (const std::string& hand : names) outputs.push_back({hand, OutputKind::pose});
@@ -57,21 +60,12 @@ py::object history_argument(const std::vector<const Scene*>& rows, const CallOpt
   out[py::str(options.hands.front())] =
       for_callable(history_in(rows, options.stacked, options.state_format), kind);
   for (std::size_t h = 1; h < options.hands.size(); ++h) {
-    // Scenes whose history is this hand's: S_k = S_0 T_0^-1 T_k (hands.hpp).
-    std::vector<Scene> moved;
-    moved.reserve(rows.size());
-    const std::string pose_name = kHandPosePrefix + options.hands[h];
-    for (const Scene* s : rows) {
-      const auto found = std::find_if(s->extra_poses.begin(), s->extra_poses.end(),
-                                      [&](const auto& p) { return p.first == pose_name; });
-      if (found == s->extra_poses.end())
-        throw InvalidArgument("the scene has no pose '" + pose_name + "' for hand " +
-                              options.hands[h]);
-      Scene other;
-      const RigidTransform S0_T_T0 = found->second * s->world_T_hand_history.front().inverse();
-      for (const RigidTransform& T : s->world_T_hand_history)
-        other.world_T_hand_history.push_back(S0_T_T0 * T);
-      moved.push_back(std::move(other));
+    // Scenes whose history is this hand's: as recorded, or S_k = S_0 T_0^-1 T_k (hands.hpp).
+    std::vector<Scene> moved(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      moved[r].world_T_hand_history = options.hands_recorded
+                                          ? props::recorded_hand_history(*rows[r], options.hands[h])
+                                          : props::other_hand_history(*rows[r], options.hands[h]);
     }
     std::vector<const Scene*> pointers;
     for (const Scene& m : moved) pointers.push_back(&m);

@@ -131,8 +131,8 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   if (!PyCallable_Check(policy.ptr()))
     throw DtypeError("policy must be callable, got a " + type_name(policy));
   const int noise = noise_of(noise_length);
-  CommonOptions o =
-      common_options(groups, views, cases, seed, tolerance, precision, extra_poses, scalars, setup);
+  CommonOptions o = common_options(groups, views, cases, seed, tolerance, precision, extra_poses,
+                                   scalars, setup, {!episodes.is_none(), !hands.is_none()});
   props::ClassifierOptions c = classifier_for(o);
   c.law_from_pointwise = !test_law;
   set_policy_call(o, c, rng, reset, action_format, state_format, "audit_policy");
@@ -141,7 +141,7 @@ py::dict audit_policy(py::object policy, py::handle groups, py::handle views, py
   o.call.asked = [&progress](std::size_t rows) { progress.asked(rows); };
   o.call.outputs = outputs_from(outputs, hands.is_none());
   set_hands(o, c, hands);
-  const auto loop = closed_loop_from(episodes, episode_length);
+  const auto loop = closed_loop_from(episodes, episode_length, o.audit.observations.get());
   if (o.call.outputs.empty()) {
     props::Classification result = props::classify_policy(batched_policy(policy, noise, o), c);
     if (loop) add_closed_loop(result, policy, noise, o, c, *loop);
@@ -364,11 +364,15 @@ each pose entry must move with g, each invariant entry (numbers of any shape) mu
 each check of the result carries its "output", and "outputs" gives each one's summary.
 hands=("left", "right"): history is a dict {hand: (H+1, 4, 4)} and the policy's dict holds one
 chunk per hand, each a "pose" output (verdicts per hand); the hands after the first are drawn
-as extra poses "hand:<name>" that move with g.
+as extra poses "hand:<name>" that move with g, or with observations= as recorded (each
+observation's "history" a dict {hand: (H+1, 4, 4)}).
 episodes=N, episode_length=T (default 16): closed-loop checks too (mode "closed_loop"): for
 each group and view, N episodes, each two rollouts of T steps from o and g o with the same noise,
 reset= called once at the start of each (the policy keeps its state through the episode), the
-first pose of each answer executed; the executed poses must agree with g step by step.
+first pose of each answer executed; the executed poses must agree with g step by step. With
+observations= whose observations carry an "episode" integer, episodes=N replays the first N
+recorded episodes as recorded instead (one g per episode; the hand does not move to the executed
+pose; no episode_length=).
 Each pointwise case draws its own noise (the same for o and g o), so a policy that passed the
 preflight and holds pointwise holds in law too: such a cell's in-distribution verdict says
 method "from_pointwise" and asks nothing more. test_law=True runs the in-distribution tests on

@@ -1,6 +1,7 @@
 #include "observations.hpp"
 
 #include <map>
+#include <optional>
 #include <string>
 
 #include "arrays.hpp"
@@ -10,7 +11,7 @@ namespace {
 
 constexpr const char* kForm =
     "give dicts with the keys history, chunk, hand_points, world_points, extra_poses, scalars, "
-    "held (docs/AUDIT.md, \"Your own observations\")";
+    "held, episode (docs/AUDIT.md, \"Your own observations\")";
 
 props::RecordedPart part_of(py::handle value, const std::string& what) {
   const RealArray a = real_array(value, what);
@@ -47,6 +48,7 @@ std::shared_ptr<const props::RecordedObservations> observations_of(py::handle va
                      type_name(value) + "; " + kForm);
   }
   std::vector<Scene> scenes;
+  std::vector<std::optional<std::int64_t>> episode;
   for (py::handle item : items) {
     const std::string where = "observations[" + std::to_string(scenes.size()) + "]";
     if (static_cast<long long>(scenes.size()) >= kMaxObservations)
@@ -57,7 +59,9 @@ std::shared_ptr<const props::RecordedObservations> observations_of(py::handle va
     std::map<std::string, props::RecordedPart> parts;
     for (const auto& [key_handle, part] : py::reinterpret_borrow<py::dict>(item)) {
       const std::string key = py::str(key_handle);
-      if (key == "extra_poses" || key == "scalars" || key == "held") {
+      // history={hand: (H+1, 4, 4)}: one history per hand ("history/NAME").
+      const bool per_hand = key == "history" && py::isinstance<py::dict>(part);
+      if (key == "extra_poses" || key == "scalars" || key == "held" || per_hand) {
         if (!py::isinstance<py::dict>(part))
           throw DtypeError(where + "['" + key + "'] must be a dict {name: value}");
         for (const auto& [name, named] : py::reinterpret_borrow<py::dict>(part)) {
@@ -69,11 +73,12 @@ std::shared_ptr<const props::RecordedObservations> observations_of(py::handle va
         parts[key] = part_of(part, where + "['" + key + "']");
       }
     }
+    episode.push_back(props::episode_of(parts, where));
     scenes.push_back(props::recorded_observation(parts, where));
   }
   std::string source = "a Python iterable";
   return std::make_shared<const props::RecordedObservations>(
-      props::recorded_observations(std::move(scenes), std::move(source)));
+      props::recorded_observations(std::move(scenes), std::move(source), episode));
 }
 
 }  // namespace handcentric::python

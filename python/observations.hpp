@@ -2,8 +2,9 @@
 // observations=: the user's own recorded observations for an audit (props/observation/
 // recorded.hpp): a path to a .jsonl or .npz file, or an iterable of dicts {"history": (H+1, 4, 4),
 // "chunk", "hand_points", "world_points", "extra_poses": {name: (4, 4)}, "scalars": {name:
-// number}, "held": {name: array}} of NumPy arrays, lists or torch tensors. Held arrays keep
-// float32 when given so (a policy's images), else become float64.
+// number}, "held": {name: array}, "episode": integer} of NumPy arrays, lists or torch tensors;
+// with several hands "history": {hand: (H+1, 4, 4)}. Held arrays keep float32 when given so (a
+// policy's images), else become float64.
 #include <pybind11/pybind11.h>
 
 #include <memory>

@@ -10,6 +10,7 @@
 #include "handcentric/core/errors.hpp"
 #include "handcentric/props/transport/plugin_protocol.hpp"
 #include "observations.hpp"
+#include "handcentric/props/observation/hands.hpp"
 
 namespace handcentric::python {
 namespace {
@@ -181,8 +182,21 @@ namespace {
 
 // observations=: the data fix the scenes' sizes and names; the callables get the recorded
 // extras; a view the data cannot tell apart from the other is audited once.
-void with_recorded(CommonOptions& o) {
+void with_recorded(CommonOptions& o, RecordedUse use) {
   const props::RecordedObservations& data = *o.audit.observations;
+  if (!data.episode.empty() && !use.episodes) {
+    throw InvalidArgument("the observations of " + data.source + " carry an 'episode' index (" +
+                          std::to_string(data.episodes().size()) +
+                          " episodes), which only the closed loop replays: give "
+                          "audit_policy(..., episodes=N), or leave 'episode' out");
+  }
+  const std::vector<std::string> hands = data.hands();
+  if (!hands.empty() && !use.hands) {
+    std::string named;
+    for (const std::string& h : hands) named += (named.empty() ? "\"" : ", \"") + h + "\"";
+    throw InvalidArgument("the observations of " + data.source +
+                          " record one history per hand: give hands=(" + named + ")");
+  }
   if (o.history || o.hand_points || o.world_points || o.chunk) {
     throw InvalidArgument(
         "history=, hand_points=, world_points= and chunk= fix the sizes of "
@@ -203,7 +217,10 @@ void with_recorded(CommonOptions& o) {
       throw InvalidArgument("scalars names '" + name + "', which the observations of " +
                             data.source + " do not record: add it under \"scalars\"");
   }
-  o.call.extras = o.call.extras || !first.extra_poses.empty() || !first.scalars.empty();
+  // The hands' poses reach the policy in history= (hands.hpp), not as extra poses.
+  const bool extra_poses = std::any_of(first.extra_poses.begin(), first.extra_poses.end(),
+                                       [](const auto& p) { return !props::is_hand_pose(p.first); });
+  o.call.extras = o.call.extras || extra_poses || !first.scalars.empty();
   if (!data.has_world_points() && o.audit.views.size() > 1)
     o.audit.views = {props::View::eye_in_hand};
 }
@@ -213,7 +230,7 @@ void with_recorded(CommonOptions& o) {
 CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
                              std::uint64_t seed, std::optional<double> tolerance,
                              const std::string& precision, py::handle extra_poses,
-                             py::handle scalars, const Setup& setup) {
+                             py::handle scalars, const Setup& setup, RecordedUse use) {
   CommonOptions o;
   o.audit.cases = cases_of(cases);
   o.audit.detect = detect_of(setup.detect, cases);
@@ -248,7 +265,7 @@ CommonOptions common_options(py::handle groups, py::handle views, py::handle cas
   o.call.cameras = camera_rig_of(setup, o.batch_size);
   o.audit.workspace = workspace_of(setup.workspace);
   o.audit.observations = observations_of(setup.observations);
-  if (o.audit.observations) with_recorded(o);
+  if (o.audit.observations) with_recorded(o, use);
   return o;
 }
 

@@ -70,7 +70,8 @@ recorded observations instead of random ones, each a dict of world-frame "histor
 (4, 4)}, which move with g, and "hand_points" (n, 3), "scalars" {name: number} and "held"
 {name: array} (a wrist camera's image, token ids), which g leaves alone; the callables then get
 the recorded extra_poses= and scalars= and held={name: array} (float32 kept) as keywords. Without
-world points in the data only the eye-in-hand view is audited.
+world points in the data only the eye-in-hand view is audited. "episode": an integer per
+observation, read by audit_policy's episodes= alone; with hands=, "history" is {hand: array}.
 A progress line with the time left goes to stderr after 3 s (quiet=True: none). Needs NumPy
 (ImportError at once without it); Ctrl-C stops it with KeyboardInterrupt.)doc";
 
@@ -101,10 +102,18 @@ std::optional<int> optional_integer(py::handle value, const char* name, long lon
 std::shared_ptr<const props::CameraRig> camera_rig_of(const Setup& setup,
                                                       std::optional<int> batch_size);
 
+/// What the caller does with recorded observations beyond single calls: replays their episodes
+/// (audit_policy with episodes=), audits several hands (hands=). Data that carry an episode index
+/// or one history per hand are refused otherwise, naming the keyword that reads them.
+struct RecordedUse {
+  bool episodes = false;
+  bool hands = false;
+};
+
 CommonOptions common_options(py::handle groups, py::handle views, py::handle cases,
                              std::uint64_t seed, std::optional<double> tolerance,
                              const std::string& precision, py::handle extra_poses,
-                             py::handle scalars, const Setup& setup);
+                             py::handle scalars, const Setup& setup, RecordedUse use = {});
 
 props::ClassifierOptions classifier_for(const CommonOptions& o);
 

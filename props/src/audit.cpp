@@ -9,6 +9,7 @@
 #include "handcentric/core/format.hpp"
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/core/representations.hpp"
+#include "handcentric/props/observation/recorded.hpp"
 #include "handcentric/props/tolerance.hpp"
 
 namespace handcentric::props {
@@ -182,10 +183,25 @@ ClassifierOptions classifier_options(const AuditOptions& options) {
 
 namespace {
 
+// The command line asks single observations of one hand: an episode index (read by the closed
+// loop) or one history per hand (read with hands=) would be silently misread; both are Python's.
+void require_single_calls(const RecordedObservations& data) {
+  if (!data.episode.empty())
+    throw InvalidArgument("the observations of " + data.source +
+                          " carry an 'episode' index, which only the closed loop of "
+                          "handcentric.audit_policy(..., episodes=N) replays: leave 'episode' out "
+                          "here");
+  if (!data.hands().empty())
+    throw InvalidArgument("the observations of " + data.source +
+                          " record one history per hand, which handcentric.audit_policy(..., "
+                          "hands=...) reads: record one history here");
+}
+
 // A plug-in's declared extra poses and scalars must be in recorded observations: the pipe would
 // otherwise fill the missing ones with placeholders the data never had.
 void require_recorded_names(const AuditOptions& audit, const PluginCapabilities& capabilities) {
   if (!audit.observations) return;
+  require_single_calls(*audit.observations);
   const Scene& first = audit.observations->scenes.front();
   auto has = [](const auto& named, const std::string& name) {
     return std::any_of(named.begin(), named.end(), [&](const auto& n) { return n.first == name; });
@@ -219,6 +235,7 @@ ClassifierOptions plugin_classifier_options(const AuditOptions& options,
 
 std::vector<Classification> audit_builtins(const std::vector<std::string>& names,
                                            const AuditOptions& options) {
+  if (options.observations) require_single_calls(*options.observations);
   const ClassifierOptions classifier = classifier_options(options);
   const std::vector<std::string> all = auditable_names();
   std::vector<Classification> out;

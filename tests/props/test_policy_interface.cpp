@@ -41,7 +41,7 @@ std::map<std::string, std::map<std::string, bool>> verdicts_by_output(const std:
 // Mutants: the result's output left unset (no "output" in the JSON); PipeOutput::select always
 // taking the first output (the gripper audited as the hand).
 TEST_CASE("a_shipped_policy_is_audited_in_its_own_layouts_output_by_output", "[unit]") {
-  const std::string flags = "--cases 40 --group translation --view eye_in_hand --json";
+  const std::string flags = "--cases 25 --group translation --view eye_in_hand --json";
   const auto held = test::run_command(shipped_audit("", flags));
   REQUIRE(held.exit_code == 0);
   const auto parsed = nlohmann::json::parse(held.out);
@@ -61,10 +61,7 @@ TEST_CASE("a_shipped_policy_is_audited_in_its_own_layouts_output_by_output", "[u
   const auto broken = verdicts_by_output(fault.out, "translation");
   CHECK(broken.at("hand").at("pointwise"));
   CHECK_FALSE(broken.at("gripper").at("pointwise"));
-  const auto text = test::run_command(shipped_audit("gripper_height",
-                                                    "--cases 40 --group "
-                                                    "translation --view "
-                                                    "eye_in_hand"));
+  const auto text = test::run_command(shipped_audit("", "--cases 25 --group translation"));
   CHECK_THAT(text.out, Contains("the plug-in's hello declares state_format pos_quat_xyzw") &&
                            Contains("output 'gripper' (invariant)"));
 }
@@ -73,7 +70,7 @@ TEST_CASE("a_shipped_policy_is_audited_in_its_own_layouts_output_by_output", "[u
 // left: its fault unseen). (The right hand's history sent as the left's is caught below, by
 // a_request_under_an_interface_speaks_the_policy_layouts: this policy's fault shows either way.)
 TEST_CASE("two_hands_are_audited_per_hand_and_a_witness_names_the_hand", "[unit]") {
-  const std::string flags = "--cases 40 --group translation --view eye_in_hand --json";
+  const std::string flags = "--cases 25 --group translation --view eye_in_hand --json";
   const auto held = test::run_command(shipped_audit("--hands", flags));
   REQUIRE(held.exit_code == 0);
   const auto all = verdicts_by_output(held.out, "translation");
@@ -133,6 +130,10 @@ TEST_CASE("a_layout_the_numbers_contradict_is_an_error_naming_the_pose", "[unit]
   CHECK(bad.exit_code != 0);
   CHECK_THAT(bad.err, Contains("\"outputs\"[\"hand\"][0]") && Contains("norm 1.5") &&
                           Contains("pos_quat_xyzw"));
+  // Mutant: the lengths of invariant outputs not checked (their poses compared instead: NO).
+  const auto length = test::run_command(shipped_audit("gripper_length", flags));
+  CHECK(length.exit_code != 0);
+  CHECK_THAT(length.err, Contains("output \"gripper\" 3 numbers after 4"));
   const auto undeclared = test::run_command(shipped_audit("undeclared", flags));
   CHECK(undeclared.exit_code != 0);
   CHECK_THAT(undeclared.err, Contains("action_format="));

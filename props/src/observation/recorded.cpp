@@ -1,6 +1,7 @@
 #include "handcentric/props/observation/recorded.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -9,6 +10,7 @@
 #include "../wire_arrays.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/format.hpp"
+#include "handcentric/props/observation/hands.hpp"
 #include "npz.hpp"
 
 namespace handcentric::props {
@@ -17,7 +19,7 @@ namespace {
 using Part = RecordedPart;
 
 constexpr const char* kParts =
-    "history, chunk, hand_points, world_points, extra_poses, scalars, held";
+    "history, chunk, hand_points, world_points, extra_poses, scalars, held, episode";
 
 // Nested JSON lists of numbers into a rectangular array (a ragged list is an error).
 void flatten(const nlohmann::json& v, std::size_t depth, int& leaf_depth, Part& out,
@@ -122,6 +124,7 @@ Scene recorded_observation(const std::map<std::string, RecordedPart>& parts,
                            const std::string& where) {
   Scene s;
   bool has_history = false;
+  std::vector<std::pair<std::string, std::vector<RigidTransform>>> hands;  // history/NAME
   for (const auto& [key, part] : parts) {
     const std::string at = where + " '" + key + "'";
     require_finite(part, at);
@@ -133,6 +136,8 @@ Scene recorded_observation(const std::map<std::string, RecordedPart>& parts,
     if (key == "history") {
       s.world_T_hand_history = poses_of(part, at, true);
       has_history = true;
+    } else if (kind == "history" && !name.empty()) {
+      hands.emplace_back(name, poses_of(part, at, true));
     } else if (key == "chunk") {
       s.world_T_hand_chunk = poses_of(part, at, true);
     } else if (key == "hand_points") {
@@ -142,6 +147,10 @@ Scene recorded_observation(const std::map<std::string, RecordedPart>& parts,
     } else if (kind == "extra_poses" && !name.empty()) {
       if (part.shape != std::vector<std::int64_t>{4, 4})
         throw InvalidArgument(at + " has shape " + shape_text(part.shape) + "; expected (4, 4)");
+      if (is_hand_pose(name))
+        throw InvalidArgument(at + ": the names \"" + kHandPosePrefix +
+                              "...\" are the hands'; record a hand's poses under history as "
+                              "{hand: (H+1, 4, 4)}");
       s.extra_poses.emplace_back(name, pose_of(part.values.data(), at));
     } else if (kind == "scalars" && !name.empty()) {
       if (part.values.size() != 1 || part.shape.size() > 1)
@@ -159,11 +168,45 @@ Scene recorded_observation(const std::map<std::string, RecordedPart>& parts,
                             " (extra_poses, scalars and held by name)");
     }
   }
+  if (hands.size() == 1)
+    throw InvalidArgument(where + " has one history per hand for one hand, '" +
+                          hands.front().first +
+                          "': with one hand give 'history' as an array (H+1, 4, 4)");
+  if (has_history && !hands.empty())
+    throw InvalidArgument(where + " has both 'history' and 'history/" + hands.front().first +
+                          "': record one history, or one per hand {hand: (H+1, 4, 4)}");
+  // One history per hand: every hand as its extra poses (observation/hands.hpp), the first in
+  // sorted order the scene's own until recorded_with_hands() picks the audit's first hand.
+  for (const auto& [hand, history] : hands) {
+    for (std::size_t k = 0; k < history.size(); ++k)
+      s.extra_poses.emplace_back(hand_pose_name(hand, static_cast<int>(k)), history[k]);
+  }
+  if (!hands.empty()) {
+    s.world_T_hand_history = hands.front().second;
+    has_history = true;
+  }
   if (!has_history)
     throw InvalidArgument(where +
                           " has no 'history' (H+1, 4, 4) of world_T_hand poses; every "
                           "observation needs at least the hand now");
   return s;
+}
+
+std::optional<std::int64_t> episode_of(std::map<std::string, RecordedPart>& parts,
+                                       const std::string& where) {
+  const auto found = parts.find("episode");
+  if (found == parts.end()) return std::nullopt;
+  const Part part = std::move(found->second);
+  parts.erase(found);
+  const double value = part.values.size() == 1 ? part.values.front() : 0.5;
+  if (part.values.size() != 1 || part.shape.size() > 1)
+    throw InvalidArgument(where + " 'episode' has shape " + shape_text(part.shape) +
+                          "; an episode index is one integer per observation");
+  if (!(std::abs(value) < 9e15) || std::round(value) != value)
+    throw InvalidArgument(where + " 'episode' is " + format_number(value) +
+                          "; an episode index is an integer: give each observation's episode "
+                          "as 0, 1, 2, ...");
+  return static_cast<std::int64_t>(value);
 }
 
 namespace {
@@ -175,7 +218,9 @@ std::map<std::string, Part> parts_of_line(const nlohmann::json& line, const std:
                           ", not an object with the parts " + kParts);
   std::map<std::string, Part> parts;
   for (const auto& [key, value] : line.items()) {
-    if (key == "extra_poses" || key == "scalars" || key == "held") {
+    // {hand: history}: an object that is not an encoded array (those carry "data").
+    const bool per_hand = key == "history" && value.is_object() && !value.contains("data");
+    if (key == "extra_poses" || key == "scalars" || key == "held" || per_hand) {
       if (!value.is_object())
         throw InvalidArgument(where + " '" + key + "' must be an object {name: value}");
       for (const auto& [name, item] : value.items())
@@ -191,17 +236,24 @@ bool ends_with(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-std::vector<Scene> from_npz(const std::map<std::string, npz::Array>& arrays,
-                            const std::string& path) {
-  const auto history = arrays.find("history");
+/// An .npz's observations: the arrays split along their first axis, N counted by "history" (or
+/// the first "history/NAME" of several hands').
+RecordedObservations from_npz(const std::map<std::string, npz::Array>& arrays,
+                              const std::string& path) {
+  auto history = arrays.find("history");
+  if (history == arrays.end()) {
+    history = arrays.lower_bound("history/");
+    if (history != arrays.end() && history->first.rfind("history/", 0) != 0) history = arrays.end();
+  }
   if (history == arrays.end() || history->second.shape.empty())
     throw InvalidArgument("observations file '" + path +
                           "' has no array 'history' of shape (N, H+1, 4, 4)");
+  const std::string& counted = history->first;
   const std::int64_t n = history->second.shape[0];
   // Each observation has at least one pose of 16 numbers: bounds N before one map per
   // observation is made (a shape such as (10**12, 0, 4, 4) holds no numbers at all).
   if (history->second.values.size() / 16 < static_cast<std::uint64_t>(n))
-    throw InvalidArgument("observations file '" + path + "': array 'history' has shape " +
+    throw InvalidArgument("observations file '" + path + "': array '" + counted + "' has shape " +
                           shape_text(history->second.shape) +
                           "; expected (N, H+1, 4, 4) with H+1 >= 1");
   std::vector<std::map<std::string, Part>> per(static_cast<std::size_t>(n));
@@ -209,7 +261,7 @@ std::vector<Scene> from_npz(const std::map<std::string, npz::Array>& arrays,
     if (a.shape.empty() || a.shape[0] != n)
       throw InvalidArgument("observations file '" + path + "': array '" + name + "' has shape " +
                             shape_text(a.shape) + "; every array's first axis counts the " +
-                            std::to_string(n) + " observations of 'history'");
+                            std::to_string(n) + " observations of '" + counted + "'");
     const std::vector<std::int64_t> item_shape(a.shape.begin() + 1, a.shape.end());
     const std::size_t item = n == 0 ? 0 : a.values.size() / static_cast<std::size_t>(n);
     for (std::int64_t i = 0; i < n; ++i) {
@@ -222,11 +274,13 @@ std::vector<Scene> from_npz(const std::map<std::string, npz::Array>& arrays,
     }
   }
   std::vector<Scene> out;
+  std::vector<std::optional<std::int64_t>> episode;
   for (std::int64_t i = 0; i < n; ++i) {
-    out.push_back(recorded_observation(per[static_cast<std::size_t>(i)],
-                                       path + " observation " + std::to_string(i)));
+    const std::string where = path + " observation " + std::to_string(i);
+    episode.push_back(episode_of(per[static_cast<std::size_t>(i)], where));
+    out.push_back(recorded_observation(per[static_cast<std::size_t>(i)], where));
   }
-  return out;
+  return recorded_observations(std::move(out), path, episode);
 }
 
 template <class Pairs>
@@ -263,6 +317,42 @@ void RecordedObservations::validate() const {
     }
     for (const auto& [name, array] : s.held) array->validate(name);
   }
+  if (!episode.empty() && episode.size() != scenes.size())
+    throw InvalidArgument("the observations of " + source + " have " +
+                          std::to_string(scenes.size()) + " observations but " +
+                          std::to_string(episode.size()) + " episode indices: give one each");
+  // An episode's observations together: an index that comes back after another's is an error.
+  std::map<std::int64_t, std::size_t> ended;  // episode -> its last observation
+  for (const RecordedEpisode& e : episodes()) {
+    const auto seen = ended.find(e.index);
+    if (seen != ended.end()) {
+      throw InvalidArgument(source + " observation " + std::to_string(e.first) + " is of episode " +
+                            std::to_string(e.index) + ", which ended at observation " +
+                            std::to_string(seen->second) +
+                            ": keep each episode's observations together, in their order");
+    }
+    ended[e.index] = e.first + e.steps - 1;
+  }
+}
+
+std::vector<RecordedEpisode> RecordedObservations::episodes() const {
+  std::vector<RecordedEpisode> out;
+  for (std::size_t i = 0; i < episode.size(); ++i) {
+    if (out.empty() || out.back().index != episode[i]) out.push_back({episode[i], i, 0});
+    ++out.back().steps;
+  }
+  return out;
+}
+
+std::vector<std::string> RecordedObservations::hands() const {
+  std::vector<std::string> out;
+  if (scenes.empty()) return out;
+  for (const auto& [name, pose] : scenes.front().extra_poses) {
+    if (is_hand_pose(name) && name.find("@-") == std::string::npos)
+      out.push_back(name.substr(std::string(kHandPosePrefix).size()));
+  }
+  std::sort(out.begin(), out.end());
+  return out;
 }
 
 bool RecordedObservations::has_world_points() const {
@@ -285,9 +375,20 @@ void RecordedObservations::require_inside(const Workspace& box) const {
   }
 }
 
-RecordedObservations recorded_observations(std::vector<Scene> scenes, std::string source) {
+RecordedObservations recorded_observations(
+    std::vector<Scene> scenes, std::string source,
+    const std::vector<std::optional<std::int64_t>>& episode) {
   RecordedObservations out;
   out.source = std::move(source);
+  const auto without = std::find(episode.begin(), episode.end(), std::nullopt);
+  if (without != episode.end() &&
+      std::any_of(episode.begin(), episode.end(), [](const auto& e) { return e.has_value(); })) {
+    throw InvalidArgument(out.source + " observation " + std::to_string(without - episode.begin()) +
+                          " has no 'episode' while others have one: give every observation its "
+                          "episode, or none");
+  }
+  for (const std::optional<std::int64_t>& e : episode)
+    if (e) out.episode.push_back(*e);
   out.has_chunks = !scenes.empty();
   for (Scene& s : scenes) {
     out.has_chunks = out.has_chunks && !s.world_T_hand_chunk.empty();
@@ -301,6 +402,7 @@ RecordedObservations recorded_observations(std::vector<Scene> scenes, std::strin
 
 RecordedObservations observations_from_json_lines(std::istream& in, const std::string& source) {
   std::vector<Scene> scenes;
+  std::vector<std::optional<std::int64_t>> episode;
   std::string line;
   for (std::size_t number = 1; std::getline(in, line); ++number) {
     if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
@@ -312,20 +414,20 @@ RecordedObservations observations_from_json_lines(std::istream& in, const std::s
       throw InvalidArgument(where + " is not JSON (" + e.what() +
                             "): write one observation object per line");
     }
-    scenes.push_back(recorded_observation(parts_of_line(parsed, where), where));
+    std::map<std::string, Part> parts = parts_of_line(parsed, where);
+    episode.push_back(episode_of(parts, where));
+    scenes.push_back(recorded_observation(parts, where));
   }
   if (in.bad()) throw FileError("cannot read the observations of " + source);
-  return recorded_observations(std::move(scenes), source);
+  return recorded_observations(std::move(scenes), source, episode);
 }
 
 RecordedObservations observations_from_npz(std::string_view bytes, const std::string& source) {
-  return recorded_observations(from_npz(npz::read_bytes(bytes, source, kMaxRecordedBytes), source),
-                               source);
+  return from_npz(npz::read_bytes(bytes, source, kMaxRecordedBytes), source);
 }
 
 RecordedObservations read_observations(const std::string& path) {
-  if (ends_with(path, ".npz"))
-    return recorded_observations(from_npz(npz::read(path, kMaxRecordedBytes), path), path);
+  if (ends_with(path, ".npz")) return from_npz(npz::read(path, kMaxRecordedBytes), path);
   if (!ends_with(path, ".jsonl") && !ends_with(path, ".json-lines") && !ends_with(path, ".ndjson"))
     throw InvalidArgument("observations file '" + path +
                           "' is neither .jsonl nor .npz: name it by its format");

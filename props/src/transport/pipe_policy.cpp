@@ -45,9 +45,8 @@ const PluginCapabilities& PipePolicy::capabilities() const {
   capabilities_ = capabilities;
   const Scene asked = with_extras(probe);
   if (reply.hello) reply = exchange_one(asked, fixed_noise(capabilities.noise, 1));
-  lengths_.clear();
-  for (const std::vector<RigidTransform>& output : remember({}, std::move(reply), asked, "probe"))
-    lengths_.push_back(output.size());
+  lengths_.clear();  // set by the probe's answer
+  (void)remember({}, std::move(reply), asked, "probe");
   cache_.clear();  // the probe's answer was kept under an empty key
   return *capabilities_;
 }
@@ -117,13 +116,17 @@ PipePolicy::Answer PipePolicy::remember(std::string key, PluginReply reply,
                                         const Scene& observation, const std::string& where) const {
   const PolicyInterface& interface = capabilities_->policy;
   Answer answer;
+  std::vector<std::size_t> lengths;  // poses per output; an invariant output's numbers
   if (!interface.named()) {
+    lengths.push_back(reply.chunk.size());
     answer.push_back(std::move(reply.chunk));
   } else {
     // Invariant numbers as poses at T_0 (named_output.hpp): the checks decide them as poses.
     const RigidTransform& T0 = observation.world_T_hand_history.at(0);
     for (std::size_t o = 0; o < interface.outputs.size(); ++o) {
       OutputValue& value = reply.outputs.at(o);
+      const bool pose = interface.outputs[o].kind == OutputKind::pose;
+      lengths.push_back(pose ? value.poses.size() : static_cast<std::size_t>(value.numbers.size()));
       answer.push_back(interface.outputs[o].kind == OutputKind::pose
                            ? std::move(value.poses)
                            : invariant_as_poses(value.numbers.data(),
@@ -131,15 +134,16 @@ PipePolicy::Answer PipePolicy::remember(std::string key, PluginReply reply,
                                                 T0));
     }
   }
-  for (std::size_t o = 0; o < lengths_.size() && o < answer.size(); ++o) {
-    if (answer[o].size() == lengths_[o]) continue;
+  if (lengths_.empty()) lengths_ = lengths;  // the probe's
+  for (std::size_t o = 0; o < lengths_.size() && o < lengths.size(); ++o) {
+    if (lengths[o] == lengths_[o]) continue;
+    const bool pose = !interface.named() || interface.outputs[o].kind == OutputKind::pose;
     const std::string what =
         interface.named() ? "output \"" + interface.outputs[o].name + "\" " : std::string();
     connection_.fail(connection_.who() + " answered policy " + where + " with " + what +
-                     std::to_string(answer[o].size()) +
-                     (interface.named() ? " entries" : " poses") + " after " +
+                     std::to_string(lengths[o]) + (pose ? " poses" : " numbers") + " after " +
                      std::to_string(lengths_[o]) +
-                     " for the probe; its length (the chunk length K) must not change");
+                     " for the probe; an output's length (the chunk length K) must not change");
   }
   if (episode_) return answer;                 // a step of a stateful rollout is no answer to keep
   if (cache_.size() > 200000) cache_.clear();  // bounded memory over long audits

@@ -10,6 +10,7 @@ argv picks planted faults (the audit must find each):
   gripper_height  the gripper width reads the hand's WORLD height: NO under translation (and
                   se3) for the gripper only, the hand chunk still equivariant
   bad_quat        answers quaternions of norm 1.5: a layout the numbers contradict (an error)
+  gripper_length  one gripper width fewer where the hand's world x is positive (an error)
   undeclared      answers its 7-number poses without declaring action_format (an error)
   --hands         two hands; with right_world_x the right hand's chunk reads its WORLD x: NO
                   under translation for the right hand, the left still equivariant
@@ -58,6 +59,8 @@ def one_hand(history, hand_points, noise):
     chunk, gripper = plan(T0, feature, hand_points, noise)
     if FAULT == "gripper_height":
         gripper = gripper + T0[2, 3]
+    if FAULT == "gripper_length" and T0[0, 3] > 0:
+        gripper = gripper[:-1]
     if "--stateful" in ARGS:
         if FAULT == "world_memory" and state["previous"] is not None:
             chunk[:, :3, 3] += 0.1 * state["previous"]

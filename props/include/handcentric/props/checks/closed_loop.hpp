@@ -17,6 +17,8 @@
 // scene; chunks of different lengths differ; a larger
 // difference that is at most 8 times the rollout's own response to a rounding-level
 // perturbation of its scene (and that response rounding-sized) is rounding, as in check.hpp.
+// Recorded observations with an episode index (options.shape.recorded) are replayed instead, as
+// recorded_episodes.hpp says; without an index, the episodes start from recorded observations.
 // A "yes" says so for the episodes run: a breaking that needs more steps, or a state the
 // episodes never reach, is not seen (the verdict's cases are its episodes).
 #include <functional>
@@ -28,8 +30,8 @@
 namespace handcentric::props {
 
 struct ClosedLoopOptions {
-  int episodes = 20;  ///< 1 to kMaxCases
-  int steps = 16;     ///< the episode's length T, 1 to 10000
+  int episodes = 20;  ///< 1 to kMaxCases (recorded: 1 to the number recorded)
+  int steps = 16;     ///< the episode's length T, 1 to 10000 (recorded: not read)
   /// Called before each rollout (the policy's reset); may be empty.
   std::function<void()> start_episode;
   /// The poses of each returned chunk before this index are executed, not compared: 1 when the

@@ -14,6 +14,15 @@
 //   hand_points    (n, 3) hand frame, optional                          held fixed
 //   scalars        {name: number} (a gripper's width)                   held fixed
 //   held           {name: array} (a wrist camera's image, token ids)    held fixed
+//   episode        an integer, optional: the recorded episode the observation belongs to
+//
+// With several hands, history is one per hand, {hand: (H+1, 4, 4)} ("history/NAME" in a .npz),
+// each moving with g (observation/hands.hpp says how a scene carries them).
+//
+// An episode index (every observation's, or none) makes the observations episodes for the
+// closed loop (checks/recorded_episodes.hpp): the observations of one episode together and in
+// their order, the episodes in the order they first appear; an index that comes back after
+// another episode's observations is an error, not a new episode.
 //
 // Held fixed is the eye-in-hand assumption of Theorem 1: what moves with the hand looks the same
 // in o and g o. An array that is in fact world-frame (a third-person image, an object position)
@@ -24,12 +33,14 @@
 // arrays as nested lists or the pipe's encoded arrays {"dtype", "shape", "data"}; or NumPy's
 // .npz (np.savez or np.savez_compressed), one array per part with the observations along a
 // leading axis: "history" (N, H+1, 4, 4), "chunk", "hand_points", "world_points",
-// "extra_poses/NAME" (N, 4, 4), "scalars/NAME" (N,), "held/NAME" (N, ...). docs/AUDIT.md,
+// "extra_poses/NAME" (N, 4, 4), "scalars/NAME" (N,), "held/NAME" (N, ...), "episode" (N,)
+// integers, "history/NAME" (N, H+1, 4, 4) per hand. docs/AUDIT.md,
 // "Your own observations".
 #include <cstddef>
 #include <cstdint>
 #include <istream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,14 +49,30 @@
 
 namespace handcentric::props {
 
+/// One recorded episode: its index as recorded and where its observations are.
+struct RecordedEpisode {
+  std::int64_t index = 0;  ///< the "episode" value its observations carry
+  std::size_t first = 0;   ///< its first observation in RecordedObservations::scenes
+  std::size_t steps = 0;   ///< how many observations it has, in order
+};
+
 struct RecordedObservations {
   std::vector<Scene> scenes;  ///< world frame; a scene without a recorded chunk has T_1 = T_0
   bool has_chunks = false;    ///< every observation recorded its chunk
   std::string source;         ///< "data.jsonl", "a Python iterable"
+  /// Each observation's "episode", or empty when the data record none.
+  std::vector<std::int64_t> episode;
+
+  /// The recorded episodes in the order they appear (empty without an episode index).
+  std::vector<RecordedEpisode> episodes() const;
+
+  /// The hands whose histories are recorded one per hand, sorted; empty with one history.
+  std::vector<std::string> hands() const;
 
   /// Throws InvalidArgument naming the observation, the part and the fix: none at all; a part
   /// that is not finite or not a rigid transform; names (extra poses, scalars, held arrays) that
-  /// differ from the first observation's (every observation carries the same, in one order).
+  /// differ from the first observation's (every observation carries the same, in one order); an
+  /// episode index of another length than scenes, or whose episode comes back after another's.
   void validate() const;
 
   /// Whether some observation has world points (the third-person view has something to move).
@@ -74,8 +101,9 @@ struct RecordedPart {
   bool float32 = false;        ///< a held array handed over as float32 (an image)
 };
 
-/// One observation from its parts, keyed "history", "chunk", "hand_points", "world_points",
-/// "extra_poses/NAME", "scalars/NAME", "held/NAME" (a std::map: names in one sorted order).
+/// One observation from its parts, keyed "history" (or "history/HAND" per hand), "chunk",
+/// "hand_points", "world_points", "extra_poses/NAME", "scalars/NAME", "held/NAME" (a std::map:
+/// names in one sorted order); "episode" is not a part of the scene (take it with episode_of).
 /// Poses need a last row (0, 0, 0, 1) to 1e-6 and a rotation block orthonormal to 1e-5 (a
 /// float32 dataset's are to ~1e-7), which is projected onto the nearest rotation so that g T is
 /// a rigid transform. Throws InvalidArgument naming `where`, the part and the fix. A scene
@@ -83,9 +111,18 @@ struct RecordedPart {
 Scene recorded_observation(const std::map<std::string, RecordedPart>& parts,
                            const std::string& where);
 
+/// Removes the part "episode" from `parts` and returns it: nullopt when absent. Throws
+/// InvalidArgument naming `where` and the value when it is not one integer.
+std::optional<std::int64_t> episode_of(std::map<std::string, RecordedPart>& parts,
+                                       const std::string& where);
+
 /// The observations, each without a chunk given T_1 = T_0 (a whole policy never reads it; a
-/// representation audit refuses data whose has_chunks is false), validated.
-RecordedObservations recorded_observations(std::vector<Scene> scenes, std::string source);
+/// representation audit refuses data whose has_chunks is false), with their episode index
+/// (empty, or one per scene: some with and some without is an error naming the first without),
+/// validated.
+RecordedObservations recorded_observations(
+    std::vector<Scene> scenes, std::string source,
+    const std::vector<std::optional<std::int64_t>>& episode = {});
 
 /// The largest file (or decompressed .npz member) read_observations accepts: 4 GiB.
 inline constexpr std::size_t kMaxRecordedBytes = std::size_t{1} << 32;

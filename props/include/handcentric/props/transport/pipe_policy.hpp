@@ -113,7 +113,8 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   mutable std::optional<PluginCapabilities> capabilities_;
   std::optional<Scene> probe_;  ///< use_probe()'s scene
   mutable std::unordered_map<std::string, Answer> cache_;
-  /// Each output's length in the probe's answer (poses; an invariant's too): it must not change.
+  /// Each output's length in the probe's answer (poses; an invariant output's numbers): it
+  /// must not change.
   mutable std::vector<std::size_t> lengths_;
   mutable std::optional<EpisodeStep> episode_;
   mutable int episodes_started_ = 0;
