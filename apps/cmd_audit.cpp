@@ -10,6 +10,7 @@
 //   handcentric audit --model hc.model
 //   handcentric audit --model image.model --floor   # the hand camera sees the table too
 //   handcentric audit --model hc.model --locate --group se3   # the first layer that breaks
+//   handcentric audit --policy-exec 'python3 p.py' --locate   # the first stage that breaks
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -22,6 +23,7 @@
 #include "handcentric/core/flow_target.hpp"
 #include "handcentric/experiments/model_audit.hpp"
 #include "handcentric/experiments/model_locate.hpp"
+#include "handcentric/experiments/plugin_locate.hpp"
 #include "handcentric/experiments/witness_panel.hpp"
 #include "handcentric/policy/learned_policy.hpp"
 #include "handcentric/policy/model_file.hpp"
@@ -55,7 +57,7 @@ struct AuditCommandOptions {
   bool pointwise = false;
   bool test_law = false;
   bool floor = false;
-  bool locate = false;  // --locate (model_locate.hpp)
+  bool locate = false;  // --locate (model_locate.hpp, plugin_locate.hpp)
   std::string exec, policy_exec, model;
   std::vector<std::string> extra_poses, scalars, expect;
   std::string profile, out;  // --profile GROUP --out DIR (audit_profile.hpp)
@@ -115,17 +117,19 @@ int gate(const std::vector<props::Classification>& results,
 
 // --locate: refused in one line, naming the fix, with what it cannot honour.
 void check_locate_options(const AuditCommandOptions& options) {
-  if (options.model.empty()) {
+  if (options.model.empty() && options.policy_exec.empty()) {
     throw InvalidArgument(
-        "--locate looks inside a trained model of this library: give --model FILE (a Python "
-        "policy: handcentric.locate, docs/AUDIT.md \"Localizing a break\")");
+        "--locate looks inside a trained model of this library or a plug-in's declared stages: "
+        "give --model FILE or --policy-exec COMMAND (a Python policy: handcentric.locate, "
+        "docs/AUDIT.md \"Localizing a break\")");
   }
   const std::pair<bool, const char*> unhonoured[] = {
       {!options.expect.empty(), "--expect (a gate: run it without --locate)"},
       {!options.witness_dir.empty(), "--witness-dir (the witness is printed)"},
       {options.test_law, "--test-law (locate asks pointwise cases only)"},
       {options.pointwise, "--pointwise (locate is pointwise already)"},
-      {!options.extra_poses.empty() || !options.scalars.empty(),
+      {options.episodes > 0, "--episodes (locate asks single calls)"},
+      {!options.model.empty() && (!options.extra_poses.empty() || !options.scalars.empty()),
        "--extra-poses and --scalars (a model reads neither)"}};
   for (const auto& [given, flag] : unhonoured) {
     if (given)
@@ -133,10 +137,16 @@ void check_locate_options(const AuditCommandOptions& options) {
   }
 }
 
-// --model M --locate: one table per group (or one JSON document), exit 0 whatever it finds.
+// --model M --locate, --policy-exec CMD --locate: one table per group (a plug-in's: per view and
+// group), or one JSON document; exit 0 whatever it finds.
 int run_locate(const AuditCommandOptions& options, props::AuditOptions& audit, bool named_groups) {
   const std::vector<experiments::ModelLocation> located =
-      experiments::locate_model(options.model, options.model, audit, named_groups, options.floor);
+      options.model.empty()
+          ? experiments::locate_plugin(
+                options.policy_exec, audit,
+                props::PluginAuditSetup{options.timeout, options.extra_poses, options.scalars, {}})
+          : experiments::locate_model(options.model, options.model, audit, named_groups,
+                                      options.floor);
   if (options.json) {
     std::cout << experiments::locate_json(located);
     return 0;
@@ -346,10 +356,11 @@ void add_audit_command(CLI::App& app, int& exit_code) {
       "--model of an image policy of the 3D task: its hand camera also sees a table fixed in the "
       "world (z <= 0), which g does not move with the scene");
   cmd->add_flag("--locate", options->locate,
-                "--model only: where the model breaks the symmetry, layer by layer (each "
+                "with --model: where the model breaks the symmetry, layer by layer (each "
                 "layer's output invariant, the decoded chunk equivariant, on the audit's "
-                "pointwise cases), the first layer that breaks with its witness (docs/AUDIT.md, "
-                "\"Localizing a break\")");
+                "pointwise cases), the first layer that breaks with its witness; with "
+                "--policy-exec: the same for the stages its hello declares, each by its kind "
+                "(docs/AUDIT.md, \"Localizing a break\")");
   floor->needs(model);
   exec->excludes(repr)->excludes(policy_exec)->excludes(model);
   policy_exec->excludes(repr)->excludes(model);

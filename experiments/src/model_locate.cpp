@@ -1,5 +1,6 @@
-// locate_layers: the audit's pointwise cases asked with every layer watched, each output decided
-// as python/handcentric/locate.py decides it (_Decider), one case at a time.
+// locate_watched: the audit's pointwise cases asked with every output watched (a model's layers,
+// a plug-in's stages), each output decided as python/handcentric/locate.py decides it
+// (_Decider), one case at a time; locate_layers: a model's layers watched through LayerWatch.
 #include "handcentric/experiments/model_locate.hpp"
 
 #include <cmath>
@@ -28,26 +29,28 @@ constexpr double kLocateInfinity = std::numeric_limits<double>::infinity();
 
 using LayerKey = std::pair<std::string, int>;  // (layer, call)
 
-/// One output of one act(): its values (a chunk's poses as 16 x K, column-major 4 x 4 each) and,
-/// for the chunk, the poses themselves.
-struct LayerOutput {
-  Eigen::MatrixXd values;
-  std::vector<RigidTransform> poses;
-};
+using LayerOutput = WatchedOutput;
 
-/// What one act() computed, layer by layer, and its chunk (keyed ("chunk", 0)).
+/// One answer's outputs by (name, call), and their order.
 struct LayerAnswer {
   std::vector<LayerKey> order;
-  std::map<LayerKey, LayerOutput> outputs;
+  std::map<LayerKey, const LayerOutput*> outputs;
+  explicit LayerAnswer(const WatchedAnswer& answer) {
+    for (const WatchedOutput& output : answer.outputs) {
+      const LayerKey key{output.name, output.call};
+      if (outputs.emplace(key, &output).second) order.push_back(key);
+    }
+  }
   const LayerOutput* find(const LayerKey& key) const {
     const auto it = outputs.find(key);
-    return it == outputs.end() ? nullptr : &it->second;
+    return it == outputs.end() ? nullptr : it->second;
   }
 };
 
+/// Every layer's output of one act(), as features, in execution order.
 class LayerRecorder final : public policy::LayerWatch {
  public:
-  explicit LayerRecorder(LayerAnswer& answer) : answer_(answer) {}
+  explicit LayerRecorder(WatchedAnswer& answer) : answer_(answer) {}
   void output(const std::string& layer, Eigen::Ref<Eigen::MatrixXf> value) override {
     keep(layer, value.cast<double>());
   }
@@ -57,31 +60,23 @@ class LayerRecorder final : public policy::LayerWatch {
 
  private:
   void keep(const std::string& layer, Eigen::MatrixXd value) {
-    const LayerKey key{layer, calls_[layer]++};
-    answer_.order.push_back(key);
-    answer_.outputs[key].values = std::move(value);
+    answer_.outputs.push_back({layer, calls_[layer]++, LayerKind::features, std::move(value), {}});
   }
-  LayerAnswer& answer_;
+  WatchedAnswer& answer_;
   std::map<std::string, int> calls_;
 };
 
-const LayerKey kChunkKey{"chunk", 0};
-
-LayerAnswer ask_watched(const props::NoisyPolicy& policy, const Scene& scene,
-                        const Eigen::VectorXd& noise) {
-  LayerAnswer answer;
+/// A model's act() with every layer watched, its decoded chunk the last output ("chunk", poses).
+WatchedAnswer ask_watched(const props::NoisyPolicy& policy, const Scene& scene,
+                          const Eigen::VectorXd& noise) {
+  WatchedAnswer answer;
   LayerRecorder recorder(answer);
-  std::vector<RigidTransform> chunk;
   {
     const policy::ScopedLayerWatch watch(recorder);
-    chunk = policy.act(scene, noise);
+    answer.chunk = policy.act(scene, noise);
   }
-  LayerOutput& out = answer.outputs[kChunkKey];
-  out.values.resize(16, static_cast<Eigen::Index>(chunk.size()));
-  for (std::size_t k = 0; k < chunk.size(); ++k)
-    out.values.col(static_cast<Eigen::Index>(k)) = chunk[k].matrix().reshaped();
-  out.poses = std::move(chunk);
-  answer.order.push_back(kChunkKey);
+  answer.outputs.push_back(
+      {"chunk", 0, LayerKind::poses, poses_as_values(answer.chunk), answer.chunk});
   return answer;
 }
 
@@ -109,11 +104,11 @@ double feature_difference(const LayerOutput& a, const LayerOutput& b) {
 }
 
 /// max_k |R - R'|_F + |p - p'| between g a_k and b_k; infinite for another length.
-double pose_difference(const LayerOutput& a, const LayerOutput& b, const RigidTransform& g) {
-  if (a.poses.size() != b.poses.size()) return kLocateInfinity;
+double pose_difference(const std::vector<RigidTransform>& a, const std::vector<RigidTransform>& b,
+                       const RigidTransform& g) {
+  if (a.size() != b.size()) return kLocateInfinity;
   double m = 0.0;
-  for (std::size_t k = 0; k < a.poses.size(); ++k)
-    m = larger_or_nan(m, distance(g * a.poses[k], b.poses[k]));
+  for (std::size_t k = 0; k < a.size(); ++k) m = larger_or_nan(m, distance(g * a[k], b[k]));
   return m;
 }
 
@@ -177,7 +172,8 @@ void decide_case(LayerRow& row, const LocateRules& rules, int case_number, const
     response = larger_or_nan(response, moved ? feature_difference(side, *moved) : kLocateInfinity);
     if (row.layer.kind == LayerKind::poses) {
       pose_response = larger_or_nan(
-          pose_response, moved ? pose_difference(side, *moved, RigidTransform()) : kLocateInfinity);
+          pose_response,
+          moved ? pose_difference(side.poses, moved->poses, RigidTransform()) : kLocateInfinity);
     }
   }
   row.layer.rounding_response = larger_or_nan(row.layer.rounding_response, response);
@@ -186,7 +182,7 @@ void decide_case(LayerRow& row, const LocateRules& rules, int case_number, const
   const auto [holds, floor] = rules.holds(error, response, scale);
   row.see(false, case_number, error, floor, scale, holds);
   if (row.layer.kind != LayerKind::poses) return;
-  const double pose_error = pose_difference(a, b, g);
+  const double pose_error = pose_difference(a.poses, b.poses, g);
   const double pose_scale = larger_or_nan(L, larger_or_nan(pose_reach(a), pose_reach(b)));
   const auto [pose_holds, pose_floor] = rules.holds(pose_error, pose_response, pose_scale);
   row.see(true, case_number, pose_error, pose_floor, pose_scale, pose_holds);
@@ -194,8 +190,11 @@ void decide_case(LayerRow& row, const LocateRules& rules, int case_number, const
 
 }  // namespace
 
-std::string to_string(LayerKind kind) {
-  return kind == LayerKind::poses ? "poses" : "features";
+Eigen::MatrixXd poses_as_values(const std::vector<RigidTransform>& poses) {
+  Eigen::MatrixXd values(16, static_cast<Eigen::Index>(poses.size()));
+  for (std::size_t k = 0; k < poses.size(); ++k)
+    values.col(static_cast<Eigen::Index>(k)) = poses[k].matrix().reshaped();
+  return values;
 }
 
 const LocatedLayer* ModelLocation::first_break() const {
@@ -207,11 +206,25 @@ const LocatedLayer* ModelLocation::first_break() const {
 ModelLocation locate_layers(std::shared_ptr<const ChunkPolicy> policy,
                             const props::CheckOptions& check, props::Group group,
                             props::View view) {
-  const props::SeededPolicy asked(policy);
+  const auto asked = std::make_shared<const props::SeededPolicy>(std::move(policy));
+  const WatchedPolicy ask = [asked](const std::vector<const Scene*>& scenes,
+                                    const std::vector<const Eigen::VectorXd*>& noises) {
+    std::vector<WatchedAnswer> answers;
+    for (std::size_t i = 0; i < scenes.size(); ++i)
+      answers.push_back(ask_watched(*asked, *scenes[i], *noises[i]));
+    return answers;
+  };
+  return locate_watched(ask, asked->name(), asked->noise_dimension(), check, group, view);
+}
+
+ModelLocation locate_watched(const WatchedPolicy& ask, const std::string& name,
+                             Eigen::Index noise_dimension, const props::CheckOptions& check,
+                             props::Group group, props::View view, const std::string& watched) {
   const std::vector<std::pair<Scene, RigidTransform>> drawn = props::drawn_cases(check, group);
   const LocateRules rules{check.relative_tolerance, check.unit_roundoff};
   ModelLocation out;
-  out.policy = asked.name();
+  out.policy = name;
+  out.watched = watched;
   out.group = group;
   out.view = view;
   out.seed = check.seed;
@@ -227,21 +240,26 @@ ModelLocation locate_layers(std::shared_ptr<const ChunkPolicy> policy,
     const Scene moved = g * o;
     // The case's own noise, for every question about it (the audit's pointwise check).
     const Eigen::VectorXd noise =
-        props::fixed_noise(asked.noise_dimension(), props::pointwise_noise_seed(check, o, g));
-    const LayerAnswer a = ask_watched(asked, o, noise), b = ask_watched(asked, moved, noise);
+        props::fixed_noise(noise_dimension, props::pointwise_noise_seed(check, o, g));
+    // o, g o, then the rounding perturbations, o's and g o's in turn, asked together.
+    std::vector<Scene> scenes{o, moved};
     std::mt19937_64 draws(check.seed ^ kLocateRoundingSeedMix);
-    std::vector<LayerAnswer> perturbed;
     for (int d = 0; d < kLocateRoundingDraws; ++d) {
       for (const Scene* side : {&o, &moved}) {
-        perturbed.push_back(ask_watched(
-            asked,
-            props::rounding_perturbation(*side, check.unit_roundoff, draws, check.shape.planar),
-            noise));
+        scenes.push_back(
+            props::rounding_perturbation(*side, check.unit_roundoff, draws, check.shape.planar));
       }
     }
+    std::vector<const Scene*> asked_scenes;
+    for (const Scene& scene : scenes) asked_scenes.push_back(&scene);
+    const std::vector<WatchedAnswer> answers =
+        ask(asked_scenes, std::vector<const Eigen::VectorXd*>(scenes.size(), &noise));
+    const LayerAnswer a(answers.at(0)), b(answers.at(1));
+    std::vector<LayerAnswer> perturbed;
+    for (std::size_t p = 2; p < answers.size(); ++p) perturbed.emplace_back(answers[p]);
     const double L = std::max(props::length_scale(o), props::length_scale(moved));
     // The chunk as the audit's pointwise check compares it: distance within REL (1 + L).
-    const double chunk_error = pose_difference(*a.find(kChunkKey), *b.find(kChunkKey), g);
+    const double chunk_error = pose_difference(answers[0].chunk, answers[1].chunk, g);
     out.chunk_error = larger_or_nan(out.chunk_error, chunk_error / (1.0 + L));
     if (!(chunk_error <= check.relative_tolerance * (1.0 + L)) && out.chunk_equivariant) {
       out.chunk_equivariant = false;
@@ -256,7 +274,7 @@ ModelLocation locate_layers(std::shared_ptr<const ChunkPolicy> policy,
         LayerRow& row = rows[key];
         row.layer.name = key.first;
         row.layer.call = key.second;
-        row.layer.kind = key == kChunkKey ? LayerKind::poses : LayerKind::features;
+        row.layer.kind = (a.find(key) ? a.find(key) : b.find(key))->kind;
       }
       LayerRow& row = rows[key];
       const LayerOutput *x = a.find(key), *y = b.find(key);

@@ -46,6 +46,8 @@ nlohmann::ordered_json locate_number_json(double x) {
 }  // namespace
 
 std::string locate_text(const ModelLocation& r) {
+  // "layer" or "stage": what one row is (ModelLocation::watched without its plural s).
+  const std::string row_word = r.watched.substr(0, r.watched.size() - 1);
   std::size_t width = 5;
   for (const LocatedLayer& layer : r.layers)
     width = std::max(width, locate_label(layer.name, layer.call).size());
@@ -53,9 +55,9 @@ std::string locate_text(const ModelLocation& r) {
   const LocatedLayer* first = r.first_break();
   out << "locate " << r.policy << " under " << props::to_string(r.group) << " ("
       << props::to_string(r.view) << ", seed " << r.seed << ", " << r.cases << " cases): "
-      << (first ? "first break at '" + first->name + "'" : std::string("no layer breaks its kind"))
+      << (first ? "first break at '" + first->name + "'" : "no " + row_word + " breaks its kind")
       << "\n";
-  out << "   " << locate_padded("layer", width) << "  " << locate_padded("kind", 8) << "  "
+  out << "   " << locate_padded(row_word, width) << "  " << locate_padded("kind", 8) << "  "
       << locate_padded("verdict", 11) << "  " << locate_padded("error", 9) << "  case\n";
   for (const LocatedLayer& layer : r.layers) {
     const char* mark = &layer == first ? ">> " : (layer.breaks ? "!  " : "   ");
@@ -95,7 +97,7 @@ std::string locate_json(const std::vector<ModelLocation>& locations) {
     j["seed"] = r.seed;
     j["cases"] = r.cases;
     j["near_identity_cases"] = r.near_identity_cases;
-    j["watched"] = "layers";
+    j["watched"] = r.watched;
     nlohmann::ordered_json layers = nlohmann::ordered_json::array();
     for (const LocatedLayer& layer : r.layers) {
       nlohmann::ordered_json row;
@@ -111,7 +113,7 @@ std::string locate_json(const std::vector<ModelLocation>& locations) {
       if (!layer.note.empty()) row["note"] = layer.note;
       layers.push_back(std::move(row));
     }
-    j["layers"] = std::move(layers);
+    j[r.watched] = std::move(layers);
     const LocatedLayer* first = r.first_break();
     j["first_break"] = first ? nlohmann::ordered_json(first->name) : nullptr;
     if (r.witness) {

@@ -260,6 +260,12 @@ std::string policy_audit_json(const std::vector<Classification>& policies,
                             {"rng", interface->rng.empty() ? nlohmann::json(nullptr)
                                                            : nlohmann::json(interface->rng)},
                             {"episodes", interface->episodes}};
+      if (!interface->stages.empty()) {
+        nlohmann::json stages = nlohmann::json::array();
+        for (const PipelineStage& stage : interface->stages)
+          stages.push_back({{"name", stage.name}, {"kind", to_string(stage.kind)}});
+        entry["interface"]["stages"] = std::move(stages);
+      }
     }
     out.push_back(entry);
   }

@@ -87,7 +87,10 @@ The package, one job a module (standard library only; NumPy where said):
   loop      serve(): the loop over stdin and the answer to each kind of request
   policy    serve_policy(): a whole policy, its cameras, rng= and reset= (episodes)
   interface a policy's own interface on the wire: state_format=, action_format=, outputs=,
-            hands= (requests read in its layouts, per hand; answers written as its outputs)
+            hands= (requests read in its layouts, per hand; answers written as its outputs),
+            and the stages of its pipeline (stages=[("to_hand", "features"), ("decode",
+            "poses")]: the policy returns (its answer, {stage: output}); `handcentric audit
+            --policy-exec CMD --locate` asks for them and names the first stage that breaks)
   seeding   a policy's own generator seeded before a call (shared with handcentric's _rng)
   geometry  the SE(3) helpers above
   formats   pose layouts: 4x4 poses as the vectors shipped policies speak (quaternions, 6D,

@@ -1,14 +1,21 @@
-"""A policy plug-in's interface on the wire: pose layouts, hands and named outputs.
+"""A policy plug-in's interface on the wire: pose layouts, hands, named outputs and stages.
 
-serve_policy(policy, state_format=, action_format=, outputs=, hands=) declares them in its
-hello (docs/AUDIT.md, "--exec"), and the audit then speaks the policy's own language:
+serve_policy(policy, state_format=, action_format=, outputs=, hands=, stages=) declares them in
+its hello (docs/AUDIT.md, "--exec"), and the audit then speaks the policy's own language:
   state_format   every pose it is sent (history rows, extra poses) is a vector of that layout
                  (formats.py: "pos_quat_xyzw", "pos_rot6d_rows", ...), history (H+1, w);
   action_format  every pose it returns is a vector of that layout, (K, w);
   hands          ("left", "right"): history is {hand: (H+1, w)} and the policy returns one
                  chunk per hand in a dict, under the hands' names;
   outputs        {"hand": "pose", "gripper": "invariant"}: the policy returns a dict; a pose
-                 entry is a chunk, an invariant one any numbers that must not change under g.
+                 entry is a chunk, an invariant one any numbers that must not change under g;
+  stages         [("normalize", "poses"), ("to_hand", "features"), ...]: the stages of its
+                 pipeline in execution order. The policy then returns the pair (its answer,
+                 {stage: value}), every stage's output for that call; a request with
+                 "stages": true (`handcentric audit --policy-exec CMD --locate`) is answered
+                 with "stages": {name: value} beside the answer, a "poses" stage's value K poses
+                 in the action layout ((B, K, ...) batched), a "features" stage's any numbers
+                 ((B, ...) batched). Other requests get the answer alone.
 (rng= and reset= are declared by serve_policy itself: policy.py.)
 The audit decodes and checks every returned pose (a quaternion off unit norm is refused naming
 it). A plug-in with an interface is sent JSON numbers (no base64 offer).
@@ -18,6 +25,28 @@ from . import formats
 from .protocol import _BadResult, _Malformed, _flatten, _is_number
 
 KINDS = ("pose", "invariant")
+STAGE_KINDS = ("poses", "features")
+
+
+def _stages(stages):
+    """stages= checked: a list of (name, kind), names distinct, kinds in STAGE_KINDS."""
+    out = []
+    for entry in stages:
+        if not isinstance(entry, (tuple, list)) or len(entry) != 2 \
+                or not isinstance(entry[0], str) or not entry[0]:
+            raise ValueError("stages= holds %r; each stage is a pair (name, kind), e.g. "
+                             "(\"to_hand\", \"features\")" % (entry,))
+        name, kind = entry
+        if kind not in STAGE_KINDS:
+            raise ValueError("stage %r has kind %r; a stage is \"poses\" (world-frame poses, "
+                             "which move with g) or \"features\" (numbers that must not "
+                             "change)" % (name, kind))
+        if any(name == n for n, _ in out):
+            raise ValueError("stages= names %r twice; give each stage a name of its own" % name)
+        out.append((name, kind))
+    if not out:
+        raise ValueError("stages= is empty; name the pipeline's stages, or leave stages= out")
+    return tuple(out)
 
 
 def _vectors(value, width, what):
@@ -33,10 +62,11 @@ def _vectors(value, width, what):
 class _Interface:
     """What serve_policy declared beyond protocol 2, and how its requests and answers read."""
 
-    def __init__(self, state_format, action_format, outputs, hands):
+    def __init__(self, state_format, action_format, outputs, hands, stages=None):
         if np is None:
-            raise ValueError("serve_policy's state_format=, action_format=, outputs= and "
-                             "hands= need NumPy")
+            raise ValueError("serve_policy's state_format=, action_format=, outputs=, hands= "
+                             "and stages= need NumPy")
+        self.stages = _stages(stages) if stages is not None else ()
         self.state = state_format or "matrix"
         self.action = action_format or "matrix"
         self.state_width = formats.width(self.state)    # ValueError naming an unknown layout
@@ -68,6 +98,8 @@ class _Interface:
             body["outputs"] = self.outputs
         if self.hands:
             body["hands"] = list(self.hands)
+        if self.stages:
+            body["stages"] = [{"name": n, "kind": k} for n, k in self.stages]
         return body
 
     # ------------------------------------------------------------------------- requests
@@ -117,17 +149,65 @@ class _Interface:
                              % (field, len(flat), w, self.action, _layout_hint(value)))
         return [flat[i:i + w] for i in range(0, len(flat), w)]
 
-    def answer(self, result):
-        """One observation's answer: {"chunk": rows} or {"outputs": {name: value}}."""
-        if not self.outputs:
-            return {"chunk": self._pose_rows(_numpy_of(result), "chunk")}
-        entries = self._entries(result)
-        return {"outputs": {name: self._pose_rows(entries[name], name) if kind == "pose"
-                            else _flatten(entries[name], name)
-                            for name, kind in self.outputs.items()}}
+    def _split_stages(self, result):
+        """With stages: the policy's (answer, {stage: value}), checked; without: (result, None)."""
+        if not self.stages:
+            return result, None
+        names = [n for n, _ in self.stages]
+        if not isinstance(result, tuple) or len(result) != 2 or not isinstance(result[1], dict):
+            raise _BadResult("with stages=%s the policy returns the pair (its answer, {stage: "
+                             "value}); it returned a %s" % (names, type(result).__name__))
+        if sorted(result[1]) != sorted(names):
+            raise _BadResult("the policy's stages are %s; stages= declares %s (return every "
+                             "declared stage's value, and no other)" % (sorted(result[1]), names))
+        return result[0], {n: _numpy_of(v) for n, v in result[1].items()}
 
-    def answers(self, result, B):
-        """A batched call's answers, one per observation."""
+    def answer(self, result, with_stages=False):
+        """One observation's answer: {"chunk": rows} or {"outputs": {name: value}}, and with
+        with_stages (a request's "stages": true) {"stages": {name: value}} in stages= order."""
+        result, values = self._split_stages(result)
+        if not self.outputs:
+            out = {"chunk": self._pose_rows(_numpy_of(result), "chunk")}
+        else:
+            entries = self._entries(result)
+            out = {"outputs": {name: self._pose_rows(entries[name], name) if kind == "pose"
+                               else _flatten(entries[name], name)
+                               for name, kind in self.outputs.items()}}
+        if with_stages:
+            out["stages"] = {name: self._pose_rows(values[name], "stages[%r]" % name)
+                             if kind == "poses" else _flatten(values[name], "stages[%r]" % name)
+                             for name, kind in self._asked_stages()}
+        return out
+
+    def _asked_stages(self):
+        if not self.stages:
+            raise _Malformed("a request with \"stages\": true, but serve_policy was given no "
+                             "stages=")
+        return self.stages
+
+    def answers(self, result, B, with_stages=()):
+        """A batched call's answers, one per observation; with_stages[i]: observation i's
+        request asked for the stages."""
+        result, values = self._split_stages(result)
+        out = self._batched_answers(result, B)
+        if any(with_stages):
+            columns = {}
+            for name, kind in self._asked_stages():
+                field = "stages[%r]" % name
+                if kind == "poses":
+                    columns[name] = self._batched_poses(values[name], B, field)
+                    continue
+                a = np.asarray(values[name], dtype=np.float64)
+                if a.ndim == 0 or a.shape[0] != B:
+                    raise _BadResult("%s has shape %s for a batch of %d observations; return "
+                                     "(%d, ...)" % (field, a.shape, B, B))
+                columns[name] = [_flatten(a[i], field) for i in range(B)]
+            for i, asked in enumerate(with_stages):
+                if asked:
+                    out[i]["stages"] = {name: columns[name][i] for name, _ in self.stages}
+        return out
+
+    def _batched_answers(self, result, B):
         if not self.outputs:
             return [{"chunk": rows} for rows in self._batched_poses(result, B, "chunk")]
         entries = self._entries(result)

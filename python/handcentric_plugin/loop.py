@@ -239,7 +239,8 @@ class _Server:
         interface = self.interface
         if self.batch_size is None:
             result = self.call(self.policy, rid, scene + (noise,), named, images, held, episode)
-            return {"chunk": _chunk(result)} if interface is None else interface.answer(result)
+            return {"chunk": _chunk(result)} if interface is None else \
+                interface.answer(result, request.get("stages") is True)
         # Batched: a batch of one.
         stacked = tuple({k: v[None] for k, v in a.items()} if isinstance(a, dict) else a[None]
                         for a in scene + (noise,))
@@ -250,7 +251,7 @@ class _Server:
         result = self.call(self.policy, rid, stacked, _stack_named([named]), images, held,
                            episode)
         return {"chunk": _chunks(result, 1)[0]} if interface is None else \
-            interface.answers(result, 1)[0]
+            interface.answers(result, 1, [request.get("stages") is True])[0]
 
     def decoded_chunk(self, request, scene, named, held):
         """decode's chunk for a decode request, K lists of 16 numbers."""
@@ -344,7 +345,8 @@ class _Server:
             result = self.call(self.policy, rid, (history, hand_points, world_points, noise),
                                named, images, held, items[0].get("episode"))
             if interface is not None:
-                return interface.answers(result, B)
+                return interface.answers(result, B, [item.get("stages") is True
+                                                     for item in items])
             return [{"chunk": c} for c in _chunks(result, B, encoded)]
         if any("decode" in item or "eps" in item or "t" in item for item in items):
             raise _Malformed("decode and flow requests are not batched")

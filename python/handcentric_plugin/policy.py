@@ -18,7 +18,7 @@ from .loop import serve
 def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, batched=False,
                  batch_size=256, encoding="base64", cameras=None, rng=None, device=None,
                  reset=None, action_format=None, state_format=None, outputs=None, hands=None,
-                 stdin=None, stdout=None):
+                 stages=None, stdin=None, stdout=None):
     """Answer `handcentric audit --policy-exec` requests: a whole policy (eq. 4 of the paper).
 
     policy(history, hand_points, world_points, noise) -> (K,4,4) world-frame poses T_1..T_K
@@ -55,13 +55,20 @@ def serve_policy(policy, *, extra_poses=(), scalars=(), noise=None, hello=None, 
         is audited on its own (a pose chunk moves with g, invariant numbers must not change).
     hands: ("left", "right"): history is {hand: (H+1, w)} and the policy returns one chunk per
         hand in its dict, under the hands' names (verdicts per hand).
-    With any of these four the requests carry JSON numbers (no base64 offer).
+    stages: [("normalize", "poses"), ("to_hand", "features"), ...]: the stages of the policy's
+        pipeline, in execution order, each producing world-frame "poses" (which must move with
+        g) or "features" (which must not change). The policy then returns the pair (its answer,
+        {stage: value}) on every call, each stage's output for that call (a "poses" value
+        (K, 4, 4) or (K, w) in the action layout, (B, K, ...) batched; a "features" value any
+        numbers, (B, ...) batched); `handcentric audit --policy-exec CMD --locate` asks for them
+        and names the first stage that breaks its kind (interface.py).
+    With any of these five the requests carry JSON numbers (no base64 offer).
     extra_poses, scalars, hello, encoding, stdin, stdout: as for serve().
     """
     interface = None
     if action_format is not None or state_format is not None or outputs is not None \
-            or hands is not None:
-        interface = _Interface(state_format, action_format, outputs, hands)
+            or hands is not None or stages is not None:
+        interface = _Interface(state_format, action_format, outputs, hands, stages)
         hello = True
     if rng is not None or reset is not None:
         policy = _paired_policy(policy, rng, reset, batched, device)
@@ -120,7 +127,9 @@ def _paired_policy(policy, rng, reset, batched, device=None):
         def as_numpy(x):  # a torch result, on any device, with or without grad
             return x.detach().cpu().numpy() if hasattr(x, "detach") else np.asarray(x)
 
-        def joined(parts):  # the rows' results, one batch again (a dict of outputs too)
+        def joined(parts):  # the rows' results, one batch again (a dict of outputs, a pair)
+            if isinstance(parts[0], tuple):
+                return tuple(joined([p[i] for p in parts]) for i in range(len(parts[0])))
             if isinstance(parts[0], dict):
                 return {k: joined([p[k] for p in parts]) for k in parts[0]}
             return np.concatenate([as_numpy(p) for p in parts], axis=0)

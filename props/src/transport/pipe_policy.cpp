@@ -73,10 +73,11 @@ std::string PipePolicy::key(const Scene& observation, const Eigen::VectorXd& noi
 }
 
 std::string PipePolicy::request_body(const Scene& observation, const Eigen::VectorXd& noise,
-                                     NumberEncoding encoding) const {
+                                     NumberEncoding encoding, bool stages) const {
   const PolicyInterface* interface = capabilities_ ? &capabilities_->policy : nullptr;
   std::string body =
       policy_request_body(observation, noise, encoding, interface, episode_ ? &*episode_ : nullptr);
+  if (stages) body += ", \"stages\": true";
   if (episode_) ++episode_->step;
   if (!capabilities_ || !capabilities_->cameras) return body;
   // Images always travel as base64 float32 arrays: a 64 x 48 RGB-D image is 49 KB so, ~150 KB
@@ -240,6 +241,47 @@ std::vector<std::vector<RigidTransform>> PipePolicy::act_fresh(
   std::vector<std::vector<RigidTransform>> out;
   for (Answer& answer : answers(observations, noises, true))
     out.push_back(std::move(answer.front()));
+  return out;
+}
+
+std::vector<PipePolicy::Staged> PipePolicy::staged_answers(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises) const {
+  const PluginCapabilities& declared = capabilities();  // runs the handshake
+  if (declared.policy.stages.empty()) {
+    throw InvalidArgument(name() +
+                          ": its hello declares no \"stages\"; declare them "
+                          "(docs/AUDIT.md, \"Localizing a break\")");
+  }
+  if (observations.size() != noises.size())
+    throw InvalidArgument(name() + ": staged_answers needs one noise vector per observation");
+  const std::size_t per_line = static_cast<std::size_t>(std::max(1, declared.batch));
+  std::vector<Staged> out;
+  for (std::size_t from = 0; from < observations.size(); from += per_line) {
+    const std::size_t to = std::min(observations.size(), from + per_line);
+    std::vector<PluginReply> replies;
+    if (declared.batch == 0) {
+      const Scene& observation = *observations[from];
+      replies.push_back(
+          connection_.exchange(RequestKind::policy_stages,
+                               request_body(observation, *noises[from], NumberEncoding::text, true),
+                               false, &declared.policy));
+    } else {
+      std::vector<std::string> bodies;
+      for (std::size_t i = from; i < to; ++i)
+        bodies.push_back(request_body(*observations[i], *noises[i], declared.encoding, true));
+      replies = connection_.exchange_batch(RequestKind::policy_stages, bodies, declared.encoding,
+                                           &declared.policy);
+    }
+    const std::string id = std::to_string(connection_.last_id());
+    for (std::size_t i = from; i < to; ++i) {
+      PluginReply& reply = replies[i - from];
+      std::vector<OutputValue> stages = std::move(reply.stages);
+      Answer answer = remember(key(*observations[i], *noises[i]), std::move(reply),
+                               *observations[i], "request " + id);
+      out.push_back({std::move(answer), std::move(stages)});
+    }
+  }
   return out;
 }
 

@@ -511,7 +511,25 @@ nlohmann::json parse_line(const std::string& line, int id, const std::string& wh
 // `answered` begins each message, which quotes the line (`line`), or else the item, written out
 // only then: a batch's items are not formatted again on the way in.
 PluginReply read_answer(const nlohmann::json& json, RequestKind kind, const std::string& answered,
+                        const std::string* line, const PolicyInterface* interface);
+
+// A policy_stages answer: the policy's answer, and its stages under `interface`.
+PluginReply read_staged_answer(const nlohmann::json& json, const std::string& answered,
+                               const std::string* line, const PolicyInterface* interface) {
+  if (interface == nullptr || interface->stages.empty()) {
+    throw PluginError(answered +
+                      ": stages were asked of a plug-in whose hello declares no "
+                      "\"stages\"");
+  }
+  PluginReply reply = read_answer(json, RequestKind::policy, answered, line, interface);
+  reply.stages = policy_wire::read_stage_values(json, *interface, answered);
+  return reply;
+}
+
+PluginReply read_answer(const nlohmann::json& json, RequestKind kind, const std::string& answered,
                         const std::string* line, const PolicyInterface* interface) {
+  if (kind == RequestKind::policy_stages)
+    return read_staged_answer(json, answered, line, interface);
   auto quoted = [&] {
     std::string out(1, '\'');
     out += one_line(line != nullptr ? *line : json.dump(), 120);

@@ -75,6 +75,43 @@ std::vector<std::string> read_hands(const nlohmann::json& hello, const std::stri
   return hands;
 }
 
+// The hello's "stages": a list of {"name", "kind"}, names distinct, kinds "poses" or "features".
+std::vector<PipelineStage> read_stages(const nlohmann::json& hello, const std::string& answered) {
+  std::vector<PipelineStage> stages;
+  if (!hello.contains("stages") || hello["stages"].is_null()) return stages;
+  const nlohmann::json& value = hello["stages"];
+  const std::string form =
+      "; declare the stages in execution order, e.g. [{\"name\": \"to_hand\", \"kind\": "
+      "\"features\"}, {\"name\": \"decode\", \"kind\": \"poses\"}]";
+  if (!value.is_array() || value.empty())
+    throw PluginError(hello_field(answered, "stages", value) + form);
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const nlohmann::json& stage = value[i];
+    const std::string at = "\"stages\"[" + std::to_string(i) + "]";
+    if (!stage.is_object() || !stage.contains("name") || !stage["name"].is_string() ||
+        stage["name"].get<std::string>().empty() || !stage.contains("kind")) {
+      throw PluginError(answered + " with a hello whose " + at + " is " +
+                        one_line(stage.dump(), 60) + form);
+    }
+    const std::string name = stage["name"].get<std::string>();
+    const auto kind = stage["kind"].is_string() ? parse_stage_kind(stage["kind"].get<std::string>())
+                                                : std::nullopt;
+    if (!kind) {
+      throw PluginError(answered + " with a hello whose " + at + " (\"" + name + "\") has kind " +
+                        one_line(stage["kind"].dump(), 40) +
+                        "; a stage is \"poses\" (world-frame poses, which move with g) or "
+                        "\"features\" (numbers that must not change under g)");
+    }
+    if (std::any_of(stages.begin(), stages.end(),
+                    [&](const PipelineStage& s) { return s.name == name; })) {
+      throw PluginError(answered + " with a hello whose \"stages\" name \"" + name +
+                        "\" twice; give each stage a name of its own");
+    }
+    stages.push_back({name, *kind});
+  }
+  return stages;
+}
+
 // One pose vector in `format`, the k-th of `field`.
 RigidTransform pose_of(const double* v, std::size_t k, const PoseFormat& format,
                        const std::string& field, const std::string& answered) {
@@ -165,6 +202,53 @@ Eigen::VectorXd read_invariant(const nlohmann::json& value, const std::string& f
                                            static_cast<Eigen::Index>(numbers.size()));
 }
 
+// The form of an answer's {name: value} field: "outputs" or "stages".
+struct NamedField {
+  const char* field;        // "outputs"
+  const char* entry;        // "an output": one of them, with its article
+  const char* asked;        // what the request asked, said before "without" ("" for outputs)
+  const char* declared_as;  // the fix's tail after "declare it in the hello's \"outputs\""
+};
+
+// `form`'s field of `answer`, read in the order of `declared` (name, a pose value?): a pose
+// value K poses of `format`, any other numbers. Every declared name answered, no other.
+std::vector<OutputValue> read_named(const nlohmann::json& answer, const NamedField& form,
+                                    const std::vector<std::pair<std::string, bool>>& declared,
+                                    const PoseFormat& format, const std::string& answered) {
+  const std::string field = form.field, entry = form.entry;
+  const std::string noun = entry.substr(entry.find(' ') + 1);  // "output"
+  std::string names;
+  for (const auto& [name, pose] : declared) names += (names.empty() ? "\"" : ", \"") + name + "\"";
+  if (!answer.contains(field) || !answer[field].is_object()) {
+    throw PluginError(answered + form.asked + " without \"" + field + "\": {name: value} for the " +
+                      field + " its hello declares (" + names + "): '" +
+                      one_line(answer.dump(), 120) + "'");
+  }
+  const nlohmann::json& given = answer[field];
+  for (const auto& item : given.items()) {
+    if (std::none_of(declared.begin(), declared.end(),
+                     [&](const auto& d) { return d.first == item.key(); })) {
+      throw PluginError(answered + " with " + entry + " \"" + item.key() +
+                        "\" its hello does not declare (it declares " + names +
+                        "); declare it in the hello's \"" + field + "\"" + form.declared_as);
+    }
+  }
+  // In the hello's order (for stages, the execution order), whatever the answer's.
+  std::vector<OutputValue> out;
+  for (const auto& [name, pose] : declared) {
+    if (!given.contains(name)) {
+      throw PluginError(answered + " without the " + noun + " \"" + name +
+                        "\" its hello declares; answer every one of " + names);
+    }
+    const std::string at = "\"" + field + "\"[\"" + name + "\"]";
+    if (pose)
+      out.push_back({read_pose_output(given[name], format, at, answered), {}});
+    else
+      out.push_back({{}, read_invariant(given[name], at, answered)});
+  }
+  return out;
+}
+
 // Poses in the state layout: lists of w numbers, or one encoded [n, w] ([n, 4, 4] for matrices).
 void append_layout_poses(std::string& out, const std::vector<RigidTransform>& poses,
                          const PoseFormat& format, NumberEncoding encoding) {
@@ -233,6 +317,7 @@ PolicyInterface read_interface(const nlohmann::json& hello, const std::string& a
     }
     interface.episodes = hello["episodes"].get<bool>();
   }
+  interface.stages = read_stages(hello, answered);
   return interface;
 }
 
@@ -308,42 +393,36 @@ std::vector<OutputValue> read_outputs(const nlohmann::json& answer,
         {read_pose_output(answer["chunk"], interface.action_format, "\"chunk\"", answered), {}});
     return out;
   }
-  std::string declared;
+  std::vector<std::pair<std::string, bool>> declared;
   for (const NamedOutput& o : interface.outputs)
-    declared += (declared.empty() ? "\"" : ", \"") + o.name + "\"";
-  if (!answer.contains("outputs") || !answer["outputs"].is_object()) {
-    throw PluginError(answered +
-                      " without \"outputs\": {name: value} for the outputs its hello "
-                      "declares (" +
-                      declared + "): '" + one_line(answer.dump(), 120) + "'");
-  }
-  const nlohmann::json& given = answer["outputs"];
-  for (const auto& item : given.items()) {
-    if (std::none_of(interface.outputs.begin(), interface.outputs.end(),
-                     [&](const NamedOutput& o) { return o.name == item.key(); })) {
-      throw PluginError(answered + " with an output \"" + item.key() +
-                        "\" its hello does not declare (it declares " + declared +
-                        "); declare it in the hello's \"outputs\" as \"pose\" or \"invariant\"");
-    }
-  }
-  for (const NamedOutput& output : interface.outputs) {
-    if (!given.contains(output.name)) {
-      throw PluginError(answered + " without the output \"" + output.name +
-                        "\" its hello declares; answer every one of " + declared);
-    }
-    const std::string field = "\"outputs\"[\"" + output.name + "\"]";
-    if (output.kind == OutputKind::pose)
-      out.push_back(
-          {read_pose_output(given[output.name], interface.action_format, field, answered), {}});
-    else
-      out.push_back({{}, read_invariant(given[output.name], field, answered)});
-  }
-  return out;
+    declared.emplace_back(o.name, o.kind == OutputKind::pose);
+  return read_named(answer, {"outputs", "an output", "", " as \"pose\" or \"invariant\""}, declared,
+                    interface.action_format, answered);
+}
+
+std::vector<OutputValue> read_stage_values(const nlohmann::json& answer,
+                                           const PolicyInterface& interface,
+                                           const std::string& answered) {
+  std::vector<std::pair<std::string, bool>> declared;
+  for (const PipelineStage& stage : interface.stages)
+    declared.emplace_back(stage.name, stage.kind == StageKind::poses);
+  return read_named(answer, {"stages", "a stage", ", a request with \"stages\": true,", ""},
+                    declared, interface.action_format, answered);
 }
 
 }  // namespace handcentric::props::policy_wire
 
 namespace handcentric::props {
+
+std::string to_string(StageKind kind) {
+  return kind == StageKind::poses ? "poses" : "features";
+}
+
+std::optional<StageKind> parse_stage_kind(const std::string& text) {
+  if (text == "poses") return StageKind::poses;
+  if (text == "features") return StageKind::features;
+  return std::nullopt;
+}
 
 std::string describe(const PolicyInterface& interface) {
   if (interface.plain() && interface.hands.empty()) return {};
@@ -382,6 +461,15 @@ std::string describe(const PolicyInterface& interface) {
     out += sep +
            "episodes (it keeps state within a closed-loop episode; every other request is a call "
            "of its own)";
+    sep = "; ";
+  }
+  if (!interface.stages.empty()) {
+    out += sep + "stages";
+    for (std::size_t s = 0; s < interface.stages.size(); ++s) {
+      out += (s > 0 ? ", " : " ") + interface.stages[s].name + " (" +
+             to_string(interface.stages[s].kind) + ")";
+    }
+    out += " (audit --locate decides each)";
   }
   return out;
 }

@@ -38,4 +38,12 @@ std::vector<OutputValue> read_outputs(const nlohmann::json& answer,
                                       const PolicyInterface& interface,
                                       const std::string& answered);
 
+/// The stages of an answer to a request with "stages": true, in the hello's order: "stages":
+/// {name: value}, a "poses" stage's value K poses in the action layout, a "features" stage's
+/// numbers. PluginError for a missing "stages", a declared stage missing, an undeclared one, or
+/// a value of the wrong form (named, with the form it must have).
+std::vector<OutputValue> read_stage_values(const nlohmann::json& answer,
+                                           const PolicyInterface& interface,
+                                           const std::string& answered);
+
 }  // namespace handcentric::props::policy_wire

@@ -17,6 +17,7 @@
 // precision). Not run: the audit's step 3 (off the case), so a layer that bins could break on
 // a bin edge. One observation per call: no batch, so no "coupled" verdict.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -28,17 +29,19 @@
 #include "handcentric/props/audit.hpp"
 #include "handcentric/props/checks/check.hpp"
 #include "handcentric/props/group.hpp"
+#include "handcentric/props/transport/policy_interface.hpp"
 #include "handcentric/props/view.hpp"
 
 namespace handcentric::experiments {
 
-/// What a layer's output must be under g: invariant features, or world poses that move with g.
-enum class LayerKind { features, poses };
-std::string to_string(LayerKind kind);
+/// What a layer's (or a stage's) output must be under g: invariant features, or world poses that
+/// move with g (props::StageKind, to_string and parse_stage_kind there: a plug-in's stages).
+using LayerKind = props::StageKind;
 
-/// One layer and call index (the MLP runs once per sampling step), in execution order.
+/// One layer (or stage) and call index (the MLP runs once per sampling step), in execution order.
 struct LocatedLayer {
-  std::string name;  ///< layer_watch.hpp's names, and "chunk" for the decoded world chunk
+  std::string name;  ///< layer_watch.hpp's names and "chunk" for the decoded world chunk; or the
+                     ///< plug-in's stage names
   int call = 0;      ///< 0, 1, ... for the layer's calls in one act()
   LayerKind kind = LayerKind::features;
   std::string verdict;        ///< "invariant", "equivariant" or "neither"
@@ -65,6 +68,8 @@ struct LocateWitness {
 
 struct ModelLocation {
   std::string policy;
+  std::string watched =
+      "layers";  ///< what the rows are: "layers" of a model, "stages" of a plug-in
   props::Group group = props::Group::se3;
   props::View view = props::View::eye_in_hand;
   std::uint64_t seed = 0;
@@ -81,6 +86,39 @@ struct ModelLocation {
   /// The first layer whose verdict is not its kind's, or null.
   const LocatedLayer* first_break() const;
 };
+
+/// One watched output of one call: its numbers (one column per sample; a poses output's: 16 x
+/// K, each pose's matrix column-major) and, for a poses output, the poses themselves.
+struct WatchedOutput {
+  std::string name;
+  int call = 0;  ///< 0, 1, ... for the output's calls in one answer
+  LayerKind kind = LayerKind::features;
+  Eigen::MatrixXd values;
+  std::vector<RigidTransform> poses;
+};
+
+/// A poses output's values: 16 x K, each pose's matrix column-major.
+Eigen::MatrixXd poses_as_values(const std::vector<RigidTransform>& poses);
+
+/// What one call computed: every watched output in execution order, and the policy's chunk.
+struct WatchedAnswer {
+  std::vector<WatchedOutput> outputs;
+  std::vector<RigidTransform> chunk;
+};
+
+/// A policy asked with its outputs watched: one answer per (observation, noise), in order.
+using WatchedPolicy = std::function<std::vector<WatchedAnswer>(
+    const std::vector<const Scene*>&, const std::vector<const Eigen::VectorXd*>&)>;
+
+/// Locates the policy `ask` answers for (named `name`, reading `noise_dimension` noise numbers)
+/// on the pointwise cases of `group` drawn with `check`, each output decided by its kind as the
+/// top of this file says; the rows are `watched` ("layers", "stages"). Each case's six scenes
+/// (o, g o, two rounding perturbations of each) are asked in one call of `ask`. Throws
+/// InvalidArgument when every case had g near the identity, and what `ask` throws.
+ModelLocation locate_watched(const WatchedPolicy& ask, const std::string& name,
+                             Eigen::Index noise_dimension, const props::CheckOptions& check,
+                             props::Group group, props::View view,
+                             const std::string& watched = "layers");
 
 /// Locates `policy` (a ChunkPolicy on this library's networks, asked through props::SeededPolicy
 /// as the audit asks a model) on the pointwise cases of `group` drawn with `check` (the audit's
@@ -109,8 +147,9 @@ std::vector<ModelLocation> locate_model(const std::string& file, const std::stri
 std::string locate_text(const ModelLocation& location);
 
 /// {"locate": [one object per group: policy, group, view, seed, cases, near_identity_cases,
-/// watched: "layers", layers: [{name, call, kind, verdict, breaks, error, case, shape,
-/// rounding_response}], first_break, witness, chunk, tolerance}]}; infinite errors as "inf".
+/// watched: "layers" (or "stages"), layers (or stages): [{name, call, kind, verdict, breaks,
+/// error, case, shape, rounding_response}], first_break, witness, chunk, tolerance}]}; infinite
+/// errors as "inf".
 std::string locate_json(const std::vector<ModelLocation>& locations);
 
 }  // namespace handcentric::experiments

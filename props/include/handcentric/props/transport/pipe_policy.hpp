@@ -74,6 +74,18 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   std::vector<Answer> answers(const std::vector<const Scene*>& observations,
                               const std::vector<const Eigen::VectorXd*>& noises, bool fresh) const;
 
+  /// An answer with the values of the pipeline's stages (policy_interface.hpp, "stages"), in
+  /// the hello's order.
+  struct Staged {
+    Answer answer;
+    std::vector<OutputValue> stages;
+  };
+  /// Each (observation, noise) asked with "stages": true, past the cache, in batched requests
+  /// of up to batch_size() when the plug-in batches. InvalidArgument when its hello declares no
+  /// stages; PluginError for an answer without them (plugin_protocol.hpp, policy_stages).
+  std::vector<Staged> staged_answers(const std::vector<const Scene*>& observations,
+                                     const std::vector<const Eigen::VectorXd*>& noises) const;
+
   /// A closed-loop rollout (policy_interface.hpp, "episodes"): from start_episode() on, each
   /// request carries "episode": {"index", "step"} (a new index, steps from 0) and is asked
   /// past the cache and not kept; end_episode() ends it.
@@ -87,8 +99,10 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   /// One request; a batch of one (in the hello's encoding) when the plug-in batches.
   PluginReply exchange_one(const Scene& observation, const Eigen::VectorXd& noise) const;
   /// A policy request, with the images of the hello's cameras when it declared some.
+  /// With `stages`, the request asks for the stages' values too ("stages": true).
   std::string request_body(const Scene& observation, const Eigen::VectorXd& noise,
-                           NumberEncoding encoding = NumberEncoding::text) const;
+                           NumberEncoding encoding = NumberEncoding::text,
+                           bool stages = false) const;
   /// The answer of `reply` to `observation` (Answer), its lengths checked against the probe's
   /// (`where` names the request), cached under `key` unless in an episode.
   Answer remember(std::string key, PluginReply reply, const Scene& observation,

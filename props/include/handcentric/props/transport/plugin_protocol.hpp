@@ -112,9 +112,13 @@ struct PluginReply {
   /// A policy reply read under a PolicyInterface with named outputs or an action layout: every
   /// output, in the interface's order (`chunk` is the first when there is one output).
   std::vector<OutputValue> outputs;
+  /// A policy_stages reply: each stage's value, in the hello's "stages" order.
+  std::vector<OutputValue> stages;
 };
 
-enum class RequestKind { encode, flow, decode, policy };
+/// policy_stages: a policy request that carries "stages": true, answered as a policy request
+/// plus "stages": {name: value} for every stage its hello declares (policy_interface.hpp).
+enum class RequestKind { encode, flow, decode, policy, policy_stages };
 
 /// Parses and validates `line` as the reply to request `id` of `kind`; `who` names the plug-in
 /// in messages. Throws PluginError with a one-line message for anything else: not JSON, nested

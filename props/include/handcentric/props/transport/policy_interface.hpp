@@ -20,7 +20,15 @@
 //   "episodes": true         it keeps state between calls: the closed loop's requests carry
 //                            "episode": {"index": e, "step": t} and it starts afresh at step 0
 //                            (every other request is a call of its own)
+//   "stages": [{"name": NAME, "kind": "poses" | "features"}, ...]
+//                            the stages of its pipeline, in execution order (docs/AUDIT.md,
+//                            "Localizing a break"): a policy request with "stages": true is
+//                            answered with "stages": {name: value} beside its chunk, a "poses"
+//                            stage's value K poses in the action layout (world-frame poses that
+//                            must move with g), a "features" stage's any numbers (which must not
+//                            change under g)
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,6 +38,20 @@
 
 namespace handcentric::props {
 
+/// What a stage of a pipeline must be under g: invariant features, or world-frame poses that
+/// move with g.
+enum class StageKind { features, poses };
+/// "features" or "poses".
+std::string to_string(StageKind kind);
+/// The kind named `text`; nullopt for anything else.
+std::optional<StageKind> parse_stage_kind(const std::string& text);
+
+/// One stage of a plug-in's pipeline, as its hello's "stages" names it.
+struct PipelineStage {
+  std::string name;
+  StageKind kind = StageKind::features;
+};
+
 struct PolicyInterface {
   PoseFormat state_format, action_format;
   /// Every output it answers, the hands first (outputs_with_hands); empty: one "chunk".
@@ -37,6 +59,8 @@ struct PolicyInterface {
   std::vector<std::string> hands;  ///< two or more, or none
   std::string rng;                 ///< "" when the hello declares none
   bool episodes = false;
+  /// The hello's "stages", in execution order; empty when it declares none.
+  std::vector<PipelineStage> stages;
 
   /// True when it answers "outputs" rather than one "chunk".
   bool named() const { return !outputs.empty(); }
@@ -44,11 +68,12 @@ struct PolicyInterface {
   bool plain() const {
     return state_format.kind == PoseFormat::Kind::matrix &&
            action_format.kind == PoseFormat::Kind::matrix && outputs.empty() && rng.empty() &&
-           !episodes;
+           !episodes && stages.empty();
   }
 };
 
-/// One output of an answer: a pose output's poses, or an invariant output's numbers.
+/// One output of an answer (or one stage's value): a pose output's poses, or an invariant
+/// output's numbers.
 struct OutputValue {
   std::vector<RigidTransform> poses;
   Eigen::VectorXd numbers;
