@@ -112,6 +112,23 @@ def load_callable(text):
     return value
 
 
+def _frequency(text):
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("not a number: %r" % text) from None
+    if not 0.0 < value < 1.0:
+        raise argparse.ArgumentTypeError("%s is not a frequency in (0, 1)" % text)
+    return value
+
+
+def _detect_option(sub):
+    sub.add_argument("--detect", type=_frequency, metavar="F",
+                     help="instead of --cases, as many cases as find a breaking on a share F of "
+                          "the (scene, g) draws with 99%% probability (detect=F; 0.01: 459 "
+                          "cases)")
+
+
 def make_parser():
     parser = _Parser(prog=PROG, description=__doc__,
                      formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -169,6 +186,7 @@ def make_parser():
         description="Audit a representation written in Python (handcentric.audit): which "
                     "groups leave its actions, observation and flow invariant.")
     common(audit, "the actions function (history, chunk, hand_points, world_points) -> 1-D")
+    _detect_option(audit)
     audit.add_argument("--observation", metavar="MODULE:FUNCTION",
                        help="the observation function (history, hand_points, world_points)")
     audit.add_argument("--chunk", type=_bounded(1, 64), metavar="K",
@@ -181,6 +199,7 @@ def make_parser():
         description="Audit a whole policy (handcentric.audit_policy): a(g o, n) = g a(o, n), "
                     "pointwise and in distribution.")
     common(policy, "the policy (history, hand_points, world_points, noise) -> (K, 4, 4)")
+    _detect_option(policy)
     policy.add_argument("--noise", type=_bounded(1, handcentric.MAX_NOISE), metavar="N",
                         help="standard normals per call, 1 to %d" % handcentric.MAX_NOISE)
     policy.add_argument("--rng", choices=("torch", "numpy", "generator"),
@@ -282,7 +301,7 @@ def _keywords(args):
     out = {}
     for option in ("groups", "views", "cases", "seed", "precision", "batch_size", "noise",
                    "array", "device", "history", "hand_points", "world_points", "chunk",
-                   "quiet", "rng"):
+                   "quiet", "rng", "detect"):
         value = getattr(args, option, None)
         if option in ("groups", "views") and value and "all" in value:
             value = None  # all: the module's default

@@ -42,3 +42,17 @@ def test_an_unknown_group_is_a_usage_error_in_either_spelling(capsys):
         else:
             raise AssertionError("no usage error")
         assert "invalid choice: 'se4'" in capsys.readouterr().err
+
+
+def test_detect_sets_the_cases_as_the_command_does(capsys):
+    # --detect 0.05: 90 cases per pointwise cell (mutant: "detect" left out of _keywords ->
+    # 1000 cases).
+    assert cli.main(["audit", TARGET, "--group", "se3", "--view", "eye_in_hand", "--detect",
+                     "0.05", "--json", "--quiet"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["detect"] == {"frequency": 0.05, "cases": 90}
+    try:
+        cli.main(["audit", TARGET, "--detect", "1.5", "--quiet"])
+    except SystemExit as stop:
+        assert stop.code == 2
+    assert "1.5 is not a frequency in (0, 1)" in capsys.readouterr().err
