@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,7 @@
 #include "commands.hpp"
 #include "handcentric/core/errors.hpp"
 #include "handcentric/core/flow_target.hpp"
+#include "handcentric/experiments/audit_report_file.hpp"
 #include "handcentric/experiments/model_audit.hpp"
 #include "handcentric/experiments/model_locate.hpp"
 #include "handcentric/experiments/plugin_locate.hpp"
@@ -52,7 +54,7 @@ struct AuditCommandOptions {
   double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
   std::string precision = "float64";
-  std::string workspace, witness_dir, observations;
+  std::string workspace, witness_dir, observations, page;
   bool json = false;
   bool pointwise = false;
   bool test_law = false;
@@ -126,6 +128,7 @@ void check_locate_options(const AuditCommandOptions& options) {
   const std::pair<bool, const char*> unhonoured[] = {
       {!options.expect.empty(), "--expect (a gate: run it without --locate)"},
       {!options.witness_dir.empty(), "--witness-dir (the witness is printed)"},
+      {!options.page.empty(), "--page (locate prints its own table)"},
       {options.test_law, "--test-law (locate asks pointwise cases only)"},
       {options.pointwise, "--pointwise (locate is pointwise already)"},
       {options.episodes > 0, "--episodes (locate asks single calls)"},
@@ -243,14 +246,20 @@ int run_audit(const AuditCommandOptions& options) {
           "--extra-poses and --scalars are for plug-ins; the built-ins read neither");
     results = props::audit_builtins(options.representations, audit);
   }
+  std::ostringstream header;  // the lines above the tables, on the page too
+  props::print_audit_header(header, audit, policies);
+  if (interface && !props::describe(*interface).empty())
+    header << props::describe(*interface) << "\n";
+  if (!options.page.empty()) {
+    experiments::write_audit_page(options.page, results, audit, header.str());
+    std::cerr << "handcentric audit: wrote " << options.page << "/index.html and index.md\n";
+  }
   if (options.json) {
     std::cout << (policies ? props::policy_audit_json(results, interface ? &*interface : nullptr)
                            : props::audit_json(results));
     return gate(results, expectations);
   }
-  props::print_audit_header(std::cout, audit, policies);
-  if (interface && !props::describe(*interface).empty())
-    std::cout << props::describe(*interface) << "\n";
+  std::cout << header.str();
   props::print_audit(std::cout, results, audit);
   if (planar_model && all_groups) std::cout << "\n" << experiments::kPlanarModelNote << "\n";
   return gate(results, expectations);
@@ -368,6 +377,11 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   model->excludes(repr);
   pointwise->needs(model);
   test_law->excludes(pointwise)->excludes(repr)->excludes(exec);
+  auto* page = cmd->add_option(
+      "--page", options->page,
+      "also write the audit as a page into DIR: index.html and index.md (the header, one "
+      "verdict grid per map, output and view, each NO cell linked to its witness and its "
+      "picture)");
   auto* profile = cmd->add_option(
       "--profile", options->profile,
       "GROUP: how far from equivariant, the error against the size of g (rad, m or the C8 "
@@ -380,6 +394,7 @@ void add_audit_command(CLI::App& app, int& exit_code) {
                   "with --profile: the sizes of g, e.g. 0.01,0.1,1 (default: the group's grid)")
       ->delimiter(',');
   profile->needs(out)->excludes(json)->excludes(pointwise)->excludes(detect)->excludes(episodes);
+  page->excludes(profile);
   out->needs(profile);
   cmd->callback([options, detect, episode_length, &exit_code] {
     options->detect_given = detect->count() > 0;

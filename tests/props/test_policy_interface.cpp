@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -120,6 +121,26 @@ TEST_CASE("a_stateful_plugin_is_audited_in_closed_loop_over_episodes", "[unit]")
                                         "hand executed, gripper compared") != std::string::npos)
         executed_note = true;
   CHECK(executed_note);
+  // The same audit as a page (--page): a grid per output with its closed-loop row, each NO
+  // linked to its witness and picture (mutant: write_audit_page not called -> no index.html).
+  const std::string page = std::filesystem::temp_directory_path() / "hc_audit_page";
+  std::filesystem::remove_all(page);
+  const auto paged = test::run_command(
+      shipped_audit("--stateful world_memory",
+                    "--cases 30 --group translation --view eye_in_hand --episodes 3 "
+                    "--episode-length 4 --page " +
+                        page));
+  REQUIRE(paged.exit_code == 0);
+  std::ifstream in(page + "/index.html");
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK_THAT(html, Contains("output &#39;gripper&#39; (invariant)") &&
+                       Contains("policy (closed loop)") &&
+                       Contains("hand executed, gripper "
+                                "compared"));
+  CHECK(std::filesystem::exists(page + "/index.md"));
+  CHECK(std::distance(std::filesystem::directory_iterator(page + "/witness"),
+                      std::filesystem::directory_iterator{}) == 2);
+  std::filesystem::remove_all(page);
   const auto without = test::run_command(
       test::cli() + " audit --episodes 2 --repr hand_centric --group se3 --cases 5");
   CHECK(without.exit_code != 0);
