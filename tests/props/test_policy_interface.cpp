@@ -41,7 +41,7 @@ std::map<std::string, std::map<std::string, bool>> verdicts_by_output(const std:
 
 }  // namespace
 
-// Mutants: the result's output left unset (no "output" in the JSON); PipeOutput::select always
+// Mutants: the result's output left unset (no "output" in the JSON); PipePolicy::chunks always
 // taking the first output (the gripper audited as the hand).
 TEST_CASE("a_shipped_policy_is_audited_in_its_own_layouts_output_by_output", "[unit]") {
   const std::string flags = "--cases 25 --group translation --view eye_in_hand --json";
@@ -69,7 +69,7 @@ TEST_CASE("a_shipped_policy_is_audited_in_its_own_layouts_output_by_output", "[u
                            Contains("output 'gripper' (invariant)"));
 }
 
-// Mutant: PipeOutput::select always taking the first output (the right hand audited as the
+// Mutant: PipePolicy::chunks always taking the first output (the right hand audited as the
 // left: its fault unseen). (The right hand's history sent as the left's is caught below, by
 // a_request_under_an_interface_speaks_the_policy_layouts: this policy's fault shows either way.)
 TEST_CASE("two_hands_are_audited_per_hand_and_a_witness_names_the_hand", "[unit]") {

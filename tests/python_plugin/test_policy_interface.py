@@ -2,32 +2,23 @@
 its own interface (handcentric_plugin/interface.py): the hello declares it, requests are read in
 its layouts (per hand), its answers written as its outputs, and reset() runs at an episode's
 first step only. The audit's side is tests/props/test_policy_interface.cpp."""
-import contextlib
-import io
-import json
 import os
 import sys
+import types
 
 import numpy as np
 import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from test_handcentric_plugin import hp, random_pose  # noqa: E402
+from test_handcentric_plugin import hp, random_pose, run_serve  # noqa: E402
 
 LAYOUT = "pos_quat_xyzw"
 
 
 def serve_lines(policy, requests, **kwargs):
     """serve_policy in-process on these requests: (answers, exit status, stderr)."""
-    lines = "".join(json.dumps(r) + "\n" for r in requests)
-    out, err = io.StringIO(), io.StringIO()
-    status = 0
-    with contextlib.redirect_stderr(err):
-        try:
-            hp.serve_policy(policy, stdin=io.StringIO(lines), stdout=out, **kwargs)
-        except SystemExit as exit_:
-            status = exit_.code
-    return [json.loads(line) for line in out.getvalue().splitlines()], status, err.getvalue()
+    return run_serve(requests, policy, helper=types.SimpleNamespace(serve=hp.serve_policy),
+                     **kwargs)
 
 
 def vectors(poses):
@@ -65,6 +56,8 @@ def test_the_hello_declares_the_interface_and_answers_speak_it():
 
 
 def test_two_hands_get_their_histories_by_name_batched_too():
+    # Mutant: every hand read from the first hand's history -> the right hand's chunk is the
+    # left's.
     rng = np.random.default_rng(2)
     L, R = [random_pose(rng)], [random_pose(rng)]
     seen = []
@@ -113,6 +106,7 @@ def test_reset_runs_at_an_episodes_first_step_and_before_every_other_call():
 
 
 def test_a_chunk_of_vectors_without_action_format_names_the_keyword():
+    # Mutant: the hint left out of protocol._chunk's message.
     def policy(history, hand_points, world_points, noise):
         return np.zeros((2, 7))
     T = [np.eye(4).ravel().tolist()]

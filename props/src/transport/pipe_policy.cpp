@@ -158,9 +158,24 @@ std::vector<RigidTransform> PipePolicy::act(const Scene& observation,
 std::vector<std::vector<RigidTransform>> PipePolicy::act_batch(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
+  return chunks(observations, noises, false);
+}
+
+std::vector<std::vector<RigidTransform>> PipePolicy::chunks(
+    const std::vector<const Scene*>& observations,
+    const std::vector<const Eigen::VectorXd*>& noises, bool fresh, std::size_t output,
+    std::optional<std::size_t> executed) const {
   std::vector<std::vector<RigidTransform>> out;
-  for (Answer& answer : answers(observations, noises, false))
-    out.push_back(std::move(answer.front()));
+  for (Answer& answer : answers(observations, noises, fresh)) {
+    if (!executed || *executed == output) {
+      out.push_back(std::move(answer.at(output)));
+      continue;
+    }
+    // The executed pose first, then the compared chunk (closed_loop.hpp, compared_from).
+    std::vector<RigidTransform> chunk{answer.at(*executed).at(0)};
+    chunk.insert(chunk.end(), answer.at(output).begin(), answer.at(output).end());
+    out.push_back(std::move(chunk));
+  }
   return out;
 }
 
@@ -238,10 +253,7 @@ std::vector<PipePolicy::Answer> PipePolicy::answers(
 std::vector<std::vector<RigidTransform>> PipePolicy::act_fresh(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
-  std::vector<std::vector<RigidTransform>> out;
-  for (Answer& answer : answers(observations, noises, true))
-    out.push_back(std::move(answer.front()));
-  return out;
+  return chunks(observations, noises, true);
 }
 
 std::vector<PipePolicy::Staged> PipePolicy::staged_answers(
@@ -297,21 +309,12 @@ PipeOutput::PipeOutput(std::shared_ptr<const PipePolicy> plugin, std::size_t out
   const std::size_t count = std::max<std::size_t>(1, plugin_->capabilities().policy.outputs.size());
   if (output_ >= count || (executed_ && *executed_ >= count))
     throw InvalidArgument(plugin_->name() + " has " + std::to_string(count) + " outputs");
-  if (executed_ == output_) executed_.reset();
 }
 
 std::string PipeOutput::name() const {
   const auto& outputs = plugin_->capabilities().policy.outputs;
   return outputs.empty() ? plugin_->name()
                          : plugin_->name() + ", output '" + outputs[output_].name + "'";
-}
-
-std::vector<RigidTransform> PipeOutput::select(const PipePolicy::Answer& answer) const {
-  if (!executed_) return answer.at(output_);
-  // The executed pose first, then the compared chunk (closed_loop.hpp, compared_from).
-  std::vector<RigidTransform> out{answer.at(*executed_).at(0)};
-  out.insert(out.end(), answer.at(output_).begin(), answer.at(output_).end());
-  return out;
 }
 
 std::vector<RigidTransform> PipeOutput::act(const Scene& observation,
@@ -322,19 +325,13 @@ std::vector<RigidTransform> PipeOutput::act(const Scene& observation,
 std::vector<std::vector<RigidTransform>> PipeOutput::act_batch(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
-  std::vector<std::vector<RigidTransform>> out;
-  for (const PipePolicy::Answer& answer : plugin_->answers(observations, noises, false))
-    out.push_back(select(answer));
-  return out;
+  return plugin_->chunks(observations, noises, false, output_, executed_);
 }
 
 std::vector<std::vector<RigidTransform>> PipeOutput::act_batch_fresh(
     const std::vector<const Scene*>& observations,
     const std::vector<const Eigen::VectorXd*>& noises) const {
-  std::vector<std::vector<RigidTransform>> out;
-  for (const PipePolicy::Answer& answer : plugin_->answers(observations, noises, true))
-    out.push_back(select(answer));
-  return out;
+  return plugin_->chunks(observations, noises, true, output_, executed_);
 }
 
 std::shared_ptr<const NoisyPolicy> as_checked(std::shared_ptr<const PipeOutput> output) {

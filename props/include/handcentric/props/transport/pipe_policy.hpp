@@ -70,6 +70,13 @@ class PipePolicy final : public NoisyPolicy, public BatchPolicy {
   /// "chunk"), each as poses: an invariant output's numbers embedded at the observation's T_0
   /// (named_output.hpp).
   using Answer = std::vector<std::vector<RigidTransform>>;
+  /// Output `output` of the answer to each (observation, noise); with `executed` (another
+  /// output), that output's first pose ahead of it, for the closed loop (compared_from = 1).
+  /// `fresh`: past the cache.
+  std::vector<std::vector<RigidTransform>> chunks(
+      const std::vector<const Scene*>& observations,
+      const std::vector<const Eigen::VectorXd*>& noises, bool fresh, std::size_t output = 0,
+      std::optional<std::size_t> executed = std::nullopt) const;
   /// The answers to each (observation, noise), as act_batch asks them; `fresh`: past the cache.
   std::vector<Answer> answers(const std::vector<const Scene*>& observations,
                               const std::vector<const Eigen::VectorXd*>& noises, bool fresh) const;
@@ -146,7 +153,6 @@ class PipeOutput final : public NoisyPolicy, public BatchPolicy {
   const PipePolicy& plugin() const { return *plugin_; }
 
  private:
-  std::vector<RigidTransform> select(const PipePolicy::Answer& answer) const;
   std::shared_ptr<const PipePolicy> plugin_;
   std::size_t output_;
   std::optional<std::size_t> executed_;
