@@ -50,6 +50,7 @@ struct AuditCommandOptions {
   int episodes = 0;  // --episodes: the closed loop of a --policy-exec plug-in (0: none)
   int episode_length = props::ClosedLoopOptions{}.steps;
   bool episode_length_given = false;
+  bool page_given = false;  // --page, even with an empty folder (refused by write_audit_page)
   std::uint64_t seed = props::AuditOptions{}.seed;
   double timeout = props::kDefaultPluginTimeout;
   double tolerance = 0.0;
@@ -128,7 +129,7 @@ void check_locate_options(const AuditCommandOptions& options) {
   const std::pair<bool, const char*> unhonoured[] = {
       {!options.expect.empty(), "--expect (a gate: run it without --locate)"},
       {!options.witness_dir.empty(), "--witness-dir (the witness is printed)"},
-      {!options.page.empty(), "--page (locate prints its own table)"},
+      {options.page_given, "--page (locate prints its own table)"},
       {options.test_law, "--test-law (locate asks pointwise cases only)"},
       {options.pointwise, "--pointwise (locate is pointwise already)"},
       {options.episodes > 0, "--episodes (locate asks single calls)"},
@@ -161,6 +162,8 @@ int run_locate(const AuditCommandOptions& options, props::AuditOptions& audit, b
 
 int run_audit(const AuditCommandOptions& options) {
   if (options.locate) check_locate_options(options);
+  if (options.page_given && options.page.empty())  // before the audit, not after it
+    throw InvalidArgument("--page needs a folder, e.g. --page audit_page");
   // CLI11 refuses --test-law beside --repr or --exec; with no source at all the audit is the
   // built-ins', representations too.
   if (options.test_law && options.policy_exec.empty() && options.model.empty()) {
@@ -250,7 +253,7 @@ int run_audit(const AuditCommandOptions& options) {
   props::print_audit_header(header, audit, policies);
   if (interface && !props::describe(*interface).empty())
     header << props::describe(*interface) << "\n";
-  if (!options.page.empty()) {
+  if (options.page_given) {
     experiments::write_audit_page(options.page, results, audit, header.str());
     std::cerr << "handcentric audit: wrote " << options.page << "/index.html and index.md\n";
   }
@@ -396,7 +399,8 @@ void add_audit_command(CLI::App& app, int& exit_code) {
   profile->needs(out)->excludes(json)->excludes(pointwise)->excludes(detect)->excludes(episodes);
   page->excludes(profile);
   out->needs(profile);
-  cmd->callback([options, detect, episode_length, &exit_code] {
+  cmd->callback([options, detect, episode_length, page, &exit_code] {
+    options->page_given = page->count() > 0;
     options->detect_given = detect->count() > 0;
     options->episode_length_given = episode_length->count() > 0;
     if (options->locate && !options->profile.empty())

@@ -32,12 +32,14 @@ void write_audit_page(const std::string& dir, const std::vector<props::Classific
   const std::string html = to_html(doc);
   const std::string markdown = to_markdown(doc);
   const std::filesystem::path folder(dir);
-  std::filesystem::create_directories(folder);
-  for (const PageFile& file : part.files) {
-    const std::filesystem::path path = folder / file.path;
-    std::filesystem::create_directories(path.parent_path());
-    write_file_atomically(path.string(), file.bytes);
+  std::error_code error;  // audit_part puts every picture under witness/
+  std::filesystem::create_directories(folder / "witness", error);
+  if (error) {
+    throw FileError("--page " + dir + ": cannot create the folder (" + error.message() +
+                    "); give a folder you can write, e.g. --page audit_page");
   }
+  for (const PageFile& file : part.files)
+    write_file_atomically((folder / file.path).string(), file.bytes);
   write_file_atomically((folder / "index.md").string(), markdown);
   write_file_atomically((folder / "index.html").string(), html);
 }

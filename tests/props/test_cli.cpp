@@ -548,6 +548,19 @@ TEST_CASE("detect_sets_the_cases_from_the_frequency_asked_for", "[unit]") {
   CHECK_THAT(bad.err, Contains("--detect 0 is not a frequency in (0, 1)"));
 }
 
+// --page refuses an empty folder before auditing, and a folder it cannot create in one line
+// naming it (mutants: the empty check removed -> exit 0 and no page; the folder's error left to
+// std::filesystem -> "internal error").
+TEST_CASE("page_refuses_a_folder_it_cannot_write_naming_it", "[unit]") {
+  const std::string audit = test::cli() + " audit --repr hand_centric --cases 5 --group se3";
+  const auto empty = test::run_command(audit + " --page ''");
+  CHECK(empty.exit_code != 0);
+  CHECK_THAT(empty.err, Contains("--page needs a folder"));
+  const auto unwritable = test::run_command(audit + " --page /proc/no_such_folder");
+  CHECK(unwritable.exit_code != 0);
+  CHECK_THAT(unwritable.err, Contains("--page /proc/no_such_folder: cannot create the folder"));
+}
+
 TEST_CASE("expect_gates_exit_1_with_the_witness_and_0_when_everything_holds", "[unit]") {
   const auto pass = test::run_command(
       test::cli() + " audit --repr hand_centric --cases 30 --expect se3,actions:c8");
